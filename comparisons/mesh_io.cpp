@@ -1,0 +1,1 @@
+#include "comparisons/mesh_io.h"

@@ -1,0 +1,1 @@
+// JSON output of results (filled in by the harness).

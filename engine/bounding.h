@@ -1,0 +1,21 @@
+// The seed's bounding check: a sphere around each body's box, centre to corner.
+#pragma once
+
+#include "engine/body.h"
+
+namespace rbx {
+
+/// Sphere through the corners of the body's local bounding box, placed in the world.
+struct BoundingSphere {
+  Vec3 center = Vec3::Zero();  // m, world
+  double radius = 0.0;         // m, centre-to-corner distance of the box
+};
+
+/// The bounding sphere of a body at its current pose.
+BoundingSphere bounding_sphere(const RigidBody& body);
+
+/// SEED_NOTES 7: two bodies may touch only if |c_a - c_b| <= r_a + r_b. (The seed compares
+/// with each radius alone, "less than both", which misses pairs.)
+bool bounding_check(const RigidBody& a, const RigidBody& b);
+
+}  // namespace rbx

@@ -1,0 +1,66 @@
+// Narrow phase after Moore & Wilhelms, as the seed describes it: the face, vertex and edge
+// tests, each returning a contact point *and* plane in one pass (SEED_NOTES 12).
+//
+// Every function here is a pure function of two shapes and two poses (no world). Shapes are in
+// their body frames; poses map them to the world. Results follow engine/contact.h: the normal is
+// unit, in the world frame, from B toward A; depth >= 0.
+#pragma once
+
+#include <optional>
+
+#include "engine/contact.h"
+#include "engine/polyhedron.h"
+
+namespace rbx {
+
+/// Which implementation of the tests to run. `Seed` is the faithful loop-over-everything
+/// version and the oracle; `Fast` must return the same answers (to round-off).
+enum class DetectorVariant { Seed, Fast };
+
+/// Tolerance (m) for point-in-mesh, relative to the larger shape: points within this distance
+/// outside a face plane count as inside, so exactly touching bodies are seen.
+double point_in_mesh_tolerance(const ConvexPolyhedron& a, const ConvexPolyhedron& b);
+
+/// SEED_NOTES 1: p is inside the convex mesh iff (p - q_f) . n_f <= tol for every face f.
+/// `p_world` is in the world frame; the mesh is placed by `pose`.
+bool point_in_mesh(const ConvexPolyhedron& mesh, const Pose& pose, const Vec3& p_world, double tol);
+
+/// Penetration of A into B along the unit normal n (from B toward A): how far A must move along
+/// n to separate, max_b (b . n) - min_a (a . n), clamped at 0. The seed defines no depth; this
+/// is the overlap of the two shapes' projections on the contact normal.
+double overlap_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                     const Pose& pb, const Vec3& n);
+
+/// Face test, one order: centroids of A's triangles that lie inside B, averaged (the seed's
+/// "better collision point"); normal = minus the outward normal of the first such triangle of A
+/// (SEED_NOTES 9). feature = "face".
+std::optional<ContactPoint> face_test(const ConvexPolyhedron& a, const Pose& pa,
+                                      const ConvexPolyhedron& b, const Pose& pb);
+
+/// Vertex test, one order: the first vertex of A inside B; normal = outward normal of B's face
+/// closest to it. feature = "vertex".
+std::optional<ContactPoint> vertex_test(const ConvexPolyhedron& a, const Pose& pa,
+                                        const ConvexPolyhedron& b, const Pose& pb);
+
+/// Edge test, one order: each edge of A is cut where it crosses the planes of B's triangles
+/// (SEED_NOTES 2), the crossing parameters sorted with 0 and 1, and the midpoint of each
+/// consecutive pair tested in B; the first inside is the point. Normal: e_a x e_b, e_b the edge
+/// of B's crossed triangle nearest the point, oriented from B toward A (SEED_NOTES 10).
+/// feature = "edge".
+std::optional<ContactPoint> edge_test(const ConvexPolyhedron& a, const Pose& pa,
+                                      const ConvexPolyhedron& b, const Pose& pb);
+
+/// One kind of test ("face", "vertex" or "edge") in both orders: (A, B), then (B, A) with the
+/// normal flipped (SEED_NOTES 8). The point and depth are symmetric.
+std::optional<ContactPoint> detect_feature(const std::string& feature, const ConvexPolyhedron& a,
+                                           const Pose& pa, const ConvexPolyhedron& b,
+                                           const Pose& pb,
+                                           DetectorVariant variant = DetectorVariant::Fast);
+
+/// The full detector in the seed's order (face, vertex, edge; each in both orders): the first
+/// hit, or nothing when the shapes do not touch.
+std::optional<ContactPoint> detect(const ConvexPolyhedron& a, const Pose& pa,
+                                   const ConvexPolyhedron& b, const Pose& pb,
+                                   DetectorVariant variant = DetectorVariant::Fast);
+
+}  // namespace rbx

@@ -1,0 +1,80 @@
+// Convex polyhedron: the one shape type of the engine (the seed's "mesh held by an actor").
+#pragma once
+
+#include <array>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "engine/math.h"
+
+namespace rbx {
+
+/// Raised when a mesh is not a valid closed convex polyhedron; the message names the feature.
+class GeometryError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Oriented plane: points x with normal . x == offset; normal is unit and outward.
+struct Plane {
+  Vec3 normal = Vec3::UnitZ();
+  double offset = 0.0;
+  /// Signed distance of x from the plane (positive outside).
+  double distance(const Vec3& x) const { return normal.dot(x) - offset; }
+};
+
+/// Undirected edge between two vertex indices (a < b).
+struct Edge {
+  int a = 0;
+  int b = 0;
+};
+
+/// Axis-aligned box given by its corners.
+struct Aabb {
+  Vec3 min = Vec3::Zero();
+  Vec3 max = Vec3::Zero();
+  Vec3 center() const { return 0.5 * (min + max); }
+  Vec3 half_extents() const { return 0.5 * (max - min); }
+};
+
+/// A closed convex polyhedron with counter-clockwise (outward) triangles, unique edges and one
+/// outward plane per triangle. Immutable once built; every constructor validates.
+class ConvexPolyhedron {
+ public:
+  /// Builds from vertices and triangles and validates: closed, consistently oriented
+  /// (outward, counter-clockwise), convex, positive volume, no degenerate triangle, no unused
+  /// vertex. Throws GeometryError naming the offending face or vertex.
+  static ConvexPolyhedron from_triangles(std::vector<Vec3> vertices,
+                                         std::vector<std::array<int, 3>> triangles);
+
+  const std::vector<Vec3>& vertices() const { return vertices_; }
+  const std::vector<std::array<int, 3>>& triangles() const { return triangles_; }
+  const std::vector<Edge>& edges() const { return edges_; }
+  /// Outward plane of triangle i.
+  const std::vector<Plane>& planes() const { return planes_; }
+  const Aabb& bounds() const { return bounds_; }
+
+  /// Enclosed volume (m^3), by the divergence theorem.
+  double volume() const;
+  /// Vertex furthest along direction d (ties: lowest index).
+  int support_index(const Vec3& d) const;
+  /// The same polyhedron with every vertex moved by offset.
+  ConvexPolyhedron translated(const Vec3& offset) const;
+
+ private:
+  std::vector<Vec3> vertices_;
+  std::vector<std::array<int, 3>> triangles_;
+  std::vector<Edge> edges_;
+  std::vector<Plane> planes_;
+  Aabb bounds_;
+};
+
+/// Box with full extents `size`, centred at the origin (12 triangles).
+ConvexPolyhedron make_box(const Vec3& size);
+/// Icosahedron subdivided `subdivisions` times and projected onto the sphere of `radius`.
+ConvexPolyhedron make_icosphere(double radius, int subdivisions);
+/// Regular `sides`-gon prism along local z, circumradius `radius`, centred at the origin.
+ConvexPolyhedron make_prism(double radius, double height, int sides);
+
+}  // namespace rbx

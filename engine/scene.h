@@ -1,0 +1,89 @@
+// A scene as plain data: simulation settings, body specifications and optional closed-form
+// expectations. Parsing lives in comparisons/scene_file; the engine only consumes this struct.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/mass_properties.h"
+#include "engine/polyhedron.h"
+
+namespace rbx {
+
+/// Time integrator.
+enum class Integrator {
+  Euler,       ///< the seed's: x += v dt, orientation by per-axis matrices with w dt
+  Symplectic,  ///< semi-implicit: v from forces first, then x; quaternion exponential map
+};
+
+/// Simulation settings ([sim] in a scene file). Defaults are the contract's.
+struct SimSettings {
+  double dt = 1e-3;                        // s, > 0
+  double duration = 1.0;                   // s, >= 0
+  Vec3 gravity = Vec3::Zero();             // m/s^2
+  double restitution = 1.0;                // e in [0, 1]
+  double friction = 0.0;                   // Coulomb mu >= 0 (the seed omits friction)
+  Integrator integrator = Integrator::Symplectic;
+  std::vector<double> sweep_dt;            // s, time steps for error against run time
+  double max_energy_ratio = 1e3;           // guard: stop when E > ratio * max(E0, tiny)
+
+  /// Number of steps to cover `duration` (the last step may end past it by < dt/2).
+  long steps() const;
+};
+
+/// One [[body]] of a scene, before mass properties are derived.
+struct BodySpec {
+  std::string name;
+  std::string shape_kind = "box";        // box | icosphere | prism | convex | mesh
+  Vec3 box_size = Vec3::Ones();          // m, full extents (box only)
+  std::shared_ptr<const ConvexPolyhedron> shape;  // in the scene's local frame
+  double mass = 1.0;                     // kg
+  bool is_static = false;
+  MassModel mass_model = MassModel::Solid;
+  Vec3 position = Vec3::Zero();          // m, world position of the shape's local origin
+  Quat orientation = Quat::Identity();
+  Vec3 velocity = Vec3::Zero();          // m/s, of the centre of mass
+  Vec3 angular_velocity = Vec3::Zero();  // rad/s, world frame
+};
+
+/// Expected state of one body at t = duration ([expect.body.NAME]).
+struct ExpectBody {
+  std::string name;
+  std::optional<Vec3> position;          // centre of mass, m
+  std::optional<Vec3> velocity;          // m/s
+  std::optional<Vec3> angular_velocity;  // rad/s, world
+};
+
+/// Expected contact between the first two bodies at the t = 0 poses ([expect.contact]).
+struct ExpectContact {
+  std::optional<bool> touching;
+  std::optional<Vec3> normal;  // unit, from B toward A
+  std::optional<double> depth;
+  std::optional<Vec3> point;
+};
+
+/// The [expect] block: closed-form ground truth with an absolute tolerance (SI).
+struct Expect {
+  double tolerance = 1e-6;
+  std::vector<ExpectBody> bodies;
+  std::optional<ExpectContact> contact;
+};
+
+/// A whole scene.
+struct Scene {
+  std::string name;
+  std::string description;
+  std::string file;                     // path it was read from, as given
+  std::vector<std::string> checks;      // contact | impulse | trajectory | stability | mass
+  std::vector<std::string> backends;    // empty: every backend that serves the checks
+  SimSettings sim;
+  std::vector<BodySpec> bodies;
+  std::optional<Expect> expect;
+
+  /// True when `checks` names c.
+  bool has_check(const std::string& c) const;
+};
+
+}  // namespace rbx

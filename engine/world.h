@@ -1,0 +1,64 @@
+// The world step: bounding check over all pairs, detection, response, integration.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "engine/body.h"
+#include "engine/contact.h"
+#include "engine/detect.h"
+#include "engine/scene.h"
+
+namespace rbx {
+
+/// One resolved collision: a detection that applied a non-zero impulse.
+struct CollisionEvent {
+  double time = 0.0;     // s, start of the step in which it was detected
+  long step = 0;
+  std::string body_a, body_b;
+  ContactPoint contact;  // normal from body_b toward body_a
+  double impulse = 0.0;  // N s, magnitude j along the normal
+};
+
+/// Outcome of a whole run.
+struct RunResult {
+  bool ok = true;
+  std::string message;                 // why the run stopped early, when !ok
+  long steps_taken = 0;
+  std::vector<CollisionEvent> events;
+  std::vector<RigidBody> bodies;       // final states
+};
+
+/// A set of bodies stepped by the seed's algorithm.
+class World {
+ public:
+  World(SimSettings sim, std::vector<RigidBody> bodies,
+        DetectorVariant variant = DetectorVariant::Fast);
+
+  /// Advances one step of sim.dt: for every pair passing the bounding check, the face, vertex
+  /// and edge tests in that order, resolving after each hit; then integration of every body.
+  void step();
+  /// Runs until `duration`, stopping early (ok = false) on a non-finite state or runaway energy.
+  RunResult run();
+
+  const std::vector<RigidBody>& bodies() const { return bodies_; }
+  const std::vector<CollisionEvent>& events() const { return events_; }
+  double time() const { return time_; }
+  /// Total kinetic plus gravitational potential energy (J).
+  double energy() const;
+
+ private:
+  void collide_pair(int i, int j);
+
+  SimSettings sim_;
+  std::vector<RigidBody> bodies_;
+  DetectorVariant variant_;
+  std::vector<CollisionEvent> events_;
+  double time_ = 0.0;
+  long step_ = 0;
+};
+
+/// Builds every body of the scene and runs it with the custom engine.
+RunResult run_scene(const Scene& scene, DetectorVariant variant = DetectorVariant::Fast);
+
+}  // namespace rbx

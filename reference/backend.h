@@ -1,0 +1,84 @@
+// The one small interface every backend implements, and the registry that names them.
+//
+// Every adapter receives the engine's own bodies (same hull vertices in the body frame, same
+// mass, centre of mass at the body origin, same inertia tensor) and converts results to the
+// contract's convention (engine/contact.h): normal from B toward A, depth >= 0, world frame, SI.
+// Conventions are converted here and nowhere else; a library's wrong answers are passed on.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "engine/body.h"
+#include "engine/contact.h"
+#include "engine/scene.h"
+#include "engine/world.h"
+
+namespace rbx {
+
+/// Outcome of a backend call.
+enum class Status { Ok, Error, Unsupported };
+
+/// "ok" | "error" | "unsupported".
+const char* to_string(Status s);
+
+/// Contact query result at given poses. Empty `contacts` with status Ok means "not touching".
+struct ContactResult {
+  Status status = Status::Ok;
+  std::string message;  // why, when not ok; or a note on a known library defect
+  std::vector<ContactPoint> contacts;
+};
+
+/// Final state of one body after a dynamics run.
+struct BodyFinal {
+  std::string name;
+  Vec3 position = Vec3::Zero();        // m, centre of mass, world
+  Quat orientation = Quat::Identity();
+  Vec3 velocity = Vec3::Zero();        // m/s
+  Vec3 angular_velocity = Vec3::Zero();  // rad/s, world frame
+};
+
+/// Optional per-step sample of all bodies (for trajectory and stability checks).
+struct StateSample {
+  double time = 0.0;
+  std::vector<BodyFinal> bodies;
+};
+
+/// Result of a dynamics run over a whole scene.
+struct DynamicsResult {
+  Status status = Status::Ok;
+  std::string message;
+  std::vector<CollisionEvent> events;  // as resolved by the backend (may be empty if unknown)
+  std::vector<BodyFinal> finals;       // same order as scene.bodies
+  std::vector<StateSample> samples;    // filled when `sample_every` > 0
+};
+
+/// Options for a dynamics run.
+struct DynamicsOptions {
+  double dt = 0.0;        // s; 0: the scene's sim.dt
+  long sample_every = 0;  // record the state every this many steps (0: never)
+};
+
+/// Contact query: bodies carry their poses. A and B in that order.
+using ContactFn = std::function<ContactResult(const RigidBody& a, const RigidBody& b)>;
+/// Dynamics run of a whole scene.
+using DynamicsFn = std::function<DynamicsResult(const Scene& scene, const DynamicsOptions& opt)>;
+
+/// One row of the registry.
+struct Backend {
+  std::string name;         // as in JSON and reports
+  std::string description;  // one line: library, algorithm
+  ContactFn contact;        // empty: no contact queries
+  DynamicsFn dynamics;      // empty: no dynamics
+};
+
+/// Every backend, in report order.
+const std::vector<Backend>& backends();
+/// The backend called `name`, or nullptr.
+const Backend* find_backend(const std::string& name);
+
+/// Builds the engine bodies of a scene (shared by adapters so all use the same inputs).
+std::vector<RigidBody> make_bodies(const Scene& scene);
+
+}  // namespace rbx

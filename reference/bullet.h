@@ -1,0 +1,15 @@
+// Bullet 3.24 (double precision): zero-margin convex hulls, GJK + EPA and polyhedral clipping, and btDiscreteDynamicsWorld as a fair single-impulse reference.
+#pragma once
+
+#include "reference/backend.h"
+
+namespace rbx {
+
+/// `bullet`: btConvexHullShape (margin 0) pair through GJK + EPA.
+ContactResult bullet_contact(const RigidBody& a, const RigidBody& b);
+/// `bullet-sat`: the same hulls with initializePolyhedralFeatures (SAT + clipping).
+ContactResult bullet_sat_contact(const RigidBody& a, const RigidBody& b);
+/// `bullet` dynamics: btDiscreteDynamicsWorld with the fair settings of REFERENCES.md.
+DynamicsResult bullet_dynamics(const Scene& scene, const DynamicsOptions& opt);
+
+}  // namespace rbx

@@ -1,0 +1,17 @@
+// FCL 0.7 adapters: Convex with libccd MPR, signed distance (GJK + EPA), Convex with GST_INDEP, and the Box-Box path.
+#pragma once
+
+#include "reference/backend.h"
+
+namespace rbx {
+
+/// `fcl`: fcl::collide on Convex shapes with GST_LIBCCD (libccd MPR).
+ContactResult fcl_contact(const RigidBody& a, const RigidBody& b);
+/// `fcl-epa`: fcl::distance with signed distance (GJK + EPA).
+ContactResult fcl_epa_contact(const RigidBody& a, const RigidBody& b);
+/// `fcl-indep`: fcl::collide on Convex shapes with GST_INDEP, defects shown as they are.
+ContactResult fcl_indep_contact(const RigidBody& a, const RigidBody& b);
+/// `fcl-box`: FCL Box-Box (boxBoxIntersect); unsupported unless both bodies are boxes.
+ContactResult fcl_box_contact(const RigidBody& a, const RigidBody& b);
+
+}  // namespace rbx

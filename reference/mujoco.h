@@ -1,0 +1,13 @@
+// MuJoCo 2.2.2: mesh geoms (convex hull), contacts from mj_forward, stepping with restitution mapped to a negative solref.
+#pragma once
+
+#include "reference/backend.h"
+
+namespace rbx {
+
+/// `mujoco`: contacts of mesh geoms from mj_forward.
+ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b);
+/// `mujoco` dynamics: mj_step with e mapped to solref.
+DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt);
+
+}  // namespace rbx
