@@ -1,1 +1,62 @@
-int main() { return 0; }
+// The `rbx` command: parses arguments, dispatches to a subcommand, maps failures to exit codes
+// (0 success, 1 a check failed, 2 bad input or usage, with one line on stderr).
+#include <CLI/CLI.hpp>
+
+#include <exception>
+#include <iostream>
+
+#include "comparisons/commands.h"
+#include "comparisons/scene_file.h"
+#include "engine/polyhedron.h"
+
+namespace {
+
+// Adds the options every scene command shares.
+void scene_options(CLI::App* cmd, rbx::SceneCommandOptions& o, bool many, bool backends) {
+  if (many)
+    cmd->add_option("scene", o.scenes, "scene files (TOML)")->required();
+  else
+    cmd->add_option("scene", o.scenes, "scene file (TOML)")->required()->expected(1);
+  cmd->add_option("--json", o.json, "write JSON results to FILE, or - for standard output");
+  cmd->add_option("--set", o.sets, "override a scene key, TOML-typed: KEY=VALUE (repeatable)");
+  cmd->add_flag("--force", o.force, "accept runs of more than 1e8 steps");
+  if (backends) cmd->add_option("--backends", o.backends, "comma-separated backend names");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"rbx: rigid-body collision detection and response testbed"};
+  app.require_subcommand(1);
+  rbx::SceneCommandOptions run_opt, contacts_opt;
+  scene_options(app.add_subcommand("run", "custom engine only: collision events and final state"),
+                run_opt, false, true);
+  scene_options(app.add_subcommand("contacts", "contact query at the t=0 poses, every backend"),
+                contacts_opt, false, true);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "rbx: " << e.what() << " (see rbx --help)\n";
+    return 2;
+  }
+
+  try {
+    if (app.got_subcommand("run")) return rbx::run_command(run_opt);
+    if (app.got_subcommand("contacts")) return rbx::contacts_command(contacts_opt);
+  } catch (const rbx::InputError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const rbx::GeometryError& e) {
+    std::cerr << "rbx: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "rbx: error: " << e.what() << "\n";
+    return 2;
+  }
+  return 2;
+}

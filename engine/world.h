@@ -37,9 +37,15 @@ class World {
 
   /// Advances one step of sim.dt: for every pair passing the bounding check, the face, vertex
   /// and edge tests in that order, resolving after each hit; then integration of every body.
-  void step();
+  /// Returns false (and sets failure()) when the state became non-finite or the energy grew
+  /// past sim.max_energy_ratio; the world must not be stepped further then.
+  bool step();
   /// Runs until `duration`, stopping early (ok = false) on a non-finite state or runaway energy.
   RunResult run();
+  /// Why the last step failed ("" while healthy): names the body, the step and the quantity.
+  const std::string& failure() const { return failure_; }
+  /// Steps taken so far.
+  long steps_taken() const { return step_; }
 
   const std::vector<RigidBody>& bodies() const { return bodies_; }
   const std::vector<CollisionEvent>& events() const { return events_; }
@@ -49,6 +55,7 @@ class World {
 
  private:
   void collide_pair(int i, int j);
+  bool check_state();
 
   SimSettings sim_;
   std::vector<RigidBody> bodies_;
@@ -56,6 +63,9 @@ class World {
   std::vector<CollisionEvent> events_;
   double time_ = 0.0;
   long step_ = 0;
+  std::string failure_;
+  double energy0_ = 0.0;       // J, total energy at t = 0
+  double energy_scale_ = 0.0;  // J, the energy budget the guard compares growth with
 };
 
 /// Builds every body of the scene and runs it with the custom engine.

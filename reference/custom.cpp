@@ -1,6 +1,60 @@
 #include "reference/custom.h"
+
+#include <exception>
+
+#include "engine/detect.h"
+
 namespace rbx {
-ContactResult custom_contact(const RigidBody&, const RigidBody&) { return {Status::Unsupported, "not built yet", {}}; }
-ContactResult custom_seed_contact(const RigidBody&, const RigidBody&) { return {Status::Unsupported, "not built yet", {}}; }
-DynamicsResult custom_dynamics(const Scene&, const DynamicsOptions&) { return {}; }
+
+namespace {
+
+ContactResult contact_with(const RigidBody& a, const RigidBody& b, DetectorVariant variant) {
+  ContactResult r;
+  const auto c = detect(*a.shape, a.pose(), *b.shape, b.pose(), variant);
+  if (c) r.contacts.push_back(*c);
+  return r;
+}
+
+BodyFinal final_of(const RigidBody& b) {
+  return {b.name, b.position, b.orientation, b.velocity, b.angular_velocity};
+}
+
+}  // namespace
+
+ContactResult custom_contact(const RigidBody& a, const RigidBody& b) {
+  return contact_with(a, b, DetectorVariant::Fast);
+}
+
+ContactResult custom_seed_contact(const RigidBody& a, const RigidBody& b) {
+  return contact_with(a, b, DetectorVariant::Seed);
+}
+
+DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  DynamicsResult r;
+  try {
+    SimSettings sim = scene.sim;
+    if (opt.dt > 0) sim.dt = opt.dt;
+    World world(sim, make_bodies(scene));
+    const long steps = sim.steps();
+    auto sample = [&] {
+      StateSample s{world.time(), {}};
+      for (const RigidBody& b : world.bodies()) s.bodies.push_back(final_of(b));
+      r.samples.push_back(std::move(s));
+    };
+    if (opt.sample_every > 0) sample();
+    while (world.steps_taken() < steps && world.step())
+      if (opt.sample_every > 0 && world.steps_taken() % opt.sample_every == 0) sample();
+    if (!world.failure().empty()) {
+      r.status = Status::Error;
+      r.message = world.failure();
+    }
+    r.events = world.events();
+    for (const RigidBody& b : world.bodies()) r.finals.push_back(final_of(b));
+  } catch (const std::exception& e) {
+    r.status = Status::Error;
+    r.message = e.what();
+  }
+  return r;
+}
+
 }  // namespace rbx

@@ -1,0 +1,129 @@
+#include "comparisons/json_io.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <stdexcept>
+
+namespace rbx {
+
+Json to_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Json to_json(const Quat& q) { return Json::array({q.w(), q.x(), q.y(), q.z()}); }
+
+Json to_json(const Mat3& m) {
+  Json rows = Json::array();
+  for (int i = 0; i < 3; ++i) rows.push_back(Json::array({m(i, 0), m(i, 1), m(i, 2)}));
+  return rows;
+}
+
+Json contact_json(const std::string& a, const std::string& b, double time, const ContactPoint& c) {
+  Json j;
+  j["bodies"] = Json::array({a, b});
+  j["time"] = time;
+  j["feature"] = c.feature;
+  j["point"] = to_json(c.point);
+  j["normal"] = to_json(c.normal);
+  j["depth"] = c.depth;
+  return j;
+}
+
+Json event_json(const CollisionEvent& e) {
+  Json j = contact_json(e.body_a, e.body_b, e.time, e.contact);
+  j["step"] = e.step;
+  j["impulse"] = e.impulse;
+  return j;
+}
+
+Json body_inputs_json(const RigidBody& b) {
+  Json j;
+  j["mass"] = b.mass;
+  j["static"] = b.is_static;
+  j["center_of_mass"] = to_json(b.position);
+  j["inertia"] = to_json(b.inertia_world());
+  return j;
+}
+
+Json final_json(const BodyFinal& f) {
+  Json j;
+  j["position"] = to_json(f.position);
+  j["orientation"] = to_json(f.orientation);
+  j["velocity"] = to_json(f.velocity);
+  j["angular_velocity"] = to_json(f.angular_velocity);
+  return j;
+}
+
+Json settings_json(const Scene& scene) {
+  const SimSettings& s = scene.sim;
+  Json j;
+  j["dt"] = s.dt;
+  j["duration"] = s.duration;
+  j["gravity"] = to_json(s.gravity);
+  j["restitution"] = s.restitution;
+  j["friction"] = s.friction;
+  j["integrator"] = s.integrator == Integrator::Euler ? "euler" : "symplectic";
+  j["max_energy_ratio"] = s.max_energy_ratio;
+  if (!s.sweep_dt.empty()) j["sweep_dt"] = s.sweep_dt;
+  return j;
+}
+
+Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsResult& r,
+                          double runtime_s) {
+  Json j;
+  j["status"] = to_string(r.status);
+  j["message"] = r.message;
+  j["runtime_s"] = runtime_s;
+  Json events = Json::array();
+  for (const CollisionEvent& e : r.events) events.push_back(event_json(e));
+  j["contacts"] = events;
+  Json bodies = Json::object();
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    Json b = body_inputs_json(inputs[i]);
+    if (i < r.finals.size()) b["final"] = final_json(r.finals[i]);
+    bodies[inputs[i].name] = b;
+  }
+  j["bodies"] = bodies;
+  return j;
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  if (path == "-") {
+    std::cout << text << std::flush;
+    return;
+  }
+  // Temporary file beside the target, then rename: readers never see a partial file.
+  const std::string tmp = path + ".tmp." + std::to_string(getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot write " + path);
+    out << text;
+    out.flush();
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw std::runtime_error("cannot write " + path);
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot write " + path);
+  }
+}
+
+void write_json(const std::string& path, const Json& j) { write_text(path, j.dump(2) + "\n"); }
+
+Stopwatch::Stopwatch()
+    : start_ns_(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                    std::chrono::steady_clock::now().time_since_epoch())
+                    .count()) {}
+
+double Stopwatch::seconds() const {
+  const long long now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                            std::chrono::steady_clock::now().time_since_epoch())
+                            .count();
+  return (now - start_ns_) * 1e-9;
+}
+
+}  // namespace rbx

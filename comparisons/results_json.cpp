@@ -1,1 +1,0 @@
-// JSON output of results (filled in by the harness).

@@ -1,0 +1,55 @@
+#include <algorithm>
+#include <sstream>
+
+#include "comparisons/commands.h"
+#include "comparisons/scene_file.h"
+
+namespace rbx {
+
+namespace {
+
+bool serves(const Backend& b, Capability cap) {
+  return cap == Capability::Contact ? static_cast<bool>(b.contact) : static_cast<bool>(b.dynamics);
+}
+
+std::vector<std::string> split_list(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream s(list);
+  std::string item;
+  while (std::getline(s, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
+                                         Capability cap) {
+  std::vector<std::string> wanted;
+  if (!list.empty()) {
+    wanted = split_list(list);
+    for (const std::string& name : wanted)
+      if (!find_backend(name)) {
+        std::string known;
+        for (const Backend& b : backends()) known += (known.empty() ? "" : ", ") + b.name;
+        throw InputError("--backends: unknown backend '" + name + "'; known: " + known);
+      }
+  } else if (!scene.backends.empty()) {
+    wanted = scene.backends;
+  }
+  // Registry order; a backend named explicitly stays even if it cannot serve (-> unsupported).
+  std::vector<std::string> out;
+  for (const Backend& b : backends()) {
+    const bool named = std::find(wanted.begin(), wanted.end(), b.name) != wanted.end();
+    if (wanted.empty() ? serves(b, cap) : named) out.push_back(b.name);
+  }
+  return out;
+}
+
+Scene load_scene_for_command(const std::string& path, const SceneCommandOptions& opt) {
+  std::vector<std::string> sets = opt.sets;
+  if (opt.force) sets.push_back("force=true");
+  return load_scene(path, sets);
+}
+
+}  // namespace rbx

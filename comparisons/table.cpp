@@ -1,0 +1,62 @@
+#include "comparisons/table.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace rbx {
+
+std::string fmt_num(double x, int digits) {
+  if (std::isnan(x)) return "nan";
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x == 0.0 ? 0.0 : x);  // no "-0"
+  return buf;
+}
+
+std::string fmt_vec(const Vec3& v, int digits) {
+  return "(" + fmt_num(v.x(), digits) + ", " + fmt_num(v.y(), digits) + ", " +
+         fmt_num(v.z(), digits) + ")";
+}
+
+Table::Table(std::vector<std::string> header) { rows_.push_back(std::move(header)); }
+
+void Table::add(std::vector<std::string> row) {
+  row.resize(rows_.front().size());
+  rows_.push_back(std::move(row));
+}
+
+void Table::print(std::ostream& out) const {
+  std::vector<size_t> width(rows_.front().size(), 0);
+  for (const auto& r : rows_)
+    for (size_t c = 0; c < r.size(); ++c) width[c] = std::max(width[c], r[c].size());
+  for (size_t i = 0; i < rows_.size(); ++i) {
+    std::string line = " ";
+    for (size_t c = 0; c < rows_[i].size(); ++c)
+      line += " " + rows_[i][c] + std::string(width[c] - rows_[i][c].size(), ' ');
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out << line << "\n";
+    if (i == 0) {
+      std::string rule = " ";
+      for (size_t c = 0; c < width.size(); ++c) rule += " " + std::string(width[c], '-');
+      out << rule << "\n";
+    }
+  }
+}
+
+std::string Table::markdown() const {
+  std::string s;
+  for (size_t i = 0; i < rows_.size(); ++i) {
+    s += "|";
+    for (const std::string& cell : rows_[i]) s += " " + cell + " |";
+    s += "\n";
+    if (i == 0) {
+      s += "|";
+      for (size_t c = 0; c < rows_[i].size(); ++c) s += "---|";
+      s += "\n";
+    }
+  }
+  return s;
+}
+
+}  // namespace rbx
