@@ -36,3 +36,28 @@ int run_command(const SceneCommandOptions& opt);
 int contacts_command(const SceneCommandOptions& opt);
 
 }  // namespace rbx
+
+namespace rbx {
+
+/// `rbx compare SCENE...`: each scene's checks, side by side; exit 1 on a violated [expect].
+int compare_command(const SceneCommandOptions& opt);
+
+/// Options of `rbx report` and `rbx check`.
+struct ReportOptions {
+  std::vector<std::string> inputs;  // scene files or folders ("" : scenes/)
+  std::string out;                  // report folder (report) ("" : reports/latest)
+  std::string baseline;             // baseline file (check) ("" : reports/baseline.json)
+  bool update = false;              // check --update: rewrite the baseline
+  std::string backends;             // --backends LIST
+  bool quiet = false;               // no progress line
+};
+
+/// `rbx report`: accuracy report over a scene library.
+int report_command(const ReportOptions& opt);
+/// `rbx check`: regression check of every accuracy metric against the baseline.
+int check_command(const ReportOptions& opt);
+
+/// Scene files under the inputs (folders searched recursively for *.toml, sorted).
+std::vector<std::string> collect_scene_files(const std::vector<std::string>& inputs);
+
+}  // namespace rbx

@@ -28,11 +28,22 @@ void scene_options(CLI::App* cmd, rbx::SceneCommandOptions& o, bool many, bool b
 int main(int argc, char** argv) {
   CLI::App app{"rbx: rigid-body collision detection and response testbed"};
   app.require_subcommand(1);
-  rbx::SceneCommandOptions run_opt, contacts_opt;
+  rbx::SceneCommandOptions run_opt, contacts_opt, compare_opt;
+  rbx::ReportOptions report_opt, check_opt;
   scene_options(app.add_subcommand("run", "custom engine only: collision events and final state"),
                 run_opt, false, true);
   scene_options(app.add_subcommand("contacts", "contact query at the t=0 poses, every backend"),
                 contacts_opt, false, true);
+  scene_options(app.add_subcommand("compare", "the scenes' checks, side by side"), compare_opt,
+                true, true);
+  CLI::App* report = app.add_subcommand("report", "accuracy report (default: scenes/ -> reports/latest)");
+  report->add_option("inputs", report_opt.inputs, "scene files or folders");
+  report->add_option("--out", report_opt.out, "output folder");
+  report->add_option("--backends", report_opt.backends, "comma-separated backend names");
+  CLI::App* check = app.add_subcommand("check", "regression check against reports/baseline.json");
+  check->add_option("inputs", check_opt.inputs, "scene files or folders (default: scenes/)");
+  check->add_option("--baseline", check_opt.baseline, "baseline file");
+  check->add_flag("--update", check_opt.update, "rewrite the baseline from this run");
 
   try {
     app.parse(argc, argv);
@@ -48,6 +59,9 @@ int main(int argc, char** argv) {
   try {
     if (app.got_subcommand("run")) return rbx::run_command(run_opt);
     if (app.got_subcommand("contacts")) return rbx::contacts_command(contacts_opt);
+    if (app.got_subcommand("compare")) return rbx::compare_command(compare_opt);
+    if (app.got_subcommand("report")) return rbx::report_command(report_opt);
+    if (app.got_subcommand("check")) return rbx::check_command(check_opt);
   } catch (const rbx::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;

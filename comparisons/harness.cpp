@@ -1,0 +1,645 @@
+#include "comparisons/harness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "comparisons/commands.h"
+#include "comparisons/contact_eval.h"
+#include "comparisons/table.h"
+#include "engine/bounding.h"
+#include "reference/exact.h"
+
+namespace rbx {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Small helpers
+
+std::string pair_name(const RigidBody& a, const RigidBody& b) { return a.name + "-" + b.name; }
+
+// A dynamics run with its wall-clock time; library exceptions become status Error.
+struct DynRun {
+  DynamicsResult result;
+  double runtime_s = 0.0;
+  double dt = 0.0;
+};
+
+DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every) {
+  DynRun run;
+  run.dt = dt;
+  Stopwatch clock;
+  try {
+    run.result = b.dynamics(scene, DynamicsOptions{dt, sample_every});
+  } catch (const std::exception& e) {
+    run.result.status = Status::Error;
+    run.result.message = e.what();
+  }
+  run.runtime_s = clock.seconds();
+  // A backend that returns fewer final states than bodies has failed in a way we must show.
+  if (run.result.status == Status::Ok && run.result.finals.size() != scene.bodies.size()) {
+    run.result.status = Status::Error;
+    run.result.message = "backend returned " + std::to_string(run.result.finals.size()) +
+                         " final states for " + std::to_string(scene.bodies.size()) + " bodies";
+  }
+  return run;
+}
+
+// Velocity error in the kinetic-energy norm: sqrt(sum m|dv|^2 + dw.I.dw) / sqrt(2 E_ref). Only
+// the bodies (and quantities) present in `ref` count; static bodies never do.
+struct RefState {
+  std::optional<Vec3> velocity, angular_velocity;
+};
+
+double ke_norm_error(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& finals,
+                     const std::vector<std::optional<RefState>>& ref, double fallback_energy) {
+  double num = 0.0, e_ref = 0.0;
+  for (size_t i = 0; i < inputs.size() && i < finals.size(); ++i) {
+    if (!ref[i] || inputs[i].is_static) continue;
+    const RigidBody& b = inputs[i];
+    const Mat3 rot = finals[i].orientation.toRotationMatrix();
+    const Mat3 inertia = rot * b.inertia_body * rot.transpose();
+    if (ref[i]->velocity) {
+      num += b.mass * (finals[i].velocity - *ref[i]->velocity).squaredNorm();
+      e_ref += 0.5 * b.mass * ref[i]->velocity->squaredNorm();
+    }
+    if (ref[i]->angular_velocity) {
+      const Vec3 dw = finals[i].angular_velocity - *ref[i]->angular_velocity;
+      num += dw.dot(inertia * dw);
+      e_ref += 0.5 * ref[i]->angular_velocity->dot(inertia * *ref[i]->angular_velocity);
+    }
+  }
+  // A reference at rest (e = 0 head-on in the centre-of-mass frame) has no energy to compare
+  // with: fall back to the initial kinetic energy.
+  if (e_ref < 1e-12 * fallback_energy) e_ref = fallback_energy;
+  if (!(e_ref > 0.0)) return std::sqrt(num);
+  return std::sqrt(num / (2.0 * e_ref));
+}
+
+double kinetic_energy(const std::vector<RigidBody>& inputs) {
+  double e = 0.0;
+  for (const RigidBody& b : inputs) e += b.kinetic_energy();
+  return e;
+}
+
+// Total energy (kinetic + gravitational potential) of a set of final states.
+double total_energy(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& s,
+                    const Vec3& gravity) {
+  double e = 0.0;
+  for (size_t i = 0; i < inputs.size() && i < s.size(); ++i) {
+    const RigidBody& b = inputs[i];
+    if (b.is_static) continue;
+    const Mat3 rot = s[i].orientation.toRotationMatrix();
+    e += 0.5 * b.mass * s[i].velocity.squaredNorm() +
+         0.5 * s[i].angular_velocity.dot(rot * b.inertia_body * rot.transpose() *
+                                         s[i].angular_velocity) -
+         b.mass * gravity.dot(s[i].position);
+  }
+  return e;
+}
+
+Vec3 linear_momentum(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& s) {
+  Vec3 p = Vec3::Zero();
+  for (size_t i = 0; i < inputs.size() && i < s.size(); ++i)
+    if (!inputs[i].is_static) p += inputs[i].mass * s[i].velocity;
+  return p;
+}
+
+Vec3 angular_momentum(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& s) {
+  Vec3 h = Vec3::Zero();
+  for (size_t i = 0; i < inputs.size() && i < s.size(); ++i) {
+    const RigidBody& b = inputs[i];
+    if (b.is_static) continue;
+    const Mat3 rot = s[i].orientation.toRotationMatrix();
+    h += s[i].position.cross(b.mass * s[i].velocity) +
+         rot * b.inertia_body * rot.transpose() * s[i].angular_velocity;
+  }
+  return h;
+}
+
+std::vector<BodyFinal> initial_states(const std::vector<RigidBody>& inputs) {
+  std::vector<BodyFinal> s;
+  for (const RigidBody& b : inputs)
+    s.push_back({b.name, b.position, b.orientation, b.velocity, b.angular_velocity});
+  return s;
+}
+
+// Distance from p to the convex planar polygon `poly` (or segment or point), in 3-D.
+double distance_to_region(const Vec3& p, const std::vector<Vec3>& poly) {
+  if (poly.empty()) return std::numeric_limits<double>::infinity();
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const Vec3& a = poly[i];
+    const Vec3& b = poly[(i + 1) % poly.size()];
+    const Vec3 ab = b - a;
+    const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+    best = std::min(best, (a + t * ab - p).norm());
+  }
+  if (poly.size() >= 3) {
+    // Inside the polygon's outline: the distance is the height above its plane.
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& v : poly) c += v;
+    c /= static_cast<double>(poly.size());
+    Vec3 n = Vec3::Zero();
+    for (size_t i = 0; i < poly.size(); ++i) n += (poly[i] - c).cross(poly[(i + 1) % poly.size()] - c);
+    if (n.norm() > 0) {
+      n.normalize();
+      const Vec3 q = p - n * n.dot(p - c);
+      bool inside = true;
+      for (size_t i = 0; i < poly.size() && inside; ++i)
+        inside = (poly[(i + 1) % poly.size()] - poly[i]).cross(q - poly[i]).dot(n) >= -1e-12;
+      if (inside) best = std::min(best, std::abs(n.dot(p - c)));
+    }
+  }
+  return best;
+}
+
+// Size of a body: its bounding-box diagonal (m).
+double body_size(const RigidBody& b) { return 2.0 * bounding_sphere(b).radius; }
+
+std::string fmt_dt(double dt) { return "self dt=" + fmt_num(dt, 3); }
+
+// Default time steps for the sweep: the scene's dt scaled by 4, 2, 1, 1/2, 1/4.
+std::vector<double> sweep_steps(const Scene& scene) {
+  if (!scene.sim.sweep_dt.empty()) {
+    std::vector<double> s = scene.sim.sweep_dt;
+    std::sort(s.rbegin(), s.rend());
+    return s;
+  }
+  const double dt = scene.sim.dt;
+  return {4 * dt, 2 * dt, dt, dt / 2, dt / 4};
+}
+
+}  // namespace
+
+std::string scene_family(const std::string& file) {
+  const std::filesystem::path p(file);
+  const std::string parent = p.parent_path().filename().string();
+  return parent.empty() ? "scenes" : parent;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The checks
+
+namespace {
+
+class Evaluator {
+ public:
+  Evaluator(const Scene& scene, const HarnessOptions& opt)
+      : scene_(scene), opt_(opt), inputs_(make_bodies(scene)) {
+    out_.family = scene_family(scene.file);
+  }
+
+  SceneEvaluation run() {
+    Json& j = out_.json;
+    j["scene"] = scene_.name;
+    j["file"] = scene_.file;
+    j["family"] = out_.family;
+    j["description"] = scene_.description;
+    j["checks"] = scene_.checks;
+    j["settings"] = settings_json(scene_);
+    backends_json_ = Json::object();
+    if (scene_.checks.empty()) out_.skipped.push_back("scene lists no checks: nothing to run");
+    if (scene_.has_check("contact")) contact_check();
+    const bool dynamics = scene_.has_check("impulse") || scene_.has_check("trajectory") ||
+                          scene_.has_check("stability");
+    if (dynamics) dynamics_checks();
+    if (scene_.has_check("mass")) mass_check();
+    j["backends"] = backends_json_;
+    Json metrics = Json::array();
+    for (const Metric& m : out_.metrics)
+      metrics.push_back({{"check", m.check}, {"backend", m.backend}, {"pair", m.pair},
+                         {"name", m.name}, {"value", m.value}, {"against", m.against}});
+    j["metrics"] = metrics;
+    Json sweep = Json::array();
+    for (const SweepPoint& s : out_.sweep)
+      sweep.push_back({{"backend", s.backend}, {"kind", s.kind}, {"dt", s.dt},
+                       {"runtime_s", s.runtime_s}, {"error", s.error}, {"against", s.against}});
+    j["sweep"] = sweep;
+    j["stability"] = stability_json_.is_null() ? Json::object() : stability_json_;
+    j["skipped"] = out_.skipped;
+    j["expect"] = {{"checked", scene_.expect.has_value()},
+                   {"passed", out_.expect_failures.empty()},
+                   {"failures", out_.expect_failures}};
+    j["disagreements"] = out_.disagreements;
+    return std::move(out_);
+  }
+
+ private:
+  void metric(const std::string& check, const std::string& backend, const std::string& pair,
+              const std::string& name, double value, const std::string& against) {
+    out_.metrics.push_back({check, backend, pair, name, value, against});
+  }
+
+  Json& backend_json(const std::string& name) {
+    if (!backends_json_.contains(name))
+      backends_json_[name] = {{"status", "ok"}, {"message", ""}, {"runtime_s", 0.0},
+                              {"contacts", Json::array()}};
+    return backends_json_[name];
+  }
+
+  void set_status(const std::string& name, Status s, const std::string& message) {
+    Json& bj = backend_json(name);
+    if (s != Status::Ok && bj["status"] == "ok") {
+      bj["status"] = to_string(s);
+      bj["message"] = message;
+    } else if (s == Status::Ok && !message.empty() && bj["message"] == "") {
+      bj["message"] = message;
+    }
+  }
+
+  // -- contact ---------------------------------------------------------------------------------
+  void contact_check() {
+    const std::vector<std::string> names = select_backends(scene_, opt_.backends, Capability::Contact);
+    const Backend& exact = *find_backend("exact");
+    int pairs = 0;
+    for (size_t i = 0; i < inputs_.size(); ++i) {
+      for (size_t k = i + 1; k < inputs_.size(); ++k) {
+        const RigidBody &a = inputs_[i], &b = inputs_[k];
+        const bool first_pair = i == 0 && k == 1;
+        if (!first_pair && (!bounding_check(a, b) || (a.is_static && b.is_static))) continue;
+        ++pairs;
+        contact_pair(a, b, first_pair, names, exact);
+      }
+    }
+    if (pairs == 0) out_.skipped.push_back("contact: no pair of bodies within bounding range");
+  }
+
+  void contact_pair(const RigidBody& a, const RigidBody& b, bool first_pair,
+                    const std::vector<std::string>& names, const Backend& exact) {
+    const std::string pair = pair_name(a, b);
+    const SatResult sat = sat_query(*a.shape, a.pose(), *b.shape, b.pose());
+    // Truth: the [expect.contact] closed form for the first pair, else the exact oracle.
+    const ExpectContact* ex = first_pair && scene_.expect && scene_.expect->contact
+                                  ? &*scene_.expect->contact : nullptr;
+    const bool have_normal = ex && ex->normal, have_depth = ex && ex->depth;
+    const bool true_touch = ex && ex->touching ? *ex->touching : sat.touching;
+    const Vec3 true_normal = have_normal ? ex->normal->normalized() : sat.normal;
+    const double true_depth = have_depth ? *ex->depth : std::max(sat.depth, 0.0);
+    const std::string normal_src = have_normal ? "analytic" : "exact";
+    const std::string depth_src = have_depth ? "analytic" : "exact";
+    const double size = std::min(body_size(a), body_size(b));
+    const double tol = scene_.expect ? scene_.expect->tolerance : 1e-6;
+
+    for (const std::string& name : names) {
+      const Backend& be = *find_backend(name);
+      // Time each query for about timing_budget_s (median of the repeats).
+      ContactRun probe = name == "exact" ? run_contact(exact, a, b) : run_contact(be, a, b);
+      int repeats = 1;
+      if (probe.result.status == Status::Ok && probe.runtime_s > 0)
+        repeats = static_cast<int>(std::clamp(opt_.timing_budget_s / probe.runtime_s, 1.0, 200.0));
+      const ContactRun run = repeats > 1 ? run_contact(be, a, b, repeats) : probe;
+      set_status(name, run.result.status, run.result.message);
+      Json& bj = backend_json(name);
+      bj["runtime_s"] = bj["runtime_s"].get<double>() + run.runtime_s;
+      for (const ContactPoint& p : run.result.contacts)
+        bj["contacts"].push_back(contact_json(a.name, b.name, 0.0, p));
+      if (run.result.status != Status::Ok) continue;
+
+      const ContactPoint* c = deepest(run.result);
+      const bool touch = c != nullptr;
+      metric("contact", name, pair, "touching_err", touch == true_touch ? 0.0 : 1.0,
+             ex && ex->touching ? "analytic" : "exact");
+      if (touch != true_touch)
+        out_.disagreements.push_back(name + " on " + pair + ": " +
+                                     (touch ? "reports a contact where there is none"
+                                            : "misses a contact"));
+      if (!touch || !true_touch) continue;
+      const double angle = angle_deg(c->normal, true_normal);
+      const double derr = std::abs(c->depth - true_depth);
+      metric("contact", name, pair, "normal_err_deg", angle, normal_src);
+      metric("contact", name, pair, "depth_err", derr, depth_src);
+      if (sat.touching && !sat.manifold.empty())
+        metric("contact", name, pair, "point_err_rel", distance_to_region(c->point, sat.manifold) / size,
+               "exact");
+      out_.sweep.push_back({name, "contact", 0.0, run.runtime_s, angle, normal_src});
+      // Disagreement marks: beyond round-off-level tolerance of the truth (1e-6 rad ~ 6e-5 deg;
+      // depth within the scene's tolerance or 1e-6 of the body size).
+      const double depth_tol = std::max(tol, 1e-6 * size);
+      if (angle > 1e-3 || derr > depth_tol) {
+        std::ostringstream s;
+        s << name << " on " << pair << ": normal off by " << fmt_num(angle, 3) << " deg, depth off by "
+          << fmt_num(derr, 3) << " m (against " << normal_src << ")";
+        out_.disagreements.push_back(s.str());
+      }
+      // [expect.contact] binds the oracle: if `exact` disagrees with the closed form, either
+      // the scene's derivation or the oracle is wrong, and compare exits 1.
+      if (name == "exact" && ex) {
+        if (have_normal && (c->normal - true_normal).norm() > tol)
+          out_.expect_failures.push_back("exact: contact normal " + fmt_vec(c->normal, 8) +
+                                         ", expected " + fmt_vec(true_normal, 8));
+        if (have_depth && derr > tol)
+          out_.expect_failures.push_back("exact: contact depth " + fmt_num(c->depth, 10) +
+                                         ", expected " + fmt_num(true_depth, 10));
+      }
+      if (name == "exact" && ex && ex->touching && touch != *ex->touching)
+        out_.expect_failures.push_back("exact: touching is " + std::string(touch ? "true" : "false"));
+    }
+  }
+
+  // -- impulse, trajectory, stability ----------------------------------------------------------
+  void dynamics_checks() {
+    const std::vector<std::string> names = select_backends(scene_, opt_.backends, Capability::Dynamics);
+    const double e0_kin = kinetic_energy(inputs_);
+    const std::vector<BodyFinal> s0 = initial_states(inputs_);
+    const double e0 = total_energy(inputs_, s0, scene_.sim.gravity);
+    const Vec3 p0 = linear_momentum(inputs_, s0), h0 = angular_momentum(inputs_, s0);
+    bool any_static = false;
+    double mass_total = 0.0, size_max = 0.0;
+    for (const RigidBody& b : inputs_) {
+      any_static = any_static || b.is_static;
+      if (!b.is_static) mass_total += b.mass;
+      size_max = std::max(size_max, body_size(b));
+    }
+    const bool closed = !any_static && scene_.sim.gravity.norm() == 0.0;
+    if (!closed)
+      out_.skipped.push_back("momentum drift: not an invariant here (static bodies or gravity)");
+    bool angular = false;  // angular metrics only where something rotates
+    for (const RigidBody& b : inputs_) angular = angular || b.angular_velocity.norm() > 0;
+    // Momentum scale: the largest momentum any body has or could get from the energy.
+    const double p_scale = std::max(p0.norm(), std::sqrt(2.0 * mass_total * std::max(e0_kin, 1e-300)));
+    const double h_scale = std::max(h0.norm(), p_scale * size_max);
+
+    // Reference for final velocities: the [expect] block, if it gives any.
+    std::vector<std::optional<RefState>> expected(inputs_.size());
+    bool have_expect = false;
+    if (scene_.expect)
+      for (const ExpectBody& eb : scene_.expect->bodies)
+        for (size_t i = 0; i < inputs_.size(); ++i)
+          if (inputs_[i].name == eb.name && (eb.velocity || eb.angular_velocity)) {
+            expected[i] = RefState{eb.velocity, eb.angular_velocity};
+            have_expect = true;
+          }
+    for (const auto& r : expected)
+      angular = angular || (r && r->angular_velocity && r->angular_velocity->norm() > 0);
+
+    const long steps = scene_.sim.steps();
+    const long sample_every = std::max<long>(1, steps / 400);
+    const bool wants_sweep = opt_.sweep && (scene_.has_check("impulse") || scene_.has_check("trajectory"));
+    const std::vector<double> dts = sweep_steps(scene_);
+    const double finest = dts.back();
+
+    for (const std::string& name : names) {
+      const Backend& be = *find_backend(name);
+      if (!be.dynamics) {
+        set_status(name, Status::Unsupported, name + " has no dynamics (contact queries only)");
+        continue;
+      }
+      const DynRun main = run_dynamics(be, scene_, scene_.sim.dt, sample_every);
+      Json& bj = backend_json(name);
+      bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
+      if (main.result.status != Status::Ok) {
+        if (scene_.has_check("stability")) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
+        continue;
+      }
+      for (const BodyFinal& f : main.result.finals) angular = angular || f.angular_velocity.norm() > 1e-12;
+
+      // Self-consistency reference: the same backend at the finest step of the sweep.
+      std::optional<DynRun> fine;
+      std::vector<DynRun> sweep_runs;
+      if (wants_sweep || !have_expect) {
+        // Without a sweep only the finest step is needed (the self-consistency reference).
+        const std::vector<double> to_run = wants_sweep ? dts : std::vector<double>{finest};
+        for (double dt : to_run) {
+          if (std::abs(dt - scene_.sim.dt) <= 1e-15 * dt) sweep_runs.push_back(main);
+          else sweep_runs.push_back(run_dynamics(be, scene_, dt, 0));
+        }
+        if (sweep_runs.back().result.status == Status::Ok) fine = sweep_runs.back();
+      }
+      auto ref_of = [&](const DynRun& r) {
+        std::vector<std::optional<RefState>> ref(inputs_.size());
+        for (size_t i = 0; i < inputs_.size(); ++i)
+          ref[i] = RefState{r.result.finals[i].velocity,
+                            angular ? std::optional<Vec3>(r.result.finals[i].angular_velocity)
+                                    : std::nullopt};
+        return ref;
+      };
+      std::string against;
+      std::vector<std::optional<RefState>> ref;
+      if (have_expect) {
+        against = "analytic";
+        ref = expected;
+      } else if (fine) {
+        against = fmt_dt(finest);
+        ref = ref_of(*fine);
+      }
+      if (!against.empty() && !(fine && !have_expect && std::abs(finest - scene_.sim.dt) < 1e-15)) {
+        metric(primary_check(), name, "", "velocity_err_ke",
+               ke_norm_error(inputs_, main.result.finals, ref, e0_kin), against);
+      } else if (against.empty()) {
+        out_.skipped.push_back(name + ": no reference for the velocity error");
+      }
+      if (wants_sweep && !against.empty()) {
+        for (const DynRun& r : sweep_runs) {
+          if (r.result.status != Status::Ok) continue;
+          if (!have_expect && &r == &sweep_runs.back()) continue;  // zero by construction
+          out_.sweep.push_back({name, "dynamics", r.dt, r.runtime_s,
+                                ke_norm_error(inputs_, r.result.finals, ref, e0_kin), against});
+        }
+      }
+      // Contact time: first event against the finest-step run of the same backend.
+      if (fine && !main.result.events.empty() && !fine->result.events.empty() &&
+          std::abs(finest - scene_.sim.dt) > 1e-15)
+        metric(primary_check(), name, "", "contact_time_err",
+               std::abs(main.result.events.front().time - fine->result.events.front().time),
+               fmt_dt(finest));
+      // Conservation: momentum (where it is an invariant), energy against what e allows.
+      const std::vector<BodyFinal>& f = main.result.finals;
+      if (closed) {
+        metric(primary_check(), name, "", "momentum_drift_err", (linear_momentum(inputs_, f) - p0).norm() / p_scale,
+               "invariant");
+        if (angular)
+          metric(primary_check(), name, "", "angular_momentum_drift_err",
+                 (angular_momentum(inputs_, f) - h0).norm() / h_scale, "invariant");
+      }
+      const double e1 = total_energy(inputs_, f, scene_.sim.gravity);
+      const double e_scale = std::max(std::abs(e0), e0_kin);
+      if (e_scale > 0) {
+        const double change = (e1 - e0) / e_scale;
+        metric(primary_check(), name, "", "energy_change_rel", change, "initial");
+        // e = 1 allows no change; e < 1 allows a loss but never a gain.
+        const double err = scene_.sim.restitution >= 1.0 ? std::abs(change) : std::max(change, 0.0);
+        metric(primary_check(), name, "", "energy_err", err, "invariant");
+      }
+      // [expect.body] binds the custom engine.
+      if (name == "custom" && scene_.expect) check_expect_bodies(main.result.finals);
+      else if (scene_.expect) mark_expect_disagreement(name, main.result.finals);
+      if (scene_.has_check("stability")) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
+    }
+    if (!angular) out_.skipped.push_back("angular metrics: nothing rotates in this scene");
+  }
+
+  std::string primary_check() const {
+    if (scene_.has_check("impulse")) return "impulse";
+    if (scene_.has_check("trajectory")) return "trajectory";
+    return "stability";
+  }
+
+  // Compares final states with [expect.body]: violations of the custom engine fail the scene.
+  std::vector<std::string> expect_violations(const std::string& name, const std::vector<BodyFinal>& finals) {
+    std::vector<std::string> v;
+    const double tol = scene_.expect->tolerance;
+    for (const ExpectBody& eb : scene_.expect->bodies) {
+      auto it = std::find_if(finals.begin(), finals.end(), [&](const BodyFinal& f) { return f.name == eb.name; });
+      if (it == finals.end()) continue;
+      auto check = [&](const char* what, const std::optional<Vec3>& want, const Vec3& got) {
+        if (want && (got - *want).cwiseAbs().maxCoeff() > tol)
+          v.push_back(name + ": body " + eb.name + " " + what + " " + fmt_vec(got, 8) + ", expected " +
+                      fmt_vec(*want, 8) + " (tolerance " + fmt_num(tol, 3) + ")");
+      };
+      check("velocity", eb.velocity, it->velocity);
+      check("angular_velocity", eb.angular_velocity, it->angular_velocity);
+      check("position", eb.position, it->position);
+    }
+    return v;
+  }
+
+  void check_expect_bodies(const std::vector<BodyFinal>& finals) {
+    for (std::string& s : expect_violations("custom", finals)) out_.expect_failures.push_back(s);
+  }
+
+  void mark_expect_disagreement(const std::string& name, const std::vector<BodyFinal>& finals) {
+    const auto v = expect_violations(name, finals);
+    if (!v.empty()) out_.disagreements.push_back(v.front() + (v.size() > 1 ? " (and more)" : ""));
+  }
+
+  // Stability on stiff and extreme scenes: non-finite states, energy growth, momentum drift,
+  // maximum penetration, tunnelling, jitter at rest, and a verdict.
+  void stability(const std::string& name, const DynRun& run, double e0, const Vec3& p0,
+                 const Vec3& h0, bool closed, double p_scale, double h_scale) {
+    Json s;
+    std::vector<std::string> why;
+    const auto& samples = run.result.samples;
+    bool nonfinite = run.result.status == Status::Error &&
+                     run.result.message.find("non-finite") != std::string::npos;
+    double e_max = e0, pen_max = 0.0, drift = 0.0, hdrift = 0.0;
+    const double e_scale = std::max({std::abs(e0), kinetic_energy(inputs_), 1e-300});
+    int tunnelled = 0;
+    // Initial separating direction per pair (exact), to see who ends up past whom.
+    std::vector<std::tuple<size_t, size_t, Vec3, double>> watch;
+    for (size_t i = 0; i < inputs_.size(); ++i)
+      for (size_t k = i + 1; k < inputs_.size(); ++k) {
+        if (inputs_[i].is_static && inputs_[k].is_static) continue;
+        const SatResult sat = sat_query(*inputs_[i].shape, inputs_[i].pose(), *inputs_[k].shape, inputs_[k].pose());
+        if (sat.touching) continue;
+        // Half-thickness of both bodies along the separating normal, at the t = 0 poses.
+        double reach = 0.0;
+        for (size_t m : {i, k}) {
+          double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+          for (size_t v = 0; v < inputs_[m].shape->vertices().size(); ++v) {
+            const double d = inputs_[m].world_vertex(static_cast<int>(v)).dot(sat.normal);
+            lo = std::min(lo, d);
+            hi = std::max(hi, d);
+          }
+          reach += 0.5 * (hi - lo);
+        }
+        watch.emplace_back(i, k, sat.normal, reach);
+      }
+    std::vector<bool> passed(watch.size(), false);
+    for (const StateSample& smp : samples) {
+      for (const BodyFinal& b : smp.bodies)
+        if (!b.position.allFinite() || !b.velocity.allFinite() || !b.angular_velocity.allFinite())
+          nonfinite = true;
+      if (nonfinite) break;
+      e_max = std::max(e_max, total_energy(inputs_, smp.bodies, scene_.sim.gravity));
+      if (closed) {
+        drift = std::max(drift, (linear_momentum(inputs_, smp.bodies) - p0).norm() / p_scale);
+        hdrift = std::max(hdrift, (angular_momentum(inputs_, smp.bodies) - h0).norm() / h_scale);
+      }
+      // Penetration: exact depth of every pair in bounding range, relative to the smaller body.
+      for (size_t i = 0; i < inputs_.size(); ++i) {
+        for (size_t k = i + 1; k < inputs_.size(); ++k) {
+          if (inputs_[i].is_static && inputs_[k].is_static) continue;
+          const Pose pa{smp.bodies[i].position, smp.bodies[i].orientation};
+          const Pose pb{smp.bodies[k].position, smp.bodies[k].orientation};
+          const double reach = bounding_sphere(inputs_[i]).radius + bounding_sphere(inputs_[k]).radius;
+          if ((pa.position - pb.position).norm() > reach + 1e-9 * reach) continue;
+          const SatResult sat = sat_query(*inputs_[i].shape, pa, *inputs_[k].shape, pb);
+          if (sat.touching)
+            pen_max = std::max(pen_max, sat.depth / std::min(body_size(inputs_[i]), body_size(inputs_[k])));
+        }
+      }
+      // Tunnelling: a pair that started apart and now lies fully on the other side.
+      for (size_t w = 0; w < watch.size(); ++w) {
+        const auto& [i, k, n, reach] = watch[w];
+        const double side0 = (inputs_[i].position - inputs_[k].position).dot(n);
+        const double side = (smp.bodies[i].position - smp.bodies[k].position).dot(n);
+        if (side0 > 0 && side < -reach) passed[w] = true;
+      }
+    }
+    for (bool p : passed) tunnelled += p ? 1 : 0;
+    // Jitter at rest: RMS speed over the last fifth of the run (only meaningful under gravity).
+    double jitter = 0.0;
+    if (scene_.sim.gravity.norm() > 0 && samples.size() >= 5) {
+      double sum = 0.0;
+      int count = 0;
+      for (size_t t = samples.size() * 4 / 5; t < samples.size(); ++t)
+        for (size_t i = 0; i < inputs_.size(); ++i)
+          if (!inputs_[i].is_static) {
+            sum += samples[t].bodies[i].velocity.squaredNorm();
+            ++count;
+          }
+      jitter = count ? std::sqrt(sum / count) : 0.0;
+    }
+    const double growth = (e_max - e0) / e_scale;
+    s["status"] = to_string(run.result.status);
+    s["nonfinite"] = nonfinite;
+    s["energy_growth_rel"] = growth;
+    if (closed) {
+      s["momentum_drift_rel"] = drift;
+      s["angular_momentum_drift_rel"] = hdrift;
+    }
+    s["max_penetration_rel"] = pen_max;
+    s["tunnelled_pairs"] = tunnelled;
+    if (scene_.sim.gravity.norm() > 0) s["jitter_rms_mps"] = jitter;
+    // Verdict: unstable on non-finite states, energy gained beyond 1 % (no energy source exists
+    // in these scenes: e <= 1, no motors), tunnelling, or a run stopped by the engine's guard.
+    if (nonfinite) why.push_back("non-finite state");
+    if (growth > 0.01) why.push_back("energy grew by " + fmt_num(100 * growth, 3) + " %");
+    if (tunnelled) why.push_back(std::to_string(tunnelled) + " pair(s) tunnelled");
+    if (run.result.status == Status::Error) why.push_back(run.result.message);
+    if (closed && drift > 1e-6) why.push_back("momentum drift " + fmt_num(drift, 3));
+    if (pen_max > 0.5) why.push_back("penetration " + fmt_num(100 * pen_max, 3) + " % of body size");
+    s["verdict"] = why.empty() ? "stable" : "unstable";
+    s["why"] = why;
+    stability_json_[name] = s;
+    metric("stability", name, "", "energy_growth_err", std::max(growth, 0.0), "invariant");
+    metric("stability", name, "", "max_penetration_rel_err", pen_max, "exact");
+    metric("stability", name, "", "tunnelled_pairs_err", tunnelled, "invariant");
+    if (scene_.sim.gravity.norm() > 0) metric("stability", name, "", "jitter_rms_mps_err", jitter, "invariant");
+  }
+
+  // -- mass ------------------------------------------------------------------------------------
+  void mass_check() {
+    // Every backend is given the engine's solid values; here the two engine models are compared
+    // with each other (the seed's vertex model against the exact solid one).
+    for (const BodySpec& spec : scene_.bodies) {
+      const MassProperties solid = solid_mass_properties(*spec.shape, spec.mass);
+      const MassProperties verts = vertex_mass_properties(*spec.shape, spec.mass);
+      const double size = (spec.shape->bounds().max - spec.shape->bounds().min).norm();
+      metric("mass", "custom", spec.name, "vertex_model_com_err_rel",
+             (verts.center_of_mass - solid.center_of_mass).norm() / size, "exact solid");
+      metric("mass", "custom", spec.name, "vertex_model_inertia_err_rel",
+             (verts.inertia - solid.inertia).norm() / solid.inertia.norm(), "exact solid");
+    }
+  }
+
+  const Scene& scene_;
+  const HarnessOptions& opt_;
+  std::vector<RigidBody> inputs_;
+  SceneEvaluation out_;
+  Json backends_json_;
+  Json stability_json_;
+};
+
+}  // namespace
+
+SceneEvaluation evaluate_scene(const Scene& scene, const HarnessOptions& opt) {
+  return Evaluator(scene, opt).run();
+}
+
+}  // namespace rbx

@@ -1,0 +1,60 @@
+// The comparison harness: runs the checks a scene asks for, with only the backends that serve
+// them, and measures every backend against the best available truth: the scene's closed form
+// ([expect]) first, else the `exact` oracle (contacts), else the same backend at its finest
+// time step (self-consistency, Erez, Tassa & Todorov 2015), else another backend (marked).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "comparisons/json_io.h"
+#include "engine/scene.h"
+
+namespace rbx {
+
+/// Harness settings.
+struct HarnessOptions {
+  std::string backends;      // --backends LIST ("" : the scene's, or all that serve a check)
+  bool sweep = true;         // run the time-step sweep for error against run time
+  double timing_budget_s = 0.01;  // per contact query and backend: repeat until this much time
+};
+
+/// One measured number.
+struct Metric {
+  std::string check;    // contact | impulse | trajectory | stability | mass
+  std::string backend;
+  std::string pair;     // "A-B" for contact metrics, "" otherwise
+  std::string name;     // e.g. normal_err_deg; names of errors contain "err"
+  double value = 0.0;
+  std::string against;  // analytic | exact | self dt=... | backend NAME | invariant
+};
+
+/// One point of error against run time.
+struct SweepPoint {
+  std::string backend;
+  std::string kind;     // "dynamics" (a time step) or "contact" (a query)
+  double dt = 0.0;      // s (dynamics)
+  double runtime_s = 0.0;
+  double error = 0.0;   // velocity error in the kinetic-energy norm, or normal angle (deg)
+  std::string against;
+};
+
+/// Everything the harness learned about one scene.
+struct SceneEvaluation {
+  std::string family;                  // folder under scenes/, or "scenes"
+  Json json;                           // the contract's per-scene object, metrics included
+  std::vector<Metric> metrics;
+  std::vector<SweepPoint> sweep;
+  std::vector<std::string> skipped;    // what was left out, and why
+  std::vector<std::string> expect_failures;  // violated [expect] entries (subjects only)
+  std::vector<std::string> disagreements;    // references that disagree with the truth
+};
+
+/// Runs every check of the scene. Never throws for a backend's failure (that backend's status
+/// becomes error); throws InputError only for bad options.
+SceneEvaluation evaluate_scene(const Scene& scene, const HarnessOptions& opt);
+
+/// The family of a scene file: its folder name under scenes/ ("seed", "analytic", ...).
+std::string scene_family(const std::string& file);
+
+}  // namespace rbx

@@ -1,0 +1,358 @@
+// `rbx report`: runs a scene library through every check and backend it needs and writes
+// report.md, results.json, CSV files and figures into one folder, atomically.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "comparisons/commands.h"
+#include "comparisons/harness.h"
+#include "comparisons/scene_file.h"
+#include "comparisons/table.h"
+
+namespace fs = std::filesystem;
+
+namespace rbx {
+
+std::vector<std::string> collect_scene_files(const std::vector<std::string>& inputs) {
+  std::vector<std::string> roots = inputs;
+  if (roots.empty()) roots.push_back("scenes");
+  std::vector<std::string> files;
+  for (const std::string& root : roots) {
+    std::error_code ec;
+    if (fs::is_directory(root, ec)) {
+      std::vector<std::string> found;
+      for (const auto& e : fs::recursive_directory_iterator(root))
+        if (e.is_regular_file() && e.path().extension() == ".toml") found.push_back(e.path().string());
+      std::sort(found.begin(), found.end());
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (fs::exists(root, ec)) {
+      files.push_back(root);
+    } else {
+      throw InputError(root + ": no such scene file or folder");
+    }
+  }
+  if (files.empty()) throw InputError("no scene files (*.toml) found under the given inputs");
+  return files;
+}
+
+namespace {
+
+// Progress on a terminal only; quiet in CI and when piped.
+class Progress {
+ public:
+  explicit Progress(bool quiet)
+      : on_(!quiet && isatty(STDERR_FILENO) && std::getenv("CI") == nullptr) {}
+  void show(size_t i, size_t n, const std::string& what, double elapsed) {
+    if (!on_) return;
+    std::cerr << "\r\033[K[" << i << "/" << n << "] " << what << " (" << fmt_num(elapsed, 3) << " s)"
+              << std::flush;
+  }
+  void done() {
+    if (on_) std::cerr << "\r\033[K" << std::flush;
+  }
+
+ private:
+  bool on_;
+};
+
+// True when a disagreement line is about backend `name`.
+bool disagrees(const SceneEvaluation& ev, const std::string& name) {
+  for (const std::string& d : ev.disagreements)
+    if (d.rfind(name + " ", 0) == 0 || d.rfind(name + ":", 0) == 0) return true;
+  return false;
+}
+
+const Metric* find_metric(const SceneEvaluation& ev, const std::string& backend,
+                          const std::string& name) {
+  for (const Metric& m : ev.metrics)
+    if (m.backend == backend && m.name == name) return &m;
+  return nullptr;
+}
+
+// The headline cell of a scene for one backend, and what it was measured against.
+std::string headline(const SceneEvaluation& ev, const std::string& backend, std::string& against) {
+  const Json& bj = ev.json["backends"];
+  if (!bj.contains(backend)) return "";
+  const std::string status = bj[backend]["status"];
+  if (status == "unsupported") return "n/a";
+  if (status == "error") return "error";
+  std::string cell;
+  if (const Metric* t = find_metric(ev, backend, "touching_err"); t && t->value > 0) {
+    cell = "wrong touch";
+  } else if (const Metric* a = find_metric(ev, backend, "normal_err_deg")) {
+    const Metric* d = find_metric(ev, backend, "depth_err");
+    cell = fmt_num(a->value, 2) + "° / " + fmt_num(d ? d->value : 0.0, 2);
+    against = a->against;
+  } else if (const Metric* v = find_metric(ev, backend, "velocity_err_ke")) {
+    cell = fmt_num(v->value, 2);
+    against = v->against;
+  } else if (ev.json["stability"].contains(backend)) {
+    cell = ev.json["stability"][backend]["verdict"];
+  } else if (t) {
+    cell = "0 (no contact)";
+  } else {
+    cell = "ok";
+  }
+  if (disagrees(ev, backend)) cell += " ✗";
+  return cell;
+}
+
+std::string csv_escape(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+// World geometry of the bodies at t = 0, for the contact pictures.
+Json geometry_json(const Scene& scene) {
+  Json g = Json::array();
+  for (const RigidBody& b : make_bodies(scene)) {
+    if (b.shape->vertices().size() > 2000) return Json::array();
+    Json verts = Json::array();
+    for (size_t i = 0; i < b.shape->vertices().size(); ++i)
+      verts.push_back(to_json(b.world_vertex(static_cast<int>(i))));
+    Json tris = Json::array();
+    for (const auto& t : b.shape->triangles()) tris.push_back({t[0], t[1], t[2]});
+    g.push_back({{"name", b.name}, {"vertices", verts}, {"triangles", tris}});
+  }
+  return g;
+}
+
+std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs,
+                           double total_s, bool figures_ok, const std::string& figures_msg) {
+  std::ostringstream md;
+  // Backends that appear anywhere, in registry order.
+  std::vector<std::string> cols;
+  for (const Backend& b : backends())
+    for (const SceneEvaluation& ev : evs)
+      if (ev.json["backends"].contains(b.name)) {
+        cols.push_back(b.name);
+        break;
+      }
+  md << "# rbx accuracy report\n\n";
+  md << scenes.size() << " scenes through " << cols.size() << " backends in " << fmt_num(total_s, 3)
+     << " s. Every number except run times is deterministic: the same scenes give the same "
+        "report.\n\n";
+  md << "## Summary\n\n";
+  md << "Headline error of each backend on each scene. Contact scenes: **normal angle (deg) / "
+        "depth error (m)** of the deepest point against the closed form (`[expect]`) or the "
+        "`exact` oracle. Dynamics scenes: **post-collision velocity error in the kinetic-energy "
+        "norm** `sqrt(sum m|dv|^2 + dw.I.dw) / sqrt(2 E_ref)` against the closed form or the "
+        "same backend at its finest time step. Stability-only scenes: the verdict. **✗** marks a "
+        "backend that disagrees with the closed form or `exact`; `n/a`: the backend cannot "
+        "serve the scene; blank: not run for this scene's checks.\n\n";
+  std::vector<std::string> header = {"scene", "checks", "against"};
+  header.insert(header.end(), cols.begin(), cols.end());
+  Table summary(header);
+  int marks = 0;
+  for (size_t i = 0; i < evs.size(); ++i) {
+    std::string against;
+    std::vector<std::string> row = {evs[i].family + "/" + scenes[i].name, "", ""};
+    std::string checks;
+    for (const std::string& c : scenes[i].checks) checks += (checks.empty() ? "" : ", ") + c;
+    row[1] = checks;
+    for (const std::string& c : cols) {
+      std::string a;
+      row.push_back(headline(evs[i], c, a));
+      if (row.back().find("✗") != std::string::npos) ++marks;
+      if (against.empty() || against == a) against = a;
+      else if (!a.empty() && a.rfind("self", 0) == 0 && against.rfind("self", 0) == 0) against = "self (finest dt)";
+    }
+    row[2] = against;
+    if (!evs[i].expect_failures.empty()) row[0] += " **[expect failed]**";
+    summary.add(row);
+  }
+  md << summary.markdown() << "\n" << marks << " cells marked ✗.\n\n";
+
+  // Disagreements, grouped by backend.
+  md << "## Who disagrees with the truth\n\n";
+  std::map<std::string, std::vector<std::string>> by_backend;
+  for (size_t i = 0; i < evs.size(); ++i)
+    for (const std::string& d : evs[i].disagreements) {
+      const std::string name = d.substr(0, d.find_first_of(" :"));
+      by_backend[name].push_back(scenes[i].name + ": " + d.substr(name.size() + 1));
+    }
+  if (by_backend.empty()) md << "No backend disagrees with a closed form or the exact oracle.\n\n";
+  for (const std::string& c : cols) {
+    if (!by_backend.count(c)) continue;
+    const auto& list = by_backend[c];
+    md << "- **" << c << "** (" << list.size() << "): ";
+    for (size_t k = 0; k < list.size() && k < 6; ++k) md << (k ? "; " : "") << list[k];
+    if (list.size() > 6) md << "; and " << list.size() - 6 << " more (see the scene details)";
+    md << "\n";
+  }
+  md << "\n";
+
+  // Error against run time.
+  md << "## Error against run time\n\n";
+  md << "Dynamics: each backend is run at every time step of the scene's `sweep_dt` (default 4, "
+        "2, 1, 1/2 and 1/4 times `dt`); error is the velocity error in the kinetic-energy norm "
+        "(against the closed form, else the finest step), run time is wall-clock per run, summed "
+        "over the family's scenes. Contacts: median time per query against the normal angle "
+        "error. Numbers: `sweep.csv`.\n\n";
+  std::set<std::string> families;
+  for (const SceneEvaluation& ev : evs)
+    for (const SweepPoint& p : ev.sweep) families.insert(ev.family + (p.kind == "contact" ? "-contact" : ""));
+  if (!figures_ok) md << "_Figures were not drawn: " << figures_msg << "_\n\n";
+  for (const std::string& f : families)
+    md << "![error against run time, " << f << "](figures/error_vs_runtime_" << f << ".png)\n\n";
+
+  // Stability.
+  md << "## Stability\n\n";
+  Table st({"scene", "backend", "verdict", "energy growth", "max penetration", "tunnelled",
+            "jitter (m/s)", "why"});
+  bool any_stab = false;
+  for (size_t i = 0; i < evs.size(); ++i) {
+    for (const auto& [name, s] : evs[i].json["stability"].items()) {
+      any_stab = true;
+      std::string why;
+      for (const auto& w : s["why"]) why += (why.empty() ? "" : "; ") + w.get<std::string>();
+      st.add({scenes[i].name, name, s["verdict"], fmt_num(s["energy_growth_rel"].get<double>(), 3),
+              fmt_num(100 * s["max_penetration_rel"].get<double>(), 3) + " %",
+              std::to_string(s["tunnelled_pairs"].get<int>()),
+              s.contains("jitter_rms_mps") ? fmt_num(s["jitter_rms_mps"].get<double>(), 3) : "-", why});
+    }
+  }
+  md << (any_stab ? st.markdown() : std::string("No scene asks for the stability check.\n")) << "\n";
+
+  // Per-scene detail.
+  md << "## Scenes\n\n";
+  for (size_t i = 0; i < evs.size(); ++i) {
+    const SceneEvaluation& ev = evs[i];
+    const std::string slug = ev.family + "_" + fs::path(scenes[i].file).stem().string();
+    md << "### " << ev.family << "/" << scenes[i].name << "\n\n";
+    if (!scenes[i].description.empty()) md << scenes[i].description << "\n\n";
+    md << "`" << scenes[i].file << "`\n\n";
+    Table status({"backend", "status", "run time (s)", "message"});
+    for (const auto& [name, bj] : ev.json["backends"].items())
+      status.add({name, bj["status"], fmt_num(bj["runtime_s"].get<double>(), 3), bj["message"]});
+    md << status.markdown() << "\n";
+    if (!ev.metrics.empty()) {
+      Table mt({"check", "pair", "metric", "backend", "value", "against"});
+      for (const Metric& m : ev.metrics)
+        mt.add({m.check, m.pair, m.name, m.backend, fmt_num(m.value, 4), m.against});
+      md << mt.markdown() << "\n";
+    }
+    for (const std::string& d : ev.disagreements) md << "- disagrees: " << d << "\n";
+    for (const std::string& s : ev.skipped) md << "- left out: " << s << "\n";
+    if (scenes[i].expect)
+      md << "- [expect]: " << (ev.expect_failures.empty() ? "passed" : "FAILED") << "\n";
+    for (const std::string& f : ev.expect_failures) md << "  - " << f << "\n";
+    if (figures_ok) {
+      if (scenes[i].has_check("contact") && !ev.json["geometry"].empty())
+        md << "\n![contacts](figures/contact_" << slug << ".png)\n";
+      if (find_metric(ev, "custom", "velocity_err_ke") || ev.json["backends"].contains("bullet"))
+        if (scenes[i].has_check("impulse"))
+          md << "\n![velocities](figures/velocity_" << slug << ".png)\n";
+    }
+    md << "\n";
+  }
+  return md.str();
+}
+
+}  // namespace
+
+int report_command(const ReportOptions& opt) {
+  const std::vector<std::string> files = collect_scene_files(opt.inputs);
+  // Every scene is read and validated before anything runs or is written.
+  std::vector<Scene> scenes;
+  for (const std::string& f : files) scenes.push_back(load_scene(f));
+  const std::string out = opt.out.empty() ? "reports/latest" : opt.out;
+
+  HarnessOptions hopt;
+  hopt.backends = opt.backends;
+  Progress progress(opt.quiet);
+  Stopwatch clock;
+  std::vector<SceneEvaluation> evs;
+  for (size_t i = 0; i < scenes.size(); ++i) {
+    progress.show(i + 1, scenes.size(), scenes[i].file, clock.seconds());
+    evs.push_back(evaluate_scene(scenes[i], hopt));
+    if (scenes[i].has_check("contact")) evs.back().json["geometry"] = geometry_json(scenes[i]);
+  }
+  progress.done();
+
+  // Everything goes into a temporary folder beside the target, renamed into place at the end.
+  const fs::path target(out);
+  if (target.has_parent_path()) fs::create_directories(target.parent_path());
+  const fs::path tmp = target.string() + ".tmp-" + std::to_string(getpid());
+  fs::remove_all(tmp);
+  fs::create_directories(tmp / "figures");
+  try {
+    Json results;
+    results["generated_by"] = "rbx report";
+    results["backends"] = Json::array();
+    for (const Backend& b : backends())
+      results["backends"].push_back({{"name", b.name}, {"description", b.description},
+                                     {"contact", static_cast<bool>(b.contact)},
+                                     {"dynamics", static_cast<bool>(b.dynamics)}});
+    results["scenes"] = Json::array();
+    for (const SceneEvaluation& ev : evs) results["scenes"].push_back(ev.json);
+    write_json((tmp / "results.json").string(), results);
+
+    std::ostringstream metrics, sweep, stab;
+    metrics << "scene,family,check,backend,pair,metric,value,against\n";
+    sweep << "scene,family,backend,kind,dt,runtime_s,error,against\n";
+    stab << "scene,family,backend,verdict,energy_growth_rel,max_penetration_rel,tunnelled_pairs,jitter_rms_mps\n";
+    for (size_t i = 0; i < evs.size(); ++i) {
+      const std::string sc = csv_escape(scenes[i].name), fam = evs[i].family;
+      for (const Metric& m : evs[i].metrics)
+        metrics << sc << "," << fam << "," << m.check << "," << m.backend << "," << m.pair << ","
+                << m.name << "," << fmt_num(m.value, 17) << "," << csv_escape(m.against) << "\n";
+      for (const SweepPoint& p : evs[i].sweep)
+        sweep << sc << "," << fam << "," << p.backend << "," << p.kind << "," << fmt_num(p.dt, 17)
+              << "," << fmt_num(p.runtime_s, 6) << "," << fmt_num(p.error, 17) << ","
+              << csv_escape(p.against) << "\n";
+      for (const auto& [name, s] : evs[i].json["stability"].items())
+        stab << sc << "," << fam << "," << name << "," << s["verdict"].get<std::string>() << ","
+             << fmt_num(s["energy_growth_rel"].get<double>(), 17) << ","
+             << fmt_num(s["max_penetration_rel"].get<double>(), 17) << ","
+             << s["tunnelled_pairs"].get<int>() << ","
+             << (s.contains("jitter_rms_mps") ? fmt_num(s["jitter_rms_mps"].get<double>(), 17) : "")
+             << "\n";
+    }
+    write_text((tmp / "metrics.csv").string(), metrics.str());
+    write_text((tmp / "sweep.csv").string(), sweep.str());
+    write_text((tmp / "stability.csv").string(), stab.str());
+
+    // Figures: matplotlib from Debian, through /usr/bin/python3.
+    const std::string script = std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/plots.py";
+    bool figures_ok = false;
+    std::string figures_msg;
+    if (!fs::exists("/usr/bin/python3")) {
+      figures_msg = "/usr/bin/python3 not found";
+    } else {
+      const std::string cmd = "/usr/bin/python3 '" + script + "' '" + tmp.string() + "' > '" +
+                              (tmp / "figures.log").string() + "' 2>&1";
+      const int rc = std::system(cmd.c_str());
+      figures_ok = rc == 0;
+      if (!figures_ok) figures_msg = "plots.py failed (see figures.log)";
+      else fs::remove(tmp / "figures.log");
+    }
+    write_text((tmp / "report.md").string(),
+               write_markdown(scenes, evs, clock.seconds(), figures_ok, figures_msg));
+    fs::remove_all(target);
+    fs::rename(tmp, target);
+  } catch (...) {
+    fs::remove_all(tmp);
+    throw;
+  }
+  int failed = 0, disagreeing = 0;
+  for (const SceneEvaluation& ev : evs) {
+    failed += ev.expect_failures.empty() ? 0 : 1;
+    disagreeing += ev.disagreements.empty() ? 0 : 1;
+  }
+  std::cout << "report: " << (target / "report.md").string() << " (" << scenes.size() << " scenes, "
+            << fmt_num(clock.seconds(), 3) << " s; " << disagreeing
+            << " scenes with a disagreeing backend; " << failed << " [expect] failures)\n";
+  return 0;
+}
+
+}  // namespace rbx
