@@ -1,7 +1,379 @@
+// Bullet 3.24, double build (BT_USE_DOUBLE_PRECISION from `pkg-config bullet-float64`).
+//
+// Contact queries: two btConvexHullShape built from the engine's body-frame hull vertices with
+// margin 0 (a margin inflates the shape by that much), one btCollisionObject each at the body's
+// pose, and btCollisionWorld::contactPairTest. Without polyhedral features the convex-convex
+// algorithm runs GJK and, on overlap, EPA (`bullet`: one point); with
+// initializePolyhedralFeatures it finds the axis by SAT and clips the hulls against each other
+// (`bullet-sat`: a manifold of several points).
+//
+// Known wrong answer, passed on (pinned in tests/reference/bullet_test.cpp): when the hulls have
+// coplanar side faces (two equal axis-aligned cubes offset along one axis), EPA
+// (btGjkEpaSolver2::Penetration) returns a diagonal normal and depth 0.1/sqrt(3) for a true
+// 0.1 along x. The fair world meets it too, since it solves contacts only after overlap.
+//
+// Dynamics: btDiscreteDynamicsWorld with the settings of REFERENCES.md that turn it into a fair
+// single-impulse reference; each setting carries its reason where it is made.
+//
+// Bullet's convention (btManifoldPoint): m_normalWorldOnB points from the callback's object 1
+// toward object 0, getDistance() < 0 when penetrating, m_positionWorldOnB lies on object 1 and
+// m_positionWorldOnA = m_positionWorldOnB + m_normalWorldOnB * distance on object 0.
 #include "reference/bullet.h"
 
+#include <btBulletCollisionCommon.h>
+#include <btBulletDynamicsCommon.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
 namespace rbx {
-ContactResult bullet_contact(const RigidBody&, const RigidBody&) { return {Status::Unsupported, "not built yet", {}}; }
-ContactResult bullet_sat_contact(const RigidBody&, const RigidBody&) { return {Status::Unsupported, "not built yet", {}}; }
-DynamicsResult bullet_dynamics(const Scene&, const DynamicsOptions&) { DynamicsResult r; r.status = Status::Unsupported; r.message = "not built yet"; return r; }
+
+namespace {
+
+// A reported point counts as a contact while its signed distance is at most this (m). GJK on
+// two exactly touching hulls returns a distance of a few ulps of the coordinates either side
+// of 0; 1e-9 m covers that for scenes of metre scale, while Bullet's breaking threshold
+// (about 0.02 m scaled by the shape) would report clearly separated pairs.
+constexpr double kTouchTolerance = 1e-9;
+
+btVector3 to_bt(const Vec3& v) { return btVector3(v.x(), v.y(), v.z()); }
+Vec3 from_bt(const btVector3& v) { return Vec3(v.x(), v.y(), v.z()); }
+
+btMatrix3x3 to_bt_basis(const Mat3& m) {
+  return btMatrix3x3(m(0, 0), m(0, 1), m(0, 2), m(1, 0), m(1, 1), m(1, 2), m(2, 0), m(2, 1),
+                     m(2, 2));
+}
+Mat3 from_bt_basis(const btMatrix3x3& m) {
+  Mat3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r(i, j) = m[i][j];
+  return r;
+}
+
+/// Zero-margin hull of `vertices` mapped by `frame` (shape frame <- body frame). With
+/// `polyhedral`, Bullet also builds its face/edge structure so the clipping path runs.
+std::unique_ptr<btConvexHullShape> make_hull(const std::vector<Vec3>& vertices, const Mat3& frame,
+                                             bool polyhedral) {
+  auto hull = std::make_unique<btConvexHullShape>();
+  // Margin first: recalcLocalAabb pads the cached box by the current margin.
+  hull->setMargin(0.0);
+  for (const Vec3& v : vertices) hull->addPoint(to_bt(Vec3(frame * v)), false);
+  hull->recalcLocalAabb();
+  if (polyhedral && !hull->initializePolyhedralFeatures())
+    throw std::runtime_error("btConvexHullShape::initializePolyhedralFeatures failed");
+  return hull;
+}
+
+/// Bullet transform of a body whose shape is expressed in `frame` axes: world = R * frame^T.
+btTransform body_transform(const RigidBody& body, const Mat3& frame_to_body) {
+  return btTransform(to_bt_basis(Mat3(body.orientation.toRotationMatrix() * frame_to_body)),
+                     to_bt(body.position));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Contact queries
+
+/// Collects contactPairTest's points, converted to the contract's convention for (A, B).
+class PairCallback : public btCollisionWorld::ContactResultCallback {
+ public:
+  PairCallback(const btCollisionObject* a, const char* feature) : a_(a), feature_(feature) {}
+
+  btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper* obj0, int, int,
+                           const btCollisionObjectWrapper*, int, int) override {
+    // Points within the breaking threshold but separated are not contacts.
+    const double distance = cp.getDistance();
+    if (distance > kTouchTolerance) return 0;
+    // m_normalWorldOnB points from the callback's object 1 toward object 0. If object 0 is our
+    // A, that is our B -> A already; if the callback swapped them, flip it.
+    const bool swapped = obj0->getCollisionObject() != a_;
+    ContactPoint c;
+    c.normal = from_bt(cp.m_normalWorldOnB).normalized();
+    if (swapped) c.normal = -c.normal;
+    c.depth = std::max(0.0, -distance);
+    // Bullet's point lies on object 1's surface; report the midpoint of the two witness points,
+    // the contract's "middle of the penetration" (symmetric in A and B).
+    c.point = 0.5 * (from_bt(cp.getPositionWorldOnA()) + from_bt(cp.getPositionWorldOnB()));
+    c.feature = feature_;
+    contacts.push_back(c);
+    return 0;
+  }
+
+  std::vector<ContactPoint> contacts;
+
+ private:
+  const btCollisionObject* a_;
+  const char* feature_;
+};
+
+/// Collision configuration, dispatcher and world for contact queries. contactPairTest creates
+/// and destroys its algorithm and manifold inside each call, so nothing carries over between
+/// queries; one context per thread only avoids re-allocating the configuration's pools
+/// (several MB) on every query.
+struct QueryContext {
+  btDefaultCollisionConfiguration configuration;
+  btCollisionDispatcher dispatcher{&configuration};
+  btDbvtBroadphase broadphase;
+  btCollisionWorld world{&dispatcher, &broadphase, &configuration};
+};
+
+ContactResult pair_query(const RigidBody& a, const RigidBody& b, bool polyhedral) {
+  try {
+    thread_local QueryContext ctx;
+    const Mat3 identity = Mat3::Identity();
+    auto hull_a = make_hull(a.shape->vertices(), identity, polyhedral);
+    auto hull_b = make_hull(b.shape->vertices(), identity, polyhedral);
+    btCollisionObject obj_a, obj_b;
+    obj_a.setCollisionShape(hull_a.get());
+    obj_b.setCollisionShape(hull_b.get());
+    obj_a.setWorldTransform(body_transform(a, identity));
+    obj_b.setWorldTransform(body_transform(b, identity));
+    // With polyhedral features the algorithm takes its axis from SAT when m_enableSatConvex is
+    // set, otherwise from GJK/EPA before clipping; `bullet-sat` is the SAT variant.
+    ctx.world.getDispatchInfo().m_enableSatConvex = polyhedral;
+    PairCallback callback(&obj_a, polyhedral ? "sat-clip" : "gjk-epa");
+    ctx.world.contactPairTest(&obj_a, &obj_b, callback);
+    return {Status::Ok, "", std::move(callback.contacts)};
+  } catch (const std::exception& e) {
+    return {Status::Error, e.what(), {}};
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Dynamics
+
+/// One scene body in Bullet: the hull in the principal frame of its inertia.
+struct BulletBody {
+  Mat3 principal = Mat3::Identity();  // Q: principal axes (columns) in body axes, det +1
+  std::unique_ptr<btConvexHullShape> shape;
+  std::unique_ptr<btRigidBody> body;
+};
+
+/// Principal axes Q (I_body = Q diag(lambda) Q^T, det Q = +1) and the principal moments.
+void principal_axes(const Mat3& inertia, Mat3* q, Vec3* moments) {
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(inertia);
+  if (eig.info() != Eigen::Success) throw std::runtime_error("inertia eigen-decomposition failed");
+  *q = eig.eigenvectors();
+  *moments = eig.eigenvalues();
+  // A reflection would mirror the hull: make Q a proper rotation.
+  if (q->determinant() < 0) q->col(0) = -q->col(0);
+}
+
+/// The engine's state of one body from Bullet's: undo the principal-frame rotation.
+BodyFinal final_state(const std::string& name, const BulletBody& bb) {
+  BodyFinal f;
+  f.name = name;
+  const btTransform& t = bb.body->getWorldTransform();
+  f.position = from_bt(t.getOrigin());
+  // Bullet's rotation is R_body * Q, so R_body = R_bt * Q^T.
+  Quat q(Mat3(from_bt_basis(t.getBasis()) * bb.principal.transpose()));
+  q.normalize();
+  // One sign of the double cover, for reproducible output.
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  f.orientation = q;
+  f.velocity = from_bt(bb.body->getLinearVelocity());
+  f.angular_velocity = from_bt(bb.body->getAngularVelocity());  // world frame in both
+  return f;
+}
+
+/// Runs the scene in a btDiscreteDynamicsWorld. `fair`: the single-impulse settings of
+/// REFERENCES.md; otherwise Bullet's defaults for the world, solver and bodies (the scene's
+/// hulls, masses, inertia, restitution and gravity are used either way).
+DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt, bool fair) {
+  DynamicsResult result;
+  try {
+    const double dt = opt.dt > 0 ? opt.dt : scene.sim.dt;  // s
+    if (!(dt > 0)) throw std::invalid_argument("time step must be > 0");
+    const long steps = std::llround(scene.sim.duration / dt);
+    const double e = scene.sim.restitution;
+    const double mu = scene.sim.friction;
+
+    btDefaultCollisionConfiguration configuration;
+    btCollisionDispatcher dispatcher(&configuration);
+    btDbvtBroadphase broadphase;
+    btSequentialImpulseConstraintSolver solver;
+    btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration);
+    // Bullet's default gravity is (0, -10, 0); the scene's is the input in both modes.
+    world.setGravity(to_bt(scene.sim.gravity));
+
+    if (fair) {
+      btContactSolverInfo& info = world.getSolverInfo();
+      // Restitution applies at any approach speed (default: none below 0.2 m/s).
+      info.m_restitutionVelocityThreshold = 0;
+      // Split impulse for every penetration depth (default: only below -0.04 m; shallower
+      // penetration is fixed by Baumgarte, m_erp2 * depth / dt added to the velocity target):
+      // position error is then removed by a separate push that adds no velocity.
+      info.m_splitImpulse = 1;
+      info.m_splitImpulsePenetrationThreshold = BT_LARGE_FLOAT;
+      // No warm starting: each step's solve starts from zero impulse, not 0.85 of the last
+      // step's. Done by the factor, not by clearing SOLVER_USE_WARMSTARTING: without that flag
+      // solveGroupCacheFriendlyFinish skips writeBackContacts, so the manifold points would
+      // never carry the applied impulses the events below are read from.
+      info.m_warmstartingFactor = 0;
+      // Enough Gauss-Seidel sweeps for multi-point manifolds to converge (default 10); a
+      // single-point impact is exact after the first.
+      info.m_numIterations = 100;
+    }
+
+    // Bodies: the engine's own (make_body), so hull, mass, centre of mass and inertia are
+    // exactly the custom engine's.
+    std::vector<BulletBody> bodies;
+    bodies.reserve(scene.bodies.size());
+    struct Remover {  // bodies leave the world before they are destroyed
+      btDiscreteDynamicsWorld* world;
+      std::vector<BulletBody>* bodies;
+      ~Remover() {
+        for (BulletBody& bb : *bodies)
+          if (bb.body) world->removeRigidBody(bb.body.get());
+      }
+    } remover{&world, &bodies};
+
+    std::vector<std::string> names;
+    for (size_t i = 0; i < scene.bodies.size(); ++i) {
+      const RigidBody rb = make_body(scene.bodies[i]);
+      names.push_back(rb.name);
+      BulletBody bb;
+      // Bullet stores a diagonal local inertia only, so the hull is placed in the principal
+      // frame of I_body (vertices Q^T v) and the body's rotation becomes R * Q. Bullet's own
+      // calculateLocalInertia is the hull's bounding box's, hence supplied here.
+      Vec3 moments = Vec3::Zero();
+      if (!rb.is_static) principal_axes(rb.inertia_body, &bb.principal, &moments);
+      bb.shape = make_hull(rb.shape->vertices(), bb.principal.transpose(), false);
+      // Static bodies: mass 0 and zero inertia make Bullet's static object.
+      const double mass = rb.is_static ? 0.0 : rb.mass;
+      btRigidBody::btRigidBodyConstructionInfo ci(mass, nullptr, bb.shape.get(), to_bt(moments));
+      ci.m_startWorldTransform = body_transform(rb, bb.principal);
+      // Bullet combines restitution (and friction) as the product of the two bodies' values;
+      // sqrt(e) on every body gives e for every pair (to 1 ulp), where "e on one body, 1 on the
+      // rest" would give 1 between two of the rest.
+      ci.m_restitution = std::sqrt(e);
+      if (fair) {
+        // Coulomb friction from the scene by the same product rule (the fair default is 0;
+        // Bullet's body default is 0.5). Damping 0: Bullet's default, made explicit.
+        ci.m_friction = std::sqrt(mu);
+        ci.m_rollingFriction = 0;
+        ci.m_spinningFriction = 0;
+        ci.m_linearDamping = 0;
+        ci.m_angularDamping = 0;
+        ci.m_additionalDamping = false;
+      }
+      bb.body = std::make_unique<btRigidBody>(ci);
+      bb.body->setUserIndex(static_cast<int>(i));
+      if (!rb.is_static) {
+        bb.body->setLinearVelocity(to_bt(rb.velocity));
+        bb.body->setAngularVelocity(to_bt(rb.angular_velocity));
+      }
+      // Gyroscopic term: Bullet's default flag BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY is
+      // kept. It advances Euler's equations I w' + w x I w = 0 in body axes by one Newton step
+      // of implicit Euler, so a torque-free asymmetric body precesses (without it w stays
+      // fixed in the world and angular momentum is not conserved). It is first order and
+      // slightly dissipative (|L| drifts by ~1.2 dt per second here, see the test). The
+      // explicit variant is explicit Euler clamped by m_maxGyroscopicForce; the implicit
+      // world-frame one linearises about the world inertia. This one uses the diagonal local
+      // inertia, which the principal frame above makes exact.
+      if (fair) {
+        // Never sleep: a slow body must keep integrating.
+        bb.body->setActivationState(DISABLE_DEACTIVATION);
+        // Contacts are solved only once the hulls overlap (default: any point within the
+        // breaking threshold, i.e. before touching), so the impulse acts at contact.
+        bb.body->setContactProcessingThreshold(0);
+      }
+      world.addRigidBody(bb.body.get());
+      bodies.push_back(std::move(bb));
+    }
+
+    // Samples: t = 0 and then every `sample_every` steps.
+    auto sample = [&](double t) {
+      StateSample s;
+      s.time = t;
+      for (size_t i = 0; i < bodies.size(); ++i)
+        s.bodies.push_back(final_state(names[i], bodies[i]));
+      result.samples.push_back(std::move(s));
+    };
+    if (opt.sample_every > 0) sample(0.0);
+
+    for (long k = 0; k < steps; ++k) {
+      // One internal step of exactly dt (maxSubSteps = 0: no fixed 1/60 s sub-stepping and no
+      // interpolated motion states).
+      world.stepSimulation(dt, 0, dt);
+
+      // Events: manifold points the solver used this step with a positive impulse. Points
+      // beyond the processing threshold were not solved and may keep an old impulse.
+      for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+        const btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
+        int i0 = manifold->getBody0()->getUserIndex();
+        int i1 = manifold->getBody1()->getUserIndex();
+        for (int p = 0; p < manifold->getNumContacts(); ++p) {
+          const btManifoldPoint& cp = manifold->getContactPoint(p);
+          if (cp.getAppliedImpulse() <= 0 ||
+              cp.getDistance() > manifold->getContactProcessingThreshold())
+            continue;
+          CollisionEvent ev;
+          ev.time = k * dt;  // detection runs at the start-of-step poses
+          ev.step = k;
+          // Normal from body 1 toward body 0; order the pair by scene index.
+          Vec3 n = from_bt(cp.m_normalWorldOnB).normalized();
+          int ia = i0, ib = i1;
+          if (ia > ib) {
+            std::swap(ia, ib);
+            n = -n;
+          }
+          ev.body_a = names[ia];
+          ev.body_b = names[ib];
+          ev.contact.normal = n;
+          ev.contact.depth = std::max(0.0, -static_cast<double>(cp.getDistance()));
+          ev.contact.point =
+              0.5 * (from_bt(cp.getPositionWorldOnA()) + from_bt(cp.getPositionWorldOnB()));
+          ev.contact.feature = "gjk-epa";
+          ev.impulse = cp.getAppliedImpulse();  // N s, along the normal
+          result.events.push_back(ev);
+        }
+      }
+
+      // A non-finite state is an error, not a result.
+      for (size_t i = 0; i < bodies.size(); ++i) {
+        const btRigidBody& b = *bodies[i].body;
+        if (!std::isfinite(b.getWorldTransform().getOrigin().length2()) ||
+            !std::isfinite(b.getLinearVelocity().length2()) ||
+            !std::isfinite(b.getAngularVelocity().length2()))
+          throw std::runtime_error("non-finite state of body " + names[i] + " at step " +
+                                   std::to_string(k + 1));
+      }
+      if (opt.sample_every > 0 && (k + 1) % opt.sample_every == 0) sample((k + 1) * dt);
+    }
+
+    for (size_t i = 0; i < bodies.size(); ++i)
+      result.finals.push_back(final_state(names[i], bodies[i]));
+    result.status = Status::Ok;
+  } catch (const std::exception& ex) {
+    result = DynamicsResult();
+    result.status = Status::Error;
+    result.message = ex.what();
+  }
+  return result;
+}
+
+}  // namespace
+
+ContactResult bullet_contact(const RigidBody& a, const RigidBody& b) {
+  return pair_query(a, b, false);
+}
+
+ContactResult bullet_sat_contact(const RigidBody& a, const RigidBody& b) {
+  return pair_query(a, b, true);
+}
+
+DynamicsResult bullet_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return run_world(scene, opt, true);
+}
+
+DynamicsResult bullet_dynamics_default_world(const Scene& scene, const DynamicsOptions& opt) {
+  return run_world(scene, opt, false);
+}
+
 }  // namespace rbx

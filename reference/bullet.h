@@ -11,5 +11,7 @@ ContactResult bullet_contact(const RigidBody& a, const RigidBody& b);
 ContactResult bullet_sat_contact(const RigidBody& a, const RigidBody& b);
 /// `bullet` dynamics: btDiscreteDynamicsWorld with the fair settings of REFERENCES.md.
 DynamicsResult bullet_dynamics(const Scene& scene, const DynamicsOptions& opt);
+/// The same world with Bullet's default settings (kept to pin the known defects they cause).
+DynamicsResult bullet_dynamics_default_world(const Scene& scene, const DynamicsOptions& opt);
 
 }  // namespace rbx

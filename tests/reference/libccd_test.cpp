@@ -1,0 +1,250 @@
+// Tests of the libccd adapter: ccdMPRPenetration (contacts[0], "mpr") and ccdGJKPenetration
+// (contacts[1], "gjk-epa") on our own support function.
+//
+// Expected values are derived by hand (comments), plus a fixed-seed cross-check against a
+// separating-axis computation written here (15 axes of two boxes: the exact minimum
+// penetration of two convex polytopes is attained on a face normal or an edge-edge cross
+// product), independent of every rbx backend.
+#include "reference/libccd.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <random>
+#include <string>
+
+namespace rbx {
+namespace {
+
+// Round-off bound for answers libccd computes exactly up to floating point (the portal or the
+// EPA face is an exact hull face): unit-scale coordinates give ~1e-15; 1e-12 leaves margin.
+constexpr double kRoundOff = 1e-12;
+
+/// A box body of full extents `size` centred (centre of mass) at `position`.
+RigidBody box_body(const std::string& name, const Vec3& size, const Vec3& position,
+                   const Quat& orientation = Quat::Identity()) {
+  BodySpec spec;
+  spec.name = name;
+  spec.shape_kind = "box";
+  spec.box_size = size;
+  spec.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
+  spec.position = position;
+  spec.orientation = orientation;
+  return make_body(spec);
+}
+
+RigidBody unit_cube(const std::string& name, const Vec3& position,
+                    const Quat& orientation = Quat::Identity()) {
+  return box_body(name, Vec3::Ones(), position, orientation);
+}
+
+/// A generic rotation (0.7 rad about (1, 2, 3)/|.|).
+Quat generic_rotation() { return Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())); }
+
+/// Extent of a body's world vertices along u: {min, max}.
+std::pair<double, double> extent(const RigidBody& body, const Vec3& u) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int i = 0; i < static_cast<int>(body.shape->vertices().size()); ++i) {
+    const double s = body.world_vertex(i).dot(u);
+    lo = std::min(lo, s);
+    hi = std::max(hi, s);
+  }
+  return {lo, hi};
+}
+
+/// How far A must move along the unit direction n (ours: from B toward A) to separate from B:
+/// until its lowest point along n reaches B's highest, max_B(n) - min_A(n).
+double depth_along(const RigidBody& a, const RigidBody& b, const Vec3& n) {
+  return extent(b, n).second - extent(a, n).first;
+}
+
+/// Exact minimum penetration depth of two box bodies by the separating-axis theorem: the least
+/// of the two-sided overlaps over A's 3 and B's 3 face normals and the 9 edge cross products.
+/// Negative when separated (the largest gap).
+double sat_depth(const RigidBody& a, const RigidBody& b) {
+  const Mat3 ra = a.pose().rotation(), rb = b.pose().rotation();
+  std::vector<Vec3> axes;
+  for (int i = 0; i < 3; ++i) {
+    axes.push_back(ra.col(i));
+    axes.push_back(rb.col(i));
+    for (int j = 0; j < 3; ++j) {
+      const Vec3 c = ra.col(i).cross(rb.col(j));
+      if (c.norm() > 1e-9) axes.push_back(c.normalized());  // parallel edges add no axis
+    }
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (const Vec3& u : axes) best = std::min({best, depth_along(a, b, u), depth_along(a, b, -u)});
+  return best;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Face pair: unit cubes, A at the origin, B at (0.9, 0, 0). Overlap 0.1 along x (1 along y, z),
+// B on A's +x side: ours n = (-1, 0, 0), depth 0.1. Rotated as a whole by R: n = R (-1, 0, 0).
+
+TEST(Libccd, FacePairConventionBothOrdersAndRotated) {
+  for (const Quat& q : {Quat::Identity(), generic_rotation()}) {
+    const RigidBody a = unit_cube("A", Vec3::Zero(), q);
+    const RigidBody b = unit_cube("B", q * Vec3(0.9, 0, 0), q);
+    for (bool swapped : {false, true}) {
+      const ContactResult r = swapped ? libccd_contact(b, a) : libccd_contact(a, b);
+      ASSERT_EQ(r.status, Status::Ok) << r.message;
+      ASSERT_EQ(r.contacts.size(), 2u);
+      EXPECT_EQ(r.contacts[0].feature, "mpr");
+      EXPECT_EQ(r.contacts[1].feature, "gjk-epa");
+      const Vec3 n = (swapped ? -1.0 : 1.0) * (q * Vec3(-1, 0, 0));
+      for (const ContactPoint& c : r.contacts) {
+        EXPECT_NEAR((c.normal - n).norm(), 0.0, kRoundOff) << c.feature;
+        EXPECT_NEAR(c.depth, 0.1, kRoundOff) << c.feature;
+        // MPR's point lies in the overlap slab x in [0.4, 0.5] of A's frame. libccd's EPA point
+        // (penEPAPos) averages the support points of A and B at the nearer half of the final
+        // polytope's vertices: a point of the hull of A and B, x in [-0.5, 1.4], not
+        // necessarily in the overlap (here x = 0.367).
+        const Vec3 local = q.conjugate() * c.point;
+        const bool is_mpr = c.feature == "mpr";
+        EXPECT_GE(local.x(), (is_mpr ? 0.4 : -0.5) - kRoundOff) << c.feature;
+        EXPECT_LE(local.x(), (is_mpr ? 0.5 : 1.4) + kRoundOff) << c.feature;
+      }
+    }
+  }
+}
+
+TEST(Libccd, SeparatedIsNoContact) {
+  // Gap 0.1 along x: both algorithms report no intersection.
+  const ContactResult r =
+      libccd_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(1.1, 0, 0)));
+  EXPECT_EQ(r.status, Status::Ok);
+  EXPECT_TRUE(r.contacts.empty());
+}
+
+TEST(Libccd, TouchingGjkHasNoDirectionPinned) {
+  // Pinned: at gap 0, MPR reports no intersection while ccdGJKPenetration reports one with
+  // depth 0 and a NaN direction; the adapter returns status Error naming it rather than a
+  // contact without a normal.
+  const ContactResult r =
+      libccd_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(1.0, 0, 0)));
+  EXPECT_EQ(r.status, Status::Error);
+  EXPECT_NE(r.message.find("ccdGJKPenetration"), std::string::npos) << r.message;
+  EXPECT_TRUE(r.contacts.empty());
+}
+
+TEST(Libccd, DiagonalCubeMprWrongEpaRight) {
+  // FCL issue 545 geometry: cube of side 0.1 centred at (0.4, 0.4, 0.4), inside unit cube A.
+  // Truth: A leaves B along -x, -y or -z by 0.5 - 0.35 = 0.15 (three-way tie).
+  // MPR follows the ray from c_A - c_B = -(0.4, 0.4, 0.4) through the origin, along
+  // (1, 1, 1)/sqrt(3); A - B is the cube of half-extent 0.55 about -(0.4, 0.4, 0.4), which the
+  // ray leaves at its corner (0.15, 0.15, 0.15): MPR reports ours n = -(1, 1, 1)/sqrt(3), depth
+  // 0.15 sqrt(3) ~ 0.2598 (pinned: a known wrong answer). EPA finds a face: an axis, 0.15.
+  const RigidBody big = unit_cube("A", Vec3::Zero());
+  const RigidBody small = box_body("B", Vec3::Constant(0.1), Vec3::Constant(0.4));
+  const ContactResult r = libccd_contact(big, small);
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.contacts.size(), 2u);
+  const ContactPoint& mpr = r.contacts[0];
+  EXPECT_NEAR((mpr.normal + Vec3::Ones().normalized()).norm(), 0.0, kRoundOff);
+  EXPECT_NEAR(mpr.depth, 0.15 * std::sqrt(3.0), kRoundOff);
+  const ContactPoint& epa = r.contacts[1];
+  EXPECT_NEAR(epa.depth, 0.15, kRoundOff);
+  EXPECT_NEAR(epa.normal.minCoeff(), -1.0, kRoundOff);  // one of -x, -y, -z ...
+  EXPECT_NEAR(epa.normal.norm(), 1.0, kRoundOff);       // ... and nothing else
+}
+
+TEST(Libccd, RandomBoxPairsAgainstSeparatingAxes) {
+  // Fixed seed. Box sizes in [0.3, 1.5] m, B's centre uniform in a cube of half-side 1 m, random
+  // orientations (so most overlaps are deep). For each pair: separated by SAT -> no contact;
+  // overlapping -> two unit normals; GJK + EPA: depth equal to the SAT minimum and to the
+  // overlap measured along its own normal, but for rare known failures (counted); MPR: depth no
+  // less than the SAT minimum (any direction needs at least the minimum translation). Pairs within
+  // 1e-6 m of touching are skipped: there the answer is a boundary convention.
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<double> size(0.3, 1.5), offset(-1.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  auto random_vec = [&](std::uniform_real_distribution<double>& d) {
+    const double x = d(rng), y = d(rng), z = d(rng);  // sequenced: same pairs on every compiler
+    return Vec3(x, y, z);
+  };
+  auto random_quat = [&] {
+    const double w = gauss(rng), x = gauss(rng), y = gauss(rng), z = gauss(rng);
+    return Quat(w, x, y, z).normalized();
+  };
+  // Convergence tolerance of MPR and EPA is 1e-10 m (adapter); 1e-8 m covers it plus the
+  // round-off of projecting unit-scale vertices.
+  constexpr double kDepthTolerance = 1e-8;
+  const int samples = 300;
+  int overlapping = 0, mpr_inconsistent = 0, epa_wrong = 0;
+  for (int k = 0; k < samples; ++k) {
+    const Vec3 size_a = random_vec(size);
+    const Quat q_a = random_quat();
+    const Vec3 size_b = random_vec(size);
+    const Vec3 centre_b = random_vec(offset);
+    const Quat q_b = random_quat();
+    const RigidBody a = box_body("A", size_a, Vec3::Zero(), q_a);
+    const RigidBody b = box_body("B", size_b, centre_b, q_b);
+    const double truth = sat_depth(a, b);
+    if (std::abs(truth) < 1e-6) continue;
+    const ContactResult r = libccd_contact(a, b);
+    ASSERT_EQ(r.status, Status::Ok) << "sample " << k << ": " << r.message;
+    if (truth < 0) {
+      EXPECT_TRUE(r.contacts.empty()) << "sample " << k;
+      continue;
+    }
+    ++overlapping;
+    ASSERT_EQ(r.contacts.size(), 2u) << "sample " << k << ": " << r.message;
+    const ContactPoint& mpr = r.contacts[0];
+    const ContactPoint& epa = r.contacts[1];
+    EXPECT_NEAR(mpr.normal.norm(), 1.0, kRoundOff);
+    EXPECT_NEAR(epa.normal.norm(), 1.0, kRoundOff);
+    if (std::abs(epa.depth - truth) > kDepthTolerance) {
+      ++epa_wrong;  // libccd 2.1 EPA defect, one case pinned in EpaUnderestimatesPinned
+    } else {
+      EXPECT_NEAR(epa.depth, depth_along(a, b, epa.normal), kDepthTolerance) << "sample " << k;
+    }
+    EXPECT_GE(mpr.depth, truth - kDepthTolerance) << "sample " << k;
+    if (std::abs(mpr.depth - depth_along(a, b, mpr.normal)) > kDepthTolerance) ++mpr_inconsistent;
+  }
+  // Keep the sample representative: with these ranges well over half the pairs overlap.
+  EXPECT_GT(overlapping, samples / 2);
+  EXPECT_LT(overlapping, samples * 9 / 10);
+  // Known defect, pinned (libccd issue 71): MPR's (normal, depth) is often not a supporting
+  // plane: moving B by depth along the normal does not separate the pair, because libccd 2.1
+  // takes the direction to the nearest point of the final portal triangle, not the face normal.
+  // Seen in about a quarter of these deep overlaps; the band keeps the pin independent of the
+  // standard library's sampling, and its lower bound is the point: the defect is present.
+  EXPECT_GT(mpr_inconsistent, overlapping / 20);
+  EXPECT_LT(mpr_inconsistent, overlapping / 2);
+  // libccd 2.1's EPA is right on all but a rare few of these pairs (1 of ~200 seen).
+  EXPECT_LE(epa_wrong, overlapping / 50);
+}
+
+TEST(Libccd, EpaUnderestimatesPinned) {
+  // A pair from the random sweep above on which libccd 2.1's ccdGJKPenetration returns a depth
+  // below the true minimum: translating B by it along its normal leaves the boxes overlapping.
+  // The same result for every epa_tolerance from 1e-4 to 1e-12 and without an iteration cap,
+  // so it is the library's, not the adapter's settings. FCL's own patched EPA (fcl-epa) gets
+  // this pair right (tests/reference/fcl_test.cpp).
+  const RigidBody a = box_body(
+      "A", Vec3(1.1619617394816926, 1.1743795334951157, 1.1237059231902502), Vec3::Zero(),
+      Quat(0.057171239174407154, 0.85098897643779126, -0.51827575490333189, 0.062765064104200047)
+          .normalized());
+  const RigidBody b = box_body(
+      "B", Vec3(1.2277854676293352, 0.73704683757464129, 0.88691392538948266),
+      Vec3(0.55841869342978101, 0.040565343341065541, -0.45090973054194416),
+      Quat(0.31812010099052296, -0.8985848754636705, 0.28341090204507841, 0.10499087358296565)
+          .normalized());
+  const double truth = sat_depth(a, b);  // ~0.8124 m, exact by the separating-axis theorem
+  const ContactResult r = libccd_contact(a, b);
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.contacts.size(), 2u);
+  const ContactPoint& epa = r.contacts[1];
+  // Pinned wrong answer: 0.72789060 m (10% short); 1e-8 m is the adapter's convergence
+  // tolerance plus round-off, so any change in libccd's EPA path shows.
+  EXPECT_NEAR(epa.depth, 0.72789060112160253, 1e-8);
+  EXPECT_LT(epa.depth, truth - 0.05);
+  // Not a supporting plane: the overlap along its own normal is deeper still.
+  EXPECT_GT(depth_along(a, b, epa.normal), truth);
+}
+
+}  // namespace
+}  // namespace rbx
