@@ -174,10 +174,15 @@ std::string num(double v) {
   if (std::isnan(v)) return "nan";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
   char buffer[40];
-  for (int precision = 1; precision <= 17; ++precision) {
+  int precision = 1;
+  for (; precision < 17; ++precision) {
     std::snprintf(buffer, sizeof buffer, "%.*g", precision, v);
     if (std::strtod(buffer, nullptr) == v) break;
   }
+  // Below a million, write all integer digits ("604800", not "6.048e+05").
+  const double a = std::abs(v);
+  if (a >= 1 && a < 1e6) precision = std::max(precision, 1 + static_cast<int>(std::log10(a)));
+  std::snprintf(buffer, sizeof buffer, "%.*g", precision, v);
   return buffer;
 }
 
@@ -241,7 +246,16 @@ int key_line(const toml::table& t, const std::string& key) {
   return 0;
 }
 
-int line_of(const toml::node* n) { return n ? static_cast<int>(n->source().begin.line) : 0; }
+// Source name of values parsed from --set: they have no line in the scene file.
+constexpr std::string_view kOverrideSource = "--set";
+
+// Line of a value in the scene file (0 if none, as for values from --set).
+int line_of(const toml::node* n) {
+  if (!n) return 0;
+  const toml::source_region& src = n->source();
+  if (src.path && *src.path == kOverrideSource) return 0;
+  return static_cast<int>(src.begin.line);
+}
 
 // Where messages point: the file as given, and which keys came from --set (no file line).
 class Reader {
@@ -437,7 +451,7 @@ void apply_override(Reader& r, toml::table& root, const std::string& item, bool&
   // VALUE is TOML: parse "v = VALUE" so that numbers, strings, arrays keep their types.
   toml::table parsed;
   try {
-    parsed = toml::parse(std::string_view("v = " + text), std::string_view("--set"));
+    parsed = toml::parse(std::string_view("v = " + text), kOverrideSource);
   } catch (const toml::parse_error& e) {
     r.fail(0, "--set " + key,
            "cannot read \"" + text + "\" as a TOML value (" + std::string(e.description()) + ")",
@@ -667,7 +681,7 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
         sides = r.integer(*n, p + "sides", "body.sides");
         if (sides < 3 || sides > 100000)
           r.fail(line_of(n), p + "sides", "must be in 3..100000, got " + std::to_string(sides),
-                 "a prism needs at least 3 sides (3 is a triangular prism)");
+                 "use 3 (a triangular prism) or more, up to 100000");
       }
       b.shape = std::make_shared<const ConvexPolyhedron>(
           make_prism(radius, height, static_cast<int>(sides)));
@@ -827,7 +841,7 @@ Expect read_expect(const Reader& r, const toml::table& t, const std::vector<Body
       if (*ec.depth < 0)
         r.fail(line_of(v), "expect.contact.depth", "penetration depth must be >= 0 m, got " +
                                                        num(*ec.depth),
-               "depth is measured along the normal; use touching = false for separated bodies");
+               "depth is the overlap along the normal (use touching = false for separated bodies)");
     }
     if (const toml::node* v = c.get("point"))
       ec.point = r.vec3(*v, "expect.contact.point", "expect.contact.point");
@@ -921,8 +935,8 @@ Scene parse_scene(const std::string& text, const std::string& path,
     for (size_t k = 0; k < scene.bodies.size(); ++k)
       if (scene.bodies[k].name == b.name)
         r.fail(line_of(n.as_table()->get("name")), "body." + b.name + ".name",
-               "duplicate body name \"" + b.name + "\" (also on line " +
-                   std::to_string(line_of((*body_array)[k].as_table()->get("name"))) + ")",
+               "duplicate body name \"" + b.name + "\" (the [[body]] on line " +
+                   std::to_string(line_of((*body_array)[k].as_table())) + " has it too)",
                "give each body a unique name");
     scene.bodies.push_back(std::move(b));
   }
