@@ -107,25 +107,43 @@ std::optional<ContactPoint> face_one(const WorldShape& a, const WorldShape& b, d
 }
 
 // Vertex test, one order (see vertex_test in the header).
-std::optional<ContactPoint> vertex_one(const WorldShape& a, const WorldShape& b, double tol) {
+// B's face closest to a point inside B: for a point inside a convex body the nearest boundary
+// point lies on the nearest face plane, so plane distance suffices (ties: lowest index).
+int closest_face(const WorldShape& b, const Vec3& v) {
   const auto& tris = b.shape->triangles();
-  for (const Vec3& v : a.vertices) {
-    if (!inside(b, v, tol)) continue;
-    // B's face closest to the point: for a point inside a convex body the nearest boundary
-    // point lies on the nearest face plane, so plane distance suffices (ties: lowest index).
-    int closest = 0;
-    double best = std::numeric_limits<double>::infinity();
-    for (size_t f = 0; f < tris.size(); ++f) {
-      const double d = std::abs((v - b.vertices[tris[f][0]]).dot(b.normals[f]));
-      if (d < best) {
-        best = d;
-        closest = static_cast<int>(f);
-      }
+  int closest = 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t f = 0; f < tris.size(); ++f) {
+    const double d = std::abs((v - b.vertices[tris[f][0]]).dot(b.normals[f]));
+    if (d < best) {
+      best = d;
+      closest = static_cast<int>(f);
     }
+  }
+  return closest;
+}
+
+std::optional<ContactPoint> vertex_one(const WorldShape& a, const WorldShape& b, double tol) {
+  for (size_t i = 0; i < a.vertices.size(); ++i) {
+    if (!inside(b, a.vertices[i], tol)) continue;
     ContactPoint cp;
-    cp.point = v;
     // B's outward normal already points from B toward A: no sign change.
-    cp.normal = b.normals[closest];
+    cp.normal = b.normals[closest_face(b, a.vertices[i])];
+    // Departure from the seed, which returns the first vertex found: every vertex of A inside B
+    // whose closest face of B shares that normal is averaged, as the seed's face test averages
+    // its hits. With only the first vertex, an edge or face landing flat on a face (both ends
+    // touch in the same step) gets its impulse at one end and a spurious spin: the "cubes
+    // rotate due to collision vectors being slightly offset" that the seed reports fixing. A
+    // single penetrating corner is unchanged.
+    Vec3 sum = a.vertices[i];
+    int hits = 1;
+    for (size_t k = i + 1; k < a.vertices.size(); ++k) {
+      if (!inside(b, a.vertices[k], tol)) continue;
+      if (b.normals[closest_face(b, a.vertices[k])].dot(cp.normal) < 1.0 - 1e-9) continue;
+      sum += a.vertices[k];
+      ++hits;
+    }
+    cp.point = sum / hits;
     cp.depth = overlap(a, b, cp.normal);  // the seed defines no depth
     cp.feature = "vertex";
     return cp;

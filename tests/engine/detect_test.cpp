@@ -147,6 +147,23 @@ TEST(Detect, CubeCornerIntoFaceIsAVertexHit) {
   }
 }
 
+TEST(Detect, EdgeLandingFlatAveragesItsVerticesOnTheSameFace) {
+  // Departure from the seed's "first vertex": a unit cube turned 45 deg about x has a bottom
+  // edge along x at depth 0.02 in a wide slab's top face. Both ends, (+-1/2, 0, -0.02) relative
+  // to the slab top, are inside B with the same closest face (the top): the point is their
+  // midpoint (0, 0, top - 0.02), so the impulse acts on the symmetry plane (no spurious spin).
+  const ConvexPolyhedron a = make_box(Vec3::Ones()), b = make_box(Vec3(4, 4, 1));
+  const double h = std::sqrt(2.0) / 2;
+  const Pose pa = pose_at(Vec3(0, 0, 0.5 + h - 0.02),
+                          Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX())));
+  const Pose pb = pose_at(Vec3::Zero());
+  const auto hit = vertex_test(a, pa, b, pb);
+  ASSERT_TRUE(hit.has_value());
+  expect_vec_near(hit->point, Vec3(0, 0, 0.48), kRoundOff);
+  expect_vec_near(hit->normal, Vec3(0, 0, 1), kRoundOff);
+  EXPECT_NEAR(hit->depth, 0.02, kRoundOff);
+}
+
 TEST(Detect, CrossedBarsAreAnEdgeHit) {
   const CrossedBars s;
   EXPECT_FALSE(detect_feature("face", s.a, s.pa, s.b, s.pb).has_value());

@@ -1,0 +1,150 @@
+// The rbx command end to end: exit codes, one-line errors, no partial output, determinism,
+// compare failing on a wrong [expect], check failing on a baseline that claims smaller errors.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CmdResult {
+  int code = -1;
+  std::string out, err;
+};
+
+// Runs the built rbx binary from the source folder with stdout and stderr captured.
+CmdResult rbx(const std::string& args) {
+  const fs::path tmp = fs::temp_directory_path() / ("rbx_cli_" + std::to_string(getpid()));
+  fs::create_directories(tmp);
+  const std::string cmd = "cd '" RBX_SOURCE_DIR "' && '" RBX_BINARY_DIR "/comparisons/rbx' " + args +
+                          " > '" + (tmp / "out").string() + "' 2> '" + (tmp / "err").string() + "'";
+  CmdResult r;
+  const int status = std::system(cmd.c_str());
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream o(tmp / "out"), e(tmp / "err");
+  std::stringstream so, se;
+  so << o.rdbuf();
+  se << e.rdbuf();
+  r.out = so.str();
+  r.err = se.str();
+  fs::remove_all(tmp);
+  return r;
+}
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("rbx_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+TEST(Cli, BadSceneExitsTwoWithOneLineAndNoOutputFile) {
+  const fs::path dir = temp_dir("bad");
+  std::ofstream(dir / "bad.toml") << "[[body]]\nname = \"A\"\nmass = -1\n";
+  const fs::path json = dir / "out.json";
+  const CmdResult r = rbx("run '" + (dir / "bad.toml").string() + "' --json '" + json.string() + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("bad.toml:3"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mass"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(json));
+  fs::remove_all(dir);
+}
+
+TEST(Cli, UsageErrorsExitTwo) {
+  EXPECT_EQ(rbx("").code, 2);
+  EXPECT_EQ(rbx("frobnicate").code, 2);
+  EXPECT_EQ(rbx("run").code, 2);
+  EXPECT_EQ(rbx("run scenes/seed/face_face.toml --backends nosuch").code, 2);
+  EXPECT_EQ(rbx("run no/such/file.toml").code, 2);
+}
+
+// Removes every "runtime_s" value, the only non-deterministic numbers.
+std::string without_timings(const std::string& json) {
+  return std::regex_replace(json, std::regex("\"runtime_s\": [-+0-9.eE]+"), "\"runtime_s\": 0");
+}
+
+TEST(Cli, RunJsonIsByteIdenticalApartFromTimings) {
+  const CmdResult a = rbx("run scenes/seed/face_face.toml --json -");
+  const CmdResult b = rbx("run scenes/seed/face_face.toml --json -");
+  ASSERT_EQ(a.code, 0) << a.err;
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_EQ(without_timings(a.out), without_timings(b.out));
+  const auto j = nlohmann::json::parse(a.out);
+  EXPECT_EQ(j["backends"]["custom"]["status"], "ok");
+  EXPECT_TRUE(j["backends"]["custom"]["bodies"].contains("A"));
+  EXPECT_GE(j["backends"]["custom"]["contacts"].size(), 1u);
+}
+
+TEST(Cli, SetOverridesAKey) {
+  const CmdResult r = rbx("run scenes/seed/face_face.toml --set sim.duration=0 --json -");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["settings"]["duration"], 0.0);
+  EXPECT_EQ(j["backends"]["custom"]["contacts"].size(), 0u);  // no time, no collision
+}
+
+TEST(Cli, CompareExitsOneOnAWrongExpectation) {
+  // Two unit cubes overlapping by 0.1 along x; the exact depth is 0.1, the scene claims 0.2.
+  const fs::path dir = temp_dir("expect");
+  const std::string body =
+      "checks = [\"contact\"]\n[sim]\nduration = 0\n"
+      "[[body]]\nname = \"A\"\n[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n"
+      "[expect]\ntolerance = 1e-9\n[expect.contact]\nnormal = [-1, 0, 0]\n";
+  std::ofstream(dir / "right.toml") << body << "depth = 0.1\n";
+  std::ofstream(dir / "wrong.toml") << body << "depth = 0.2\n";
+  EXPECT_EQ(rbx("compare '" + (dir / "right.toml").string() + "' --backends exact,custom").code, 0);
+  const CmdResult wrong = rbx("compare '" + (dir / "wrong.toml").string() + "' --backends exact,custom");
+  EXPECT_EQ(wrong.code, 1);
+  EXPECT_NE(wrong.out.find("[expect] FAILED"), std::string::npos) << wrong.out;
+  fs::remove_all(dir);
+}
+
+TEST(Cli, CheckPassesOnItsOwnBaselineAndFailsOnOneClaimingSmallerErrors) {
+  const fs::path dir = temp_dir("check");
+  const std::string base = (dir / "baseline.json").string();
+  const std::string scenes = "scenes/seed";
+  ASSERT_EQ(rbx("check " + scenes + " --baseline '" + base + "' --update").code, 0);
+  const CmdResult same = rbx("check " + scenes + " --baseline '" + base + "'");
+  EXPECT_EQ(same.code, 0) << same.out << same.err;
+  // Halve every non-zero error in the baseline: the rerun must now be reported worse.
+  nlohmann::json b;
+  std::ifstream(base) >> b;
+  int halved = 0;
+  for (auto& [k, v] : b["metrics"].items())
+    if (v.is_number() && v.get<double>() > 1e-9) {
+      v = v.get<double>() * 0.5;
+      ++halved;
+    }
+  ASSERT_GT(halved, 0);
+  std::ofstream(base) << b.dump(2);
+  const CmdResult worse = rbx("check " + scenes + " --baseline '" + base + "'");
+  EXPECT_EQ(worse.code, 1);
+  EXPECT_NE(worse.out.find("worse: "), std::string::npos) << worse.out;
+  fs::remove_all(dir);
+}
+
+TEST(Cli, ReportWritesEverythingIntoItsFolder) {
+  const fs::path dir = temp_dir("report");
+  const CmdResult r = rbx("report scenes/seed/face_face.toml --out '" + (dir / "out").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* f : {"report.md", "results.json", "metrics.csv", "sweep.csv", "stability.csv"})
+    EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
+  // Nothing temporary is left beside it.
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir)) (void)e, ++entries;
+  EXPECT_EQ(entries, 1);
+  fs::remove_all(dir);
+}
+
+}  // namespace
