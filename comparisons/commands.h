@@ -57,6 +57,11 @@ int report_command(const ReportOptions& opt);
 /// `rbx check`: regression check of every accuracy metric against the baseline.
 int check_command(const ReportOptions& opt);
 
+/// The scene library as a markdown table (family, scene, description, checks, backends).
+std::string scene_table_markdown(const std::vector<std::string>& inputs);
+/// `rbx scenes`: prints scene_table_markdown.
+int scenes_command(const std::vector<std::string>& inputs);
+
 /// Scene files under the inputs (folders searched recursively for *.toml, sorted).
 std::vector<std::string> collect_scene_files(const std::vector<std::string>& inputs);
 

@@ -40,6 +40,9 @@ int main(int argc, char** argv) {
   report->add_option("inputs", report_opt.inputs, "scene files or folders");
   report->add_option("--out", report_opt.out, "output folder");
   report->add_option("--backends", report_opt.backends, "comma-separated backend names");
+  std::vector<std::string> scenes_inputs;
+  app.add_subcommand("scenes", "the scene library as a markdown table (scenes/README.md)")
+      ->add_option("inputs", scenes_inputs, "scene files or folders (default: scenes/)");
   CLI::App* check = app.add_subcommand("check", "regression check against reports/baseline.json");
   check->add_option("inputs", check_opt.inputs, "scene files or folders (default: scenes/)");
   check->add_option("--baseline", check_opt.baseline, "baseline file");
@@ -62,6 +65,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("compare")) return rbx::compare_command(compare_opt);
     if (app.got_subcommand("report")) return rbx::report_command(report_opt);
     if (app.got_subcommand("check")) return rbx::check_command(check_opt);
+    if (app.got_subcommand("scenes")) return rbx::scenes_command(scenes_inputs);
   } catch (const rbx::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;

@@ -1,6 +1,476 @@
+// ODE 0.16.2 adapter: every body becomes a dCreateConvex geom built from its body-frame hull
+// (coplanar triangles merged into polygons), attached to a dBody with our mass and inertia;
+// static bodies are geoms without a body.
+//
+// Errors: ODE's dError and dDebug print and then exit()/abort() unless a handler is installed,
+// and a handler that returns gets the same fate. Ours copy the message and longjmp back to
+// guarded(), which the caller turns into Status::Error. ODE is C++ inside, so the jump may skip
+// its internal clean-up: after an error the world is only destroyed, never stepped again.
+// dMessage (non-fatal: ODE carries on, e.g. "LCP internal error, s <= 0" when the Dantzig
+// solver meets a degenerate pivot) is counted and the first one quoted in the result's
+// message; the status stays Ok, as ODE's own result does.
 #include "reference/ode.h"
 
+#include <ode/ode.h>
+
+#include <algorithm>
+#include <cmath>
+#include <csetjmp>
+#include <cstdarg>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <utility>
+
+namespace {
+
+// Error state of the calling thread (plain char arrays: the handlers run inside ODE).
+thread_local std::jmp_buf* t_jump = nullptr;
+thread_local char t_error[512];
+thread_local char t_warning[512];
+thread_local long t_message_count = 0;
+
+}  // namespace
+
+extern "C" {
+
+// dError / dDebug: format, then jump back to guarded(); outside it, terminate as ODE would.
+static void rbx_ode_on_error(int errnum, const char* msg, va_list ap) {
+  char text[400];
+  std::vsnprintf(text, sizeof(text), msg ? msg : "", ap);
+  std::snprintf(t_error, sizeof(t_error), "ODE error %d: %s", errnum, text);
+  if (t_jump) std::longjmp(*t_jump, 1);
+  std::fprintf(stderr, "%s (outside a guarded call)\n", t_error);
+  std::abort();
+}
+
+// dMessage: count, and keep the first message; the caller reports it.
+static void rbx_ode_on_message(int errnum, const char* msg, va_list ap) {
+  ++t_message_count;
+  if (t_warning[0] != '\0') return;
+  char text[400];
+  std::vsnprintf(text, sizeof(text), msg ? msg : "", ap);
+  std::snprintf(t_warning, sizeof(t_warning), "ODE message %d: %s", errnum, text);
+}
+
+}  // extern "C"
+
 namespace rbx {
-ContactResult ode_contact(const RigidBody&, const RigidBody&) { return {Status::Unsupported, "not built yet", {}}; }
-DynamicsResult ode_dynamics(const Scene&, const DynamicsOptions&) { DynamicsResult r; r.status = Status::Unsupported; r.message = "not built yet"; return r; }
+namespace {
+
+// At most this many contact points per geom pair (dCollide's flags).
+constexpr int kMaxContacts = 32;
+// A contact point closing slower than this (m/s) is not an impact. After a perfectly inelastic
+// impact or at rest the normal velocity should be zero, but CFM (1e-10) leaves the contact
+// closing at ~1e-7 of the impact speed (1.5e-7 m/s after a 2 m/s impact): not a new collision.
+constexpr double kClosingSpeed = 1e-6;
+
+// Initialises ODE once per process and its per-thread data once per thread, and installs the
+// handlers.
+void init_ode() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    dInitODE2(0);
+    dSetErrorHandler(rbx_ode_on_error);
+    dSetDebugHandler(rbx_ode_on_error);
+    dSetMessageHandler(rbx_ode_on_message);
+  });
+  thread_local bool thread_ready = false;
+  if (!thread_ready) {
+    dAllocateODEDataForThread(dAllocateMaskAll);
+    thread_ready = true;
+  }
+}
+
+// Runs f() so that an ODE error returns false (message in t_error) instead of exiting.
+// f must own no object with a non-trivial destructor (the longjmp skips its frame).
+template <class F>
+bool guarded(F&& f) {
+  std::jmp_buf env;
+  std::jmp_buf* const outer = t_jump;
+  t_jump = &env;
+  if (setjmp(env) != 0) {
+    t_jump = outer;
+    return false;
+  }
+  f();
+  t_jump = outer;
+  return true;
+}
+
+// The arrays dCreateConvex reads. ODE keeps pointers to them, so they must outlive the geom.
+struct ConvexData {
+  std::vector<dReal> planes;       // a, b, c, d per face: outward unit n, n . x = d
+  std::vector<dReal> points;       // x, y, z per vertex
+  std::vector<unsigned> polygons;  // per face: vertex count, then indices counter-clockwise
+  unsigned face_count = 0;
+};
+
+// Builds ODE's convex description of a hull, in the hull's own frame. Coplanar triangles are
+// merged into one polygon (its boundary walked from the triangles' directed edges), so ODE
+// sees the true faces and edges, not the triangulation's diagonals.
+ConvexData make_convex_data(const ConvexPolyhedron& hull) {
+  ConvexData c;
+  const auto& v = hull.vertices();
+  for (const Vec3& p : v) c.points.insert(c.points.end(), {p.x(), p.y(), p.z()});
+  double size = 0.0;
+  for (const Vec3& p : v) size = std::max(size, p.norm());
+  const double tol = 1e-9 * std::max(size, 1.0);
+
+  // Group triangles by plane.
+  const auto& tris = hull.triangles();
+  const auto& planes = hull.planes();
+  std::vector<int> group(tris.size(), -1);
+  std::vector<int> group_plane;
+  for (size_t t = 0; t < tris.size(); ++t) {
+    for (size_t g = 0; g < group_plane.size() && group[t] < 0; ++g) {
+      const Plane& p = planes[group_plane[g]];
+      if (planes[t].normal.dot(p.normal) > 1.0 - 1e-9 &&
+          std::abs(planes[t].offset - p.offset) < tol)
+        group[t] = static_cast<int>(g);
+    }
+    if (group[t] < 0) {
+      group[t] = static_cast<int>(group_plane.size());
+      group_plane.push_back(static_cast<int>(t));
+    }
+  }
+
+  // Each group's boundary: directed edges whose reverse is not in the same group, chained.
+  for (size_t g = 0; g < group_plane.size(); ++g) {
+    std::map<std::pair<int, int>, bool> edges;
+    for (size_t t = 0; t < tris.size(); ++t)
+      if (group[t] == static_cast<int>(g))
+        for (int k = 0; k < 3; ++k) edges[{tris[t][k], tris[t][(k + 1) % 3]}] = true;
+    std::map<int, int> next;
+    for (const auto& [e, unused] : edges)
+      if (!edges.count({e.second, e.first})) next[e.first] = e.second;
+    std::vector<unsigned> loop;
+    const int start = next.begin()->first;
+    int at = start;
+    do {
+      loop.push_back(static_cast<unsigned>(at));
+      at = next.at(at);
+    } while (at != start && loop.size() <= next.size());
+    const Plane& p = planes[group_plane[g]];
+    c.planes.insert(c.planes.end(), {p.normal.x(), p.normal.y(), p.normal.z(), p.offset});
+    c.polygons.push_back(static_cast<unsigned>(loop.size()));
+    c.polygons.insert(c.polygons.end(), loop.begin(), loop.end());
+  }
+  c.face_count = static_cast<unsigned>(group_plane.size());
+  return c;
+}
+
+// A convex geom and the data it points to.
+struct ConvexGeom {
+  std::unique_ptr<ConvexData> data;
+  dGeomID geom = nullptr;
+};
+
+// Creates the convex geom of a body in `space` (may be 0).
+ConvexGeom make_geom(dSpaceID space, const RigidBody& b) {
+  ConvexGeom g;
+  g.data = std::make_unique<ConvexData>(make_convex_data(*b.shape));
+  const ConvexData& d = *g.data;
+  g.geom = dCreateConvex(space, d.planes.data(), d.face_count, d.points.data(),
+                         static_cast<unsigned>(b.shape->vertices().size()), d.polygons.data());
+  return g;
+}
+
+// Places a geom (without a body) at a body's pose.
+void place_geom(dGeomID g, const RigidBody& b) {
+  const Quat o = b.orientation.normalized();
+  dGeomSetPosition(g, b.position.x(), b.position.y(), b.position.z());
+  const dQuaternion q = {o.w(), o.x(), o.y(), o.z()};
+  dGeomSetQuaternion(g, q);
+}
+
+// Our contact from ODE's: the normal points into g1 (from g2 toward g1), depth positive. With
+// g1 = A that is already ours.
+ContactPoint convert_contact(const dContactGeom& c) {
+  ContactPoint p;
+  p.point = Vec3(c.pos[0], c.pos[1], c.pos[2]);
+  p.normal = Vec3(c.normal[0], c.normal[1], c.normal[2]);
+  p.depth = c.depth;
+  p.feature = "convex";
+  return p;
+}
+
+// Owners of ODE objects.
+struct WorldOwner {
+  dWorldID world = nullptr;
+  dSpaceID space = nullptr;
+  dJointGroupID contacts = nullptr;
+  std::vector<ConvexGeom> geoms;
+  ~WorldOwner() {
+    for (ConvexGeom& g : geoms)
+      if (g.geom) dGeomDestroy(g.geom);
+    if (contacts) dJointGroupDestroy(contacts);
+    if (space) dSpaceDestroy(space);
+    if (world) dWorldDestroy(world);
+  }
+};
+
+// One contact joint created in a step, with what we need to report it.
+struct StepContact {
+  int a = 0, b = 0;       // scene indices, a < b
+  dContactGeom geom{};    // g1 belongs to a
+  double approach = 0.0;  // m/s, relative normal velocity before the step (< 0: closing)
+  dJointFeedback* feedback = nullptr;
+};
+
+// State passed through dSpaceCollide to the near callback.
+struct CollideContext {
+  dWorldID world = nullptr;
+  dJointGroupID group = nullptr;
+  double restitution = 1.0;
+  double friction = 0.0;
+  std::vector<StepContact> contacts;
+  std::deque<dJointFeedback> feedback;  // deque: stable addresses while growing
+};
+
+// Scene index stored in a geom's user data.
+int scene_index(dGeomID g) {
+  return static_cast<int>(reinterpret_cast<std::intptr_t>(dGeomGetData(g)));
+}
+
+// Velocity of a body's material point at world position p (zero for no body).
+Vec3 point_velocity(dBodyID body, const dReal* p) {
+  if (!body) return Vec3::Zero();
+  dVector3 v;
+  dBodyGetPointVel(body, p[0], p[1], p[2], v);
+  return Vec3(v[0], v[1], v[2]);
+}
+
+// Near callback: contact joints with dContactBounce for every contact point of a pair. Only
+// trivially destructible locals (an error inside dCollide longjmps over this frame).
+void near_callback(void* data, dGeomID o1, dGeomID o2) {
+  auto* ctx = static_cast<CollideContext*>(data);
+  dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
+  if (!b1 && !b2) return;  // two static geoms
+  if (scene_index(o1) > scene_index(o2)) {
+    std::swap(o1, o2);
+    std::swap(b1, b2);
+  }
+  dContact contact[kMaxContacts] = {};
+  const int n = dCollide(o1, o2, kMaxContacts, &contact[0].geom, sizeof(dContact));
+  for (int i = 0; i < n; ++i) {
+    dContact& c = contact[i];
+    c.surface.mode = dContactBounce;
+    c.surface.mu = ctx->friction;  // 0: frictionless
+    c.surface.bounce = ctx->restitution;
+    c.surface.bounce_vel = 0.0;
+    dJointID j = dJointCreateContact(ctx->world, ctx->group, &c);
+    dJointAttach(j, b1, b2);
+    ctx->feedback.emplace_back();
+    dJointSetFeedback(j, &ctx->feedback.back());
+    StepContact sc;
+    sc.a = scene_index(o1);
+    sc.b = scene_index(o2);
+    sc.geom = c.geom;
+    const Vec3 n_ours(c.geom.normal[0], c.geom.normal[1], c.geom.normal[2]);
+    sc.approach = (point_velocity(b1, c.geom.pos) - point_velocity(b2, c.geom.pos)).dot(n_ours);
+    sc.feedback = &ctx->feedback.back();
+    ctx->contacts.push_back(sc);
+  }
+}
+
+// State of scene body i after the run.
+BodyFinal read_state(const RigidBody& b, dBodyID body) {
+  BodyFinal f;
+  f.name = b.name;
+  if (!body) {
+    f.position = b.position;
+    f.orientation = b.orientation;
+    return f;
+  }
+  const dReal* p = dBodyGetPosition(body);
+  const dReal* q = dBodyGetQuaternion(body);
+  const dReal* v = dBodyGetLinearVel(body);
+  const dReal* w = dBodyGetAngularVel(body);  // world frame
+  f.position = Vec3(p[0], p[1], p[2]);
+  f.orientation = Quat(q[0], q[1], q[2], q[3]).normalized();
+  f.velocity = Vec3(v[0], v[1], v[2]);
+  f.angular_velocity = Vec3(w[0], w[1], w[2]);
+  return f;
+}
+
+}  // namespace
+
+ContactResult ode_contact(const RigidBody& a, const RigidBody& b) {
+  init_ode();
+  ContactResult r;
+  ConvexGeom ga = make_geom(nullptr, a);
+  ConvexGeom gb = make_geom(nullptr, b);
+  place_geom(ga.geom, a);
+  place_geom(gb.geom, b);
+  dContactGeom contacts[kMaxContacts];
+  int n = 0;
+  t_warning[0] = '\0';
+  const dGeomID g1 = ga.geom, g2 = gb.geom;
+  const bool ok =
+      guarded([&] { n = dCollide(g1, g2, kMaxContacts, contacts, sizeof(dContactGeom)); });
+  dGeomDestroy(ga.geom);
+  dGeomDestroy(gb.geom);
+  if (!ok) return {Status::Error, t_error, {}};
+  if (t_warning[0] != '\0') r.message = t_warning;
+  for (int i = 0; i < n; ++i) r.contacts.push_back(convert_contact(contacts[i]));
+  return r;
+}
+
+DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  init_ode();
+  DynamicsResult r;
+  const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
+  if (!(dt > 0.0)) return {Status::Error, "ODE: time step must be > 0", {}, {}, {}};
+  const long steps = static_cast<long>(std::llround(scene.sim.duration / dt));
+  std::vector<RigidBody> bodies;
+  bodies.reserve(scene.bodies.size());
+  for (const BodySpec& spec : scene.bodies) bodies.push_back(make_body(spec));
+
+  // World: gravity from the scene; ERP and CFM at ODE's defaults (0.2, 1e-10).
+  //  - CFM softens each contact by a relative CFM / (dt * inverse effective mass), ~1e-7 here.
+  //  - Position correction: a contact's target separation speed is
+  //    max(e * approach speed, ERP * depth / dt), so a contact first seen at depth d leaves at
+  //    >= 0.2 d / dt whatever e is: it changes impacts only for e below ~0.2 * (d / (v dt)) (an
+  //    e = 0 head-on impact seen 1 mm deep at dt = 1 ms separates at 0.2 m/s). Capping that
+  //    velocity at 0 (dWorldSetContactMaxCorrectingVel) made e = 0 exact, but with ODE's
+  //    one-point convex manifold a resting cube then tips about its single contact and sinks
+  //    (0.77 m in 2 s in a 3-cube stack), so the defaults stay.
+  WorldOwner w;
+  w.world = dWorldCreate();
+  w.space = dSimpleSpaceCreate(nullptr);
+  w.contacts = dJointGroupCreate(0);
+  const Vec3& g = scene.sim.gravity;
+  dWorldSetGravity(w.world, g.x(), g.y(), g.z());
+
+  // Bodies: our mass and inertia about the centre of mass at the body origin.
+  std::vector<dBodyID> ode_bodies(bodies.size(), nullptr);
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    const RigidBody& b = bodies[i];
+    w.geoms.push_back(make_geom(w.space, b));
+    dGeomID geom = w.geoms.back().geom;
+    dGeomSetData(geom, reinterpret_cast<void*>(static_cast<std::intptr_t>(i)));
+    if (b.is_static) {
+      place_geom(geom, b);
+      continue;
+    }
+    dBodyID body = dBodyCreate(w.world);
+    dMass mass;
+    const Mat3& I = b.inertia_body;
+    dMassSetParameters(&mass, b.mass, 0, 0, 0, I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2),
+                       I(1, 2));
+    // dBodySetMass checks the mass (dMassCheck) and calls dDebug on failure.
+    if (!guarded([&] { dBodySetMass(body, &mass); })) {
+      r.status = Status::Error;
+      r.message = std::string("ODE dBodySetMass (") + b.name + "): " + t_error;
+      return r;
+    }
+    const Quat o = b.orientation.normalized();
+    const dQuaternion q = {o.w(), o.x(), o.y(), o.z()};
+    dBodySetPosition(body, b.position.x(), b.position.y(), b.position.z());
+    dBodySetQuaternion(body, q);
+    dBodySetLinearVel(body, b.velocity.x(), b.velocity.y(), b.velocity.z());
+    dBodySetAngularVel(body, b.angular_velocity.x(), b.angular_velocity.y(),
+                       b.angular_velocity.z());
+    // Exact rotation by w dt each step instead of the linearised quaternion update (a setting
+    // for a fair reference; ODE's default is the infinitesimal update).
+    dBodySetFiniteRotationMode(body, 1);
+    dGeomSetBody(geom, body);
+    ode_bodies[i] = body;
+  }
+
+  auto sample = [&](double time) {
+    StateSample s;
+    s.time = time;
+    for (size_t i = 0; i < bodies.size(); ++i)
+      s.bodies.push_back(read_state(bodies[i], ode_bodies[i]));
+    r.samples.push_back(std::move(s));
+  };
+
+  CollideContext ctx;
+  ctx.world = w.world;
+  ctx.group = w.contacts;
+  ctx.restitution = scene.sim.restitution;
+  ctx.friction = scene.sim.friction;
+  t_warning[0] = '\0';
+  t_message_count = 0;
+  long first_message_step = -1;
+  for (long step = 0; step < steps; ++step) {
+    if (opt.sample_every > 0 && step % opt.sample_every == 0) sample(step * dt);
+    ctx.contacts.clear();
+    ctx.feedback.clear();
+    CollideContext* c = &ctx;
+    const dSpaceID space = w.space;
+    const dWorldID world = w.world;
+    if (!guarded([&] {
+          dSpaceCollide(space, c, near_callback);
+          dWorldStep(world, dt);
+        })) {
+      r.status = Status::Error;
+      r.message = "ODE at step " + std::to_string(step) + ": " + t_error;
+      return r;
+    }
+    if (t_warning[0] != '\0' && first_message_step < 0) first_message_step = step;
+    // Events: one per pair and step where the bodies were closing at some contact point and
+    // the contact pushed; point and normal averaged over the pair's points, depth the largest,
+    // impulse the sum of the normal impulses f . n dt.
+    std::map<std::pair<int, int>, CollisionEvent> pair_events;
+    std::map<std::pair<int, int>, int> pair_points;
+    std::map<std::pair<int, int>, bool> pair_closing;
+    for (const StepContact& sc : ctx.contacts) {
+      const std::pair<int, int> key{sc.a, sc.b};
+      const ContactPoint cp = convert_contact(sc.geom);
+      // Force along the normal (N). With two bodies f1 acts on a; with one, ODE moves the
+      // body into the first slot, so take whichever slot is filled (the push is >= 0).
+      const dJointFeedback& fb = *sc.feedback;
+      const Vec3 f1(fb.f1[0], fb.f1[1], fb.f1[2]), f2(fb.f2[0], fb.f2[1], fb.f2[2]);
+      const double push = (ode_bodies[sc.a] && ode_bodies[sc.b])
+                              ? f1.dot(cp.normal)
+                              : std::max(std::abs(f1.dot(cp.normal)), std::abs(f2.dot(cp.normal)));
+      const double impulse = push * dt;  // N s
+      CollisionEvent& ev = pair_events[key];
+      if (pair_points[key]++ == 0) {
+        ev.time = step * dt;
+        ev.step = step;
+        ev.body_a = bodies[sc.a].name;
+        ev.body_b = bodies[sc.b].name;
+        ev.contact = cp;
+        ev.contact.point.setZero();
+        ev.contact.normal.setZero();
+        ev.contact.depth = 0.0;
+      }
+      ev.contact.point += cp.point;
+      ev.contact.normal += cp.normal;
+      ev.contact.depth = std::max(ev.contact.depth, cp.depth);
+      ev.impulse += impulse;
+      if (sc.approach < -kClosingSpeed) pair_closing[key] = true;
+    }
+    for (auto& [key, ev] : pair_events) {
+      if (!pair_closing[key] || !(ev.impulse > 0.0)) continue;
+      ev.contact.point /= pair_points[key];
+      if (ev.contact.normal.norm() > 0.0) ev.contact.normal.normalize();
+      r.events.push_back(ev);
+    }
+    dJointGroupEmpty(w.contacts);
+  }
+  if (opt.sample_every > 0 && steps % opt.sample_every == 0) sample(steps * dt);
+  if (t_message_count > 0)
+    r.message = std::to_string(t_message_count) + " ODE message(s), the first at step " +
+                std::to_string(first_message_step) + ": " + t_warning;
+
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    BodyFinal f = read_state(bodies[i], ode_bodies[i]);
+    if (!f.position.allFinite() || !f.velocity.allFinite() || !f.angular_velocity.allFinite()) {
+      r.status = Status::Error;
+      r.message = "ODE: non-finite final state of " + f.name;
+    }
+    r.finals.push_back(f);
+  }
+  return r;
+}
+
 }  // namespace rbx

@@ -1,0 +1,337 @@
+// MuJoCo 2.2.2 adapter: contact conventions, the mesh recentring, the box-box half-depth defect,
+// and impacts against hand-derived single-impulse answers.
+#include "reference/mujoco.h"
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+namespace rbx {
+namespace {
+
+// A box specification (solid mass model unless changed).
+BodySpec box_spec(const std::string& name, const Vec3& size, const Vec3& position,
+                  double mass = 1.0, const Quat& orientation = Quat::Identity()) {
+  BodySpec s;
+  s.name = name;
+  s.shape_kind = "box";
+  s.box_size = size;
+  s.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
+  s.mass = mass;
+  s.position = position;
+  s.orientation = orientation;
+  return s;
+}
+
+// Square pyramid: base (+-0.5, +-0.5, 0), apex (0, 0, 1), in the scene's local frame.
+BodySpec pyramid_spec(const std::string& name, const Vec3& position, const Quat& orientation) {
+  BodySpec s;
+  s.name = name;
+  s.shape_kind = "convex";
+  s.shape = std::make_shared<const ConvexPolyhedron>(ConvexPolyhedron::from_triangles(
+      {Vec3(-0.5, -0.5, 0), Vec3(0.5, -0.5, 0), Vec3(0.5, 0.5, 0), Vec3(-0.5, 0.5, 0),
+       Vec3(0, 0, 1)},
+      {{0, 2, 1}, {0, 3, 2}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}));
+  s.position = position;
+  s.orientation = orientation;
+  return s;
+}
+
+// Unit cube whose body diagonal (1,1,1) points along +x: its vertex (0.5,0.5,0.5) leads at
+// sqrt(3)/2 ahead of the centre, on the line of centres (a 1-D impact with no lever arm).
+Quat diagonal_along_x() { return Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitX()); }
+
+// MuJoCo stores mesh vertices as float: coordinates of size 0.5..1 carry ~6e-8 round-off, and
+// the compiler's recentring adds a few more float operations; 1e-6 m covers them.
+constexpr double kFloatGeometry = 1e-6;
+
+// --- Contact conventions ------------------------------------------------------------------
+
+TEST(MujocoContact, OverlapAlongXGivesNormalFromBTowardA) {
+  // Unit cubes, B centred at x = 0.9: the faces x = 0.5 (A) and x = 0.4 (B) overlap by 0.1;
+  // pushing A out of B is along -x.
+  const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
+  const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3(0.9, 0, 0)));
+  const ContactResult r = mujoco_contact(a, b);
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.contacts.size(), 1u);  // mesh-mesh in 2.2.2: MPR, one point
+  const ContactPoint& c = r.contacts[0];
+  EXPECT_NEAR(c.normal.x(), -1.0, kFloatGeometry);
+  EXPECT_NEAR(c.normal.y(), 0.0, kFloatGeometry);
+  EXPECT_NEAR(c.normal.z(), 0.0, kFloatGeometry);
+  EXPECT_NEAR(c.depth, 0.1, kFloatGeometry);
+  // MuJoCo's point is the midpoint between the surfaces: x = (0.4 + 0.5) / 2, somewhere on the
+  // 1 x 1 overlap patch (in 2.2.2 a corner of it, not the centre).
+  EXPECT_NEAR(c.point.x(), 0.45, kFloatGeometry);
+  EXPECT_LE(std::abs(c.point.y()), 0.5 + kFloatGeometry);
+  EXPECT_LE(std::abs(c.point.z()), 0.5 + kFloatGeometry);
+}
+
+TEST(MujocoContact, SwappingTheBodiesFlipsTheNormal) {
+  // Same pair as above with B first: now B is pushed out of A along +x; same depth.
+  const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
+  const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3(0.9, 0, 0)));
+  const ContactResult r = mujoco_contact(b, a);
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.contacts.size(), 1u);
+  EXPECT_NEAR(r.contacts[0].normal.x(), 1.0, kFloatGeometry);
+  EXPECT_NEAR(r.contacts[0].normal.y(), 0.0, kFloatGeometry);
+  EXPECT_NEAR(r.contacts[0].depth, 0.1, kFloatGeometry);
+  EXPECT_NEAR(r.contacts[0].point.x(), 0.45, kFloatGeometry);
+}
+
+TEST(MujocoContact, RotatedPairGivesWorldFrameNormal) {
+  // Both cubes turned by 0.3 rad about z, B at q * (0.9, 0.2, 0.1): in A's frame this is the
+  // overlap above (0.1 along A's x, the y and z offsets leave the faces overlapping), so the
+  // world normal is q * (-1, 0, 0) = (-cos 0.3, -sin 0.3, 0) and the depth 0.1.
+  const Quat q(Eigen::AngleAxisd(0.3, Vec3::UnitZ()));
+  const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero(), 1.0, q));
+  const RigidBody b = make_body(box_spec("B", Vec3::Ones(), q * Vec3(0.9, 0.2, 0.1), 1.0, q));
+  const ContactResult r = mujoco_contact(a, b);
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.contacts.size(), 1u);
+  EXPECT_NEAR(r.contacts[0].normal.x(), -std::cos(0.3), kFloatGeometry);
+  EXPECT_NEAR(r.contacts[0].normal.y(), -std::sin(0.3), kFloatGeometry);
+  EXPECT_NEAR(r.contacts[0].normal.z(), 0.0, kFloatGeometry);
+  EXPECT_NEAR(r.contacts[0].depth, 0.1, kFloatGeometry);
+}
+
+TEST(MujocoContact, TouchingAndSeparatedPairs) {
+  const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
+  // Faces exactly touching (B at x = 1): no penetration; a zero-depth contact would be allowed.
+  const ContactResult touching =
+      mujoco_contact(a, make_body(box_spec("B", Vec3::Ones(), Vec3(1, 0, 0))));
+  ASSERT_EQ(touching.status, Status::Ok) << touching.message;
+  for (const ContactPoint& c : touching.contacts) EXPECT_LE(c.depth, kFloatGeometry);
+  // 1 mm apart: nothing.
+  const ContactResult apart =
+      mujoco_contact(a, make_body(box_spec("B", Vec3::Ones(), Vec3(1.001, 0, 0))));
+  ASSERT_EQ(apart.status, Status::Ok) << apart.message;
+  EXPECT_TRUE(apart.contacts.empty());
+}
+
+TEST(MujocoContact, RecentredMeshStaysOnOurPose) {
+  // A square pyramid under the seed's vertex mass model has its centre of mass at the vertex
+  // average, z = 1/5 above the base, while MuJoCo recentres the mesh on its volume centroid,
+  // z = 1/4. Turned 30 deg about z with its base at z = 0, on a 2 x 2 x 1 box whose top is at
+  // z = 0.02: the base sinks 0.02 into the box top (the base's corners reach sqrt(2)/2 < 1 from
+  // the axis, inside the top face), so the contact is (0, 0, 1) from the box toward the
+  // pyramid with depth 0.02. An uncompensated 0.05 shift would change the depth.
+  BodySpec p = pyramid_spec("P", Vec3::Zero(), Quat(Eigen::AngleAxisd(M_PI / 6, Vec3::UnitZ())));
+  p.mass_model = MassModel::Vertices;
+  const RigidBody pyramid = make_body(p);
+  ASSERT_NEAR(pyramid.position.z(), 0.2, 1e-12);  // our centre of mass
+  const RigidBody table = make_body(box_spec("T", Vec3(2, 2, 1), Vec3(0, 0, -0.48)));
+  const ContactResult r = mujoco_contact(pyramid, table);
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.contacts.size(), 1u);
+  EXPECT_NEAR(r.contacts[0].normal.z(), 1.0, kFloatGeometry);
+  EXPECT_NEAR(r.contacts[0].depth, 0.02, kFloatGeometry);
+  // Between the two surfaces z = 0 and z = 0.02, over the pyramid's base. (MuJoCo documents
+  // the point as the midpoint; its MPR point is an average of portal support points, which
+  // here lands at z = 0.02/3, not 0.01.)
+  EXPECT_GE(r.contacts[0].point.z(), -kFloatGeometry);
+  EXPECT_LE(r.contacts[0].point.z(), 0.02 + kFloatGeometry);
+  EXPECT_LE(r.contacts[0].point.head<2>().norm(), std::sqrt(0.5) + kFloatGeometry);
+}
+
+// --- Known defect: box-box half depth -------------------------------------------------------
+
+// Loads MJCF text through MuJoCo's virtual file system.
+mjModel* load_mjcf(const char* xml) {
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  const int n = static_cast<int>(std::strlen(xml));
+  if (mj_makeEmptyFileVFS(vfs.get(), "pin.xml", n) != 0) return nullptr;
+  std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), "pin.xml")], xml, n);
+  char error[512] = "";
+  mjModel* m = mj_loadXML("pin.xml", vfs.get(), error, sizeof(error));
+  mj_deleteVFS(vfs.get());
+  return m;
+}
+
+TEST(MujocoKnownDefect, BoxBoxReportsHalfTheDepth) {
+  // Two unit box geoms (primitive type "box", not meshes) overlapping 0.1 along x, as in
+  // OverlapAlongX. The true depth is 0.1; MuJoCo 2.2.2's box-box collider reports
+  // dist = -0.05 (fixed upstream much later). This test pins the defect: if it fails, the
+  // library changed and REFERENCES.md must be updated. The adapter uses mesh geoms, which get
+  // 0.1 (OverlapAlongXGivesNormalFromBTowardA).
+  mjModel* m = load_mjcf(R"(<mujoco><worldbody>
+      <body pos="0 0 0"><freejoint/><geom type="box" size="0.5 0.5 0.5"/></body>
+      <body pos="0.9 0 0"><freejoint/><geom type="box" size="0.5 0.5 0.5"/></body>
+      </worldbody></mujoco>)");
+  ASSERT_NE(m, nullptr);
+  mjData* d = mj_makeData(m);
+  mj_forward(m, d);
+  ASSERT_GE(d->ncon, 1);
+  for (int i = 0; i < d->ncon; ++i) {
+    // Box geoms are stored in double: only round-off separates the answer from 0.05.
+    EXPECT_NEAR(-d->contact[i].dist, 0.05, 1e-12) << "contact " << i;
+    EXPECT_NEAR(std::abs(d->contact[i].frame[0]), 1.0, 1e-12);
+  }
+  mj_deleteData(d);
+  mj_deleteModel(m);
+}
+
+// --- Dynamics -------------------------------------------------------------------------------
+
+// Head-on scene: A (m1 = 1, diagonal along x) at v1 = +1, B (m2 = 3, axis-aligned) at v2 = -1.
+// A's leading vertex starts `gap` short of B's face at x = 0.
+Scene head_on(double restitution, double gap, double dt) {
+  Scene s;
+  s.sim.dt = dt;
+  s.sim.duration = 0.1;  // the soft contact lasts ~25 steps = 25 ms
+  s.sim.restitution = restitution;
+  s.bodies.push_back(
+      box_spec("A", Vec3::Ones(), Vec3(-std::sqrt(3.0) / 2 - gap, 0, 0), 1.0, diagonal_along_x()));
+  s.bodies.back().velocity = Vec3(1, 0, 0);
+  s.bodies.push_back(box_spec("B", Vec3::Ones(), Vec3(0.5, 0, 0), 3.0));
+  s.bodies.back().velocity = Vec3(-1, 0, 0);
+  return s;
+}
+
+// 1-D closed form: v1' = (m1 v1 + m2 v2 + m2 e (v2 - v1)) / (m1 + m2),
+// v2' = (m1 v1 + m2 v2 + m1 e (v1 - v2)) / (m1 + m2); with m1 = 1, m2 = 3, v1 = 1, v2 = -1:
+// e = 0.5: v1' = (-2 - 3) / 4 = -1.25, v2' = (-2 + 1) / 4 = -0.25;
+// e = 1:   v1' = (-2 - 6) / 4 = -2,    v2' = (-2 + 2) / 4 = 0.
+// The impulse is j = (1 + e) m1 m2 / (m1 + m2) |v1 - v2| = (1 + e) * 0.75 * 2.
+struct HeadOnAnswer {
+  double e, v1, v2, impulse;
+};
+constexpr HeadOnAnswer kHeadOn[] = {{0.5, -1.25, -0.25, 2.25}, {1.0, -2.0, 0.0, 3.0}};
+
+TEST(MujocoDynamics, HeadOnImpactAtTheCalibratedEntryPhase) {
+  // Closing speed 2 m/s, dt = 1 ms: a gap of 3 mm leaves the vertex 1 mm = half a step's travel
+  // inside B at the first step that sees the contact: entry phase 1/2, the phase the damping is
+  // calibrated at. The remaining model error is the impedance d = 0.9999 (the solver reaches
+  // aref to 1e-4 relative), so velocities and impulse agree to 1e-4.
+  for (const HeadOnAnswer& want : kHeadOn) {
+    const DynamicsResult r = mujoco_dynamics(head_on(want.e, 0.003, 1e-3), {});
+    ASSERT_EQ(r.status, Status::Ok) << r.message;
+    ASSERT_EQ(r.finals.size(), 2u);
+    EXPECT_NEAR(r.finals[0].velocity.x(), want.v1, 1e-4) << "e = " << want.e;
+    EXPECT_NEAR(r.finals[1].velocity.x(), want.v2, 1e-4) << "e = " << want.e;
+    // Momentum 1*1 + 3*(-1) = -2 is conserved to round-off (equal and opposite forces).
+    EXPECT_NEAR(r.finals[0].velocity.x() + 3.0 * r.finals[1].velocity.x(), -2.0, 1e-9);
+    // No lever arm: no spin (round-off only).
+    EXPECT_LT(r.finals[0].angular_velocity.norm(), 1e-9);
+    // One collision event (one contact episode), B -> A normal along -x.
+    ASSERT_EQ(r.events.size(), 1u);
+    EXPECT_EQ(r.events[0].body_a, "A");
+    EXPECT_EQ(r.events[0].body_b, "B");
+    EXPECT_NEAR(r.events[0].contact.normal.x(), -1.0, kFloatGeometry);
+    EXPECT_NEAR(r.events[0].impulse, want.impulse, 1e-4);  // = momentum change of A
+  }
+}
+
+TEST(MujocoDynamics, HeadOnImpactAtAnotherEntryPhase) {
+  // Gap 4 mm - 1 um: the vertex is only 1 um inside when the contact is first seen (phase
+  // ~0). The adapter's recursion (mujoco.cpp, soft_contact_restitution) puts e between 0.485
+  // and 0.517 over entry phases 0..1 for a target of 0.5, so |e - 0.5| <= 0.018 and the
+  // velocities move by at most m2/(m1+m2) |de| |v1 - v2| = 0.75 * 0.018 * 2 = 0.027 (A) and
+  // m1/(m1+m2) |de| 2 = 0.009 (B). This is the price of detecting contact at step starts.
+  const DynamicsResult r = mujoco_dynamics(head_on(0.5, 0.004 - 1e-6, 1e-3), {});
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  EXPECT_NEAR(r.finals[0].velocity.x(), -1.25, 0.027);
+  EXPECT_NEAR(r.finals[1].velocity.x(), -0.25, 0.009);
+  EXPECT_NEAR(r.finals[0].velocity.x() + 3.0 * r.finals[1].velocity.x(), -2.0, 1e-9);
+}
+
+TEST(MujocoDynamics, CubeCornerOnStaticSlab) {
+  // Unit cube (m = 1, solid: I = m/6 * 1, the same in every orientation), rotated 45 deg about
+  // x then 10 deg about y, falling at 1 m/s onto a static slab; no gravity, e = 0.5.
+  // Lowest vertex: local (0.5, -0.5, -0.5) -> Rx(45): (0.5, 0, -sqrt(2)/2) -> Ry(10):
+  //   r = (0.5 cos10 - sqrt(2)/2 sin10, 0, -0.5 sin10 - sqrt(2)/2 cos10) = (0.36962, 0, -0.78319)
+  // (its neighbour (-0.5, -0.5, -0.5) ends 0.17 m higher, so one vertex strikes).
+  // Single impulse along n = (0, 0, 1) at r: r x n = (0, -r_x, 0),
+  //   j = -(1 + e) v_n / (1/m + (r x n) . 6/m (r x n)) = 1.5 / (1 + 6 r_x^2),
+  //   v' = (0, 0, -1 + j),  w' = 6 j (r x n) = (0, -6 r_x j, 0).
+  const double deg = M_PI / 180.0;
+  const double rx = 0.5 * std::cos(10 * deg) - std::sqrt(0.5) * std::sin(10 * deg);
+  const double rz = -0.5 * std::sin(10 * deg) - std::sqrt(0.5) * std::cos(10 * deg);
+  const double e = 0.5;
+  const double j = (1 + e) / (1 + 6 * rx * rx);
+  // dt = 0.1 ms; the slab top 0.15 mm below the vertex: entry phase 1/2 (see above).
+  const double dt = 1e-4;
+  Scene s;
+  s.sim.dt = dt;
+  s.sim.duration = 0.006;  // contact ~2.5 ms; the next vertex is still 0.17 m up
+  s.sim.restitution = e;
+  s.bodies.push_back(box_spec("cube", Vec3::Ones(), Vec3::Zero(), 1.0,
+                              Quat(rotation_from_euler_deg(Vec3(45, 10, 0)))));
+  s.bodies.back().velocity = Vec3(0, 0, -1);
+  s.bodies.push_back(box_spec("slab", Vec3(4, 4, 1), Vec3(0, 0, rz - 0.5 - 1.5 * dt)));
+  s.bodies.back().is_static = true;
+  const DynamicsResult r = mujoco_dynamics(s, {});
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  // Tolerance: a soft contact is not an instantaneous impulse. Over its ~25 steps (2.5 ms) the
+  // cube turns by about |w'| T / 2 = 1.8 * 2.5e-3 / 2 = 2.3e-3 rad, moving the lever r_x by
+  // |r_z| * 2.3e-3 = 1.8e-3 (0.5%); that shifts j by ~0.45% (3.7e-3 N s), v_z by as much and
+  // w_y by 6 (r_x dj + j dr_x) ~ 1.7e-2. We allow 5e-3 m/s and 2e-2 rad/s.
+  EXPECT_NEAR(r.finals[0].velocity.z(), -1 + j, 5e-3);
+  EXPECT_NEAR(r.finals[0].angular_velocity.y(), -6 * rx * j, 2e-2);
+  EXPECT_NEAR(r.finals[0].velocity.x(), 0.0, 1e-9);
+  EXPECT_NEAR(r.finals[0].angular_velocity.x(), 0.0, 1e-6);
+  // The static slab is a world geom: its pose is unchanged and it never moves.
+  EXPECT_EQ(r.finals[1].velocity, Vec3::Zero());
+  EXPECT_NEAR(r.finals[1].position.z(), rz - 0.5 - 1.5 * dt, 1e-15);
+}
+
+TEST(MujocoDynamics, FreeRotationStaysInTheWorldFrame) {
+  // A cube has isotropic inertia, so Euler's equations give a constant world angular velocity
+  // and the orientation q(t) = exp(w t) q0. MuJoCo's free joint keeps w in the body frame: a
+  // missing conversion would show here, since the cube starts turned.
+  const Vec3 w(1, 2, 3);  // rad/s, world
+  const Quat q0(Eigen::AngleAxisd(0.7, Vec3(1, -2, 0.5).normalized()));
+  Scene s;
+  s.sim.dt = 1e-3;
+  s.sim.duration = 0.1;
+  s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero(), 1.0, q0));
+  s.bodies.back().angular_velocity = w;
+  const DynamicsResult r = mujoco_dynamics(s, {});
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  // Round-off over 100 steps of an exact quaternion update.
+  EXPECT_LT((r.finals[0].angular_velocity - w).norm(), 1e-9);
+  const Quat expect = Quat(Eigen::AngleAxisd(w.norm() * 0.1, w.normalized())) * q0;
+  EXPECT_LT(std::abs(std::abs(expect.dot(r.finals[0].orientation)) - 1.0), 1e-9);
+}
+
+TEST(MujocoDynamics, FreeFallSamples) {
+  // Semi-implicit Euler from rest: v_n = g n dt, x_n = x0 + g dt^2 n (n + 1) / 2 exactly (up to
+  // round-off). Samples every 10 steps over 100 steps: t = 0, 0.01, ..., 0.1 (11 samples).
+  const double g = -9.81, dt = 1e-3;
+  Scene s;
+  s.sim.dt = dt;
+  s.sim.duration = 0.1;
+  s.sim.gravity = Vec3(0, 0, g);
+  s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3(0, 0, 5)));
+  DynamicsOptions opt;
+  opt.sample_every = 10;
+  const DynamicsResult r = mujoco_dynamics(s, opt);
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.samples.size(), 11u);
+  for (size_t k = 0; k < r.samples.size(); ++k) {
+    const double n = 10.0 * k;
+    EXPECT_NEAR(r.samples[k].time, n * dt, 1e-12);
+    EXPECT_NEAR(r.samples[k].bodies[0].velocity.z(), g * n * dt, 1e-12);
+    EXPECT_NEAR(r.samples[k].bodies[0].position.z(), 5 + g * dt * dt * n * (n + 1) / 2, 1e-12);
+  }
+  EXPECT_NEAR(r.finals[0].velocity.z(), g * 0.1, 1e-12);
+}
+
+TEST(MujocoDynamics, NonFiniteStateIsAnError) {
+  // MuJoCo warns about a NaN velocity and silently resets the state; the adapter must say so.
+  Scene s;
+  s.sim.duration = 0.01;
+  s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero()));
+  s.bodies.back().velocity = Vec3(std::nan(""), 0, 0);
+  const DynamicsResult r = mujoco_dynamics(s, {});
+  EXPECT_EQ(r.status, Status::Error);
+  EXPECT_NE(r.message.find("MuJoCo"), std::string::npos) << r.message;
+}
+
+}  // namespace
+}  // namespace rbx
