@@ -66,6 +66,8 @@ int compare_command(const SceneCommandOptions& opt) {
       if (ev.expect_failures.empty())
         out << "  [expect]: passed\n";
       for (const std::string& s : ev.expect_failures) out << "  [expect] FAILED: " << s << "\n";
+      if (!ev.expect_failures.empty() && !scene.expect->known_failure.empty())
+        out << "  [expect] known failure: " << scene.expect->known_failure << "\n";
     }
     out << "\n";
     if (!ev.expect_failures.empty()) ++failed;

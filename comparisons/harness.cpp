@@ -224,7 +224,8 @@ class Evaluator {
     j["skipped"] = out_.skipped;
     j["expect"] = {{"checked", scene_.expect.has_value()},
                    {"passed", out_.expect_failures.empty()},
-                   {"failures", out_.expect_failures}};
+                   {"failures", out_.expect_failures},
+                   {"known_failure", scene_.expect ? scene_.expect->known_failure : ""}};
     j["disagreements"] = out_.disagreements;
     return std::move(out_);
   }

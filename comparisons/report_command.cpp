@@ -167,7 +167,8 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
       else if (!a.empty() && a.rfind("self", 0) == 0 && against.rfind("self", 0) == 0) against = "self (finest dt)";
     }
     row[2] = against;
-    if (!evs[i].expect_failures.empty()) row[0] += " **[expect failed]**";
+    if (!evs[i].expect_failures.empty())
+      row[0] += scenes[i].expect->known_failure.empty() ? " **[expect failed]**" : " [expect: known failure]";
     summary.add(row);
   }
   md << summary.markdown() << "\n" << marks << " cells marked ✗.\n\n";
@@ -246,6 +247,8 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
     if (scenes[i].expect)
       md << "- [expect]: " << (ev.expect_failures.empty() ? "passed" : "FAILED") << "\n";
     for (const std::string& f : ev.expect_failures) md << "  - " << f << "\n";
+    if (scenes[i].expect && !scenes[i].expect->known_failure.empty())
+      md << "  - known failure: " << scenes[i].expect->known_failure << "\n";
     if (figures_ok) {
       if (scenes[i].has_check("contact") && !ev.json["geometry"].empty())
         md << "\n![contacts](figures/contact_" << slug << ".png)\n";

@@ -65,6 +65,7 @@ const KeyInfo kKeys[] = {
     {"body.velocity", "[0, 0, 0]"},
     {"body.angular_velocity", "[0, 0, 0]"},
     {"expect.tolerance", "1e-6"},
+    {"expect.known_failure", "\"custom: no resting contact (SEED_NOTES 12)\""},
     {"expect.body.position", "[0, 0, 0]"},
     {"expect.body.velocity", "[0, 0, 0]"},
     {"expect.body.angular_velocity", "[0, 0, 0]"},
@@ -790,6 +791,10 @@ Expect read_expect(const Reader& r, const toml::table& t, const std::vector<Body
       r.fail(line_of(n), "expect.tolerance", "must be > 0, got " + num(e.tolerance),
              "write an absolute tolerance in SI units, e.g. tolerance = 1e-6");
   }
+  // A closed form the custom engine is known to miss (a documented limitation): kept as the
+  // truth, reported as known, and pinned by the tests so a fix is noticed.
+  if (const toml::node* n = t.get("known_failure"))
+    e.known_failure = r.string(*n, "expect.known_failure", "expect.known_failure");
   std::vector<std::string> names;
   for (const BodySpec& b : bodies) names.push_back(b.name);
 

@@ -210,6 +210,13 @@ Vec3 edge_normal(const WorldShape& a, const WorldShape& b, const Vec3& v_i, cons
   // crossed triangle's outward normal.
   const double plus = overlap(a, b, n), minus = overlap(a, b, -n);
   if (minus < plus - tol || (std::abs(minus - plus) <= tol && n.dot(n_face) < 0.0)) n = -n;
+  // Departure: e_a x e_b is the normal of an edge-EDGE contact. When A's edge pierces the
+  // interior of B's face (an edge-face contact, e.g. a box edge crossing a wall after a face
+  // hit), e_a x e_b lies in the wall and is no way out; e_b may even be the diagonal that
+  // splits a square face in two, which is no edge of the solid. Of the two candidates, the one
+  // that separates the bodies with the smaller translation is the contact normal (the rule a
+  // separating-axis test applies to all axes, here to the two the seed's test produces).
+  if (overlap(a, b, n_face) < std::min(plus, minus) - tol) return n_face;
   return n;
 }
 

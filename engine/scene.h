@@ -67,6 +67,7 @@ struct ExpectContact {
 /// The [expect] block: closed-form ground truth with an absolute tolerance (SI).
 struct Expect {
   double tolerance = 1e-6;
+  std::string known_failure;  // non-empty: the custom engine is known to miss this, and why
   std::vector<ExpectBody> bodies;
   std::optional<ExpectContact> contact;
 };

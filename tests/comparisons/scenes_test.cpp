@@ -63,6 +63,13 @@ TEST_P(SceneExpect, ClosedFormHolds) {
   opt.sweep = false;
   const SceneEvaluation ev = evaluate_scene(s, opt);
   EXPECT_TRUE(ev.json["expect"]["checked"].get<bool>());
+  if (!s.expect->known_failure.empty()) {
+    // A documented limitation: the closed form stays the truth and the engine must still miss
+    // it; when it stops failing, the limitation is gone and the marker must go.
+    EXPECT_FALSE(ev.expect_failures.empty())
+        << GetParam() << ": now passes; remove known_failure (" << s.expect->known_failure << ")";
+    return;
+  }
   for (const std::string& f : ev.expect_failures) ADD_FAILURE() << GetParam() << ": " << f;
 }
 

@@ -164,6 +164,19 @@ TEST(Detect, EdgeLandingFlatAveragesItsVerticesOnTheSameFace) {
   EXPECT_NEAR(hit->depth, 0.02, kRoundOff);
 }
 
+TEST(Detect, EdgePiercingAFaceTakesTheFaceNormal) {
+  // A unit cube 0.05 deep in a wall whose face is the plane x = 0 (the wall B spans x < 0).
+  // A's four edges along x pierce the wall's face; e_a x e_b lies in the wall plane (for any
+  // e_b of the face, the face diagonal included) and would push A sideways by ~1 m. The wall's
+  // outward normal +x separates with 0.05: it is the contact normal, depth 0.05.
+  const ConvexPolyhedron a = make_box(Vec3::Ones()), b = make_box(Vec3(2, 8, 8));
+  const Pose pa = pose_at(Vec3(0.45, 0.3, -0.2)), pb = pose_at(Vec3(-1, 0, 0));
+  const auto hit = edge_test(a, pa, b, pb);
+  ASSERT_TRUE(hit.has_value());
+  expect_vec_near(hit->normal, Vec3(1, 0, 0), kRoundOff);
+  EXPECT_NEAR(hit->depth, 0.05, kRoundOff);
+}
+
 TEST(Detect, CrossedBarsAreAnEdgeHit) {
   const CrossedBars s;
   EXPECT_FALSE(detect_feature("face", s.a, s.pa, s.b, s.pb).has_value());
