@@ -61,6 +61,7 @@ int compare_command(const SceneCommandOptions& opt) {
     status.print(out);
     print_side_by_side(out, ev);
     for (const std::string& s : ev.disagreements) out << "  disagrees: " << s << "\n";
+    for (const std::string& s : ev.deviations) out << "  deviates: " << s << "\n";
     for (const std::string& s : ev.skipped) out << "  left out: " << s << "\n";
     if (scene.expect) {
       if (ev.expect_failures.empty())

@@ -47,8 +47,15 @@ struct SceneEvaluation {
   std::vector<SweepPoint> sweep;
   std::vector<std::string> skipped;    // what was left out, and why
   std::vector<std::string> expect_failures;  // violated [expect] entries (subjects only)
-  std::vector<std::string> disagreements;    // references that disagree with the truth
+  std::vector<std::string> disagreements;    // clearly different from the truth (see kMark*)
+  std::vector<std::string> deviations;       // beyond the scene's tolerance, yet close
 };
+
+/// Thresholds between a deviation and a disagreement: a contact normal more than 1 degree off or
+/// a depth more than 1 % of the smaller body off; a velocity error above 0.1 % (energy norm).
+constexpr double kMarkAngleDeg = 1.0;
+constexpr double kMarkDepthRel = 0.01;
+constexpr double kMarkVelocityErr = 1e-3;
 
 /// Runs every check of the scene. Never throws for a backend's failure (that backend's status
 /// becomes error); throws InputError only for bad options.

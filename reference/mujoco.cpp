@@ -174,9 +174,12 @@ std::string build_mjcf(const std::vector<RigidBody>& bodies, bool all_free,
   // not by the iteration stopping early.
   s << "<option timestep=\"" << num(opt.dt) << "\" gravity=\"" << vec_text(opt.gravity)
     << "\" integrator=\"Euler\" mpr_tolerance=\"1e-12\" mpr_iterations=\"500\"/>\n";
+  // Contact buffers: 8 points per pair for small scenes; for many bodies, where a body touches
+  // only its neighbours, 16 per body (8 per pair over all pairs of 100 bodies is more memory
+  // than mj_makeData will allocate).
   const size_t pairs = std::max<size_t>(1, n * (n - 1) / 2);
-  s << "<size nconmax=\"" << std::max<size_t>(100, 8 * pairs) << "\" njmax=\""
-    << std::max<size_t>(500, 24 * pairs) << "\"/>\n";
+  const size_t ncon = std::max<size_t>(100, std::min(8 * pairs, 16 * n));
+  s << "<size nconmax=\"" << ncon << "\" njmax=\"" << 3 * ncon << "\"/>\n";
   s << "<asset>\n";
   for (size_t i = 0; i < n; ++i) s << mesh_element("hull" + std::to_string(i), *bodies[i].shape);
   s << "</asset>\n<worldbody>\n";
