@@ -60,10 +60,24 @@ struct DynamicsOptions {
   long sample_every = 0;  // record the state every this many steps (0: never)
 };
 
+/// Mass properties as a library computes them by itself from the body's hull (with its own
+/// default settings), in the body frame. Reported next to the exact values; every backend is
+/// still given the exact ones for its runs.
+struct MassResult {
+  Status status = Status::Ok;
+  std::string message;                 // e.g. the settings it was computed with
+  double mass = 0.0;                   // kg
+  double volume = -1.0;                // m^3, negative when the library does not say
+  Vec3 center_of_mass = Vec3::Zero();  // m, body frame
+  Mat3 inertia = Mat3::Zero();         // kg m^2, about its centre of mass, body axes
+};
+
 /// Contact query: bodies carry their poses. A and B in that order.
 using ContactFn = std::function<ContactResult(const RigidBody& a, const RigidBody& b)>;
 /// Dynamics run of a whole scene.
 using DynamicsFn = std::function<DynamicsResult(const Scene& scene, const DynamicsOptions& opt)>;
+/// The library's own mass properties of a body's hull for the body's mass.
+using MassFn = std::function<MassResult(const RigidBody& body)>;
 
 /// One row of the registry.
 struct Backend {
@@ -71,6 +85,7 @@ struct Backend {
   std::string description;  // one line: library, algorithm
   ContactFn contact;        // empty: no contact queries
   DynamicsFn dynamics;      // empty: no dynamics
+  MassFn mass = nullptr;    // empty: the library computes no mass properties of a hull
 };
 
 /// Every backend, in report order.

@@ -376,4 +376,20 @@ DynamicsResult bullet_dynamics_default_world(const Scene& scene, const DynamicsO
   return run_world(scene, opt, false);
 }
 
+MassResult bullet_mass(const RigidBody& body) {
+  MassResult r;
+  btConvexHullShape hull;
+  for (const Vec3& v : body.shape->vertices()) hull.addPoint(to_bt(v), false);
+  hull.recalcLocalAabb();
+  // Left at Bullet's default collision margin, as a user of the library would have it.
+  btVector3 inertia(0, 0, 0);
+  hull.calculateLocalInertia(body.mass, inertia);
+  r.mass = body.mass;
+  r.center_of_mass = Vec3::Zero();  // Bullet takes the shape origin as the centre of mass
+  r.inertia = from_bt(inertia).asDiagonal();
+  r.message = "calculateLocalInertia, default margin " + std::to_string(hull.getMargin()) +
+              " m: bounding-box inertia about the shape origin";
+  return r;
+}
+
 }  // namespace rbx

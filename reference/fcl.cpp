@@ -209,4 +209,25 @@ ContactResult fcl_box_contact(const RigidBody& a, const RigidBody& b) {
   });
 }
 
+MassResult fcl_mass(const RigidBody& body) {
+  MassResult r;
+  try {
+    const auto convex = make_convex(*body.shape);
+    r.volume = convex->computeVolume();
+    r.mass = body.mass;
+    r.center_of_mass = convex->computeCOM();
+    // FCL integrates at unit density: scale to the body's mass.
+    r.inertia = convex->computeMomentofInertiaRelatedToCOM() * (body.mass / r.volume);
+    // Convention: FCL's Box/Sphere return the inertia at unit density, and the base class's
+    // parallel-axis shift assumes it, so we scale by the density mass / volume. FCL 0.7's
+    // Convex returns it per unit MASS instead (convex-inl.h divides by the volume): the result
+    // is off by 1/V, shown as it is.
+    r.message = "fcl::Convex, unit-density convention scaled to the mass (0.7's Convex is per unit mass)";
+  } catch (const std::exception& e) {
+    r.status = Status::Error;
+    r.message = e.what();
+  }
+  return r;
+}
+
 }  // namespace rbx

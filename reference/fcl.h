@@ -13,5 +13,8 @@ ContactResult fcl_epa_contact(const RigidBody& a, const RigidBody& b);
 ContactResult fcl_indep_contact(const RigidBody& a, const RigidBody& b);
 /// `fcl-box`: FCL Box-Box (boxBoxIntersect); unsupported unless both bodies are boxes.
 ContactResult fcl_box_contact(const RigidBody& a, const RigidBody& b);
+/// FCL's own Convex volume, centre of mass and inertia (computeVolume, computeCOM,
+/// computeMomentofInertiaRelatedToCOM at uniform density mass / volume).
+MassResult fcl_mass(const RigidBody& body);
 
 }  // namespace rbx

@@ -93,6 +93,8 @@ ContactResult run_isolated(const std::function<ContactResult()>& query, double t
       r = query();
     } catch (const std::exception& e) {
       r = {Status::Error, e.what(), {}};
+    } catch (...) {  // anything else must not escape: the child would run on as a second rbx
+      r = {Status::Error, "library call threw a non-standard exception", {}};
     }
     const std::string bytes = encode(r);
     size_t off = 0;

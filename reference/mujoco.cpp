@@ -544,4 +544,26 @@ DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   return r;
 }
 
+MassResult mujoco_mass(const RigidBody& body) {
+  MassResult r;
+  std::ostringstream xml;
+  xml << "<mujoco model=\"rbx_mass\">\n<compiler inertiafromgeom=\"true\"/>\n<asset>\n"
+      << mesh_element("hull", *body.shape) << "</asset>\n<worldbody>\n<body name=\"b\">\n"
+      << "<freejoint/>\n<geom type=\"mesh\" mesh=\"hull\" mass=\"" << num(body.mass)
+      << "\"/>\n</body>\n</worldbody>\n</mujoco>\n";
+  std::string error;
+  ModelPtr m = load_model(xml.str(), &error);
+  if (!m) return {Status::Error, error, 0.0, -1.0, Vec3::Zero(), Mat3::Zero()};
+  const int b = 1;  // body 0 is the world
+  r.mass = m->body_mass[b];
+  r.center_of_mass = Vec3(m->body_ipos[3 * b], m->body_ipos[3 * b + 1], m->body_ipos[3 * b + 2]);
+  const Quat q(m->body_iquat[4 * b], m->body_iquat[4 * b + 1], m->body_iquat[4 * b + 2],
+               m->body_iquat[4 * b + 3]);
+  const Vec3 moments(m->body_inertia[3 * b], m->body_inertia[3 * b + 1], m->body_inertia[3 * b + 2]);
+  const Mat3 rot = q.normalized().toRotationMatrix();
+  r.inertia = rot * moments.asDiagonal() * rot.transpose();
+  r.message = "mesh geom, inertiafromgeom";
+  return r;
+}
+
 }  // namespace rbx
