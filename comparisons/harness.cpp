@@ -415,12 +415,17 @@ class Evaluator {
       // Velocity errors belong to the impulse and trajectory checks: a stability-only scene
       // does not pay for the self-consistency run.
       const bool wants_velocity = scene_.has_check("impulse") || scene_.has_check("trajectory");
-      if (wants_sweep || (!have_expect && wants_velocity)) {
+      if (wants_sweep || (!have_expect && wants_velocity) || scene_.has_check("trajectory")) {
         // Without a sweep only the finest step is needed (the self-consistency reference).
         const std::vector<double> to_run = wants_sweep ? dts : std::vector<double>{finest};
         for (double dt : to_run) {
           if (std::abs(dt - scene_.sim.dt) <= 1e-15 * dt) sweep_runs.push_back(main);
-          else sweep_runs.push_back(run_dynamics(be, scene_, dt, 0));
+          else {
+            // The finest run of a trajectory check is sampled at the same times as the main run.
+            const bool sample = scene_.has_check("trajectory") && dt == finest;
+            const long every = sample ? std::max<long>(1, std::lround(sample_every * scene_.sim.dt / dt)) : 0;
+            sweep_runs.push_back(run_dynamics(be, scene_, dt, every));
+          }
         }
         if (sweep_runs.back().result.status == Status::Ok) fine = sweep_runs.back();
       }
@@ -454,6 +459,29 @@ class Evaluator {
           out_.sweep.push_back({name, "dynamics", r.dt, r.runtime_s,
                                 ke_norm_error(inputs_, r.result.finals, ref, e0_kin), against});
         }
+      }
+      // State divergence over time: how far any point of a body is from where the finest-step
+      // run puts it at the same sample time, |dx| + (size / 2) * rotation angle (an upper bound),
+      // relative to the body's size.
+      if (scene_.has_check("trajectory") && fine && !fine->result.samples.empty() &&
+          std::abs(finest - scene_.sim.dt) > 1e-15) {
+        double worst = 0.0;
+        size_t k = 0;
+        for (const StateSample& smp : main.result.samples) {
+          while (k + 1 < fine->result.samples.size() &&
+                 std::abs(fine->result.samples[k + 1].time - smp.time) <=
+                     std::abs(fine->result.samples[k].time - smp.time))
+            ++k;
+          const StateSample& ref = fine->result.samples[k];
+          if (std::abs(ref.time - smp.time) > 0.5 * scene_.sim.dt) continue;  // no partner
+          for (size_t i = 0; i < inputs_.size() && i < ref.bodies.size(); ++i)
+            if (!inputs_[i].is_static)
+              worst = std::max(worst, (smp.bodies[i].position - ref.bodies[i].position).norm() /
+                                              body_size(inputs_[i]) +
+                                          0.5 * smp.bodies[i].orientation.angularDistance(
+                                                    ref.bodies[i].orientation));
+        }
+        metric("trajectory", name, "", "state_divergence_err", worst, fmt_dt(finest));
       }
       // Contact time: first event against the finest-step run of the same backend.
       if (fine && !main.result.events.empty() && !fine->result.events.empty() &&
