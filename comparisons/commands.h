@@ -66,3 +66,17 @@ int scenes_command(const std::vector<std::string>& inputs);
 std::vector<std::string> collect_scene_files(const std::vector<std::string>& inputs);
 
 }  // namespace rbx
+
+namespace rbx {
+
+/// Options of `rbx bench`.
+struct BenchOptions {
+  std::string out;     // output folder ("" : reports, for reports/perf.md)
+  bool quick = false;  // --quick: fewer sizes and shorter runs (under a minute)
+};
+
+/// `rbx bench`: narrow phase of every contact backend, broad phase and whole step, timed with
+/// Google Benchmark; writes perf.md, perf.json, perf.csv and log-log figures to the folder.
+int bench_command(const BenchOptions& opt);
+
+}  // namespace rbx

@@ -47,6 +47,10 @@ int main(int argc, char** argv) {
   check->add_option("inputs", check_opt.inputs, "scene files or folders (default: scenes/)");
   check->add_option("--baseline", check_opt.baseline, "baseline file");
   check->add_flag("--update", check_opt.update, "rewrite the baseline from this run");
+  rbx::BenchOptions bench_opt;
+  CLI::App* bench = app.add_subcommand("bench", "performance comparison (default: reports/perf.md)");
+  bench->add_option("--out", bench_opt.out, "output folder");
+  bench->add_flag("--quick", bench_opt.quick, "fewer sizes and shorter runs (under a minute)");
 
   try {
     app.parse(argc, argv);
@@ -66,6 +70,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("report")) return rbx::report_command(report_opt);
     if (app.got_subcommand("check")) return rbx::check_command(check_opt);
     if (app.got_subcommand("scenes")) return rbx::scenes_command(scenes_inputs);
+    if (app.got_subcommand("bench")) return rbx::bench_command(bench_opt);
   } catch (const rbx::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;

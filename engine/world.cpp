@@ -10,8 +10,10 @@
 
 namespace rbx {
 
-World::World(SimSettings sim, std::vector<RigidBody> bodies, DetectorVariant variant)
-    : sim_(std::move(sim)), bodies_(std::move(bodies)), variant_(variant) {
+World::World(SimSettings sim, std::vector<RigidBody> bodies, DetectorVariant variant,
+             BroadPhaseMethod broad_phase)
+    : sim_(std::move(sim)), bodies_(std::move(bodies)), variant_(variant),
+      broad_phase_(broad_phase) {
   // Energy guard budget: the initial kinetic energy, or the work gravity could do over the
   // bodies' own sizes, whichever is larger, so a scene starting at rest is not flagged.
   energy0_ = energy();
@@ -30,11 +32,11 @@ double World::energy() const {
   return e;
 }
 
-void World::collide_pair(int i, int j) {
+void World::collide_pair(int i, int j, bool bounded) {
   RigidBody& a = bodies_[i];
   RigidBody& b = bodies_[j];
   if (a.is_static && b.is_static) return;
-  if (!bounding_check(a, b)) return;
+  if (!bounded && !bounding_check(a, b)) return;
   // The seed's order: face, vertex, edge; each resolved as soon as it hits. After the first
   // impulse the pair separates at the contact, so later hits add an impulse only if the new
   // velocities still approach at their own point.
@@ -74,10 +76,19 @@ bool World::check_state() {
 
 bool World::step() {
   if (!failure_.empty()) return false;
-  // Bounding check over all pairs, detection and response, in index order (deterministic).
-  const int n = static_cast<int>(bodies_.size());
-  for (int i = 0; i < n; ++i)
-    for (int j = i + 1; j < n; ++j) collide_pair(i, j);
+  // Bounding check, detection and response, in index order (deterministic). Responses change
+  // velocities only, never poses, so the pairs passing the bounding check are fixed for the
+  // whole step and the broad phase can find them all first; it returns them in the seed's
+  // (i, j) order, so the contacts are resolved in the same order as by the double loop.
+  if (broad_phase_.method() == BroadPhaseMethod::AllPairs) {
+    // The seed's double loop, kept as it was (the oracle of the broad phase).
+    const int n = static_cast<int>(bodies_.size());
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) collide_pair(i, j, false);
+  } else {
+    for (const BodyPair& pair : broad_phase_.find_pairs(bodies_))
+      collide_pair(pair.first, pair.second, true);
+  }
   for (RigidBody& b : bodies_) integrate(b, sim_, sim_.dt);
   ++step_;
   time_ = step_ * sim_.dt;
@@ -97,10 +108,10 @@ RunResult World::run() {
   return r;
 }
 
-RunResult run_scene(const Scene& scene, DetectorVariant variant) {
+RunResult run_scene(const Scene& scene, DetectorVariant variant, BroadPhaseMethod broad_phase) {
   std::vector<RigidBody> bodies;
   for (const BodySpec& spec : scene.bodies) bodies.push_back(make_body(spec));
-  World world(scene.sim, std::move(bodies), variant);
+  World world(scene.sim, std::move(bodies), variant, broad_phase);
   return world.run();
 }
 

@@ -1,10 +1,11 @@
-// The world step: bounding check over all pairs, detection, response, integration.
+// The world step: broad phase (the bounding check), detection, response, integration.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "engine/body.h"
+#include "engine/broadphase.h"
 #include "engine/contact.h"
 #include "engine/detect.h"
 #include "engine/scene.h"
@@ -32,11 +33,16 @@ struct RunResult {
 /// A set of bodies stepped by the seed's algorithm.
 class World {
  public:
+  /// `broad_phase` chooses how the pairs passing the bounding check are found; every method
+  /// finds the same pairs and the world resolves them in the seed's (i, j) order, so results
+  /// do not depend on it (AllPairs is the seed's double loop).
   World(SimSettings sim, std::vector<RigidBody> bodies,
-        DetectorVariant variant = DetectorVariant::Fast);
+        DetectorVariant variant = DetectorVariant::Fast,
+        BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree);
 
-  /// Advances one step of sim.dt: for every pair passing the bounding check, the face, vertex
-  /// and edge tests in that order, resolving after each hit; then integration of every body.
+  /// Advances one step of sim.dt: for every pair passing the bounding check (in (i, j) order),
+  /// the face, vertex and edge tests in that order, resolving after each hit; then integration
+  /// of every body.
   /// Returns false (and sets failure()) when the state became non-finite or the energy grew
   /// past sim.max_energy_ratio; the world must not be stepped further then.
   bool step();
@@ -54,12 +60,15 @@ class World {
   double energy() const;
 
  private:
-  void collide_pair(int i, int j);
+  // Detection and response for bodies i and j; `bounded`: the pair already passed the
+  // bounding check.
+  void collide_pair(int i, int j, bool bounded);
   bool check_state();
 
   SimSettings sim_;
   std::vector<RigidBody> bodies_;
   DetectorVariant variant_;
+  BroadPhase broad_phase_;
   std::vector<CollisionEvent> events_;
   double time_ = 0.0;
   long step_ = 0;
@@ -69,6 +78,7 @@ class World {
 };
 
 /// Builds every body of the scene and runs it with the custom engine.
-RunResult run_scene(const Scene& scene, DetectorVariant variant = DetectorVariant::Fast);
+RunResult run_scene(const Scene& scene, DetectorVariant variant = DetectorVariant::Fast,
+                    BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree);
 
 }  // namespace rbx

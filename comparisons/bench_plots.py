@@ -1,0 +1,130 @@
+#!/usr/bin/python3
+"""Figures of `rbx bench`: log-log time against size for the narrow phase (one figure per pose
+kind, one line per backend and variant) and the broad phase (one line per method), and bars of
+microseconds per body per step for the whole step.
+
+Usage: bench_plots.py DIR  (reads DIR/perf.json, writes DIR/figures/perf_*.png and *.svg)
+"""
+import json
+import os
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+# One colour and marker per backend, stable across figures (the order of the registry).
+BACKENDS = ["custom", "exact", "fcl", "fcl-epa", "fcl-indep", "fcl-box", "libccd", "bullet",
+            "bullet-sat", "mujoco", "ode"]
+COLOURS = dict(zip(BACKENDS, plt.cm.tab20.colors[::2] + plt.cm.tab20.colors[1::2]))
+MARKERS = dict(zip(BACKENDS, "os^vD<>pPX*"))
+METHOD_STYLE = {"all-pairs": ("tab:red", "o"), "sweep-and-prune": ("tab:orange", "s"),
+                "tree": ("tab:blue", "^")}
+
+
+def save(fig, out, name):
+    fig.tight_layout()
+    for ext in ("png", "svg"):
+        fig.savefig(os.path.join(out, f"{name}.{ext}"), dpi=110)
+    plt.close(fig)
+
+
+def narrowphase(rows, out):
+    """Time per query against hull vertices, log-log; the box drawn as a separate marker at N=8."""
+    by_pose = defaultdict(lambda: defaultdict(list))
+    for r in rows:
+        if r["kind"] == "narrowphase" and r["ns_per_query"] is not None:
+            by_pose[r["pose"]][(r["backend"], r["variant"])].append(
+                (r["vertices"], r["ns_per_query"]))
+    for pose, series in by_pose.items():
+        fig, ax = plt.subplots(figsize=(8, 5.5))
+        for (backend, variant), pts in sorted(series.items()):
+            pts.sort()
+            hull = [(n, t * 1e-3) for n, t in pts if n > 8]
+            box = [(n, t * 1e-3) for n, t in pts if n == 8]
+            colour = COLOURS.get(backend, "black")
+            marker = MARKERS.get(backend, "o")
+            dashed = variant == "seed"
+            label = backend if variant == "default" else f"{backend} ({variant})"
+            if hull:
+                ax.plot([p[0] for p in hull], [p[1] for p in hull], marker=marker, color=colour,
+                        linestyle="--" if dashed else "-", label=label,
+                        linewidth=2.5 if (backend == "custom" and not dashed) else 1.2)
+            if box:
+                ax.plot([p[0] for p in box], [p[1] for p in box], marker=marker, color=colour,
+                        linestyle="none", markerfacecolor="none", markersize=9,
+                        label=None if hull else label)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("hull vertices N (box at N = 8, open markers)")
+        ax.set_ylabel("time per query (µs)")
+        ax.set_title(f"Narrow phase, {pose} poses")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8, ncol=2)
+        save(fig, out, f"perf_narrowphase_{pose}")
+
+
+def broadphase(rows, out):
+    series = defaultdict(list)
+    for r in rows:
+        if r["kind"] == "broadphase" and r["ns_per_step"] is not None:
+            series[r["method"]].append((r["bodies"], r["ns_per_step"] * 1e-6))
+    if not series:
+        return
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for method, pts in sorted(series.items()):
+        pts.sort()
+        colour, marker = METHOD_STYLE.get(method, ("black", "o"))
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=marker, color=colour,
+                label=method)
+    # A slope-1 guide through the first point of the tree.
+    if "tree" in series:
+        n0, t0 = sorted(series["tree"])[0]
+        xs = [n0, sorted(series["tree"])[-1][0]]
+        ax.plot(xs, [t0 * x / n0 for x in xs], color="grey", linestyle=":", label="slope 1")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("bodies")
+    ax.set_ylabel("pair finding per step (ms)")
+    ax.set_title("Broad phase (same pairs from every method)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=9)
+    save(fig, out, "perf_broadphase")
+
+
+def step(rows, out):
+    bars = [r for r in rows if r["kind"] == "step" and r["us_per_body_step"] is not None]
+    if not bars:
+        return
+    fig, ax = plt.subplots(figsize=(7, 4))
+    labels = [f'{r["scene"]}\n{r["backend"]}' + ("" if r["variant"] == "default"
+                                                 else f' ({r["variant"]})') for r in bars]
+    colours = [COLOURS.get(r["backend"], "black") for r in bars]
+    ax.bar(range(len(bars)), [max(r["us_per_body_step"], 1e-3) for r in bars], color=colours)
+    ax.set_xticks(range(len(bars)))
+    ax.set_xticklabels(labels, fontsize=7)
+    ax.set_yscale("log")
+    ax.set_ylabel("µs per body per step")
+    ax.set_title("Whole step, scenes/many/")
+    ax.grid(True, axis="y", which="both", alpha=0.3)
+    save(fig, out, "perf_step")
+
+
+def main():
+    if len(sys.argv) != 2:
+        print(__doc__, file=sys.stderr)
+        return 2
+    folder = sys.argv[1]
+    rows = json.load(open(os.path.join(folder, "perf.json")))["rows"]
+    out = os.path.join(folder, "figures")
+    os.makedirs(out, exist_ok=True)
+    narrowphase(rows, out)
+    broadphase(rows, out)
+    step(rows, out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

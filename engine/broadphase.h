@@ -1,0 +1,74 @@
+// Broad phase: the pairs of bodies that pass the seed's bounding check (SEED_NOTES 7), found
+// without testing every pair.
+//
+// Design note. Every method returns exactly the pairs i < j for which bounding_check(bodies[i],
+// bodies[j]) is true, sorted by (i, j): the same set, in the order of the seed's double loop, so
+// the world resolves the same contacts in the same order whatever the method. The faster
+// methods only decide which pairs get the exact test: each bounding sphere is enclosed in an
+// axis-aligned box padded far beyond round-off, boxes that do not overlap cannot hold spheres
+// that do, and every surviving pair is then tested with the seed's own sphere expression.
+//   - all-pairs: the seed's loop, O(N^2); kept as the oracle.
+//   - sweep-and-prune: boxes sorted along the axis of largest spread (kept from call to call, so
+//     a small motion costs an insertion sort), then swept; O(N log N + pairs overlapping on that
+//     axis), which for bodies spread through a volume grows like N^(5/3).
+//   - tree: a bounding volume hierarchy of the boxes, rebuilt on every call (median splits), and
+//     traversed against itself; O(N log N + pairs), whatever the mix of body sizes.
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include "engine/body.h"
+#include "engine/bounding.h"
+
+namespace rbx {
+
+/// How candidate pairs are found (all give the same pairs; see the design note).
+enum class BroadPhaseMethod { AllPairs, SweepAndPrune, Tree };
+
+/// "all-pairs" | "sweep-and-prune" | "tree".
+const char* to_string(BroadPhaseMethod method);
+
+/// Two body indices, i < j.
+using BodyPair = std::pair<int, int>;
+
+/// A broad phase with reusable storage (and, for sweep and prune, the order of the last call).
+class BroadPhase {
+ public:
+  explicit BroadPhase(BroadPhaseMethod method = BroadPhaseMethod::Tree) : method_(method) {}
+
+  /// Every pair i < j of `bodies` for which bounding_check is true, sorted by (i, j). The
+  /// reference stays valid until the next call.
+  const std::vector<BodyPair>& find_pairs(const std::vector<RigidBody>& bodies);
+
+  BroadPhaseMethod method() const { return method_; }
+
+ private:
+  // A node of the tree over body boxes.
+  struct Node {
+    Vec3 min = Vec3::Zero(), max = Vec3::Zero();  // m, world
+    int child = -1;          // first child (the second is child + 1); -1 for a leaf
+    int begin = 0, end = 0;  // bodies order_[begin, end)
+  };
+
+  void all_pairs();
+  void sweep_and_prune();
+  void tree();
+  // The seed's test (bounding_check) on the cached spheres: |c_i - c_j| <= r_i + r_j.
+  bool spheres_touch(int i, int j) const;
+  // Records (min(i, j), max(i, j)) when the spheres touch.
+  void test_pair(int i, int j);
+
+  BroadPhaseMethod method_;
+  std::vector<BoundingSphere> spheres_;  // this call's bounding spheres (bounding_sphere())
+  std::vector<Vec3> box_min_, box_max_;  // m, padded boxes around them
+  std::vector<int> order_;               // sweep and prune: sorted along sap_axis_; tree: leaves
+  int sap_axis_ = -1;                    // axis of the last sweep (-1: none yet)
+  std::vector<Node> nodes_;              // tree
+  std::vector<std::pair<int, int>> node_pairs_;  // tree: traversal stack
+  std::vector<Vec3> leaf_min_, leaf_max_;        // tree: boxes in tree order
+  std::vector<BoundingSphere> leaf_spheres_;     // tree: spheres in tree order
+  std::vector<BodyPair> pairs_;
+};
+
+}  // namespace rbx

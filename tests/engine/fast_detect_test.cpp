@@ -1,0 +1,230 @@
+// The fast detector against the faithful seed loops (its oracle): on thousands of fixed-seed
+// poses of boxes, prisms and (sheared) icospheres from 8 to 642 vertices, touching, deep and
+// separated, the fast path returns the same hit or miss, feature, point, normal and depth as
+// the seed path, for the full detector and for each feature test alone (the world calls those).
+#include "engine/detect.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace rbx {
+namespace {
+
+// The fast path evaluates the seed's own floating-point expressions on the same world-frame
+// data and only skips evaluations a bound proves irrelevant, so its answers are expected to be
+// bit-identical: every comparison below is exact (no tolerance).
+void expect_same(const std::optional<ContactPoint>& fast, const std::optional<ContactPoint>& seed,
+                 const std::string& where) {
+  ASSERT_EQ(fast.has_value(), seed.has_value()) << where;
+  if (!seed) return;
+  EXPECT_EQ(fast->feature, seed->feature) << where;
+  EXPECT_EQ(fast->point, seed->point) << where << "\n fast " << fast->point.transpose()
+                                      << "\n seed " << seed->point.transpose();
+  EXPECT_EQ(fast->normal, seed->normal) << where << "\n fast " << fast->normal.transpose()
+                                        << "\n seed " << seed->normal.transpose();
+  EXPECT_EQ(fast->depth, seed->depth) << where;
+}
+
+Quat random_rotation(std::mt19937_64& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  return Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
+}
+
+Vec3 random_direction(std::mt19937_64& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  Vec3 d(g(rng), g(rng), g(rng));
+  return d.normalized();
+}
+
+// An icosphere under a fixed shear and stretch: convex (a linear image of a convex polyhedron),
+// with no symmetry left, so ties between faces are as rare as in generic hulls.
+ConvexPolyhedron sheared_icosphere(int subdivisions) {
+  const ConvexPolyhedron s = make_icosphere(0.5, subdivisions);
+  Mat3 m;
+  m << 1.0, 0.2, 0.0, 0.0, 0.8, 0.1, 0.1, 0.0, 0.6;
+  std::vector<Vec3> v;
+  for (const Vec3& p : s.vertices()) v.push_back(m * p);
+  return ConvexPolyhedron::from_triangles(v, s.triangles());
+}
+
+// Extent (m) of a shape along a world direction d at a pose: its support value h(d).
+double support(const ConvexPolyhedron& s, const Pose& p, const Vec3& d) {
+  double h = -1e300;
+  for (const Vec3& v : s.vertices()) h = std::max(h, p.apply(v).dot(d));
+  return h;
+}
+
+struct Tally {
+  int hits = 0, misses = 0;
+  std::map<std::string, int> features;
+};
+
+// Compares the two variants at one pose: the full detector and each feature test alone.
+void compare_at(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                const Pose& pb, const std::string& where, Tally& tally) {
+  const auto seed = detect(a, pa, b, pb, DetectorVariant::Seed);
+  const auto fast = detect(a, pa, b, pb, DetectorVariant::Fast);
+  expect_same(fast, seed, where);
+  if (seed) {
+    ++tally.hits;
+    ++tally.features[seed->feature];
+  } else {
+    ++tally.misses;
+  }
+  for (const char* feature : {"face", "vertex", "edge"})
+    expect_same(detect_feature(feature, a, pa, b, pb, DetectorVariant::Fast),
+                detect_feature(feature, a, pa, b, pb, DetectorVariant::Seed),
+                where + " feature " + feature);
+}
+
+// Random poses of a pair: B placed along a random direction d at the support-plane distance
+// h_A(d) + h_B(-d), then moved by `offset` times the larger size along d (negative: pushed
+// in) and by a small random sideways shift. Offsets: touching (within 1% of the size either
+// way), deep (10-30%), separated (1-10%).
+void random_poses(const ConvexPolyhedron& a, const ConvexPolyhedron& b, int count, uint64_t seed,
+                  const std::string& name, Tally& tally) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double size = std::max((a.bounds().max - a.bounds().min).norm(),
+                               (b.bounds().max - b.bounds().min).norm());
+  for (int i = 0; i < count; ++i) {
+    Pose pa, pb;
+    pa.position = Vec3(unit(rng), unit(rng), unit(rng)) - Vec3::Constant(0.5);
+    pa.orientation = random_rotation(rng);
+    pb.orientation = random_rotation(rng);
+    const Vec3 d = random_direction(rng);
+    pb.position = pa.position;
+    const double reach = support(a, pa, d) + support(b, pb, -d) - pb.position.dot(d) +
+                         pa.position.dot(d);
+    double offset;
+    switch (i % 3) {
+      case 0: offset = 0.02 * unit(rng) - 0.01; break;   // touching
+      case 1: offset = -0.1 - 0.2 * unit(rng); break;    // deep
+      default: offset = 0.01 + 0.09 * unit(rng); break;  // separated
+    }
+    pb.position = pa.position + (reach + offset * size) * d + 0.05 * size * random_direction(rng);
+    compare_at(a, pa, b, pb, name + " pose " + std::to_string(i), tally);
+  }
+}
+
+// Structured poses where ties decide the answer: axis-aligned orientations (multiples of 90
+// degrees) and offsets on a grid of quarter sizes, so faces are coplanar, vertices land exactly
+// on faces and edges on edges.
+void grid_poses(const ConvexPolyhedron& a, const ConvexPolyhedron& b, const std::string& name,
+                Tally& tally) {
+  const Quat quarter_turns[] = {Quat::Identity(),
+                                Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX())),
+                                Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ())),
+                                Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()))};
+  const double step = 0.25 * (b.bounds().max - b.bounds().min).maxCoeff();
+  int i = 0;
+  for (const Quat& q : quarter_turns)
+    for (int x = 2; x <= 5; ++x)
+      for (int y = -2; y <= 2; y += 2)
+        for (int z = -1; z <= 1; ++z) {
+          Pose pa, pb;
+          pb.orientation = q;
+          pb.position = Vec3(x * step, y * step, z * step);
+          compare_at(a, pa, b, pb, name + " grid " + std::to_string(i++), tally);
+        }
+}
+
+// A hit rate inside a band keeps the samples representative: every kind of answer is tested.
+void expect_representative(const Tally& t, const std::string& name) {
+  const int total = t.hits + t.misses;
+  EXPECT_GE(t.hits, total / 5) << name << ": too few contacts for the sample to test hits";
+  EXPECT_GE(t.misses, total / 10) << name << ": too few misses for the sample to test them";
+}
+
+TEST(FastDetect, BoxesMatchSeed) {
+  const ConvexPolyhedron a = make_box(Vec3(1, 1, 1)), b = make_box(Vec3(1.2, 0.6, 0.9));
+  Tally t;
+  random_poses(a, b, 3000, 1, "box-box", t);
+  grid_poses(a, b, "box-box", t);
+  expect_representative(t, "box-box");
+  // Random box poses reach all three tests.
+  EXPECT_GT(t.features["face"], 0);
+  EXPECT_GT(t.features["vertex"], 0);
+  EXPECT_GT(t.features["edge"], 0);
+}
+
+TEST(FastDetect, PrismsMatchSeed) {
+  // 8 sides: 28 triangles (plain loops); 24 sides: 92 triangles (hierarchies); both have
+  // fan-triangulated caps, so several coplanar triangles share a plane.
+  const ConvexPolyhedron p8 = make_prism(0.5, 0.8, 8), p24 = make_prism(0.5, 1.0, 24);
+  const ConvexPolyhedron box = make_box(Vec3(1, 1, 1));
+  Tally t;
+  random_poses(p24, p8, 1000, 2, "prism24-prism8", t);
+  random_poses(box, p24, 1000, 3, "box-prism24", t);
+  random_poses(p24, p24, 500, 4, "prism24-prism24", t);
+  // Two small shapes (plain loops and the plane table), one with 6-triangle fan caps.
+  random_poses(p8, box, 1000, 9, "prism8-box", t);
+  grid_poses(p8, box, "prism8-box", t);
+  grid_poses(p24, box, "prism24-box", t);
+  grid_poses(p24, p24, "prism24-prism24", t);
+  expect_representative(t, "prisms");
+  EXPECT_GT(t.features["edge"], 0);
+}
+
+TEST(FastDetect, IcospheresMatchSeed) {
+  const ConvexPolyhedron s1 = sheared_icosphere(1), s2 = sheared_icosphere(2);
+  const ConvexPolyhedron i2 = make_icosphere(0.5, 2), i3 = make_icosphere(0.5, 3);
+  const ConvexPolyhedron box = make_box(Vec3(1, 1, 1));
+  Tally t;
+  // Counts kept so that the seed oracle (~16 N^2 primitive tests a pose) runs in about a second.
+  random_poses(s1, s2, 600, 5, "sheared42-sheared162", t);
+  random_poses(box, s2, 400, 6, "box-sheared162", t);
+  random_poses(i2, s2, 200, 7, "ico162-sheared162", t);
+  random_poses(i3, s1, 60, 8, "ico642-sheared42", t);
+  grid_poses(i2, i2, "ico162-ico162", t);
+  expect_representative(t, "icospheres");
+}
+
+// Many distinct shapes alive at once and shapes destroyed and rebuilt at reused addresses: the
+// cached hierarchies always belong to the shape asked about.
+TEST(FastDetect, CacheFollowsShapes) {
+  Tally t;
+  for (int round = 0; round < 20; ++round) {
+    // A new shape each round, likely at the address of the last one, with a different size.
+    const ConvexPolyhedron a = make_prism(0.3 + 0.02 * round, 0.5, 20);
+    const ConvexPolyhedron b = make_prism(0.4, 0.3 + 0.03 * round, 20);
+    random_poses(a, b, 30, 100 + round, "round " + std::to_string(round), t);
+  }
+  expect_representative(t, "rebuilt shapes");
+}
+
+// The fast path keeps the last pair's world data for the next test of the same pair (the world
+// asks for the face, vertex and edge tests in turn): a different shape at the same poses must
+// not reuse it. Boxes of growing size, at the same fixed poses, one after the other.
+TEST(FastDetect, SamePosesNewShapes) {
+  Pose pa, pb;
+  pb.position = Vec3(1.0, 0.1, 0.05);
+  pb.orientation = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
+  int hits = 0;
+  for (int k = 0; k < 20; ++k) {
+    const ConvexPolyhedron a = make_box(Vec3::Constant(0.5 + 0.05 * k));
+    const ConvexPolyhedron b = make_box(Vec3(1.0, 0.8, 0.6));
+    for (const char* feature : {"face", "vertex", "edge"})
+      expect_same(detect_feature(feature, a, pa, b, pb, DetectorVariant::Fast),
+                  detect_feature(feature, a, pa, b, pb, DetectorVariant::Seed),
+                  "size " + std::to_string(k) + " " + feature);
+    const auto seed = detect(a, pa, b, pb, DetectorVariant::Seed);
+    expect_same(detect(a, pa, b, pb, DetectorVariant::Fast), seed, "size " + std::to_string(k));
+    hits += seed ? 1 : 0;
+  }
+  // B (half extents 0.5, 0.4, 0.3, any rotation) lies within its circumsphere of radius
+  // sqrt(0.25 + 0.16 + 0.09) = 0.707 m and contains its insphere of radius 0.3 m, centred at
+  // (1.0, 0.1, 0.05). A's half size grows from 0.25 m (k = 0: B starts at x >= 0.293 > 0.25,
+  // no contact) to 0.725 m (k = 19: B reaches x <= 0.7 with |y|, |z| < 0.725, the bodies
+  // overlap, and an edge crossing the overlap is found by the edge test): both answers occur.
+  EXPECT_GT(hits, 0);
+  EXPECT_LT(hits, 20);
+}
+
+}  // namespace
+}  // namespace rbx
