@@ -207,9 +207,10 @@ ObjLines scan_obj_lines(const std::string& text, const std::string& path, bool c
 std::string annotate(const std::string& message, const ObjLines& lines,
                      const std::vector<int>& triangle_face) {
   auto face_line = [&](int t) {
-    return t >= 0 && t < static_cast<int>(triangle_face.size())
-               ? lines.face_line[triangle_face[t]]
-               : -1;
+    if (t < 0 || t >= static_cast<int>(triangle_face.size())) return -1;
+    // tinyobjloader also ends lines at a lone '\r', so it can count more faces than the scan.
+    const int f = triangle_face[t];
+    return f < static_cast<int>(lines.face_line.size()) ? lines.face_line[f] : -1;
   };
   auto vertex_line = [&](int v) {
     return v >= 0 && v < static_cast<int>(lines.vertex_line.size()) ? lines.vertex_line[v] : -1;
@@ -251,6 +252,8 @@ ConvexPolyhedron load_obj(const std::string& path, bool hull) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw GeometryError(path + ": file not found");
   if (fs::is_directory(path, ec)) throw GeometryError(path + ": is a folder, not an OBJ file");
+  if (!fs::is_regular_file(path, ec))  // /dev/zero, a FIFO: reading would never end
+    throw GeometryError(path + ": is not a regular file (a device or a pipe), not an OBJ file");
   std::ifstream file(path, std::ios::binary);
   if (!file) throw GeometryError(path + ": cannot be read (" + std::strerror(errno) + ")");
   std::ostringstream buffer;

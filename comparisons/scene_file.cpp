@@ -955,6 +955,8 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   std::error_code ec;
   if (fs::is_directory(path, ec))
     throw InputError(path + ": is a folder, not a scene file; pass a .toml file");
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))  // /dev/zero, a FIFO: endless read
+    throw InputError(path + ": is not a regular file (a device or a pipe); pass a .toml file");
   std::ifstream file(path, std::ios::binary);
   if (!file)
     throw InputError(path + ": cannot open the scene file (" + std::strerror(errno) +

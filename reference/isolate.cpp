@@ -114,7 +114,8 @@ ContactResult run_isolated(const std::function<ContactResult()>& query, double t
   bool timed_out = false;
   char buf[4096];
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+    // Rounded up: truncating would time out up to 1 ms before the deadline.
+    const auto left = std::chrono::ceil<std::chrono::milliseconds>(
         deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) {
       timed_out = true;
