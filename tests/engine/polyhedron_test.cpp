@@ -207,6 +207,43 @@ TEST(PolyhedronValidation, NonConvexNamesTheVertexAndFace) {
   expect_rejected(v, t, {"not convex", "vertex 6", "face 10"});
 }
 
+TEST(PolyhedronValidation, PrunedConvexityCheckNamesWhatTheFullScanNames) {
+  // The convexity check prunes with a box tree over the vertices. Oracle: the plain scan of
+  // every vertex against every face plane, with the check's tolerance (1e-9 of the size), which
+  // names the first face with an outside vertex and its lowest-numbered outside vertex. Every
+  // 7th vertex of a 642-vertex icosphere in turn is pushed out by 5% of the radius (a face
+  // here sags ~1% below the sphere, so each push makes a dent).
+  const ConvexPolyhedron sphere = make_icosphere(1.0, 3);
+  const Triangles& t = sphere.triangles();
+  for (int k = 0; k < static_cast<int>(sphere.vertices().size()); k += 7) {
+    std::vector<Vec3> v = sphere.vertices();
+    v[k] *= 1.05;
+    Vec3 lo = v[0], hi = v[0];
+    for (const Vec3& x : v) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+    const double tol = 1e-9 * std::max((hi - lo).maxCoeff(), hi.cwiseAbs().maxCoeff());
+    std::string expected;
+    for (size_t f = 0; f < t.size() && expected.empty(); ++f) {
+      const Vec3 n = (v[t[f][1]] - v[t[f][0]]).cross(v[t[f][2]] - v[t[f][0]]).normalized();
+      for (int i = 0; i < static_cast<int>(v.size()) && expected.empty(); ++i)
+        if (n.dot(v[i]) - n.dot(v[t[f][0]]) > tol)
+          expected = "vertex " + std::to_string(i) + " ";
+      if (!expected.empty()) expected += "* face " + std::to_string(f) + " ";
+    }
+    ASSERT_FALSE(expected.empty()) << "the push of vertex " << k << " made no dent";
+    try {
+      ConvexPolyhedron::from_triangles(v, t);
+      ADD_FAILURE() << "vertex " << k << " pushed out was accepted";
+    } catch (const GeometryError& e) {
+      const std::string m = e.what();
+      const std::string vertex = expected.substr(0, expected.find('*'));
+      const std::string face = expected.substr(expected.find('*') + 2);
+      EXPECT_NE(m.find("not convex: " + vertex), std::string::npos) << m << " / " << expected;
+      EXPECT_NE(m.find("plane of " + face + "("), std::string::npos)
+          << m << " / " << expected;
+    }
+  }
+}
+
 TEST(PolyhedronValidation, ZeroVolumeIsRejected) {
   // The tetrahedron's topology on four coplanar points: no triangle is degenerate (each spans
   // half the unit square) but the enclosed volume is 0.
