@@ -15,10 +15,11 @@
 // Every case runs one untimed pass first (warm-up: caches, lazily built hierarchies, page
 // faults), then Google Benchmark times iterations until the case's minimum time.
 //
-// Output, into --out (default reports/, so reports/perf.md as CONTRACT.md names it; outside
-// reports/latest, which `rbx report` replaces whole), each file written atomically next to
-// whatever the folder holds already: perf.md, perf.json, perf.csv and figures/perf_*.{png,svg}
-// (comparisons/bench_plots.py, matplotlib).
+// Output, into --out (default reports/latest, beside `rbx report`'s files, which that command
+// carries over when it replaces the folder), each file written atomically next to whatever the
+// folder holds already: perf.md, perf.json, perf.csv and figures/perf_*.{png,svg}
+// (comparisons/bench_plots.py, matplotlib). Without --out, reports/perf.md (the path
+// CONTRACT.md names) gets a copy of perf.md whose figure links point into latest/.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
@@ -335,7 +336,7 @@ double find_time(const std::vector<NarrowRow>& rows, const std::string& backend,
 
 int bench_command(const BenchOptions& opt) {
   const Plan plan = make_plan(opt.quick);
-  const std::string out = opt.out.empty() ? "reports" : opt.out;
+  const std::string out = opt.out.empty() ? "reports/latest" : opt.out;
   Stopwatch clock;
   std::mt19937_64 rng(20240606);
 
@@ -810,6 +811,13 @@ int bench_command(const BenchOptions& opt) {
   } catch (...) {
     fs::remove_all(tmp);
     throw;
+  }
+  // The contract's reports/perf.md: the same page, its figure links relative to reports/.
+  if (opt.out.empty()) {
+    std::string page = md.str();
+    for (size_t at = 0; (at = page.find("](figures/", at)) != std::string::npos; at += 17)
+      page.replace(at, 10, "](latest/figures/");
+    write_text((target.parent_path() / "perf.md").string(), page);
   }
   std::cout << "bench: " << (target / "perf.md").string() << " (" << total << " cases, "
             << fmt(clock.seconds(), 3) << " s)\n";

@@ -71,7 +71,7 @@ namespace rbx {
 
 /// Options of `rbx bench`.
 struct BenchOptions {
-  std::string out;     // output folder ("" : reports, for reports/perf.md)
+  std::string out;     // output folder ("" : reports/latest, plus reports/perf.md)
   bool quick = false;  // --quick: fewer sizes and shorter runs (under a minute)
 };
 

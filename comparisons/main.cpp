@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
   check->add_option("--baseline", check_opt.baseline, "baseline file");
   check->add_flag("--update", check_opt.update, "rewrite the baseline from this run");
   rbx::BenchOptions bench_opt;
-  CLI::App* bench = app.add_subcommand("bench", "performance comparison (default: reports/perf.md)");
+  CLI::App* bench = app.add_subcommand("bench", "performance comparison (default: reports/latest, and reports/perf.md)");
   bench->add_option("--out", bench_opt.out, "output folder");
   bench->add_flag("--quick", bench_opt.quick, "fewer sizes and shorter runs (under a minute)");
 

@@ -346,6 +346,14 @@ int report_command(const ReportOptions& opt) {
     }
     write_text((tmp / "report.md").string(),
                write_markdown(scenes, evs, clock.seconds(), figures_ok, figures_msg));
+    // `rbx bench` output in the old folder is kept (its own command, not this report's).
+    std::error_code ec;
+    for (const char* f : {"perf.md", "perf.json", "perf.csv"})
+      if (fs::exists(target / f, ec)) fs::rename(target / f, tmp / f);
+    if (fs::is_directory(target / "figures", ec))
+      for (const auto& entry : fs::directory_iterator(target / "figures", ec))
+        if (entry.path().filename().string().rfind("perf_", 0) == 0)
+          fs::rename(entry.path(), tmp / "figures" / entry.path().filename());
     fs::remove_all(target);
     fs::rename(tmp, target);
   } catch (...) {
