@@ -570,6 +570,14 @@ class Evaluator {
     double e_max = e0, pen_max = 0.0, drift = 0.0, hdrift = 0.0;
     const double e_scale = std::max({std::abs(e0), kinetic_energy(inputs_), 1e-300});
     int tunnelled = 0;
+    // Per body, once: the exact query's topology, and a radius about the centre of mass that
+    // holds every vertex (the bounding sphere's, plus its centre's offset from the COM).
+    std::vector<SatShape> sat_shapes;
+    std::vector<double> radius;
+    for (const RigidBody& b : inputs_) {
+      sat_shapes.emplace_back(*b.shape);
+      radius.push_back(bounding_sphere(b).radius + b.shape->bounds().center().norm());
+    }
     // Initial separating direction per pair (exact), to see who ends up past whom. Watched:
     // every pair with a static body (walls, floors), and every pair in scenes of up to three
     // bodies; free bodies in a crowd legitimately change sides, and 500,000 pairs cost too much.
@@ -578,7 +586,7 @@ class Evaluator {
       for (size_t k = i + 1; k < inputs_.size(); ++k) {
         if (inputs_[i].is_static && inputs_[k].is_static) continue;
         if (inputs_.size() > 3 && !inputs_[i].is_static && !inputs_[k].is_static) continue;
-        const SatResult sat = sat_query(*inputs_[i].shape, inputs_[i].pose(), *inputs_[k].shape, inputs_[k].pose());
+        const SatResult sat = sat_query(sat_shapes[i], inputs_[i].pose(), sat_shapes[k], inputs_[k].pose());
         if (sat.touching) continue;
         // Half-thickness of both bodies along the separating normal, at the t = 0 poses.
         double reach = 0.0;
@@ -610,9 +618,9 @@ class Evaluator {
           if (inputs_[i].is_static && inputs_[k].is_static) continue;
           const Pose pa{smp.bodies[i].position, smp.bodies[i].orientation};
           const Pose pb{smp.bodies[k].position, smp.bodies[k].orientation};
-          const double reach = bounding_sphere(inputs_[i]).radius + bounding_sphere(inputs_[k]).radius;
+          const double reach = radius[i] + radius[k];
           if ((pa.position - pb.position).norm() > reach + 1e-9 * reach) continue;
-          const SatResult sat = sat_query(*inputs_[i].shape, pa, *inputs_[k].shape, pb);
+          const SatResult sat = sat_query(sat_shapes[i], pa, sat_shapes[k], pb);
           if (sat.touching)
             pen_max = std::max(pen_max, sat.depth / std::min(body_size(inputs_[i]), body_size(inputs_[k])));
         }
@@ -625,7 +633,7 @@ class Evaluator {
         const Vec3 d = smp.bodies[i].position - smp.bodies[k].position;
         const double side0 = d0.dot(n), side = d.dot(n);
         const double lateral = (d - side * n).norm();
-        const double beside = bounding_sphere(inputs_[i]).radius + bounding_sphere(inputs_[k]).radius;
+        const double beside = radius[i] + radius[k];
         if (side0 > 0 && side < -reach && lateral < beside) passed[w] = true;
       }
     }

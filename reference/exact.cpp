@@ -41,6 +41,7 @@
 #include <limits>
 #include <map>
 #include <stdexcept>
+#include <memory>
 #include <unordered_map>
 #include <utility>
 
@@ -87,6 +88,11 @@ constexpr double kTieCosine = 1e-10;
 // ~1e-16): generous, since a kept pair costs time only.
 constexpr double kMinkowskiSlack = 1e-12;
 
+}  // namespace
+
+// The topology types are named (not file-local) so that SatShape in exact.h can hold one.
+namespace exact_detail {
+
 // One merged (polygonal) face of a polyhedron, in the body frame.
 struct MergedFace {
   Vec3 normal = Vec3::UnitZ();  // unit, outward
@@ -110,6 +116,14 @@ struct Topology {
   std::vector<std::vector<int>> vertex_faces;  // faces touching each vertex
   std::vector<std::vector<int>> neighbours;    // vertices joined to each vertex by a mesh edge
 };
+
+}  // namespace exact_detail
+
+namespace {
+
+using exact_detail::FeatureEdge;
+using exact_detail::MergedFace;
+using exact_detail::Topology;
 
 // Merges coplanar triangles into polygonal faces and lists the edges of the solid.
 Topology build_topology(const ConvexPolyhedron& p) {
@@ -235,20 +249,21 @@ Topology build_topology(const ConvexPolyhedron& p) {
 
 // A polyhedron placed in the world, coordinates relative to the query origin.
 struct Placed {
-  Topology topo;
+  const Topology* topo = nullptr;  // the shape's, from its SatShape
   std::vector<Vec3> x;             // m, vertices relative to the query origin
   std::vector<Vec3> face_normals;  // unit, world, outward
   std::vector<Vec3> directions;    // unit, world, one per parallel-edge class
 };
 
-Placed place(const ConvexPolyhedron& p, const Pose& pose, const Vec3& origin) {
+Placed place(const SatShape& shape, const Pose& pose, const Vec3& origin) {
+  const ConvexPolyhedron& p = shape.shape();
   Placed s;
-  s.topo = build_topology(p);
+  s.topo = &shape.topology();
   const Mat3 r = pose.rotation();
   const Vec3 offset = pose.position - origin;
   for (const Vec3& v : p.vertices()) s.x.push_back(r * v + offset);
-  for (const MergedFace& f : s.topo.faces) s.face_normals.push_back(r * f.normal);
-  for (const Vec3& d : s.topo.directions) s.directions.push_back(r * d);
+  for (const MergedFace& f : s.topo->faces) s.face_normals.push_back(r * f.normal);
+  for (const Vec3& d : s.topo->directions) s.directions.push_back(r * d);
   return s;
 }
 
@@ -263,7 +278,7 @@ double support(const Placed& s, const Vec3& dir, int& start) {
   double best = s.x[at].dot(dir);
   for (bool moved = true; moved;) {
     moved = false;
-    for (int nb : s.topo.neighbours[at]) {
+    for (int nb : s.topo->neighbours[at]) {
       const double h = s.x[nb].dot(dir);
       if (h > best) {
         best = h;
@@ -304,17 +319,17 @@ struct Axis {
 // Face axes of `owner` (slot o): overlap = owner's extent along u minus the other's minimum.
 void face_axes(const Placed& owner, const Placed& other, int o, std::vector<Axis>& out) {
   int deepest = 0;  // warm start: consecutive faces have nearby supports
-  for (size_t f = 0; f < owner.topo.faces.size(); ++f) {
+  for (size_t f = 0; f < owner.topo->faces.size(); ++f) {
     const Vec3& u = owner.face_normals[f];
     double hi = -std::numeric_limits<double>::infinity();
-    for (int w : owner.topo.faces[f].vertices) hi = std::max(hi, owner.x[w].dot(u));
+    for (int w : owner.topo->faces[f].vertices) hi = std::max(hi, owner.x[w].dot(u));
     const double lo = -support(other, -u, deepest);
     Axis ax;
     ax.overlap = hi - lo;
     ax.normal = o == 1 ? u : Vec3(-u);  // B's face pushes A along u; A's face pulls A back
     ax.owner = o;
     ax.face = static_cast<int>(f);
-    ax.area = owner.topo.faces[f].area;
+    ax.area = owner.topo->faces[f].area;
     ax.outward = u;
     out.push_back(ax);
   }
@@ -354,17 +369,17 @@ ArcBall arc_ball(const Vec3& p, const Vec3& q, int edge) {
 // from a sweep over the arcs' bounding balls sorted along x, so the cost grows with the number of
 // nearby arcs, not with the product of the edge counts.
 std::vector<Axis> edge_axes(const Placed& a, const Placed& b) {
-  const long long nb = static_cast<long long>(b.topo.directions.size());
+  const long long nb = static_cast<long long>(b.topo->directions.size());
   // Arcs of B negated (Minkowski difference A - B); b x a for A's arcs, d x c for B's.
   std::vector<Vec3> bxa, dxc;
-  for (const FeatureEdge& e : a.topo.edges)
+  for (const FeatureEdge& e : a.topo->edges)
     bxa.push_back(a.face_normals[e.face1].cross(a.face_normals[e.face0]));
-  for (const FeatureEdge& e : b.topo.edges)
+  for (const FeatureEdge& e : b.topo->edges)
     dxc.push_back((-b.face_normals[e.face1]).cross(-b.face_normals[e.face0]));
   std::vector<ArcBall> balls_b;
   double max_radius_b = 0.0;
-  for (size_t j = 0; j < b.topo.edges.size(); ++j) {
-    const FeatureEdge& e = b.topo.edges[j];
+  for (size_t j = 0; j < b.topo->edges.size(); ++j) {
+    const FeatureEdge& e = b.topo->edges[j];
     balls_b.push_back(
         arc_ball(-b.face_normals[e.face0], -b.face_normals[e.face1], static_cast<int>(j)));
     max_radius_b = std::max(max_radius_b, balls_b.back().radius);
@@ -374,8 +389,8 @@ std::vector<Axis> edge_axes(const Placed& a, const Placed& b) {
 
   // Class pairs, as ca * nb + cb, each with one edge pair of that class pair.
   std::vector<std::pair<long long, std::pair<int, int>>> needed;
-  for (size_t i = 0; i < a.topo.edges.size(); ++i) {
-    const FeatureEdge& ea = a.topo.edges[i];
+  for (size_t i = 0; i < a.topo->edges.size(); ++i) {
+    const FeatureEdge& ea = a.topo->edges[i];
     const Vec3& na = a.face_normals[ea.face0];
     const Vec3& nb_ = a.face_normals[ea.face1];
     const ArcBall ball = arc_ball(na, nb_, static_cast<int>(i));
@@ -385,7 +400,7 @@ std::vector<Axis> edge_axes(const Placed& a, const Placed& b) {
                                [](const ArcBall& x, double v) { return x.mid.x() < v; });
     for (; it != balls_b.end() && it->mid.x() <= ball.mid.x() + reach; ++it) {
       if ((it->mid - ball.mid).norm() > ball.radius + it->radius) continue;
-      const FeatureEdge& eb = b.topo.edges[it->edge];
+      const FeatureEdge& eb = b.topo->edges[it->edge];
       const Vec3 c = -b.face_normals[eb.face0];
       const Vec3 d = -b.face_normals[eb.face1];
       const double cba = c.dot(bxa[i]), dba = d.dot(bxa[i]);
@@ -409,8 +424,8 @@ std::vector<Axis> edge_axes(const Placed& a, const Placed& b) {
     if (s <= kParallelSine) continue;
     m /= s;
     // Supports climbed from the pair's own edges, where a true Minkowski face has them.
-    int sa_hi = a.topo.edges[edges.first].a, sa_lo = sa_hi;
-    int sb_hi = b.topo.edges[edges.second].a, sb_lo = sb_hi;
+    int sa_hi = a.topo->edges[edges.first].a, sa_lo = sa_hi;
+    int sb_hi = b.topo->edges[edges.second].a, sb_lo = sb_hi;
     const double hi_a = support(a, m, sa_hi), lo_a = -support(a, -m, sa_lo);
     const double hi_b = support(b, m, sb_hi), lo_b = -support(b, -m, sb_lo);
     const double plus = hi_b - lo_a;   // move A along +m
@@ -481,7 +496,7 @@ void closest_points(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& 
 // Face-axis manifold: reference face `face` of `ref`, incident feature of `inc`.
 std::vector<Vec3> face_manifold(const Placed& ref, int face, const Placed& inc, double tol) {
   const Vec3& n = ref.face_normals[face];
-  const MergedFace& rf = ref.topo.faces[face];
+  const MergedFace& rf = ref.topo->faces[face];
   double plane = -std::numeric_limits<double>::infinity();
   for (int w : rf.vertices) plane = std::max(plane, ref.x[w].dot(n));
 
@@ -489,7 +504,7 @@ std::vector<Vec3> face_manifold(const Placed& ref, int face, const Placed& inc, 
   int deepest = 0;
   for (size_t i = 1; i < inc.x.size(); ++i)
     if (inc.x[i].dot(n) < inc.x[deepest].dot(n)) deepest = static_cast<int>(i);
-  const std::vector<int>& around = inc.topo.vertex_faces[deepest];
+  const std::vector<int>& around = inc.topo->vertex_faces[deepest];
   double best = std::numeric_limits<double>::infinity();
   for (int f : around) best = std::min(best, inc.face_normals[f].dot(n));
   std::vector<int> tied;
@@ -499,12 +514,12 @@ std::vector<Vec3> face_manifold(const Placed& ref, int face, const Placed& inc, 
   // Incident polygon: one face's loop, or the feature the tied faces share (edge or vertex).
   std::vector<Vec3> poly;
   if (tied.size() == 1) {
-    for (int w : inc.topo.faces[tied[0]].loop) poly.push_back(inc.x[w]);
+    for (int w : inc.topo->faces[tied[0]].loop) poly.push_back(inc.x[w]);
   } else {
-    std::vector<int> common = inc.topo.faces[tied[0]].vertices;
+    std::vector<int> common = inc.topo->faces[tied[0]].vertices;
     for (size_t k = 1; k < tied.size(); ++k) {
       std::vector<int> both;
-      const auto& fv = inc.topo.faces[tied[k]].vertices;
+      const auto& fv = inc.topo->faces[tied[k]].vertices;
       std::set_intersection(common.begin(), common.end(), fv.begin(), fv.end(),
                             std::back_inserter(both));
       common = std::move(both);
@@ -558,8 +573,8 @@ Vec3 edge_manifold(const Placed& a, int class_a, const Placed& b, int class_b, c
   auto supporting = [](const Placed& s, int cls, const Vec3& dir) {
     int best = -1;
     double best_s = std::numeric_limits<double>::infinity();
-    for (size_t i = 0; i < s.topo.edges.size(); ++i) {
-      const FeatureEdge& e = s.topo.edges[i];
+    for (size_t i = 0; i < s.topo->edges.size(); ++i) {
+      const FeatureEdge& e = s.topo->edges[i];
       if (e.direction != cls) continue;
       const double h = (s.x[e.a] + s.x[e.b]).dot(dir);
       if (h < best_s) {
@@ -567,7 +582,7 @@ Vec3 edge_manifold(const Placed& a, int class_a, const Placed& b, int class_b, c
         best = static_cast<int>(i);
       }
     }
-    return s.topo.edges[best];
+    return s.topo->edges[best];
   };
   const FeatureEdge ea = supporting(a, class_a, n);
   const FeatureEdge eb = supporting(b, class_b, -n);
@@ -596,8 +611,15 @@ Vec3 centroid(const std::vector<Vec3>& pts, const Vec3& normal) {
 
 }  // namespace
 
+SatShape::SatShape(const ConvexPolyhedron& shape)
+    : shape_(&shape), topology_(std::make_shared<const Topology>(build_topology(shape))) {}
+
 SatResult sat_query(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                     const Pose& pb) {
+  return sat_query(SatShape(a), pa, SatShape(b), pb);
+}
+
+SatResult sat_query(const SatShape& a, const Pose& pa, const SatShape& b, const Pose& pb) {
   // Query origin: midpoint of the two poses (symmetric in the arguments).
   const Vec3 origin = 0.5 * (pa.position + pb.position);
   const Placed sa = place(a, pa, origin);

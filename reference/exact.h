@@ -1,6 +1,8 @@
 // Exact contact oracle: separating-axis test over all face normals and edge-pair cross products, and the contact manifold by clipping the reference face against the incident face.
 #pragma once
 
+#include <memory>
+
 #include "reference/backend.h"
 
 namespace rbx {
@@ -14,9 +16,31 @@ struct SatResult {
   std::vector<Vec3> manifold;  // contact polygon (world): clipped reference/incident faces
 };
 
+namespace exact_detail {
+struct Topology;  // merged faces, feature edges and parallel-edge classes (exact.cpp)
+}  // namespace exact_detail
+
+/// A polyhedron prepared for the exact query: its merged faces and edge classes, computed once
+/// for many queries (the shape must outlive it; copies share the topology).
+class SatShape {
+ public:
+  explicit SatShape(const ConvexPolyhedron& shape);
+  /// The polyhedron it was built from.
+  const ConvexPolyhedron& shape() const { return *shape_; }
+  /// Its topology (exact.cpp).
+  const exact_detail::Topology& topology() const { return *topology_; }
+
+ private:
+  const ConvexPolyhedron* shape_;
+  std::shared_ptr<const exact_detail::Topology> topology_;
+};
+
 /// Exact separating-axis query.
 SatResult sat_query(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                     const Pose& pb);
+
+/// The same query on prepared shapes (same answer, without rebuilding their topology).
+SatResult sat_query(const SatShape& a, const Pose& pa, const SatShape& b, const Pose& pb);
 
 /// Backend `exact`: one contact per manifold point, each with the SAT normal and depth;
 /// the first contact is the manifold centroid.

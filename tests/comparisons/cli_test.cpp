@@ -161,10 +161,20 @@ TEST(Cli, CheckPassesOnItsOwnBaselineAndFailsOnOneClaimingSmallerErrors) {
 
 TEST(Cli, ReportWritesEverythingIntoItsFolder) {
   const fs::path dir = temp_dir("report");
+  // An earlier `rbx bench` in the same folder: kept; an old report file: replaced.
+  fs::create_directories(dir / "out/figures");
+  std::ofstream(dir / "out/perf.md") << "bench page";
+  std::ofstream(dir / "out/figures/perf_step.png") << "bench figure";
+  std::ofstream(dir / "out/stale.md") << "old";
   const CmdResult r = rbx("report scenes/seed/face_face.toml --out '" + (dir / "out").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* f : {"report.md", "results.json", "metrics.csv", "sweep.csv", "stability.csv"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
+  std::stringstream page;
+  page << std::ifstream(dir / "out/perf.md").rdbuf();
+  EXPECT_EQ(page.str(), "bench page");
+  EXPECT_TRUE(fs::exists(dir / "out/figures/perf_step.png"));
+  EXPECT_FALSE(fs::exists(dir / "out/stale.md"));
   // Nothing temporary is left beside it.
   int entries = 0;
   for (const auto& e : fs::directory_iterator(dir)) (void)e, ++entries;
