@@ -1484,8 +1484,12 @@ const Prepared& prepare(const ConvexPolyhedron& a, const Pose& pa, const ConvexP
   const bool small = static_cast<int>(a.triangles().size()) <= kSmallTriangles &&
                      static_cast<int>(b.triangles().size()) <= kSmallTriangles;
   if (small && reusable && same_pose(pa, pose_a) && same_pose(pb, pose_b) && copy_a.same(a) &&
-      copy_b.same(b))
+      copy_b.same(b)) {
+    // Equal geometry, but maybe another object (the last one may be gone): point at these.
+    last.a.shape = &a;
+    last.b.shape = &b;
     return last;
+  }
   last.lim = limits_of(a, pa, b, pb);
   last.a = place(a, pa, 0);
   last.b = place(b, pb, 1);

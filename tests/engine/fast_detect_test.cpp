@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <map>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -224,6 +225,29 @@ TEST(FastDetect, SamePosesNewShapes) {
   // overlap, and an edge crossing the overlap is found by the edge test): both answers occur.
   EXPECT_GT(hits, 0);
   EXPECT_LT(hits, 20);
+}
+
+// The reused preparation of the last pair must not keep pointing at the last pair's shapes:
+// equal shapes at the same poses, the first ones destroyed before the second query (found by
+// the convex_detect fuzzer: a read of a dead shape, reported by ASan, which `./rbx test
+// --sanitize` turns into a failure here).
+TEST(FastDetect, EqualShapesAfterTheFirstAreDestroyed) {
+  Pose pa, pb;
+  pb.position = Vec3(0.9, 0.1, 0.05);
+  pb.orientation = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
+  auto a = std::make_unique<ConvexPolyhedron>(make_box(Vec3::Constant(1.0)));
+  auto b = std::make_unique<ConvexPolyhedron>(make_box(Vec3(1.0, 0.8, 0.6)));
+  const auto first = detect(*a, pa, *b, pb, DetectorVariant::Fast);
+  ASSERT_TRUE(first.has_value());
+  // New objects, built while the old ones are alive so that they get other addresses.
+  auto a2 = std::make_unique<ConvexPolyhedron>(make_box(Vec3::Constant(1.0)));
+  auto b2 = std::make_unique<ConvexPolyhedron>(make_box(Vec3(1.0, 0.8, 0.6)));
+  a.reset();
+  b.reset();
+  for (const char* feature : {"face", "vertex", "edge"})
+    expect_same(detect_feature(feature, *a2, pa, *b2, pb, DetectorVariant::Fast),
+                detect_feature(feature, *a2, pa, *b2, pb, DetectorVariant::Seed), feature);
+  expect_same(detect(*a2, pa, *b2, pb, DetectorVariant::Fast), first, "equal shapes");
 }
 
 }  // namespace
