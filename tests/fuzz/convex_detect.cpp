@@ -1,0 +1,120 @@
+// Fuzz target `convex_detect`: the custom detector on random convex pairs (see targets.h).
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "comparisons/mesh_io.h"
+#include "engine/detect.h"
+#include "tests/fuzz/byte_reader.h"
+#include "tests/fuzz/targets.h"
+
+namespace rbx::fuzz {
+
+namespace {
+
+// A power of two from 2^-12 to 2^12 (m): shapes from ~0.2 mm to ~4 km, size ratios to 2^24.
+double scale_from(ByteReader& in) { return std::ldexp(1.0, in.u8() % 25 - 12); }
+
+// 4 to 16 points on a 1/8 grid times the shape's scale: coplanar, collinear and coincident
+// points are common, which is what the hull and the detector's degenerate branches need.
+std::vector<Vec3> decode_points(ByteReader& in) {
+  const double scale = scale_from(in);
+  const int n = 4 + in.u8() % 13;
+  std::vector<Vec3> points;
+  for (int i = 0; i < n; ++i)
+    points.emplace_back(in.i8() / 8.0 * scale, in.i8() / 8.0 * scale, in.i8() / 8.0 * scale);
+  return points;
+}
+
+// A pose: position in units of `reach` (so the shapes overlap often), orientation from four
+// signed bytes normalised (small integers give exact 90 and 180 degree turns too).
+Pose decode_pose(ByteReader& in, double reach) {
+  Pose p;
+  p.position = Vec3(in.i8(), in.i8(), in.i8()) * (reach / 64.0);
+  const Quat q(in.i8(), in.i8(), in.i8(), in.i8());
+  if (q.norm() > 0) p.orientation = q.normalized();
+  return p;
+}
+
+// Size (m) of a shape: the diagonal of its bounding box.
+double size_of(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
+
+// World bounding box of a placed shape.
+Aabb world_box(const ConvexPolyhedron& s, const Pose& pose) {
+  Aabb box;
+  box.min = box.max = pose.apply(s.vertices()[0]);
+  for (const Vec3& v : s.vertices()) {
+    const Vec3 w = pose.apply(v);
+    box.min = box.min.cwiseMin(w);
+    box.max = box.max.cwiseMax(w);
+  }
+  return box;
+}
+
+std::string describe(const ContactPoint& c) {
+  std::ostringstream s;
+  s.precision(17);
+  s << c.feature << " point (" << c.point.transpose() << ") normal (" << c.normal.transpose()
+    << ") depth " << c.depth;
+  return s.str();
+}
+
+// The contract of a contact (engine/contact.h): unit normal, finite point, finite depth >= 0.
+void check_contact(const ContactPoint& c, const std::string& variant) {
+  const std::string what = variant + ": " + describe(c);
+  require(c.point.allFinite(), "non-finite point: " + what);
+  require(c.normal.allFinite(), "non-finite normal: " + what);
+  // Unit to round-off: a normalised vector is within a few ulps of length 1.
+  require(std::abs(c.normal.norm() - 1.0) < 1e-12, "normal not unit: " + what);
+  require(std::isfinite(c.depth) && c.depth >= 0, "depth negative or non-finite: " + what);
+  require(c.feature == "face" || c.feature == "vertex" || c.feature == "edge",
+          "unknown feature: " + what);
+}
+
+}  // namespace
+
+void convex_detect(const uint8_t* data, size_t size) {
+  ByteReader in(data, size);
+  const std::vector<Vec3> points_a = decode_points(in);
+  const std::vector<Vec3> points_b = decode_points(in);
+  std::optional<ConvexPolyhedron> a, b;
+  try {
+    a = convex_hull(points_a);
+    b = convex_hull(points_b);
+  } catch (const GeometryError&) {
+    return;  // flat or too few distinct points: not a pair to test
+  }
+  const double reach = size_of(*a) + size_of(*b);
+  const Pose pa = decode_pose(in, reach);
+  const Pose pb = decode_pose(in, reach);
+
+  const std::optional<ContactPoint> seed = detect(*a, pa, *b, pb, DetectorVariant::Seed);
+  const std::optional<ContactPoint> fast = detect(*a, pa, *b, pb, DetectorVariant::Fast);
+  if (seed) check_contact(*seed, "Seed");
+  if (fast) check_contact(*fast, "Fast");
+
+  // Apart shapes have no contact. The detector counts points up to its tolerance outside a face
+  // plane as inside; near a sharp vertex that slab reaches tol / sin(angle) out, and the 1/8
+  // grid allows angles down to ~1e-5 rad, so only a gap above 1e-3 of the larger size is
+  // certainly no touch.
+  const Aabb box_a = world_box(*a, pa), box_b = world_box(*b, pb);
+  const double gap = std::max((box_a.min - box_b.max).maxCoeff(), (box_b.min - box_a.max).maxCoeff());
+  const double larger = std::max(size_of(*a), size_of(*b));
+  if (gap > 1e-3 * larger) require(!seed, "contact between shapes " + std::to_string(gap) + " m apart: " + describe(*seed));
+
+  // Fast must give Seed's answer (engine/detect.h), to round-off: both sum the same handful of
+  // terms of order `reach`, so 1e-9 of it is ~10^6 ulps of room for a different order of sums.
+  require(seed.has_value() == fast.has_value(), "Fast and Seed disagree on touching");
+  if (seed && fast) {
+    const double tol = 1e-9 * reach;
+    require(seed->feature == fast->feature,
+            "Fast and Seed disagree on the feature: " + describe(*seed) + " vs " + describe(*fast));
+    require((seed->point - fast->point).norm() <= tol && (seed->normal - fast->normal).norm() <= 1e-9 &&
+                std::abs(seed->depth - fast->depth) <= tol,
+            "Fast and Seed disagree: " + describe(*seed) + " vs " + describe(*fast));
+  }
+}
+
+}  // namespace rbx::fuzz
