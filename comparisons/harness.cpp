@@ -707,6 +707,17 @@ class Evaluator {
         if (r.volume >= 0)
           metric("mass", name, body.name, "volume_err_rel", std::abs(r.volume - volume) / volume,
                  "exact solid");
+        // Marks: above 1 % a different model or a defect (✗); above 1e-6, more than the
+        // round-off of a library storing vertices in float (MuJoCo), a deviation (~).
+        const double worst = std::max({std::abs(r.mass - exact.mass) / exact.mass,
+                                       (r.center_of_mass - exact.center_of_mass).norm() / size,
+                                       (r.inertia - exact.inertia).norm() / exact.inertia.norm()});
+        const std::string what =
+            name + " on " + body.name + ": mass properties off by " + fmt_num(worst, 3) +
+            " (relative, worst of mass, centre of mass and inertia) against the exact solid" +
+            (name == "custom" ? " (the seed's point masses at the vertices)" : "");
+        if (worst > 1e-2) out_.disagreements.push_back(what);
+        else if (worst > 1e-6) out_.deviations.push_back(what);
       };
       // The seed's model (point masses at the vertices) on the same hull.
       const MassProperties seed = vertex_mass_properties(*body.shape, body.mass);

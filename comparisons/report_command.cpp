@@ -93,6 +93,13 @@ std::string headline(const SceneEvaluation& ev, const std::string& backend, std:
   } else if (const Metric* v = find_metric(ev, backend, "velocity_err_ke")) {
     cell = fmt_num(v->value, 2);
     against = v->against;
+  } else if (find_metric(ev, backend, "inertia_err_rel")) {
+    // Mass scenes: the worst relative inertia error over the bodies.
+    double worst = 0.0;
+    for (const Metric& m : ev.metrics)
+      if (m.backend == backend && m.name == "inertia_err_rel") worst = std::max(worst, m.value);
+    cell = "inertia " + fmt_num(worst, 2);
+    against = "exact solid";
   } else if (ev.json["stability"].contains(backend)) {
     cell = ev.json["stability"][backend]["verdict"];
   } else if (t) {
