@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
+
 namespace rbx {
 
 namespace {
@@ -14,6 +16,41 @@ Quat exp_map(const Vec3& phi) {
 }
 
 }  // namespace
+
+Quat rotate_free_body(const Quat& orientation, const Mat3& inertia_body, const Vec3& momentum,
+                      double dt) {
+  // Design note. The free rigid body H = sum_k l_k^2 / (2 I_k) (l = body-frame momentum,
+  // I_k principal moments, ascending) is split as a symmetric top, which has an exact flow,
+  // plus a remainder on the middle axis, also exact; Strang composition of the two is second
+  // order, symplectic and keeps L exactly (Touma & Wisdom 1994; Dullweber, Leimkuhler and
+  // McLachlan 1997). The top's equal pair is the middle moment's nearer neighbour, so the
+  // remainder is as small as it can be, and zero for axisymmetric and isotropic bodies, whose
+  // motion is then exact for any dt. The earlier exponential map of w dt with w recovered from
+  // L after the step kept L but let the energy drift at first order (3 % in 16 s of an
+  // intermediate-axis spin at dt = 1e-3).
+  Eigen::SelfAdjointEigenSolver<Mat3> eig;
+  eig.computeDirect(inertia_body);
+  const Vec3 moments = eig.eigenvalues();
+  const Mat3 axes = eig.eigenvectors();  // columns: principal axes in the body frame
+  const bool low_pair = moments(1) - moments(0) <= moments(2) - moments(1);
+  const double reference = low_pair ? moments(0) : moments(2);  // the top's equal moment
+  const int symmetric_axis = low_pair ? 2 : 0;
+  const Vec3 u_sym = axes.col(symmetric_axis);
+  const Vec3 u_mid = axes.col(1);
+  const double c_sym = 1.0 / moments(symmetric_axis) - 1.0 / reference;
+  const double c_mid = 1.0 / moments(1) - 1.0 / reference;
+  // Flow of c (u.l)^2 / 2 for time h: the body turns about its own axis u by c (u.l) h.
+  auto about_body_axis = [&](const Quat& q, const Vec3& u, double c, double h) {
+    const Vec3 l = q.conjugate() * momentum;
+    return (q * exp_map(u * (c * u.dot(l) * h))).normalized();
+  };
+  Quat q = about_body_axis(orientation, u_mid, c_mid, 0.5 * dt);
+  // Symmetric top for dt: a turn about L by |L| dt / I_ref (l fixed) and a turn about the
+  // symmetry axis (u_sym.l fixed); the two commute.
+  const Quat spin = exp_map(momentum * (dt / reference));
+  q = (spin * about_body_axis(q, u_sym, c_sym, dt)).normalized();
+  return about_body_axis(q, u_mid, c_mid, 0.5 * dt);
+}
 
 void integrate_euler(RigidBody& body, const Vec3& gravity, double dt) {
   if (body.is_static) return;
@@ -34,14 +71,11 @@ void integrate_symplectic(RigidBody& body, const Vec3& gravity, double dt) {
   // Semi-implicit Euler: velocity from forces first, then position with the new velocity.
   body.velocity += gravity * dt;
   body.position += body.velocity * dt;
-  // Torque-free rotation. Design note: the world angular momentum L = I_w w is the conserved
-  // quantity, so we carry L across the step: rotate by the exponential map of w dt, then
-  // recover w = I_w(new)^-1 L. This keeps L exact to round-off for any dt and gives the
-  // gyroscopic precession of asymmetric bodies (w changes as I_w rotates); the energy error is
-  // first order in dt. (An implicit body-frame gyroscopic solve, as in Box2D/Catto, would
-  // instead trade exact L for damping.)
+  // Torque-free rotation: the world angular momentum L is constant, the body turns under it.
   const Vec3 momentum = body.inertia_world() * body.angular_velocity;
-  body.orientation = (exp_map(body.angular_velocity * dt) * body.orientation).normalized();
+  if (momentum.norm() > 0.0) {
+    body.orientation = rotate_free_body(body.orientation, body.inertia_body, momentum, dt);
+  }
   body.angular_velocity = body.inverse_inertia_world() * momentum;
 }
 

@@ -10,10 +10,18 @@ namespace rbx {
 /// w * dt with the seed's matrices; move the centre by v * dt; then add gravity to v.
 void integrate_euler(RigidBody& body, const Vec3& gravity, double dt);
 
-/// Semi-implicit (symplectic) Euler: v += g dt first, then x += v dt; the angular velocity is
-/// advanced with the gyroscopic term (torque-free Euler equations, implicit in the body frame),
-/// then the orientation by the quaternion exponential map, renormalised.
+/// Semi-implicit (symplectic) Euler: v += g dt first, then x += v dt; the rotation is the
+/// torque-free motion with gyroscopic precession (rotate_free_body), carrying the world angular
+/// momentum L exactly; then w = I_w^-1 L. Departs from the seed (SEED_NOTES 11), which holds w
+/// fixed in the world.
 void integrate_symplectic(RigidBody& body, const Vec3& gravity, double dt);
+
+/// Orientation after dt of a torque-free body with body-frame inertia `inertia_body` (kg m^2)
+/// and world angular momentum `momentum` (kg m^2/s): Strang splitting into a symmetric top and
+/// a middle-axis remainder, each by unit quaternions (exponential map), renormalised. Second
+/// order; L exact; energy error bounded (no drift); exact for axisymmetric bodies.
+Quat rotate_free_body(const Quat& orientation, const Mat3& inertia_body, const Vec3& momentum,
+                      double dt);
 
 /// Dispatches on the scene's integrator. Static bodies never move.
 void integrate(RigidBody& body, const SimSettings& sim, double dt);
