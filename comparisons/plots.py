@@ -35,7 +35,7 @@ def save(fig, out, name):
 def error_vs_runtime(report, out):
     """Dynamics: one curve per backend over the time steps; contacts: one point per scene."""
     rows = list(csv.DictReader(open(os.path.join(report, "sweep.csv"))))
-    dyn = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))  # family, backend, dt
+    sweeps = defaultdict(list)  # (family, scene, backend) -> [(dt, runtime, error)]
     con = defaultdict(lambda: defaultdict(list))  # family, backend
     for r in rows:
         if r["kind"] == "dynamics":
@@ -43,25 +43,32 @@ def error_vs_runtime(report, out):
             # self-consistency error is zero at the finest step by construction).
             if r["against"] != "analytic":
                 continue
-            dyn[r["family"]][r["backend"]][float(r["dt"])].append(
-                (float(r["runtime_s"]), float(r["error"])))
+            sweeps[(r["family"], r["scene"], r["backend"])].append(
+                (float(r["dt"]), float(r["runtime_s"]), float(r["error"])))
         else:
             con[r["family"]][r["backend"]].append((float(r["runtime_s"]), float(r["error"])))
+    # Scenes differ in dt (and some set their own sweep_dt), so the points of a curve are the
+    # k-th step of each scene's sweep, coarse to fine, not one absolute dt: grouping by dt would
+    # put a different set of scenes behind every point.
+    dyn = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))  # family, backend, k
+    for (family, _, backend), pts in sweeps.items():
+        for k, (_, runtime, error) in enumerate(sorted(pts, reverse=True)):
+            dyn[family][backend][k].append((runtime, error))
     for family, per_backend in dyn.items():
         fig, ax = plt.subplots(figsize=(6.4, 4.6))
         for backend in sorted(per_backend, key=lambda b: BACKENDS.index(b) if b in BACKENDS else 99):
             pts = []
-            for dt, vals in sorted(per_backend[backend].items(), reverse=True):
+            for k, vals in sorted(per_backend[backend].items()):
                 # Run time summed over the scenes; error as the geometric mean, so one large
                 # error does not hide how the others converge.
                 runtime = sum(v[0] for v in vals)
                 error = math.exp(sum(math.log(max(v[1], FLOOR)) for v in vals) / len(vals))
-                pts.append((runtime, error, dt))
+                pts.append((runtime, error, k))
             ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=MARKERS.get(backend, "o"),
                     color=COLOURS.get(backend), label=backend)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("run time over the family's scenes (s); points: dt from coarse to fine")
+        ax.set_xlabel("run time over the family's scenes (s)\npoints: each scene's time steps, coarse to fine")
         ax.set_ylabel("velocity error, kinetic-energy norm\n(geometric mean over closed-form scenes)")
         ax.set_title(f"{family}: error against run time (time-step sweep)")
         ax.grid(True, which="both", alpha=0.3)
