@@ -41,6 +41,7 @@ class BroadPhase {
   /// reference stays valid until the next call.
   const std::vector<BodyPair>& find_pairs(const std::vector<RigidBody>& bodies);
 
+  /// The method this broad phase runs.
   BroadPhaseMethod method() const { return method_; }
 
  private:

@@ -38,7 +38,9 @@ std::optional<ContactPoint> face_test(const ConvexPolyhedron& a, const Pose& pa,
                                       const ConvexPolyhedron& b, const Pose& pb);
 
 /// Vertex test, one order: the first vertex of A inside B; normal = outward normal of B's face
-/// closest to it. feature = "vertex".
+/// closest to it. Departure from the seed: the point is the average of every vertex of A inside
+/// B whose closest face of B has that same normal (an edge or face landing flat gets its
+/// impulse at its middle, not at one end). feature = "vertex".
 std::optional<ContactPoint> vertex_test(const ConvexPolyhedron& a, const Pose& pa,
                                         const ConvexPolyhedron& b, const Pose& pb);
 
@@ -46,7 +48,9 @@ std::optional<ContactPoint> vertex_test(const ConvexPolyhedron& a, const Pose& p
 /// (SEED_NOTES 2), the crossing parameters sorted with 0 and 1, and the midpoint of each
 /// consecutive pair tested in B; the first inside is the point. Normal: e_a x e_b, e_b the edge
 /// of B's crossed triangle nearest the point, oriented from B toward A (SEED_NOTES 10).
-/// feature = "edge".
+/// Departure: where the crossed triangle's outward normal separates the shapes with a smaller
+/// translation than e_a x e_b (an edge piercing a face, not an edge), that face normal is
+/// taken. feature = "edge".
 std::optional<ContactPoint> edge_test(const ConvexPolyhedron& a, const Pose& pa,
                                       const ConvexPolyhedron& b, const Pose& pb);
 

@@ -34,7 +34,9 @@ struct Edge {
 struct Aabb {
   Vec3 min = Vec3::Zero();
   Vec3 max = Vec3::Zero();
+  /// Centre of the box (m).
   Vec3 center() const { return 0.5 * (min + max); }
+  /// Half the box's extent along each axis (m).
   Vec3 half_extents() const { return 0.5 * (max - min); }
 };
 
@@ -48,11 +50,15 @@ class ConvexPolyhedron {
   static ConvexPolyhedron from_triangles(std::vector<Vec3> vertices,
                                          std::vector<std::array<int, 3>> triangles);
 
+  /// Vertices (m), in the shape's frame.
   const std::vector<Vec3>& vertices() const { return vertices_; }
+  /// Triangles as vertex indices, counter-clockwise seen from outside.
   const std::vector<std::array<int, 3>>& triangles() const { return triangles_; }
+  /// Unique edges of the triangulation (each once, whatever its two triangles).
   const std::vector<Edge>& edges() const { return edges_; }
   /// Outward plane of triangle i.
   const std::vector<Plane>& planes() const { return planes_; }
+  /// Axis-aligned bounds of the vertices, in the shape's frame.
   const Aabb& bounds() const { return bounds_; }
 
   /// Enclosed volume (m^3), by the divergence theorem.

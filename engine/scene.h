@@ -15,7 +15,7 @@ namespace rbx {
 /// Time integrator.
 enum class Integrator {
   Euler,       ///< the seed's: x += v dt, orientation by per-axis matrices with w dt
-  Symplectic,  ///< semi-implicit: v from forces first, then x; quaternion exponential map
+  Symplectic,  ///< semi-implicit: v from forces first, then x; torque-free rotation by splitting
 };
 
 /// Simulation settings ([sim] in a scene file). Defaults are the contract's.

@@ -53,8 +53,11 @@ class World {
   /// Steps taken so far.
   long steps_taken() const { return step_; }
 
+  /// The bodies in their current state, in scene order.
   const std::vector<RigidBody>& bodies() const { return bodies_; }
+  /// Every collision resolved so far, in order.
   const std::vector<CollisionEvent>& events() const { return events_; }
+  /// Simulated time (s) reached.
   double time() const { return time_; }
   /// Total kinetic plus gravitational potential energy (J).
   double energy() const;

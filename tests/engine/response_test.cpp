@@ -198,5 +198,27 @@ TEST(Response, WorldInverseInertiaUsesRotation) {
   EXPECT_LT((a.inverse_inertia_world() * iw - Mat3::Identity()).norm(), 1e-13);
 }
 
+TEST(Response, ImpulseOnARotatedBodyUsesTheWorldInertia) {
+  // SEED_NOTES 5 inside the impulse. The same box (world moments 10, 13, 5) moves at -1 m/s
+  // along x into a static body; contact normal n = +x at r = (0, 0, 1) from its centre, so
+  // r x n = (0, 1, 0) and only the world yy moment (13) enters:
+  //   j = -(1 + e) v_rel.n / (1/m + 1/13) = 2 / (1/12 + 1/13) = 12.48 (e = 1),
+  //   dw = I_w^-1 (r x j n) = (0, j/13, 0) = (0, 0.96, 0),  dv = j/m n = (1.04, 0, 0).
+  // With the body-frame inverse the yy moment would be 10: j = 10.909, dw_y = 1.0909.
+  const Quat q(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()));
+  RigidBody a = box_body("A", Vec3(1, 2, 3), 12, Vec3::Zero(), q, Vec3(-1, 0, 0));
+  RigidBody b = box_body("B", Vec3(1, 1, 1), 1, Vec3(-5, 0, 0), Quat::Identity(), Vec3::Zero(),
+                         Vec3::Zero(), true);
+  ContactPoint c;
+  c.point = Vec3(0, 0, 1);
+  c.normal = Vec3(1, 0, 0);
+  const double j = apply_impulse(a, b, c, 1.0);
+  // A handful of operations on O(10) numbers.
+  EXPECT_NEAR(j, 12.48, 1e-12);
+  EXPECT_LT((a.angular_velocity - Vec3(0, 0.96, 0)).norm(), 1e-13);
+  EXPECT_LT((a.velocity - Vec3(0.04, 0, 0)).norm(), 1e-13);
+  EXPECT_EQ(b.velocity, Vec3::Zero());
+}
+
 }  // namespace
 }  // namespace rbx
