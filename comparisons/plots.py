@@ -9,6 +9,7 @@ import json
 import math
 import os
 import sys
+import tomllib
 from collections import defaultdict
 
 import matplotlib
@@ -25,6 +26,13 @@ MARKERS = dict(zip(BACKENDS, "os^vD<>pPX*"))
 FLOOR = 1e-17  # errors at round-off are drawn at this floor on log axes
 
 
+def median(values):
+    """Median of a non-empty list (mean of the middle two for an even count)."""
+    v = sorted(values)
+    n = len(v)
+    return v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2])
+
+
 def save(fig, out, name):
     fig.tight_layout()
     for ext in ("png", "svg"):
@@ -33,7 +41,7 @@ def save(fig, out, name):
 
 
 def error_vs_runtime(report, out):
-    """Dynamics: one curve per backend over the time steps; contacts: one point per scene."""
+    """Dynamics: per backend, each scene's sweep and the median scene; contacts: a point per scene."""
     rows = list(csv.DictReader(open(os.path.join(report, "sweep.csv"))))
     sweeps = defaultdict(list)  # (family, scene, backend) -> [(dt, runtime, error)]
     con = defaultdict(lambda: defaultdict(list))  # family, backend
@@ -57,20 +65,26 @@ def error_vs_runtime(report, out):
     for family, per_backend in dyn.items():
         fig, ax = plt.subplots(figsize=(6.4, 4.6))
         for backend in sorted(per_backend, key=lambda b: BACKENDS.index(b) if b in BACKENDS else 99):
+            colour = COLOURS.get(backend)
+            # Thin: each scene's own sweep (its run time, its error).
+            for (fam, _, b), pts in sorted(sweeps.items()):
+                if fam == family and b == backend:
+                    pts = sorted(pts, reverse=True)
+                    ax.plot([p[1] for p in pts], [max(p[2], FLOOR) for p in pts], color=colour,
+                            lw=0.7, alpha=0.3)
+            # Bold: the median scene at each step of the sweeps (median run time, median error),
+            # so neither one exact scene nor one failed scene decides where the curve lies.
             pts = []
             for k, vals in sorted(per_backend[backend].items()):
-                # Run time summed over the scenes; error as the geometric mean, so one large
-                # error does not hide how the others converge.
-                runtime = sum(v[0] for v in vals)
-                error = math.exp(sum(math.log(max(v[1], FLOOR)) for v in vals) / len(vals))
-                pts.append((runtime, error, k))
+                pts.append((median([v[0] for v in vals]), max(median([v[1] for v in vals]), FLOOR)))
             ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=MARKERS.get(backend, "o"),
-                    color=COLOURS.get(backend), label=backend)
+                    color=colour, lw=2, label=backend)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("run time over the family's scenes (s)\npoints: each scene's time steps, coarse to fine")
-        ax.set_ylabel("velocity error, kinetic-energy norm\n(geometric mean over closed-form scenes)")
-        ax.set_title(f"{family}: error against run time (time-step sweep)")
+        ax.set_xlabel("run time per scene (s)\npoints: each scene's time steps, coarse to fine")
+        ax.set_ylabel("velocity error, kinetic-energy norm\n(bold: median scene; thin: each scene)")
+        ax.set_title(f"{family}: error against run time (closed-form scenes; exact = {FLOOR:g})",
+                     fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
         save(fig, out, f"error_vs_runtime_{family}")
@@ -101,27 +115,49 @@ def slug(scene):
     return f"{scene['family']}_{stem}"
 
 
+def expected_final(scene):
+    """The scene's [expect.body.NAME] velocities, read from its TOML file ({} when unreadable)."""
+    try:
+        with open(scene["file"], "rb") as f:
+            doc = tomllib.load(f)
+    except (OSError, tomllib.TOMLDecodeError):
+        return {}
+    return doc.get("expect", {}).get("body", {})
+
+
 def velocity_bars(scene, out):
-    """Final velocity components of each moving body, one bar per backend (and the closed form)."""
+    """Final linear and angular velocity of each moving body, one bar per backend; the closed
+    form from the scene's [expect] as a black tick where the scene gives one."""
     backends = [b for b, r in scene["backends"].items()
                 if r.get("status") == "ok" and "bodies" in r
                 and any("final" in v for v in r["bodies"].values())]
     if not backends:
         return
     first = scene["backends"][backends[0]]["bodies"]
-    bodies = [n for n, v in first.items() if not v.get("static")]
+    bodies = [n for n, v in first.items() if not v.get("static") and "final" in v]
     if not bodies or len(bodies) > 6:
         return
-    fig, axes = plt.subplots(1, len(bodies), figsize=(3.2 * len(bodies) + 1, 3.6), squeeze=False)
+    expect = expected_final(scene)
+    labels = ["vx", "vy", "vz", "wx", "wy", "wz"]
+    fig, axes = plt.subplots(1, len(bodies), figsize=(4.2 * len(bodies) + 1, 3.8), squeeze=False)
     width = 0.8 / (len(backends) + 1)
     for ax, body in zip(axes[0], bodies):
         for k, b in enumerate(backends):
-            v = scene["backends"][b]["bodies"][body]["final"]["velocity"]
-            ax.bar([i + k * width for i in range(3)], v, width, label=b, color=COLOURS.get(b))
-        ax.set_xticks([i + 0.4 - width / 2 for i in range(3)])
-        ax.set_xticklabels(["vx", "vy", "vz"])
+            f = scene["backends"][b]["bodies"][body]["final"]
+            ax.bar([i + k * width for i in range(6)], f["velocity"] + f["angular_velocity"], width,
+                   label=b, color=COLOURS.get(b))
+        e = expect.get(body, {})
+        truth = (e.get("velocity") or [None] * 3) + (e.get("angular_velocity") or [None] * 3)
+        xs = [i + (len(backends) - 1) * width / 2 for i in range(6)]  # centre of each group
+        marked = [(x, t) for x, t in zip(xs, truth) if t is not None]
+        if marked:
+            ax.scatter([m[0] for m in marked], [m[1] for m in marked], marker="_", s=400,
+                       color="black", linewidths=2, label="closed form", zorder=3)
+        ax.set_xticks(xs)
+        ax.set_xticklabels(labels)
         ax.axhline(0, color="black", lw=0.6)
-        ax.set_title(f"body {body}: final velocity (m/s)", fontsize=9)
+        ax.axvline(2.5 + (len(backends) - 1) * width / 2, color="grey", lw=0.5, ls=":")
+        ax.set_title(f"body {body}: final v (m/s) and w (rad/s)", fontsize=9)
     axes[0][0].legend(fontsize=7)
     fig.suptitle(scene["scene"], fontsize=10)
     save(fig, out, f"velocity_{slug(scene)}")
