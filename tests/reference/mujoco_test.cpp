@@ -138,6 +138,70 @@ TEST(MujocoContact, RecentredMeshStaysOnOurPose) {
   EXPECT_LE(r.contacts[0].point.head<2>().norm(), std::sqrt(0.5) + kFloatGeometry);
 }
 
+// --- Known wrong answer: MPR on a small cube at a big cube's corner (FCL issue 545) ----------
+
+// REFERENCES.md and scenes/contact/small_on_diagonal.toml: a 0.1 cube B centred at (0.4, 0.4,
+// 0.4) inside the unit cube A at the origin. B spans [0.35, 0.45]^3; the least translation that
+// frees it is 0.15 along an axis (0.5 - 0.35; a three-way tie), so the truth is depth 0.15 with
+// an axis normal. MuJoCo 2.2.2 runs libccd's MPR on mesh geoms with the geom centres as the
+// interior point: the ray from c_A - c_B = -(0.4, 0.4, 0.4) through the origin leaves the
+// Minkowski difference (the cube of half-extent 0.55 about -(0.4, 0.4, 0.4)) exactly at its
+// corner (0.15, 0.15, 0.15): the diagonal, at distance 0.15 sqrt(3) ~ 0.2598.
+RigidBody diagonal_big() { return make_body(box_spec("A", Vec3::Ones(), Vec3::Zero())); }
+RigidBody diagonal_small(const Vec3& centre) {
+  return make_body(box_spec("B", Vec3::Constant(0.1), centre));
+}
+
+TEST(MujocoKnownWrongAnswer, SmallCubeOnTheDiagonalPinned) {
+  // Pinned as the adapter returns it. Ours: normal from B toward A = -(1, 1, 1)/sqrt(3) (MuJoCo's
+  // frame, geom1 -> geom2, is the diagonal toward the small cube), depth 0.15 sqrt(3). MuJoCo
+  // stores the vertices as float (0.05 -> 0.0500000007), hence kFloatGeometry.
+  const ContactResult r = mujoco_contact(diagonal_big(), diagonal_small(Vec3::Constant(0.4)));
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.contacts.size(), 1u);
+  const ContactPoint& c = r.contacts[0];
+  EXPECT_NEAR((c.normal + Vec3::Ones().normalized()).norm(), 0.0, kFloatGeometry)
+      << c.normal.transpose();
+  EXPECT_NEAR(c.depth, 0.15 * std::sqrt(3.0), kFloatGeometry);
+  // Against the truth (an axis, 0.15): 54.7 deg off and sqrt(3) too deep.
+  EXPECT_GT(c.depth - 0.15, 0.1);
+  // Swapped (the scene's order, small cube first): the same wrong answer, flipped.
+  const ContactResult swapped = mujoco_contact(diagonal_small(Vec3::Constant(0.4)), diagonal_big());
+  ASSERT_EQ(swapped.status, Status::Ok) << swapped.message;
+  ASSERT_EQ(swapped.contacts.size(), 1u);
+  EXPECT_NEAR((swapped.contacts[0].normal - Vec3::Ones().normalized()).norm(), 0.0, kFloatGeometry)
+      << swapped.contacts[0].normal.transpose();
+  EXPECT_NEAR(swapped.contacts[0].depth, 0.15 * std::sqrt(3.0), kFloatGeometry);
+}
+
+TEST(MujocoKnownWrongAnswer, SmallCubeNearTheDiagonalPinned) {
+  // scenes/contact/small_near_diagonal.toml: the small cube at (0.4, 0.39, 0.39), first. Truth:
+  // it spans x in [0.35, 0.45], y and z in [0.34, 0.44]; out along +x costs 0.15, along +y or
+  // +z 0.16: unique answer n = (1, 0, 0) (from the big cube toward the small one), depth 0.15.
+  // Measured, not derived (MPR's final portal is not a face of the Minkowski difference here):
+  // MuJoCo answers n = (2.5, 1, 1)/sqrt(8.25) = (0.87039, 0.34816, 0.34816), 29.5 deg off the
+  // axis, and depth 0.172337, which is not even the overlap along its own normal (0.242: the
+  // small cube's lowest point along n is 0.541 and the big cube's highest 0.783): the depth is
+  // the distance to the last portal's plane. Float vertices: kFloatGeometry.
+  const double n_long = 2.5 / std::sqrt(8.25), n_short = 1.0 / std::sqrt(8.25);
+  const double measured_depth = 0.17233688105783818;
+  for (bool swapped : {false, true}) {
+    const RigidBody small = diagonal_small(Vec3(0.4, 0.39, 0.39));
+    const ContactResult r =
+        swapped ? mujoco_contact(diagonal_big(), small) : mujoco_contact(small, diagonal_big());
+    ASSERT_EQ(r.status, Status::Ok) << r.message;
+    ASSERT_EQ(r.contacts.size(), 1u);
+    const ContactPoint& c = r.contacts[0];
+    const double sign = swapped ? -1.0 : 1.0;  // ours points toward the first body
+    EXPECT_NEAR((c.normal - sign * Vec3(n_long, n_short, n_short)).norm(), 0.0, kFloatGeometry)
+        << c.normal.transpose();
+    EXPECT_NEAR(c.depth, measured_depth, kFloatGeometry);
+    // Clearly not the truth (+-x, 0.15).
+    EXPECT_GT(std::abs(c.depth - 0.15), 0.02);
+    EXPECT_LT(std::abs(c.normal.x()), 0.9);
+  }
+}
+
 // --- Known defect: box-box half depth -------------------------------------------------------
 
 // Loads MJCF text through MuJoCo's virtual file system.
