@@ -6,8 +6,12 @@
 #include <mujoco/mujoco.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <map>
 #include <memory>
+#include <set>
+#include <utility>
 
 namespace rbx {
 namespace {
@@ -238,6 +242,126 @@ TEST(MujocoKnownDefect, BoxBoxReportsHalfTheDepth) {
   }
   mj_deleteData(d);
   mj_deleteModel(m);
+}
+
+// --- Errors: mju_error becomes Status::Error -------------------------------------------------
+
+// An allocator for MuJoCo (mju_user_malloc / mju_user_free) that counts its calls and fails
+// the `fail_at`-th (1-based; 0: never): every MuJoCo allocation goes through mju_malloc, which
+// calls mju_error("Could not allocate memory") when it gets nullptr. Blocks are 64-byte
+// aligned as MuJoCo's own (2.2.2 checks its buffer layout against that alignment; plain
+// malloc gave "mjModel buffer size mismatch") and come from aligned_alloc, so MuJoCo's default
+// free can release them after the hooks are gone.
+//
+// Leaks: the longjmp out of a failed mj_makeData abandons its partial mjData, which the
+// destructor frees (the sanitizer build checks for leaks). It must not free what MuJoCo itself
+// keeps from one mj_loadXML to the next (freed by the next load: freeing it here was a double
+// free): those are the blocks a clean query leaves live, identified by their call number.
+struct FailingAllocator {
+  static long calls, fail_at;
+  static std::map<void*, long>* live;  // block -> number of the call that allocated it
+  static void* allocate(size_t n) {
+    if (++calls == fail_at) return nullptr;
+    void* p = std::aligned_alloc(64, (n + 63) / 64 * 64);
+    if (p) (*live)[p] = calls;
+    return p;
+  }
+  static void release(void* p) {
+    live->erase(p);
+    std::free(p);
+  }
+  // Installs the hooks until destruction; `kept` are the call numbers whose blocks MuJoCo keeps
+  // after a clean query.
+  FailingAllocator(long fail, std::set<long> kept) : kept_by_mujoco(std::move(kept)) {
+    calls = 0;
+    fail_at = fail;
+    live = &blocks;
+    mju_user_malloc = allocate;
+    mju_user_free = release;
+  }
+  ~FailingAllocator() {
+    mju_user_malloc = nullptr;
+    mju_user_free = nullptr;
+    for (const auto& [p, call] : blocks)
+      if (!kept_by_mujoco.count(call)) std::free(p);
+  }
+  std::map<void*, long> blocks;
+  std::set<long> kept_by_mujoco;
+};
+long FailingAllocator::calls = 0;
+long FailingAllocator::fail_at = 0;
+std::map<void*, long>* FailingAllocator::live = nullptr;
+
+// A clean contact query under the counting allocator: how many allocations it makes (model
+// compile, mjData) and which of them MuJoCo keeps afterwards.
+struct AllocationProfile {
+  long calls = 0;
+  std::set<long> kept;
+};
+AllocationProfile profile_contact_query(const RigidBody& a, const RigidBody& b) {
+  AllocationProfile out;
+  std::set<long> all;  // keep everything: nothing is freed after a clean query
+  for (long k = 1; k <= 1000; ++k) all.insert(k);
+  FailingAllocator count(0, all);
+  EXPECT_EQ(mujoco_contact(a, b).status, Status::Ok);
+  out.calls = FailingAllocator::calls;
+  for (const auto& [p, call] : count.blocks) out.kept.insert(call);
+  return out;
+}
+
+TEST(MujocoErrors, MjuErrorInMakeDataIsAStatusErrorWithItsMessage) {
+  // A real mju_error on the adapter's own guarded path: the last allocation of a contact query
+  // is mj_makeData's (after mj_loadXML, whose compiler catches its own errors), and it fails.
+  // MuJoCo calls mju_error("Could not allocate memory"), which by default exits the process;
+  // the adapter's mju_user_error handler must jump back and return status Error with the
+  // message, and the next query must work.
+  const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
+  const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3(0.9, 0, 0)));
+  const AllocationProfile clean = profile_contact_query(a, b);
+  const long n = clean.calls;
+  ASSERT_GT(n, 2);
+  ASSERT_LT(n, 1000);
+  {
+    FailingAllocator fail_last(n, clean.kept);
+    const ContactResult r = mujoco_contact(a, b);
+    EXPECT_EQ(FailingAllocator::calls, n);  // it did reach the failing allocation
+    EXPECT_EQ(r.status, Status::Error);
+    EXPECT_EQ(r.message, "MuJoCo mj_makeData: Could not allocate memory");
+    EXPECT_TRUE(r.contacts.empty());
+  }
+  // Still alive, and MuJoCo still answers (the face pair above: one contact, depth 0.1).
+  const ContactResult again = mujoco_contact(a, b);
+  ASSERT_EQ(again.status, Status::Ok) << again.message;
+  ASSERT_EQ(again.contacts.size(), 1u);
+  EXPECT_NEAR(again.contacts[0].depth, 0.1, kFloatGeometry);
+}
+
+TEST(MujocoErrors, EveryFailedAllocationIsAStatusError) {
+  // Each of the query's allocations failed in turn: every one must come back as status Error
+  // naming the failure, whether it happens in the VFS, inside the compiler (reported through
+  // mj_loadXML's error buffer) or in mj_makeData (through the adapter's handler). Before the
+  // VFS call was guarded, failing the first allocation ended the process ("MuJoCo error outside
+  // a guarded call").
+  const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
+  const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3(0.9, 0, 0)));
+  const AllocationProfile clean = profile_contact_query(a, b);
+  const long n = clean.calls;
+  ASSERT_LT(n, 1000);
+  int through_compiler = 0, through_handler = 0;
+  for (long k = 1; k <= n; ++k) {
+    FailingAllocator fail(k, clean.kept);
+    const ContactResult r = mujoco_contact(a, b);
+    EXPECT_EQ(r.status, Status::Error) << "allocation " << k;
+    EXPECT_NE(r.message.find("Could not allocate memory"), std::string::npos)
+        << "allocation " << k << ": " << r.message;
+    if (r.message.rfind("MuJoCo mj_loadXML", 0) == 0) ++through_compiler;
+    if (r.message.rfind("MuJoCo mj_makeData", 0) == 0 ||
+        r.message.rfind("MuJoCo mj_makeEmptyFileVFS", 0) == 0)
+      ++through_handler;
+  }
+  EXPECT_EQ(through_compiler + through_handler, n);
+  EXPECT_GT(through_compiler, 0);
+  EXPECT_GT(through_handler, 1);  // the VFS file and at least one of mj_makeData's
 }
 
 // --- Dynamics -------------------------------------------------------------------------------
