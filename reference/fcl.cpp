@@ -174,8 +174,20 @@ ContactResult fcl_epa_contact(const RigidBody& a, const RigidBody& b) {
 }
 
 ContactResult fcl_indep_contact(const RigidBody& a, const RigidBody& b) {
-  // Only collide() is called: FCL's INDEP distance can hit an assertion (REFERENCES.md), so it
-  // is never run in this process.
+  // Only collide() is called, in this process, without run_isolated: it cannot abort. INDEP's
+  // *distance* can: fcl::distance's signed-distance workaround (narrowphase/distance-inl.h,
+  // `assert(index != ...)`, line 177) trips on INDEP's negative depths, and libfcl.so.0.7 is
+  // built without NDEBUG, so it aborts (pinned in tests/reference/fcl_isolated_test.cpp); it is
+  // never called here. collide() on two Convex goes collision_func_matrix -> ShapeShapeCollide
+  // -> GJKSolver_indep::shapeIntersect -> ShapeIntersectIndepImpl (gjk_solver_indep-inl.h),
+  // which runs detail::GJK and detail::EPA (gjk-inl.h, epa-inl.h) with bounded iterations and
+  // fixed-size stores, and reports trouble through its status (EPA::Failed -> no contact),
+  // never by assert: the only assertions in FCL 0.7's narrow phase are in
+  // gjk_libccd-inl.h (GST_LIBCCD only), distance-inl.h (above) and the primitive-shape
+  // algorithms, none on this path; Convex's constructor asserts non-null arrays, which
+  // make_convex always passes. (Eigen's own bounds assertions are live in the library too;
+  // they guard indexing, not the input geometry.) So no input can make this path abort, and a
+  // fork per query would buy nothing.
   ContactResult r = guarded("fcl::collide (GST_INDEP)", [&] {
     return collide(convex_geometry(a), to_fcl(a.pose()), convex_geometry(b), to_fcl(b.pose()),
                    fcl::GST_INDEP, "gjk-epa-indep");

@@ -213,7 +213,17 @@ ModelPtr load_model(const std::string& xml, std::string* error) {
   std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
   mj_defaultVFS(vfs.get());
   const char* name = "rbx_model.xml";
-  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size())) != 0) {
+  // Guarded: when its allocation fails, mj_makeEmptyFileVFS ends in mju_error (mju_malloc's
+  // "Could not allocate memory"), not in its return code; unguarded, that ended the process
+  // (found by the allocation-failure test in tests/reference/mujoco_test.cpp).
+  mjVFS* const v = vfs.get();
+  const int size = static_cast<int>(xml.size());
+  int made = -1;
+  if (!guarded([&] { made = mj_makeEmptyFileVFS(v, name, size); })) {
+    *error = std::string("MuJoCo mj_makeEmptyFileVFS: ") + t_error;
+    return nullptr;
+  }
+  if (made != 0) {
     *error = "MuJoCo VFS: cannot create the model file";
     return nullptr;
   }

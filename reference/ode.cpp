@@ -245,8 +245,9 @@ Vec3 point_velocity(dBodyID body, const dReal* p) {
   return Vec3(v[0], v[1], v[2]);
 }
 
-// Near callback: contact joints with dContactBounce for every contact point of a pair. Only
-// trivially destructible locals (an error inside dCollide longjmps over this frame).
+// Near callback: contact joints with dContactBounce (and Coulomb friction) for every contact
+// point of a pair. Only trivially destructible locals (an error inside dCollide longjmps over
+// this frame).
 void near_callback(void* data, dGeomID o1, dGeomID o2) {
   auto* ctx = static_cast<CollideContext*>(data);
   dBodyID b1 = dGeomGetBody(o1), b2 = dGeomGetBody(o2);
@@ -259,9 +260,20 @@ void near_callback(void* data, dGeomID o1, dGeomID o2) {
   const int n = dCollide(o1, o2, kMaxContacts, &contact[0].geom, sizeof(dContact));
   for (int i = 0; i < n; ++i) {
     dContact& c = contact[i];
-    c.surface.mode = dContactBounce;
-    c.surface.mu = ctx->friction;  // 0: frictionless
-    c.surface.bounce = ctx->restitution;
+    // dContactBounce: restitution as a target separation speed (joints/contact.cpp, getInfo2:
+    // the normal row's target becomes max(bounce * approach speed, ERP * depth / dt)).
+    // dContactApprox1: without it ODE bounds each friction row by +-mu as a *force* in newtons
+    // (lo = -mu, hi = mu in getInfo2), not by mu times the normal force; Approx1 sets each
+    // friction row's findex to its normal row, and the LCP solver (lcp.cpp, dSolveLCP) then
+    // uses hi = |mu * normal force|: Coulomb friction, with a friction pyramid whose two
+    // directions come from dPlaneSpace. With mu = 0 ODE adds no friction rows at all
+    // (getInfo1), so the flag changes nothing for frictionless scenes.
+    // No dContactSoftERP / dContactSoftCFM: the world's ERP and CFM apply (see ode_dynamics).
+    c.surface.mode = dContactBounce | dContactApprox1;
+    c.surface.mu = ctx->friction;         // the scene's Coulomb coefficient; 0: frictionless
+    c.surface.bounce = ctx->restitution;  // the scene's coefficient of restitution e
+    // Bounce at any approach speed: ODE bounces only when the approach speed exceeds
+    // bounce_vel (strictly), and the seed's single-impulse law has no threshold.
     c.surface.bounce_vel = 0.0;
     dJointID j = dJointCreateContact(ctx->world, ctx->group, &c);
     dJointAttach(j, b1, b2);

@@ -164,6 +164,16 @@ bool is_negative_axis(const Vec3& n, double tol) {
   return false;
 }
 
+/// The six orientations of a cube that map it onto itself used by FCL's box-box tests.
+std::vector<Quat> cube_symmetries() {
+  return {Quat::Identity(),
+          Quat(Eigen::AngleAxisd(M_PI, Vec3::UnitX())),
+          Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX())),
+          Quat(Eigen::AngleAxisd(3 * M_PI / 2, Vec3::UnitX())),
+          Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY())),
+          Quat(Eigen::AngleAxisd(3 * M_PI / 2, Vec3::UnitY()))};
+}
+
 // ---------------------------------------------------------------------------------------------
 // fcl: Convex, GST_LIBCCD (libccd MPR).
 
@@ -307,6 +317,112 @@ TEST(FclIndep, AlignedFacePairWrongEpaFacePinned) {
   EXPECT_NEAR(r.contacts[0].depth, -0.1 / std::sqrt(3.0), kRoundOff);
 }
 
+TEST(FclIndep, RotatedPairBothOrdersNormalInTheFirstBodysFramePinned) {
+  // The rotated offset pair of RotatedPairNormalInLocalFrameAndNegativeDepthPinned in both
+  // orders. (A, B): n = R^T (truth) = (-1, 0, 0), depth -0.1 (pinned above). (B, A): the truth
+  // flips to R (1, 0, 0), and INDEP leaves it in the first body's (B's) frame, also R: (1, 0, 0),
+  // depth -0.1. The point is the one defect-free output: FCL maps it to the world
+  // (tf1 * (w0 - n d / 2)), on the overlap's mid-plane x = 0.45 of A's frame in both orders.
+  const Quat q = generic_rotation();
+  const RigidBody a = unit_cube("A", Vec3::Zero(), q);
+  const RigidBody b = unit_cube("B", q * Vec3(0.9, 0.2, 0.1), q);
+  for (bool swapped : {false, true}) {
+    const ContactResult r = swapped ? fcl_indep_contact(b, a) : fcl_indep_contact(a, b);
+    ASSERT_EQ(r.status, Status::Ok) << r.message;
+    ASSERT_EQ(r.contacts.size(), 1u);
+    const ContactPoint& c = r.contacts[0];
+    EXPECT_NEAR((c.normal - Vec3(swapped ? 1 : -1, 0, 0)).norm(), 0.0, kRoundOff)
+        << c.normal.transpose();
+    EXPECT_NEAR(c.depth, -0.1, kRoundOff);
+    const Vec3 local = q.conjugate() * c.point;  // A's frame
+    EXPECT_NEAR(local.x(), kMidPlaneX, kRoundOff) << local.transpose();
+    EXPECT_LE(std::abs(local.y() - 0.1), 0.4 + kRoundOff);  // |y - 0.2/2| within the overlap
+    EXPECT_LE(std::abs(local.z() - 0.05), 0.45 + kRoundOff);
+  }
+}
+
+TEST(FclIndep, PublicBoxCaseBothOrdersAndSymmetriesPinned) {
+  // FCL's public case 1 (A = unit cube rotated 45 deg about y, B = size-3 cube below, truth:
+  // ours n = +z for (A, B), depth sqrt(2)/2) with B in the 6 orientations that map it onto
+  // itself. The geometry never changes, so any change in the output is INDEP's.
+  //  - (B, A): FCL's A -> B normal is +z in the world, left in B's frame: S^T z for B's
+  //    orientation S; ours is its opposite, -S^T z. Depth -sqrt(2)/2. B's frame shows through.
+  //  - (A, B): A's frame does not change, so the local-frame normal is R_y(45)^T z =
+  //    (-sin 45, 0, cos 45), depth -sqrt(2)/2, except for B turned 180 deg about x, where EPA
+  //    stops on a wrong face of the Minkowski difference: the side face y = -2 (A's half-width
+  //    0.5 + B's 1.5), ours (0, -1, 0) with depth -2. Pinned.
+  const double s = std::sqrt(0.5);
+  const RigidBody a =
+      unit_cube("A", Vec3::Zero(), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY())));
+  const std::vector<Quat> syms = cube_symmetries();
+  for (size_t k = 0; k < syms.size(); ++k) {
+    const RigidBody b = box_body("B", Vec3::Constant(3), Vec3(0, 0, -1.5), syms[k]);
+    const ContactResult ba = fcl_indep_contact(b, a);
+    ASSERT_EQ(ba.contacts.size(), 1u) << "symmetry " << k;
+    EXPECT_NEAR((ba.contacts[0].normal + syms[k].conjugate() * Vec3::UnitZ()).norm(), 0.0,
+                kRoundOff)
+        << "symmetry " << k << ": " << ba.contacts[0].normal.transpose();
+    EXPECT_NEAR(ba.contacts[0].depth, -s, kRoundOff) << "symmetry " << k;
+
+    const ContactResult ab = fcl_indep_contact(a, b);
+    ASSERT_EQ(ab.contacts.size(), 1u) << "symmetry " << k;
+    const bool wrong_face = k == 1;  // 180 deg about x
+    const Vec3 n = wrong_face ? Vec3(0, -1, 0) : Vec3(-s, 0, s);
+    EXPECT_NEAR((ab.contacts[0].normal - n).norm(), 0.0, kRoundOff)
+        << "symmetry " << k << ": " << ab.contacts[0].normal.transpose();
+    EXPECT_NEAR(ab.contacts[0].depth, wrong_face ? -2.0 : -s, kRoundOff) << "symmetry " << k;
+  }
+}
+
+TEST(FclIndep, AlignedFacePairSwappedGivesAnotherWrongFacePinned) {
+  // AlignedFacePairWrongEpaFacePinned with the bodies swapped: not the flip of (A, B)'s wrong
+  // diagonal (1, -1, -1)/sqrt(3) but another one: FCL's A -> B normal (-1, -1, -1)/sqrt(3),
+  // ours (1, 1, 1)/sqrt(3), same depth -0.1/sqrt(3). Truth: (1, 0, 0), 0.1.
+  const ContactResult r =
+      fcl_indep_contact(unit_cube("B", kFaceOffset), unit_cube("A", Vec3::Zero()));
+  ASSERT_EQ(r.contacts.size(), 1u);
+  EXPECT_NEAR((r.contacts[0].normal - Vec3(1, 1, 1).normalized()).norm(), 0.0, kRoundOff)
+      << r.contacts[0].normal.transpose();
+  EXPECT_NEAR(r.contacts[0].depth, -0.1 / std::sqrt(3.0), kRoundOff);
+}
+
+TEST(FclIndep, TouchingGivesAMinusZeroDepthContactPinned) {
+  // Gap 0 (unlike MPR, which reports nothing): GJK ends "inside" and EPA returns depth 0,
+  // negated to -0.0, at the corner (0.5, -0.5, -0.5) of the touching faces. The normal is
+  // FCL's A -> B +x in both orders, so ours is (-1, 0, 0) for (A, B), right, and also
+  // (-1, 0, 0) for (B, A), where the truth is (1, 0, 0): at zero depth the direction is
+  // whatever EPA's first face was. Pinned exactly: 0 and its sign bit, no round-off.
+  const RigidBody a = unit_cube("A", Vec3::Zero());
+  for (bool swapped : {false, true}) {
+    const ContactResult r =
+        swapped ? fcl_indep_contact(touching_b(), a) : fcl_indep_contact(a, touching_b());
+    ASSERT_EQ(r.status, Status::Ok) << r.message;
+    ASSERT_EQ(r.contacts.size(), 1u) << "swapped " << swapped;
+    const ContactPoint& c = r.contacts[0];
+    EXPECT_EQ(c.depth, 0.0);
+    EXPECT_TRUE(std::signbit(c.depth)) << "swapped " << swapped;
+    EXPECT_NEAR((c.normal - Vec3(-1, 0, 0)).norm(), 0.0, kRoundOff)
+        << "swapped " << swapped << ": " << c.normal.transpose();
+    EXPECT_NEAR((c.point - Vec3(0.5, -0.5, -0.5)).norm(), 0.0, kRoundOff) << c.point.transpose();
+  }
+}
+
+TEST(FclIndep, DiagonalCubeGetsTheMinimumPenetrationWithTheSignDefect) {
+  // The MPR wrong answer's pair (DiagonalCubeKnownWrongAnswerPinned): INDEP's EPA finds the
+  // true minimum, an axis (FCL picks +z of the three-way tie, A -> B) and 0.15, with the depth
+  // negated. A is not rotated, so the local-frame defect does not show; the normal, ours -z,
+  // flips with the order.
+  for (bool swapped : {false, true}) {
+    const ContactResult r = swapped ? fcl_indep_contact(diagonal_small(), diagonal_big())
+                                    : fcl_indep_contact(diagonal_big(), diagonal_small());
+    ASSERT_EQ(r.status, Status::Ok) << r.message;
+    ASSERT_EQ(r.contacts.size(), 1u);
+    EXPECT_NEAR((r.contacts[0].normal - Vec3(0, 0, swapped ? 1 : -1)).norm(), 0.0, kRoundOff)
+        << r.contacts[0].normal.transpose();
+    EXPECT_NEAR(r.contacts[0].depth, -kDiagonalDepth, kRoundOff);
+  }
+}
+
 TEST(FclIndep, SeparatedIsNoContact) {
   const ContactResult r = fcl_indep_contact(unit_cube("A", Vec3::Zero()), separated_b());
   EXPECT_EQ(r.status, Status::Ok);
@@ -372,16 +488,6 @@ TEST(FclBox, DiagonalCubeGetsTheMinimumPenetration) {
     EXPECT_TRUE(is_negative_axis(c.normal, kRoundOff)) << c.normal.transpose();
     EXPECT_NEAR(c.depth, kDiagonalDepth, kRoundOff);
   }
-}
-
-/// The six orientations of a cube that map it onto itself used by FCL's box-box tests.
-std::vector<Quat> cube_symmetries() {
-  return {Quat::Identity(),
-          Quat(Eigen::AngleAxisd(M_PI, Vec3::UnitX())),
-          Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX())),
-          Quat(Eigen::AngleAxisd(3 * M_PI / 2, Vec3::UnitX())),
-          Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY())),
-          Quat(Eigen::AngleAxisd(3 * M_PI / 2, Vec3::UnitY()))};
 }
 
 TEST(FclBox, PublicCaseUnitCubeOnEdgeIntoBigCube) {

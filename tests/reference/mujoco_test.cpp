@@ -6,8 +6,12 @@
 #include <mujoco/mujoco.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <map>
 #include <memory>
+#include <set>
+#include <utility>
 
 namespace rbx {
 namespace {
@@ -138,6 +142,70 @@ TEST(MujocoContact, RecentredMeshStaysOnOurPose) {
   EXPECT_LE(r.contacts[0].point.head<2>().norm(), std::sqrt(0.5) + kFloatGeometry);
 }
 
+// --- Known wrong answer: MPR on a small cube at a big cube's corner (FCL issue 545) ----------
+
+// REFERENCES.md and scenes/contact/small_on_diagonal.toml: a 0.1 cube B centred at (0.4, 0.4,
+// 0.4) inside the unit cube A at the origin. B spans [0.35, 0.45]^3; the least translation that
+// frees it is 0.15 along an axis (0.5 - 0.35; a three-way tie), so the truth is depth 0.15 with
+// an axis normal. MuJoCo 2.2.2 runs libccd's MPR on mesh geoms with the geom centres as the
+// interior point: the ray from c_A - c_B = -(0.4, 0.4, 0.4) through the origin leaves the
+// Minkowski difference (the cube of half-extent 0.55 about -(0.4, 0.4, 0.4)) exactly at its
+// corner (0.15, 0.15, 0.15): the diagonal, at distance 0.15 sqrt(3) ~ 0.2598.
+RigidBody diagonal_big() { return make_body(box_spec("A", Vec3::Ones(), Vec3::Zero())); }
+RigidBody diagonal_small(const Vec3& centre) {
+  return make_body(box_spec("B", Vec3::Constant(0.1), centre));
+}
+
+TEST(MujocoKnownWrongAnswer, SmallCubeOnTheDiagonalPinned) {
+  // Pinned as the adapter returns it. Ours: normal from B toward A = -(1, 1, 1)/sqrt(3) (MuJoCo's
+  // frame, geom1 -> geom2, is the diagonal toward the small cube), depth 0.15 sqrt(3). MuJoCo
+  // stores the vertices as float (0.05 -> 0.0500000007), hence kFloatGeometry.
+  const ContactResult r = mujoco_contact(diagonal_big(), diagonal_small(Vec3::Constant(0.4)));
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.contacts.size(), 1u);
+  const ContactPoint& c = r.contacts[0];
+  EXPECT_NEAR((c.normal + Vec3::Ones().normalized()).norm(), 0.0, kFloatGeometry)
+      << c.normal.transpose();
+  EXPECT_NEAR(c.depth, 0.15 * std::sqrt(3.0), kFloatGeometry);
+  // Against the truth (an axis, 0.15): 54.7 deg off and sqrt(3) too deep.
+  EXPECT_GT(c.depth - 0.15, 0.1);
+  // Swapped (the scene's order, small cube first): the same wrong answer, flipped.
+  const ContactResult swapped = mujoco_contact(diagonal_small(Vec3::Constant(0.4)), diagonal_big());
+  ASSERT_EQ(swapped.status, Status::Ok) << swapped.message;
+  ASSERT_EQ(swapped.contacts.size(), 1u);
+  EXPECT_NEAR((swapped.contacts[0].normal - Vec3::Ones().normalized()).norm(), 0.0, kFloatGeometry)
+      << swapped.contacts[0].normal.transpose();
+  EXPECT_NEAR(swapped.contacts[0].depth, 0.15 * std::sqrt(3.0), kFloatGeometry);
+}
+
+TEST(MujocoKnownWrongAnswer, SmallCubeNearTheDiagonalPinned) {
+  // scenes/contact/small_near_diagonal.toml: the small cube at (0.4, 0.39, 0.39), first. Truth:
+  // it spans x in [0.35, 0.45], y and z in [0.34, 0.44]; out along +x costs 0.15, along +y or
+  // +z 0.16: unique answer n = (1, 0, 0) (from the big cube toward the small one), depth 0.15.
+  // Measured, not derived (MPR's final portal is not a face of the Minkowski difference here):
+  // MuJoCo answers n = (2.5, 1, 1)/sqrt(8.25) = (0.87039, 0.34816, 0.34816), 29.5 deg off the
+  // axis, and depth 0.172337, which is not even the overlap along its own normal (0.242: the
+  // small cube's lowest point along n is 0.541 and the big cube's highest 0.783): the depth is
+  // the distance to the last portal's plane. Float vertices: kFloatGeometry.
+  const double n_long = 2.5 / std::sqrt(8.25), n_short = 1.0 / std::sqrt(8.25);
+  const double measured_depth = 0.17233688105783818;
+  for (bool swapped : {false, true}) {
+    const RigidBody small = diagonal_small(Vec3(0.4, 0.39, 0.39));
+    const ContactResult r =
+        swapped ? mujoco_contact(diagonal_big(), small) : mujoco_contact(small, diagonal_big());
+    ASSERT_EQ(r.status, Status::Ok) << r.message;
+    ASSERT_EQ(r.contacts.size(), 1u);
+    const ContactPoint& c = r.contacts[0];
+    const double sign = swapped ? -1.0 : 1.0;  // ours points toward the first body
+    EXPECT_NEAR((c.normal - sign * Vec3(n_long, n_short, n_short)).norm(), 0.0, kFloatGeometry)
+        << c.normal.transpose();
+    EXPECT_NEAR(c.depth, measured_depth, kFloatGeometry);
+    // Clearly not the truth (+-x, 0.15).
+    EXPECT_GT(std::abs(c.depth - 0.15), 0.02);
+    EXPECT_LT(std::abs(c.normal.x()), 0.9);
+  }
+}
+
 // --- Known defect: box-box half depth -------------------------------------------------------
 
 // Loads MJCF text through MuJoCo's virtual file system.
@@ -174,6 +242,126 @@ TEST(MujocoKnownDefect, BoxBoxReportsHalfTheDepth) {
   }
   mj_deleteData(d);
   mj_deleteModel(m);
+}
+
+// --- Errors: mju_error becomes Status::Error -------------------------------------------------
+
+// An allocator for MuJoCo (mju_user_malloc / mju_user_free) that counts its calls and fails
+// the `fail_at`-th (1-based; 0: never): every MuJoCo allocation goes through mju_malloc, which
+// calls mju_error("Could not allocate memory") when it gets nullptr. Blocks are 64-byte
+// aligned as MuJoCo's own (2.2.2 checks its buffer layout against that alignment; plain
+// malloc gave "mjModel buffer size mismatch") and come from aligned_alloc, so MuJoCo's default
+// free can release them after the hooks are gone.
+//
+// Leaks: the longjmp out of a failed mj_makeData abandons its partial mjData, which the
+// destructor frees (the sanitizer build checks for leaks). It must not free what MuJoCo itself
+// keeps from one mj_loadXML to the next (freed by the next load: freeing it here was a double
+// free): those are the blocks a clean query leaves live, identified by their call number.
+struct FailingAllocator {
+  static long calls, fail_at;
+  static std::map<void*, long>* live;  // block -> number of the call that allocated it
+  static void* allocate(size_t n) {
+    if (++calls == fail_at) return nullptr;
+    void* p = std::aligned_alloc(64, (n + 63) / 64 * 64);
+    if (p) (*live)[p] = calls;
+    return p;
+  }
+  static void release(void* p) {
+    live->erase(p);
+    std::free(p);
+  }
+  // Installs the hooks until destruction; `kept` are the call numbers whose blocks MuJoCo keeps
+  // after a clean query.
+  FailingAllocator(long fail, std::set<long> kept) : kept_by_mujoco(std::move(kept)) {
+    calls = 0;
+    fail_at = fail;
+    live = &blocks;
+    mju_user_malloc = allocate;
+    mju_user_free = release;
+  }
+  ~FailingAllocator() {
+    mju_user_malloc = nullptr;
+    mju_user_free = nullptr;
+    for (const auto& [p, call] : blocks)
+      if (!kept_by_mujoco.count(call)) std::free(p);
+  }
+  std::map<void*, long> blocks;
+  std::set<long> kept_by_mujoco;
+};
+long FailingAllocator::calls = 0;
+long FailingAllocator::fail_at = 0;
+std::map<void*, long>* FailingAllocator::live = nullptr;
+
+// A clean contact query under the counting allocator: how many allocations it makes (model
+// compile, mjData) and which of them MuJoCo keeps afterwards.
+struct AllocationProfile {
+  long calls = 0;
+  std::set<long> kept;
+};
+AllocationProfile profile_contact_query(const RigidBody& a, const RigidBody& b) {
+  AllocationProfile out;
+  std::set<long> all;  // keep everything: nothing is freed after a clean query
+  for (long k = 1; k <= 1000; ++k) all.insert(k);
+  FailingAllocator count(0, all);
+  EXPECT_EQ(mujoco_contact(a, b).status, Status::Ok);
+  out.calls = FailingAllocator::calls;
+  for (const auto& [p, call] : count.blocks) out.kept.insert(call);
+  return out;
+}
+
+TEST(MujocoErrors, MjuErrorInMakeDataIsAStatusErrorWithItsMessage) {
+  // A real mju_error on the adapter's own guarded path: the last allocation of a contact query
+  // is mj_makeData's (after mj_loadXML, whose compiler catches its own errors), and it fails.
+  // MuJoCo calls mju_error("Could not allocate memory"), which by default exits the process;
+  // the adapter's mju_user_error handler must jump back and return status Error with the
+  // message, and the next query must work.
+  const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
+  const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3(0.9, 0, 0)));
+  const AllocationProfile clean = profile_contact_query(a, b);
+  const long n = clean.calls;
+  ASSERT_GT(n, 2);
+  ASSERT_LT(n, 1000);
+  {
+    FailingAllocator fail_last(n, clean.kept);
+    const ContactResult r = mujoco_contact(a, b);
+    EXPECT_EQ(FailingAllocator::calls, n);  // it did reach the failing allocation
+    EXPECT_EQ(r.status, Status::Error);
+    EXPECT_EQ(r.message, "MuJoCo mj_makeData: Could not allocate memory");
+    EXPECT_TRUE(r.contacts.empty());
+  }
+  // Still alive, and MuJoCo still answers (the face pair above: one contact, depth 0.1).
+  const ContactResult again = mujoco_contact(a, b);
+  ASSERT_EQ(again.status, Status::Ok) << again.message;
+  ASSERT_EQ(again.contacts.size(), 1u);
+  EXPECT_NEAR(again.contacts[0].depth, 0.1, kFloatGeometry);
+}
+
+TEST(MujocoErrors, EveryFailedAllocationIsAStatusError) {
+  // Each of the query's allocations failed in turn: every one must come back as status Error
+  // naming the failure, whether it happens in the VFS, inside the compiler (reported through
+  // mj_loadXML's error buffer) or in mj_makeData (through the adapter's handler). Before the
+  // VFS call was guarded, failing the first allocation ended the process ("MuJoCo error outside
+  // a guarded call").
+  const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
+  const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3(0.9, 0, 0)));
+  const AllocationProfile clean = profile_contact_query(a, b);
+  const long n = clean.calls;
+  ASSERT_LT(n, 1000);
+  int through_compiler = 0, through_handler = 0;
+  for (long k = 1; k <= n; ++k) {
+    FailingAllocator fail(k, clean.kept);
+    const ContactResult r = mujoco_contact(a, b);
+    EXPECT_EQ(r.status, Status::Error) << "allocation " << k;
+    EXPECT_NE(r.message.find("Could not allocate memory"), std::string::npos)
+        << "allocation " << k << ": " << r.message;
+    if (r.message.rfind("MuJoCo mj_loadXML", 0) == 0) ++through_compiler;
+    if (r.message.rfind("MuJoCo mj_makeData", 0) == 0 ||
+        r.message.rfind("MuJoCo mj_makeEmptyFileVFS", 0) == 0)
+      ++through_handler;
+  }
+  EXPECT_EQ(through_compiler + through_handler, n);
+  EXPECT_GT(through_compiler, 0);
+  EXPECT_GT(through_handler, 1);  // the VFS file and at least one of mj_makeData's
 }
 
 // --- Dynamics -------------------------------------------------------------------------------

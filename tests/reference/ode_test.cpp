@@ -272,6 +272,48 @@ TEST(OdeDynamics, CubeCornerOnStaticSlab) {
   }
 }
 
+TEST(OdeDynamics, FrictionIsCoulombMuTimesTheNormalImpulse) {
+  // sim.friction is a Coulomb coefficient; ODE's surface.mu is one only with dContactApprox1
+  // (without it mu bounds the friction *force* in newtons: see ode.cpp, near_callback).
+  // A unit cube (m = 1, I = 1/6 identity) stands on a vertex, its body diagonal vertical, so
+  // the lowest vertex is r = (0, 0, -h), h = sqrt(3)/2, straight below the centre. It hits a
+  // static slab at v = (2, 0, -1) with e = 0.5, mu = 0.1, no gravity.
+  //  - Normal (0, 0, 1): r x n = 0, so j_n = (1 + e) * 1 = 1.5 and v_z' = -1 + 1.5 = 0.5.
+  //  - Sticking would need a tangential impulse j = v_x / (1/m + h^2 / I) = 2 / 5.5 = 0.364
+  //    (r x x = (0, -h, 0), I^-1 = 6); Coulomb allows mu j_n = 0.15, so the cube slides and
+  //    j_t = 0.15 along -x: v_x' = 2 - 0.15 = 1.85, w' = 6 r x (-0.15, 0, 0) = (0, 0.9 h, 0).
+  //    (Still sliding afterwards: v_x' + (w' x r)_x = 1.85 - 0.9 h^2 = 1.175 > 0.)
+  //  - The normal is along z, so ODE's friction pyramid (dPlaneSpace: -y and x) is aligned
+  //    with the sliding direction and equals the cone here.
+  // Read as a force limit (no Approx1), mu = 0.1 N would allow only 0.1 N * dt = 1e-4 N s:
+  // v_x' = 1.9999. Tolerance 1e-5 as in CubeCornerOnStaticSlab (contact point within ~1 um of
+  // the vertex, CFM ~1e-7 relative).
+  const double h = std::sqrt(3.0) / 2;
+  const double dt = 1e-3;
+  Scene s;
+  s.sim.dt = dt;
+  s.sim.duration = 0.01;  // impact at step 2; the cube has left the slab well before the end
+  s.sim.restitution = 0.5;
+  s.sim.friction = 0.1;
+  s.bodies.push_back(box_spec("cube", Vec3::Ones(), Vec3::Zero(), 1.0,
+                              Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), -Vec3::UnitZ())));
+  s.bodies.back().velocity = Vec3(2, 0, -1);
+  // Slab top 2 mm - 1 um below the vertex: seen 1 um deep at the third step (dt = 1 ms).
+  s.bodies.push_back(box_spec("slab", Vec3(4, 4, 1), Vec3(0, 0, -h - 0.5 - 0.002 + 1e-6)));
+  s.bodies.back().is_static = true;
+  const DynamicsResult r = ode_dynamics(s, {});
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  const BodyFinal& cube = r.finals[0];
+  EXPECT_NEAR(cube.velocity.x(), 1.85, 1e-5);
+  EXPECT_NEAR(cube.velocity.y(), 0.0, 1e-5);
+  EXPECT_NEAR(cube.velocity.z(), 0.5, 1e-5);
+  EXPECT_NEAR(cube.angular_velocity.x(), 0.0, 1e-5);
+  EXPECT_NEAR(cube.angular_velocity.y(), 0.9 * h, 1e-5);
+  EXPECT_NEAR(cube.angular_velocity.z(), 0.0, 1e-5);
+  ASSERT_EQ(r.events.size(), 1u);
+  EXPECT_NEAR(r.events[0].impulse, 1.5, 1e-5);  // normal impulse only
+}
+
 TEST(OdeDynamics, FreeRotationStaysInTheWorldFrame) {
   // Isotropic cube: constant world angular velocity, q(t) = exp(w t) q0 (the adapter selects
   // ODE's finite rotation mode, exact for constant w). Round-off over 100 steps.
