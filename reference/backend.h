@@ -6,6 +6,7 @@
 // Conventions are converted here and nowhere else; a library's wrong answers are passed on.
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -30,12 +31,28 @@ struct ContactResult {
   std::vector<ContactPoint> contacts;
 };
 
+/// A library answer of "touching" whose normal is zero or not finite (libccd's MPR sets its
+/// direction to zero below CCD_EPS of depth) defines no contact normal. Returns `r` unchanged
+/// when every normal is a unit vector, else status Error saying which query, at what depth.
+/// This labels a library's answer; it corrects nothing.
+inline ContactResult reject_undefined_normals(ContactResult r, const std::string& query) {
+  for (const ContactPoint& c : r.contacts) {
+    const double n = c.normal.norm();
+    if (std::isfinite(n) && n > 0.5) continue;
+    return {Status::Error,
+            query + " reported a contact (depth " + std::to_string(c.depth) +
+                ") with a zero or undefined normal",
+            {}};
+  }
+  return r;
+}
+
 /// Final state of one body after a dynamics run.
 struct BodyFinal {
   std::string name;
-  Vec3 position = Vec3::Zero();        // m, centre of mass, world
+  Vec3 position = Vec3::Zero();  // m, centre of mass, world
   Quat orientation = Quat::Identity();
-  Vec3 velocity = Vec3::Zero();        // m/s
+  Vec3 velocity = Vec3::Zero();          // m/s
   Vec3 angular_velocity = Vec3::Zero();  // rad/s, world frame
 };
 

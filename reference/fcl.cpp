@@ -130,10 +130,15 @@ std::shared_ptr<fcl::CollisionGeometryd> convex_geometry(const RigidBody& body) 
 }  // namespace
 
 ContactResult fcl_contact(const RigidBody& a, const RigidBody& b) {
-  return guarded("fcl::collide (GST_LIBCCD)", [&] {
-    return collide(convex_geometry(a), to_fcl(a.pose()), convex_geometry(b), to_fcl(b.pose()),
-                   fcl::GST_LIBCCD, "mpr");
-  });
+  // At depth below CCD_EPS libccd's MPR sets its direction to zero ("can be anything",
+  // mpr.c findPenetr) and FCL copies it as the normal: labelled as no normal, not a 180 deg miss.
+  return reject_undefined_normals(guarded("fcl::collide (GST_LIBCCD)",
+                                          [&] {
+                                            return collide(convex_geometry(a), to_fcl(a.pose()),
+                                                           convex_geometry(b), to_fcl(b.pose()),
+                                                           fcl::GST_LIBCCD, "mpr");
+                                          }),
+                                  "fcl::collide (GST_LIBCCD, libccd MPR)");
 }
 
 ContactResult fcl_epa_contact(const RigidBody& a, const RigidBody& b) {
@@ -234,7 +239,8 @@ MassResult fcl_mass(const RigidBody& body) {
     // parallel-axis shift assumes it, so we scale by the density mass / volume. FCL 0.7's
     // Convex returns it per unit MASS instead (convex-inl.h divides by the volume): the result
     // is off by 1/V, shown as it is.
-    r.message = "fcl::Convex, unit-density convention scaled to the mass (0.7's Convex is per unit mass)";
+    r.message =
+        "fcl::Convex, unit-density convention scaled to the mass (0.7's Convex is per unit mass)";
   } catch (const std::exception& e) {
     r.status = Status::Error;
     r.message = e.what();

@@ -1,6 +1,9 @@
 // ODE 0.16.2 adapter: every body becomes a dCreateConvex geom built from its body-frame hull
 // (coplanar triangles merged into polygons), attached to a dBody with our mass and inertia;
-// static bodies are geoms without a body.
+// static bodies are geoms without a body. Debian builds ODE with libccd
+// (dLIBCCD_CONVEX_CONVEX: libode links libccd), so convex-convex pairs run dCollideConvexConvexCCD,
+// libccd's MPR with one contact point, not ODE's own convex SAT: its depths and points match the
+// `fcl` backend's (both MPR) bit for bit on the same pair.
 //
 // Errors: ODE's dError and dDebug print and then exit()/abort() unless a handler is installed,
 // and a handler that returns gets the same fate. Ours copy the message and longjmp back to
@@ -330,7 +333,9 @@ ContactResult ode_contact(const RigidBody& a, const RigidBody& b) {
   if (!ok) return {Status::Error, t_error, {}};
   if (t_warning[0] != '\0') r.message = t_warning;
   for (int i = 0; i < n; ++i) r.contacts.push_back(convert_contact(contacts[i]));
-  return r;
+  // Debian's ODE routes convex-convex to libccd MPR (dCollideConvexConvexCCD): at depth below
+  // CCD_EPS its direction, hence ODE's normal, is zero. Labelled, not scored as a 180 deg miss.
+  return reject_undefined_normals(std::move(r), "dCollide (convex-convex via libccd MPR)");
 }
 
 DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {

@@ -182,6 +182,17 @@ TEST(FclMpr, FacePairConventionBothOrdersAndRotated) {
   check_face_pair(fcl_contact, kRoundOff);
 }
 
+TEST(FclMpr, ExactTouchingOffCentreHasNoNormalAndIsAnError) {
+  // scenes/contact/touching_zero_depth.toml: A exactly on top of B, shifted (0.3, 0.2). Unlike
+  // the centred touching pair below, MPR here reports contact at a round-off depth with its
+  // direction zeroed (mpr.c findPenetr, below CCD_EPS), which FCL copies as the normal.
+  // Pinned: the adapter labels that as no normal (status Error), not a 180 deg miss.
+  const ContactResult r =
+      fcl_contact(unit_cube("A", Vec3(0.3, 0.2, 1)), unit_cube("B", Vec3::Zero()));
+  EXPECT_EQ(r.status, Status::Error);
+  EXPECT_NE(r.message.find("zero or undefined normal"), std::string::npos) << r.message;
+}
+
 TEST(FclMpr, OneContactLabelledMpr) {
   const ContactResult r = fcl_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
   ASSERT_EQ(r.contacts.size(), 1u);  // Convex-Convex through MPR yields a single point

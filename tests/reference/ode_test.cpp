@@ -110,6 +110,18 @@ TEST(OdeContact, TouchingAndSeparatedPairs) {
   EXPECT_TRUE(apart.contacts.empty());
 }
 
+TEST(OdeKnownBehaviour, ExactTouchingOffCentreHasNoNormalAndIsAnError) {
+  // scenes/contact/touching_zero_depth.toml: A sits exactly on B, shifted (0.3, 0.2) sideways.
+  // Debian's ODE runs convex-convex through libccd MPR, which reports this pose as touching at
+  // a round-off depth with its direction set to zero (mpr.c: "can be anything" below CCD_EPS).
+  // Pinned: the adapter labels that as no normal (status Error) instead of scoring (0, 0, 0).
+  const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3(0.3, 0.2, 1)));
+  const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3::Zero()));
+  const ContactResult r = ode_contact(a, b);
+  EXPECT_EQ(r.status, Status::Error);
+  EXPECT_NE(r.message.find("zero or undefined normal"), std::string::npos) << r.message;
+}
+
 TEST(OdeContact, MergedFacesOfAPyramidOnABox) {
   // Pyramid (vertex mass model: centre of mass 1/5 above the base) turned 30 deg about z, its
   // base at z = 0 sunk 0.02 into the top of a 2 x 2 x 1 box (top at z = 0.02): normal (0,0,1)
