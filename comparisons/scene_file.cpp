@@ -265,6 +265,8 @@ class Reader {
 
   const std::string& path() const { return path_; }
   void mark_overridden(const std::string& key) { overridden_.insert(key); }
+  /// True when `key` (or a table holding it) was set by --set.
+  bool overridden(const std::string& key) const { return is_overridden(key); }
 
   /// Throws the one-line InputError. `line` 0 means no line; an overridden key is shown as
   /// "--set KEY" without a line, since its value is not in the file.
@@ -383,7 +385,9 @@ class Reader {
  private:
   bool is_overridden(const std::string& key) const {
     for (const std::string& o : overridden_)
-      if (o == key || starts_with(key, o + ".") || starts_with(o, key + ".")) return true;
+      if (o == key || starts_with(key, o + ".") || starts_with(key, o + "[") ||
+          starts_with(o, key + "."))
+        return true;
     return false;
   }
 
@@ -594,20 +598,30 @@ void read_sim(const Reader& r, const toml::table& sim, SimSettings& s, bool forc
              "write e.g. max_energy_ratio = 1e3 (the default)");
   }
 
-  // A run of more than 1e8 steps is refused unless forced: it is nearly always a unit slip.
-  if (force) return;
-  const bool has_duration = sim.contains("duration");
-  auto refuse = [&](double dt, const char* dt_key) {
+  // A run of more than 1e8 steps is refused unless forced: it is nearly always a unit slip. Even
+  // forced, the count must be one a run can take (finite, at most 2^53; see kMaxStepCount).
+  // Blamed key: a sweep entry for its own step; for sim.dt, the duration when the file sets it
+  // (a week at 1e-3 is a long duration), unless only the step came from --set.
+  const toml::node* duration_node = sim.get("duration");
+  const bool blame_duration =
+      duration_node && !(r.overridden("sim.dt") && !r.overridden("sim.duration"));
+  auto refuse = [&](double dt, const std::string& dt_key, const toml::node* dt_node) {
     const double steps = s.duration / dt;
-    if (steps <= kMaxSteps) return;
-    const char* key = has_duration ? "duration" : dt_key;
-    r.fail(line_of(sim.get(key)), std::string("sim.") + key,
-           "duration " + num(s.duration) + " s at dt = " + num(dt) + " s is " + num(steps) +
-               " steps, more than the limit of 1e8",
-           "shorten duration, raise dt, or pass --force to run it anyway");
+    const bool countable = steps <= kMaxStepCount;  // false for inf and NaN too
+    if (countable && (force || steps <= kMaxSteps)) return;
+    const bool duration_key = dt_key == "sim.dt" && blame_duration;
+    const std::string what = "duration " + num(s.duration) + " s at dt = " + num(dt) + " s is " +
+                             num(steps) + " steps, ";
+    r.fail(line_of(duration_key ? duration_node : dt_node), duration_key ? "sim.duration" : dt_key,
+           countable ? what + "more than the limit of 1e8"
+                     : what + "more than 2^53, the most a run can count, even with --force",
+           countable ? "shorten duration, raise dt, or pass --force to run it anyway"
+                     : "shorten duration or raise dt");
   };
-  refuse(s.dt, "dt");
-  for (const double dt : s.sweep_dt) refuse(dt, "sweep_dt");
+  refuse(s.dt, "sim.dt", sim.get("dt"));
+  if (const toml::node* n = sim.get("sweep_dt"))
+    for (size_t k = 0; k < s.sweep_dt.size(); ++k)
+      refuse(s.sweep_dt[k], "sim.sweep_dt[" + std::to_string(k) + "]", n->as_array()->get(k));
 }
 
 // Builds one body from its [[body]] table; mesh paths are resolved against `folder`.

@@ -385,6 +385,45 @@ TEST(SceneOverrides, ForceAdmitsAbsurdDurations) {
   EXPECT_EQ(s.sim.steps(), 1000000000L);
 }
 
+TEST(SceneOverrides, ForceStillRefusesUncountableStepCounts) {
+  // 1e300 s at 1e-3 s (1e303 steps) and 1 s at 1e-320 s (1/1e-320 overflows to inf) are beyond
+  // 2^53 steps: before, llround overflowed and the run took no steps and exited 0.
+  const std::string text = "[sim]\nduration = 1.0\n[[body]]\nname = \"A\"\n";
+  EXPECT_EQ(input_error([&] {
+              parse_scene(text, "t.toml", {"sim.duration=1e300", "force=true"});
+            }),
+            "t.toml: --set sim.duration: duration 1e+300 s at dt = 0.001 s is 1e+303 steps, more "
+            "than 2^53, the most a run can count, even with --force; shorten duration or raise dt");
+  EXPECT_EQ(input_error([&] {
+              parse_scene(text, "t.toml", {"sim.dt=1e-320", "force=true"});
+            }),
+            "t.toml: --set sim.dt: duration 1 s at dt = 1e-320 s is inf steps, more than "
+            "2^53, the most a run can count, even with --force; shorten duration or raise dt");
+  // A sweep step is checked too, and named (not the duration).
+  EXPECT_EQ(input_error([&] {
+              parse_scene(
+                  "[sim]\nduration = 1e10\nsweep_dt = [1e-2, 1e-12]\n[[body]]\nname = "
+                  "\"A\"\n",
+                  "t.toml", {"force=true"});
+            }),
+            "t.toml:3: sim.sweep_dt[1]: duration 1e+10 s at dt = 1e-12 s is 1e+22 steps, more than "
+            "2^53, the most a run can count, even with --force; shorten duration or raise dt");
+  // At the limit, forced, is accepted and counted exactly.
+  const Scene s = parse_scene(text, "t.toml", {"sim.duration=9007199254740.992", "force=true"});
+  EXPECT_EQ(s.sim.steps(), 9007199254740992L);
+}
+
+TEST(SceneOverrides, UnforcedSweepStepBlamesTheSweepEntry) {
+  // 1 s at a sweep step of 1e-12 s is 1e12 steps; the key at fault is the sweep entry, not the
+  // duration on line 2.
+  EXPECT_EQ(input_error([] {
+              parse_scene("[sim]\nduration = 1.0\nsweep_dt = [1e-12]\n[[body]]\nname = \"A\"\n",
+                          "t.toml");
+            }),
+            "t.toml:3: sim.sweep_dt[0]: duration 1 s at dt = 1e-12 s is 1e+12 steps, more than the "
+            "limit of 1e8; shorten duration, raise dt, or pass --force to run it anyway");
+}
+
 // ---- files -------------------------------------------------------------------------------------
 
 TEST(SceneFile, MissingSceneFileSaysSo) {
