@@ -737,6 +737,9 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
                "name the .obj file (paths are relative to the scene's folder)");
       try {
         b.shape = std::make_shared<const ConvexPolyhedron>(load_obj(resolved.string(), hull));
+      } catch (const ObjReadError& e) {
+        // Not readable as OBJ text: the error says what would help (hull = true would not).
+        r.fail(line_of(n), p + "file", e.what(), e.fix());
       } catch (const GeometryError& e) {
         std::string what = e.what();
         const std::string hint = " (use hull = true for its convex hull)";

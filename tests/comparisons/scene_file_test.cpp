@@ -2,10 +2,16 @@
 // rotation order, --set overrides, and the mesh readers (Qhull hulls, OBJ files).
 #include "comparisons/scene_file.h"
 
+#include <grp.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -554,6 +560,43 @@ TEST(LoadObj, SelfIntersectionIsAWrappedHull) {
   const ConvexPolyhedron hull = load_obj("tests/bad_input/mesh_self_intersecting.obj", true);
   EXPECT_EQ(hull.vertices().size(), 6u);
   EXPECT_NEAR(hull.volume(), 4.0 / 3.0, kRoundOff);
+}
+
+TEST(LoadObj, VertexLinesAreReadStrictly) {
+  // A tetrahedron whose fourth vertex line is `last`: tinyobjloader alone read a bad or missing
+  // coordinate as 0; each case must be refused naming the line (5) and the coordinate.
+  const fs::path dir = fs::temp_directory_path() / ("rbx_obj_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string path = (dir / "t.obj").string();
+  auto load = [&](const std::string& last, const std::string& eol = "\n") {
+    std::ofstream(path, std::ios::binary)
+        << "# t" << eol << "v 0 0 0" << eol << "v 1 0 0" << eol << "v 0 1 0" << eol << last << eol
+        << "f 1 3 2" << eol << "f 1 2 4" << eol << "f 1 4 3" << eol << "f 2 3 4" << eol;
+    try {
+      return std::to_string(load_obj(path, false).vertices().size());
+    } catch (const ObjReadError& e) {
+      return std::string(e.what()).substr(path.size() + 2);
+    }
+  };
+  EXPECT_EQ(load("v 0 0 1"), "4");
+  EXPECT_EQ(load("v 0 0 1 1.0"), "4");       // w, as the OBJ format allows
+  EXPECT_EQ(load("v 0 0 1e0 # apex"), "4");  // a trailing comment
+  EXPECT_EQ(load("v 0 0 1", "\r\n"), "4");   // Windows line ends
+  EXPECT_EQ(load("v 0 0 nan"), "line 5: v line: z is \"nan\", not a finite number");
+  EXPECT_EQ(load("v 0 0 1e999"), "line 5: v line: z is \"1e999\", not a finite number");
+  EXPECT_EQ(load("v 0 abc 1"), "line 5: v line: y is \"abc\", not a number");
+  EXPECT_EQ(load("v 0x1 0 1"), "line 5: v line: x is \"0x1\", not a number");
+  EXPECT_EQ(load("v 0 0"), "line 5: v line has 2 numbers, a vertex needs 3 (x y z)");
+  EXPECT_EQ(load("v"), "line 5: v line has 0 numbers, a vertex needs 3 (x y z)");
+  EXPECT_EQ(load("v 0 0 1 inf"), "line 5: v line: w is \"inf\", not a finite number");
+  EXPECT_EQ(load("v 0 0 1 1 1"),
+            "line 5: v line has more than 4 numbers (x y z and an optional w)");
+  // Old Mac line ends (a lone CR) count lines as tinyobjloader does.
+  EXPECT_EQ(load("v 0 0", "\r"), "line 5: v line has 2 numbers, a vertex needs 3 (x y z)");
+  // With hull = true too (there the bad vertex silently changed the shape).
+  std::ofstream(path) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 nan\n";
+  EXPECT_THROW(load_obj(path, true), ObjReadError);
+  fs::remove_all(dir);
 }
 
 }  // namespace
