@@ -335,6 +335,15 @@ ConvexPolyhedron load_obj(const std::string& path, bool hull) {
   for (int i = 0; i < nv; ++i)
     vertices[i] = Vec3(attrib.vertices[3 * i], attrib.vertices[3 * i + 1],
                        attrib.vertices[3 * i + 2]);
+  // Coordinates beyond kMaxLength overflow squared lengths and volumes (polyhedron.h).
+  for (int i = 0; i < nv; ++i)
+    if (!(vertices[i].cwiseAbs().maxCoeff() <= kMaxLength))
+      throw ObjReadError(
+          path + ": line " +
+              std::to_string(i < static_cast<int>(lines.vertex_line.size()) ? lines.vertex_line[i]
+                                                                            : -1) +
+              ": vertex " + std::to_string(i + 1) + " lies beyond 1e12 m of the origin",
+          "scale the mesh to metres, within 1e12 m of its origin");
   if (nv == 0)
     throw ObjReadError(path + ": no vertices (no 'v' lines), not an OBJ mesh",
                        "fix the OBJ file: give its vertices (v x y z) and faces (f i j k)");

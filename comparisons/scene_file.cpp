@@ -663,6 +663,11 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
     if (!(v > 0))
       r.fail(line_of(n), p + key, std::string(what) + " must be > 0 m, got " + num(v),
              std::string("write e.g. ") + key + " = " + example_of(std::string("body.") + key));
+    // Beyond the range, squared lengths and volumes overflow or underflow (kMaxLength).
+    if (!(v >= kMinLength && v <= kMaxLength))
+      r.fail(line_of(n), p + key, std::string(what) + " must be in [1e-12, 1e12] m, got " + num(v),
+             std::string("give it in metres, e.g. ") + key + " = " +
+                 example_of(std::string("body.") + key));
     return v;
   };
   auto shape_line = [&]() { return t.get("shape") ? line_of(t.get("shape")) : table_line; };
@@ -674,6 +679,11 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
           r.fail(line_of(n), p + "size",
                  "every extent must be > 0 m, got " + vec_text(b.box_size),
                  "write full extents, e.g. size = [1, 1, 1]");
+        // Beyond the range, squared lengths and volumes overflow or underflow (kMaxLength).
+        if (!(b.box_size.minCoeff() >= kMinLength && b.box_size.maxCoeff() <= kMaxLength))
+          r.fail(line_of(n), p + "size",
+                 "every extent must be in [1e-12, 1e12] m, got " + vec_text(b.box_size),
+                 "give full extents in metres, e.g. size = [1, 1, 1]");
       }
       b.shape = std::make_shared<const ConvexPolyhedron>(make_box(b.box_size));
     } else if (b.shape_kind == "icosphere") {
@@ -707,8 +717,15 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
                "add vertices = [[x, y, z], ...] (at least 4 points spanning a volume)");
       const toml::array& a = r.array(*n, p + "vertices", "body.vertices");
       std::vector<Vec3> points;
-      for (size_t k = 0; k < a.size(); ++k)
-        points.push_back(r.vec3(*a.get(k), p + "vertices[" + std::to_string(k) + "]", "body.vertices"));
+      for (size_t k = 0; k < a.size(); ++k) {
+        const std::string key = p + "vertices[" + std::to_string(k) + "]";
+        points.push_back(r.vec3(*a.get(k), key, "body.vertices"));
+        // Coordinates beyond kMaxLength overflow squared lengths and volumes.
+        if (!(points.back().cwiseAbs().maxCoeff() <= kMaxLength))
+          r.fail(line_of(a.get(k)), key,
+                 "coordinates must be within 1e12 m of the origin, got " + vec_text(points.back()),
+                 "give local coordinates in metres");
+      }
       try {
         b.shape = std::make_shared<const ConvexPolyhedron>(convex_hull(points));
       } catch (const GeometryError& e) {

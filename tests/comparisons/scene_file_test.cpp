@@ -94,7 +94,9 @@ TEST(BadInputCatalogue, CoversEveryCaseOfTheBrief) {
         "expect_unknown_body", "unknown_check", "unknown_backend", "unknown_integrator",
         "unknown_mass_model", "unknown_shape", "non_unit_quaternion", "rotation_and_orientation",
         "mesh_missing", "mesh_folder", "mesh_open", "mesh_nonconvex", "mesh_degenerate",
-        "mesh_self_intersecting", "mesh_index_out_of_range", "binary_junk"})
+        "mesh_self_intersecting", "mesh_index_out_of_range", "binary_junk", "mesh_vertex_nan",
+        "mesh_vertex_not_number", "mesh_vertex_missing_z", "huge_size", "huge_radius",
+        "sweep_dt_absurd"})
     EXPECT_NE(std::find(names.begin(), names.end(), required), names.end()) << required;
 }
 
@@ -428,6 +430,48 @@ TEST(SceneOverrides, UnforcedSweepStepBlamesTheSweepEntry) {
             }),
             "t.toml:3: sim.sweep_dt[0]: duration 1 s at dt = 1e-12 s is 1e+12 steps, more than the "
             "limit of 1e8; shorten duration, raise dt, or pass --force to run it anyway");
+}
+
+TEST(SceneFile, ShapeLengthsStayWhereSquaresAndVolumesAreFinite) {
+  // Before, [1e200, 1, 1] overflowed the volume and was called "zero area"; a 1e13 m vertex and
+  // a 1e-13 m extent are just past the [1e-12, 1e12] m range.
+  const std::string body = "[[body]]\nname = \"A\"\n";
+  EXPECT_EQ(input_error([&] { parse_scene(body + "size = [1e200, 1, 1]\n", "t.toml"); }),
+            "t.toml:3: body.A.size: every extent must be in [1e-12, 1e12] m, got [1e+200, 1, 1]; "
+            "give full extents in metres, e.g. size = [1, 1, 1]");
+  EXPECT_EQ(input_error([&] { parse_scene(body + "size = [1, 1e-13, 1]\n", "t.toml"); }),
+            "t.toml:3: body.A.size: every extent must be in [1e-12, 1e12] m, got [1, 1e-13, 1]; "
+            "give full extents in metres, e.g. size = [1, 1, 1]");
+  EXPECT_EQ(
+      input_error([&] { parse_scene(body + "shape = \"icosphere\"\nradius = 2e12\n", "t.toml"); }),
+      "t.toml:4: body.A.radius: radius must be in [1e-12, 1e12] m, got 2e+12; give it in "
+      "metres, e.g. radius = 0.5");
+  EXPECT_EQ(
+      input_error([&] { parse_scene(body + "shape = \"prism\"\nheight = 1e300\n", "t.toml"); }),
+      "t.toml:4: body.A.height: height must be in [1e-12, 1e12] m, got 1e+300; give it in "
+      "metres, e.g. height = 1.0");
+  EXPECT_EQ(input_error([&] {
+              parse_scene(body +
+                              "shape = \"convex\"\nvertices = [[0, 0, 0], [1e13, 0, 0], "
+                              "[0, 1, 0], [0, 0, 1]]\n",
+                          "t.toml");
+            }),
+            "t.toml:4: body.A.vertices[1]: coordinates must be within 1e12 m of the origin, got "
+            "[1e+13, 0, 0]; give local coordinates in metres");
+  // The range's ends themselves are accepted.
+  EXPECT_NO_THROW(parse_scene(body + "size = [1e12, 1e12, 1e12]\n", "t.toml"));
+  EXPECT_NO_THROW(parse_scene(body + "size = [1e-12, 1e-12, 1e-12]\n", "t.toml"));
+  // An OBJ vertex too, naming the OBJ line.
+  const fs::path dir = fs::temp_directory_path() / ("rbx_far_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "far.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e200\n";
+  const std::string scene = (dir / "s.toml").string();
+  std::ofstream(scene) << body << "shape = \"mesh\"\nfile = \"far.obj\"\nhull = true\n";
+  EXPECT_EQ(input_error([&] { load_scene(scene); }),
+            scene + ":4: body.A.file: " + (dir / "far.obj").string() +
+                ": line 4: vertex 4 lies beyond 1e12 m of the origin; scale the mesh to metres, "
+                "within 1e12 m of its origin");
+  fs::remove_all(dir);
 }
 
 // ---- files -------------------------------------------------------------------------------------
