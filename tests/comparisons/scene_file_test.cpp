@@ -100,6 +100,58 @@ TEST(BadInputCatalogue, CoversEveryCaseOfTheBrief) {
     EXPECT_NE(std::find(names.begin(), names.end(), required), names.end()) << required;
 }
 
+// The catalogue's one case that cannot be a committed file: a mesh its reader may not read.
+// CI runs as root, which ignores file modes, so the load runs in a child that drops to the
+// unprivileged user nobody (65534) first; the message comes back through a pipe.
+TEST(BadInputCatalogue, UnreadableMeshNamesThePermissionFix) {
+  char pattern[] = "/tmp/rbx_unreadable_XXXXXX";
+  ASSERT_NE(::mkdtemp(pattern), nullptr) << std::strerror(errno);
+  const std::string dir = pattern;
+  const std::string scene = dir + "/scene.toml", mesh = dir + "/mesh.obj";
+  std::ofstream(scene) << "[[body]]\nname = \"A\"\nshape = \"mesh\"\nfile = \"mesh.obj\"\n";
+  std::ofstream(mesh) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  // Traversable folder and readable scene; the mesh exists but has no permissions at all.
+  ASSERT_EQ(::chmod(dir.c_str(), 0755), 0);
+  ASSERT_EQ(::chmod(scene.c_str(), 0644), 0);
+  ASSERT_EQ(::chmod(mesh.c_str(), 0000), 0);
+
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    // Child: drop root (groups first, then gid, then uid), load, report, exit without cleanup.
+    ::close(fds[0]);
+    std::string message;
+    if (::geteuid() == 0 &&
+        (::setgroups(0, nullptr) != 0 || ::setgid(65534) != 0 || ::setuid(65534) != 0)) {
+      message = std::string("cannot drop to nobody: ") + std::strerror(errno);
+    } else {
+      try {
+        load_scene(scene);
+        message = "no error: the mesh was read";
+      } catch (const std::exception& e) {
+        message = e.what();
+      }
+    }
+    const ssize_t written = ::write(fds[1], message.data(), message.size());
+    ::_exit(written == static_cast<ssize_t>(message.size()) ? 0 : 1);
+  }
+  ::close(fds[1]);
+  std::string message;
+  char buffer[512];
+  for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) > 0;) message.append(buffer, n);
+  ::close(fds[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ::chmod(mesh.c_str(), 0644);
+  fs::remove_all(dir);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  EXPECT_EQ(message, scene + ":4: body.A.file: " + mesh +
+                         ": cannot be read (Permission denied); make the file readable by this "
+                         "user (chmod a+r), and its folders searchable");
+}
+
 // ---- good scenes -------------------------------------------------------------------------------
 
 const char* kFullScene = R"(
