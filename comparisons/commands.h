@@ -26,6 +26,9 @@ enum class Capability { Contact, Dynamics };
 /// scene's `backends`, else every backend with the capability. Names are kept in registry order.
 std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
                                          Capability cap);
+/// The same, choosing from `table` instead of the registry (the harness's seam for tests).
+std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
+                                         Capability cap, const std::vector<Backend>& table);
 
 /// Loads a scene applying --set and --force (InputError on bad input).
 Scene load_scene_for_command(const std::string& path, const SceneCommandOptions& opt);

@@ -191,7 +191,10 @@ namespace {
 class Evaluator {
  public:
   Evaluator(const Scene& scene, const HarnessOptions& opt)
-      : scene_(scene), opt_(opt), inputs_(make_bodies(scene)) {
+      : scene_(scene),
+        opt_(opt),
+        table_(opt.registry ? *opt.registry : backends()),
+        inputs_(make_bodies(scene)) {
     out_.family = scene_family(scene.file);
   }
 
@@ -238,6 +241,12 @@ class Evaluator {
     out_.metrics.push_back({check, backend, pair, name, value, against});
   }
 
+  // The backend called `name` in the table (select_backends only returns names from it).
+  const Backend& backend(const std::string& name) const {
+    return *std::find_if(table_.begin(), table_.end(),
+                         [&](const Backend& b) { return b.name == name; });
+  }
+
   Json& backend_json(const std::string& name) {
     if (!backends_json_.contains(name))
       backends_json_[name] = {{"status", "ok"}, {"message", ""}, {"runtime_s", 0.0},
@@ -257,7 +266,8 @@ class Evaluator {
 
   // -- contact ---------------------------------------------------------------------------------
   void contact_check() {
-    const std::vector<std::string> names = select_backends(scene_, opt_.backends, Capability::Contact);
+    const std::vector<std::string> names =
+        select_backends(scene_, opt_.backends, Capability::Contact, table_);
     const Backend& exact = *find_backend("exact");
     int pairs = 0;
     for (size_t i = 0; i < inputs_.size(); ++i) {
@@ -289,7 +299,7 @@ class Evaluator {
     const double tol = scene_.expect ? scene_.expect->tolerance : 1e-6;
 
     for (const std::string& name : names) {
-      const Backend& be = *find_backend(name);
+      const Backend& be = backend(name);
       // Time each query for about timing_budget_s (median of the repeats).
       ContactRun probe = name == "exact" ? run_contact(exact, a, b) : run_contact(be, a, b);
       int repeats = 1;
@@ -354,7 +364,8 @@ class Evaluator {
 
   // -- impulse, trajectory, stability ----------------------------------------------------------
   void dynamics_checks() {
-    const std::vector<std::string> names = select_backends(scene_, opt_.backends, Capability::Dynamics);
+    const std::vector<std::string> names =
+        select_backends(scene_, opt_.backends, Capability::Dynamics, table_);
     const double e0_kin = kinetic_energy(inputs_);
     const std::vector<BodyFinal> s0 = initial_states(inputs_);
     const double e0 = total_energy(inputs_, s0, scene_.sim.gravity);
@@ -395,7 +406,7 @@ class Evaluator {
     const double finest = dts.back();
 
     for (const std::string& name : names) {
-      const Backend& be = *find_backend(name);
+      const Backend& be = backend(name);
       if (!be.dynamics) {
         set_status(name, Status::Unsupported, name + " has no dynamics (contact queries only)");
         continue;
@@ -685,8 +696,9 @@ class Evaluator {
   // exact uniform-density values. Every backend still runs with the exact values.
   void mass_check() {
     std::vector<const Backend*> libs;
-    const std::vector<std::string> wanted = select_backends(scene_, opt_.backends, Capability::Contact);
-    for (const Backend& b : backends())
+    const std::vector<std::string> wanted =
+        select_backends(scene_, opt_.backends, Capability::Contact, table_);
+    for (const Backend& b : table_)
       if (b.mass && (opt_.backends.empty() ||
                      std::find(wanted.begin(), wanted.end(), b.name) != wanted.end()))
         libs.push_back(&b);
@@ -738,6 +750,7 @@ class Evaluator {
 
   const Scene& scene_;
   const HarnessOptions& opt_;
+  const std::vector<Backend>& table_;  // the backends to choose from
   std::vector<RigidBody> inputs_;
   SceneEvaluation out_;
   Json backends_json_;

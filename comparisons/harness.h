@@ -9,6 +9,7 @@
 
 #include "comparisons/json_io.h"
 #include "engine/scene.h"
+#include "reference/backend.h"
 
 namespace rbx {
 
@@ -17,6 +18,9 @@ struct HarnessOptions {
   std::string backends;      // --backends LIST ("" : the scene's, or all that serve a check)
   bool sweep = true;         // run the time-step sweep for error against run time
   double timing_budget_s = 0.01;  // per contact query and backend: repeat until this much time
+  /// Backends to choose from; nullptr: the registry (reference/registry.cpp). Tests pass their
+  /// own table to add a failing backend without touching the registry.
+  const std::vector<Backend>* registry = nullptr;
 };
 
 /// One measured number.

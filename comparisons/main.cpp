@@ -19,7 +19,7 @@ void scene_options(CLI::App* cmd, rbx::SceneCommandOptions& o, bool many, bool b
     cmd->add_option("scene", o.scenes, "scene file (TOML)")->required()->expected(1);
   cmd->add_option("--json", o.json, "write JSON results to FILE, or - for standard output");
   cmd->add_option("--set", o.sets, "override a scene key, TOML-typed: KEY=VALUE (repeatable)");
-  cmd->add_flag("--force", o.force, "accept runs of more than 1e8 steps");
+  cmd->add_flag("--force", o.force, "accept runs of more than 1e8 steps (at most 2^53)");
   if (backends) cmd->add_option("--backends", o.backends, "comma-separated backend names");
 }
 

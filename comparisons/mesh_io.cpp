@@ -178,17 +178,63 @@ struct ObjLines {
   std::vector<int> face_line;
 };
 
+// What fixes a malformed 'v' line.
+constexpr const char* kVertexFix =
+    "write each vertex as v x y z, three finite numbers (a fourth, w, must be finite too)";
+
+// A decimal number as OBJ writes one ("-1", "0.5", "2.5e-3"); strtod alone would also take
+// "nan", "inf" and hexadecimal, which tinyobjloader does not.
+bool decimal_number(const std::string& word) {
+  static const std::regex number(R"([+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?)");
+  return std::regex_match(word, number);
+}
+
+// Checks one 'v' statement strictly (tinyobjloader reads a bad or missing coordinate as 0,
+// silently giving another shape): x y z, then at most w, every one a finite decimal number.
+// A '#' ends the statement (a trailing comment).
+void check_vertex_line(std::istringstream& words, const std::string& path, int number) {
+  static const char* const kNames[] = {"x", "y", "z", "w"};
+  const std::string where = path + ": line " + std::to_string(number) + ": ";
+  int count = 0;
+  for (std::string w; words >> w;) {
+    if (w[0] == '#') break;
+    if (count == 4)
+      throw ObjReadError(where + "v line has more than 4 numbers (x y z and an optional w)",
+                         kVertexFix);
+    const std::string shown = "\"" + (w.size() > 20 ? w.substr(0, 17) + "..." : w) + "\"";
+    // "nan", "inf" and overflowing decimals ("1e999") read as numbers, but not finite ones.
+    char* end = nullptr;
+    const double value = std::strtod(w.c_str(), &end);
+    if (*end == '\0' && !std::isfinite(value))
+      throw ObjReadError(
+          where + "v line: " + kNames[count] + " is " + shown + ", not a finite number",
+          kVertexFix);
+    if (!decimal_number(w))
+      throw ObjReadError(where + "v line: " + kNames[count] + " is " + shown + ", not a number",
+                         kVertexFix);
+    ++count;
+  }
+  if (count < 3)
+    throw ObjReadError(where + "v line has " + std::to_string(count) +
+                           (count == 1 ? " number" : " numbers") + ", a vertex needs 3 (x y z)",
+                       kVertexFix);
+}
+
 ObjLines scan_obj_lines(const std::string& text, const std::string& path, bool check_faces) {
   ObjLines lines;
-  std::istringstream in(text);
-  std::string line;
   int number = 0;
-  while (std::getline(in, line)) {
+  // Lines end at "\n", "\r\n" or a lone "\r", as tinyobjloader reads them.
+  for (size_t at = 0; at < text.size();) {
+    size_t end = text.find_first_of("\r\n", at);
+    if (end == std::string::npos) end = text.size();
+    const std::string line = text.substr(at, end - at);
+    at = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
     ++number;
     std::istringstream words(line);
     std::string tag;
     if (!(words >> tag)) continue;
     if (tag == "v") {
+      check_vertex_line(words, path, number);
       lines.vertex_line.push_back(number);
     } else if (tag == "f") {
       int corners = 0;
@@ -208,7 +254,7 @@ std::string annotate(const std::string& message, const ObjLines& lines,
                      const std::vector<int>& triangle_face) {
   auto face_line = [&](int t) {
     if (t < 0 || t >= static_cast<int>(triangle_face.size())) return -1;
-    // tinyobjloader also ends lines at a lone '\r', so it can count more faces than the scan.
+    // The scan splits lines as tinyobjloader does; the bound stays as a guard.
     const int f = triangle_face[t];
     return f < static_cast<int>(lines.face_line.size()) ? lines.face_line[f] : -1;
   };
@@ -253,14 +299,24 @@ ConvexPolyhedron load_obj(const std::string& path, bool hull) {
   if (!fs::exists(path, ec)) throw GeometryError(path + ": file not found");
   if (fs::is_directory(path, ec)) throw GeometryError(path + ": is a folder, not an OBJ file");
   if (!fs::is_regular_file(path, ec))  // /dev/zero, a FIFO: reading would never end
-    throw GeometryError(path + ": is not a regular file (a device or a pipe), not an OBJ file");
+    throw ObjReadError(path + ": is not a regular file (a device or a pipe), not an OBJ file",
+                       "name a regular .obj file");
   std::ifstream file(path, std::ios::binary);
-  if (!file) throw GeometryError(path + ": cannot be read (" + std::strerror(errno) + ")");
+  if (!file) {
+    // Permissions are the usual cause; anything else (EIO, ...) is named by strerror.
+    const int error = errno;
+    throw ObjReadError(path + ": cannot be read (" + std::strerror(error) + ")",
+                       error == EACCES || error == EPERM
+                           ? "make the file readable by this user (chmod a+r), and its folders "
+                             "searchable"
+                           : "check that the file can be read");
+  }
   std::ostringstream buffer;
   buffer << file.rdbuf();
   const std::string text = buffer.str();
   if (text.find('\0') != std::string::npos)
-    throw GeometryError(path + ": contains NUL bytes: a binary file, not a text OBJ file");
+    throw ObjReadError(path + ": contains NUL bytes: a binary file, not a text OBJ file",
+                       "name a text OBJ file (v x y z and f i j k lines)");
   const ObjLines lines = scan_obj_lines(text, path, /*check_faces=*/!hull);
 
   // Parse without tinyobjloader's triangulation: we fan-triangulate below, after checking the
@@ -279,7 +335,18 @@ ConvexPolyhedron load_obj(const std::string& path, bool hull) {
   for (int i = 0; i < nv; ++i)
     vertices[i] = Vec3(attrib.vertices[3 * i], attrib.vertices[3 * i + 1],
                        attrib.vertices[3 * i + 2]);
-  if (nv == 0) throw GeometryError(path + ": no vertices (no 'v' lines), not an OBJ mesh");
+  // Coordinates beyond kMaxLength overflow squared lengths and volumes (polyhedron.h).
+  for (int i = 0; i < nv; ++i)
+    if (!(vertices[i].cwiseAbs().maxCoeff() <= kMaxLength))
+      throw ObjReadError(
+          path + ": line " +
+              std::to_string(i < static_cast<int>(lines.vertex_line.size()) ? lines.vertex_line[i]
+                                                                            : -1) +
+              ": vertex " + std::to_string(i + 1) + " lies beyond 1e12 m of the origin",
+          "scale the mesh to metres, within 1e12 m of its origin");
+  if (nv == 0)
+    throw ObjReadError(path + ": no vertices (no 'v' lines), not an OBJ mesh",
+                       "fix the OBJ file: give its vertices (v x y z) and faces (f i j k)");
 
   // With hull = true the faces play no part: the hull of the vertices is the shape.
   if (hull) {

@@ -265,6 +265,8 @@ class Reader {
 
   const std::string& path() const { return path_; }
   void mark_overridden(const std::string& key) { overridden_.insert(key); }
+  /// True when `key` (or a table holding it) was set by --set.
+  bool overridden(const std::string& key) const { return is_overridden(key); }
 
   /// Throws the one-line InputError. `line` 0 means no line; an overridden key is shown as
   /// "--set KEY" without a line, since its value is not in the file.
@@ -383,7 +385,9 @@ class Reader {
  private:
   bool is_overridden(const std::string& key) const {
     for (const std::string& o : overridden_)
-      if (o == key || starts_with(key, o + ".") || starts_with(o, key + ".")) return true;
+      if (o == key || starts_with(key, o + ".") || starts_with(key, o + "[") ||
+          starts_with(o, key + "."))
+        return true;
     return false;
   }
 
@@ -594,20 +598,30 @@ void read_sim(const Reader& r, const toml::table& sim, SimSettings& s, bool forc
              "write e.g. max_energy_ratio = 1e3 (the default)");
   }
 
-  // A run of more than 1e8 steps is refused unless forced: it is nearly always a unit slip.
-  if (force) return;
-  const bool has_duration = sim.contains("duration");
-  auto refuse = [&](double dt, const char* dt_key) {
+  // A run of more than 1e8 steps is refused unless forced: it is nearly always a unit slip. Even
+  // forced, the count must be one a run can take (finite, at most 2^53; see kMaxStepCount).
+  // Blamed key: a sweep entry for its own step; for sim.dt, the duration when the file sets it
+  // (a week at 1e-3 is a long duration), unless only the step came from --set.
+  const toml::node* duration_node = sim.get("duration");
+  const bool blame_duration =
+      duration_node && !(r.overridden("sim.dt") && !r.overridden("sim.duration"));
+  auto refuse = [&](double dt, const std::string& dt_key, const toml::node* dt_node) {
     const double steps = s.duration / dt;
-    if (steps <= kMaxSteps) return;
-    const char* key = has_duration ? "duration" : dt_key;
-    r.fail(line_of(sim.get(key)), std::string("sim.") + key,
-           "duration " + num(s.duration) + " s at dt = " + num(dt) + " s is " + num(steps) +
-               " steps, more than the limit of 1e8",
-           "shorten duration, raise dt, or pass --force to run it anyway");
+    const bool countable = steps <= kMaxStepCount;  // false for inf and NaN too
+    if (countable && (force || steps <= kMaxSteps)) return;
+    const bool duration_key = dt_key == "sim.dt" && blame_duration;
+    const std::string what = "duration " + num(s.duration) + " s at dt = " + num(dt) + " s is " +
+                             num(steps) + " steps, ";
+    r.fail(line_of(duration_key ? duration_node : dt_node), duration_key ? "sim.duration" : dt_key,
+           countable ? what + "more than the limit of 1e8"
+                     : what + "more than 2^53, the most a run can count, even with --force",
+           countable ? "shorten duration, raise dt, or pass --force to run it anyway"
+                     : "shorten duration or raise dt");
   };
-  refuse(s.dt, "dt");
-  for (const double dt : s.sweep_dt) refuse(dt, "sweep_dt");
+  refuse(s.dt, "sim.dt", sim.get("dt"));
+  if (const toml::node* n = sim.get("sweep_dt"))
+    for (size_t k = 0; k < s.sweep_dt.size(); ++k)
+      refuse(s.sweep_dt[k], "sim.sweep_dt[" + std::to_string(k) + "]", n->as_array()->get(k));
 }
 
 // Builds one body from its [[body]] table; mesh paths are resolved against `folder`.
@@ -649,6 +663,11 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
     if (!(v > 0))
       r.fail(line_of(n), p + key, std::string(what) + " must be > 0 m, got " + num(v),
              std::string("write e.g. ") + key + " = " + example_of(std::string("body.") + key));
+    // Beyond the range, squared lengths and volumes overflow or underflow (kMaxLength).
+    if (!(v >= kMinLength && v <= kMaxLength))
+      r.fail(line_of(n), p + key, std::string(what) + " must be in [1e-12, 1e12] m, got " + num(v),
+             std::string("give it in metres, e.g. ") + key + " = " +
+                 example_of(std::string("body.") + key));
     return v;
   };
   auto shape_line = [&]() { return t.get("shape") ? line_of(t.get("shape")) : table_line; };
@@ -660,6 +679,11 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
           r.fail(line_of(n), p + "size",
                  "every extent must be > 0 m, got " + vec_text(b.box_size),
                  "write full extents, e.g. size = [1, 1, 1]");
+        // Beyond the range, squared lengths and volumes overflow or underflow (kMaxLength).
+        if (!(b.box_size.minCoeff() >= kMinLength && b.box_size.maxCoeff() <= kMaxLength))
+          r.fail(line_of(n), p + "size",
+                 "every extent must be in [1e-12, 1e12] m, got " + vec_text(b.box_size),
+                 "give full extents in metres, e.g. size = [1, 1, 1]");
       }
       b.shape = std::make_shared<const ConvexPolyhedron>(make_box(b.box_size));
     } else if (b.shape_kind == "icosphere") {
@@ -693,8 +717,15 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
                "add vertices = [[x, y, z], ...] (at least 4 points spanning a volume)");
       const toml::array& a = r.array(*n, p + "vertices", "body.vertices");
       std::vector<Vec3> points;
-      for (size_t k = 0; k < a.size(); ++k)
-        points.push_back(r.vec3(*a.get(k), p + "vertices[" + std::to_string(k) + "]", "body.vertices"));
+      for (size_t k = 0; k < a.size(); ++k) {
+        const std::string key = p + "vertices[" + std::to_string(k) + "]";
+        points.push_back(r.vec3(*a.get(k), key, "body.vertices"));
+        // Coordinates beyond kMaxLength overflow squared lengths and volumes.
+        if (!(points.back().cwiseAbs().maxCoeff() <= kMaxLength))
+          r.fail(line_of(a.get(k)), key,
+                 "coordinates must be within 1e12 m of the origin, got " + vec_text(points.back()),
+                 "give local coordinates in metres");
+      }
       try {
         b.shape = std::make_shared<const ConvexPolyhedron>(convex_hull(points));
       } catch (const GeometryError& e) {
@@ -723,6 +754,9 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
                "name the .obj file (paths are relative to the scene's folder)");
       try {
         b.shape = std::make_shared<const ConvexPolyhedron>(load_obj(resolved.string(), hull));
+      } catch (const ObjReadError& e) {
+        // Not readable as OBJ text: the error says what would help (hull = true would not).
+        r.fail(line_of(n), p + "file", e.what(), e.fix());
       } catch (const GeometryError& e) {
         std::string what = e.what();
         const std::string hint = " (use hull = true for its convex hull)";

@@ -25,21 +25,30 @@ std::vector<std::string> split_list(const std::string& list) {
 
 std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
                                          Capability cap) {
+  return select_backends(scene, list, cap, backends());
+}
+
+std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
+                                         Capability cap, const std::vector<Backend>& table) {
+  auto known = [&](const std::string& name) {
+    return std::any_of(table.begin(), table.end(),
+                       [&](const Backend& b) { return b.name == name; });
+  };
   std::vector<std::string> wanted;
   if (!list.empty()) {
     wanted = split_list(list);
     for (const std::string& name : wanted)
-      if (!find_backend(name)) {
-        std::string known;
-        for (const Backend& b : backends()) known += (known.empty() ? "" : ", ") + b.name;
-        throw InputError("--backends: unknown backend '" + name + "'; known: " + known);
+      if (!known(name)) {
+        std::string names;
+        for (const Backend& b : table) names += (names.empty() ? "" : ", ") + b.name;
+        throw InputError("--backends: unknown backend '" + name + "'; known: " + names);
       }
   } else if (!scene.backends.empty()) {
     wanted = scene.backends;
   }
-  // Registry order; a backend named explicitly stays even if it cannot serve (-> unsupported).
+  // Table order; a backend named explicitly stays even if it cannot serve (-> unsupported).
   std::vector<std::string> out;
-  for (const Backend& b : backends()) {
+  for (const Backend& b : table) {
     const bool named = std::find(wanted.begin(), wanted.end(), b.name) != wanted.end();
     if (wanted.empty() ? serves(b, cap) : named) out.push_back(b.name);
   }

@@ -16,6 +16,15 @@ class GeometryError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Range of lengths (m) a shape may have: extents, radii, heights, and the magnitude of vertex
+/// coordinates. Validation squares lengths (L^2), takes triple products (L^3, volumes) and the
+/// inertia integrates r^2 over the volume (L^5); at L = 1e12 m those stay near 1e60, far below
+/// the double limit of 1.8e308 (a 1e150 m box overflowed and was called "zero volume"), and
+/// 1e12 m is already 7 astronomical units. The lower end keeps L^5 near 1e-60, far above the
+/// double underflow near 1e-308; nothing physical in a rigid-body scene is below a picometre.
+constexpr double kMaxLength = 1e12;
+constexpr double kMinLength = 1e-12;
+
 /// Oriented plane: points x with normal . x == offset; normal is unit and outward.
 struct Plane {
   Vec3 normal = Vec3::UnitZ();

@@ -12,6 +12,16 @@
 
 namespace rbx {
 
+/// Most steps a run can take: 2^53, the last integer a double counts exactly. Beyond it
+/// duration / dt no longer names one step count, and a little further its cast to long overflows
+/// (llround of 1e303 gave a negative count: a run of no steps that reported success).
+constexpr double kMaxStepCount = 9007199254740992.0;
+
+/// Number of steps of `dt` covering `duration` (rounded to the nearest; the last step may end past
+/// it by < dt/2). Throws std::domain_error, naming duration and dt, when that count is not finite
+/// or exceeds kMaxStepCount, so no caller casts an out-of-range value.
+long step_count(double duration, double dt);
+
 /// Time integrator.
 enum class Integrator {
   Euler,       ///< the seed's: x += v dt, orientation by per-axis matrices with w dt
@@ -29,7 +39,8 @@ struct SimSettings {
   std::vector<double> sweep_dt;            // s, time steps for error against run time
   double max_energy_ratio = 1e3;           // guard: stop when E > ratio * max(E0, tiny)
 
-  /// Number of steps to cover `duration` (the last step may end past it by < dt/2).
+  /// Number of steps to cover `duration`: step_count(duration, dt) (throws std::domain_error when
+  /// that is not a countable number).
   long steps() const;
 };
 

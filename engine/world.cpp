@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "engine/bounding.h"
@@ -48,6 +50,21 @@ void World::collide_pair(int i, int j, bool bounded) {
   }
 }
 
+namespace {
+
+// Shortest decimal that reads back as the same double, so that a message never shows two
+// different numbers alike (max_energy_ratio = 1.000001 printed "1" with 6 digits).
+std::string shortest(double v) {
+  char buffer[40];
+  for (int precision = 1; precision <= 17; ++precision) {
+    std::snprintf(buffer, sizeof buffer, "%.*g", precision, v);
+    if (std::strtod(buffer, nullptr) == v) break;
+  }
+  return buffer;
+}
+
+}  // namespace
+
 bool World::check_state() {
   auto fail = [&](const RigidBody& b, const char* what) {
     std::ostringstream s;
@@ -61,13 +78,27 @@ bool World::check_state() {
     if (!b.velocity.allFinite()) return fail(b, "velocity");
     if (!b.angular_velocity.allFinite()) return fail(b, "angular velocity");
     if (!b.orientation.coeffs().allFinite()) return fail(b, "orientation");
+    // Finite states can still overflow the energy (1/2 m v^2 at v = 1e155 m/s); the growth test
+    // below would then compare inf - inf = NaN, which no bound catches.
+    if (b.is_static) continue;
+    if (!std::isfinite(b.kinetic_energy())) return fail(b, "kinetic energy");
+    if (!std::isfinite(b.mass * sim_.gravity.dot(b.position))) return fail(b, "potential energy");
   }
+  // The sum of finite energies can still overflow.
   const double e = energy();
-  if (e - energy0_ > (sim_.max_energy_ratio - 1.0) * energy_scale_) {
+  if (!std::isfinite(e)) {
     std::ostringstream s;
-    s << "energy grew from " << energy0_ << " J to " << e << " J (more than max_energy_ratio = "
-      << sim_.max_energy_ratio << " times the budget) at step " << step_ << " (t = " << time_
-      << " s)";
+    s << "non-finite total energy (" << e << " J, the sum over the bodies) at step " << step_
+      << " (t = " << time_ << " s)";
+    failure_ = s.str();
+    return false;
+  }
+  // Negated, so that NaN fails too (an infinite start makes the growth inf - inf).
+  if (!(e - energy0_ <= (sim_.max_energy_ratio - 1.0) * energy_scale_)) {
+    std::ostringstream s;
+    s << "energy grew from " << shortest(energy0_) << " J to " << shortest(e)
+      << " J (more than max_energy_ratio = " << shortest(sim_.max_energy_ratio)
+      << " times the budget) at step " << step_ << " (t = " << time_ << " s)";
     failure_ = s.str();
     return false;
   }

@@ -189,7 +189,7 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt, bool fa
   try {
     const double dt = opt.dt > 0 ? opt.dt : scene.sim.dt;  // s
     if (!(dt > 0)) throw std::invalid_argument("time step must be > 0");
-    const long steps = std::llround(scene.sim.duration / dt);
+    const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
     const double e = scene.sim.restitution;
     const double mu = scene.sim.friction;
 

@@ -343,7 +343,7 @@ DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   DynamicsResult r;
   const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
   if (!(dt > 0.0)) return {Status::Error, "ODE: time step must be > 0", {}, {}, {}};
-  const long steps = static_cast<long>(std::llround(scene.sim.duration / dt));
+  const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
   std::vector<RigidBody> bodies;
   bodies.reserve(scene.bodies.size());
   for (const BodySpec& spec : scene.bodies) bodies.push_back(make_body(spec));

@@ -4,12 +4,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -59,6 +62,68 @@ TEST(Cli, BadSceneExitsTwoWithOneLineAndNoOutputFile) {
   EXPECT_NE(r.err.find("mass"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(json));
   fs::remove_all(dir);
+}
+
+// Every scene of the bad-input catalogue (stems of tests/bad_input/*.toml, sorted).
+std::vector<std::string> bad_input_catalogue() {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(fs::path(RBX_SOURCE_DIR) / "tests/bad_input"))
+    if (entry.path().extension() == ".toml") names.push_back(entry.path().stem().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+class CliBadInput : public ::testing::TestWithParam<std::string> {};
+
+// `rbx run` on each entry: exit 2, stderr exactly the entry's one expected line, and no output
+// file: none created where there was none, and an existing one left byte for byte as it was.
+TEST_P(CliBadInput, RunExitsTwoWithTheExpectedLineAndWritesNothing) {
+  const std::string scene = "tests/bad_input/" + GetParam() + ".toml";
+  std::ifstream expected_file(fs::path(RBX_SOURCE_DIR) /
+                              ("tests/bad_input/" + GetParam() + ".expected"));
+  std::stringstream expected;
+  expected << expected_file.rdbuf();
+  ASSERT_FALSE(expected.str().empty()) << "missing " << GetParam() << ".expected";
+  std::string line = expected.str();
+  if (line.back() != '\n') line += '\n';
+
+  const fs::path dir = temp_dir("bad_input_" + GetParam());
+  const fs::path out = dir / "out.json";
+  const CmdResult r = rbx("run " + scene + " --json '" + out.string() + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, line);
+  EXPECT_FALSE(fs::exists(out));
+
+  const fs::path existing = dir / "existing.json";
+  const std::string before = "{\"kept\": true}\n";
+  std::ofstream(existing, std::ios::binary) << before;
+  const CmdResult again = rbx("run " + scene + " --json '" + existing.string() + "'");
+  EXPECT_EQ(again.code, 2);
+  EXPECT_EQ(again.err, line);
+  std::stringstream after;
+  after << std::ifstream(existing, std::ios::binary).rdbuf();
+  EXPECT_EQ(after.str(), before);
+  // Nothing else (no temporary file) is left in the folder.
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir)) (void)e, ++entries;
+  EXPECT_EQ(entries, 1);
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(Catalogue, CliBadInput, ::testing::ValuesIn(bad_input_catalogue()),
+                         [](const auto& info) { return info.param; });
+
+TEST(Cli, ForcedUncountableStepCountsExitTwo) {
+  // With --force, 1e300 s (1e303 steps) and dt = 1e-320 s (inf steps) used to run no steps and
+  // exit 0 ("final state at t = -9.22337e+15 s").
+  for (const char* set : {"sim.duration=1e300", "sim.dt=1e-320"}) {
+    const CmdResult r = rbx(std::string("run scenes/seed/face_face.toml --force --set ") + set);
+    EXPECT_EQ(r.code, 2) << set;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("--set sim."), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("more than 2^53"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("final state"), std::string::npos) << r.out;
+  }
 }
 
 TEST(Cli, UsageErrorsExitTwo) {

@@ -117,6 +117,45 @@ TEST(World, EnergyGuardStopsARunawayRun) {
   EXPECT_TRUE(ok.run().ok);
 }
 
+TEST(World, EnergyGuardCatchesAnInfiniteInitialEnergy) {
+  // v = 1e155 m/s is finite, but 1/2 m v^2 = 5e309 J overflows to inf; the growth test then
+  // compared inf - inf = NaN, which is never greater than a bound, and the run went on.
+  World w(sim_with(1e-3, 1.0, 1.0),
+          {box_body("A", Vec3::Ones(), 1, Vec3::Zero(), Quat::Identity(), Vec3(1e155, 0, 0))});
+  const RunResult r = w.run();
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.steps_taken, 1);
+  EXPECT_EQ(r.message, "non-finite kinetic energy of body A at step 1 (t = 0.001 s)");
+}
+
+TEST(World, EnergyGuardCatchesATotalThatOverflows) {
+  // Two bodies of 1.69e308 J each (m = 2 kg, v = 1.3e154 m/s): each finite (the limit is
+  // 1.8e308), their sum inf.
+  const double v = 1.3e154;
+  World w(sim_with(1e-3, 1.0, 1.0),
+          {box_body("A", Vec3::Ones(), 2, Vec3::Zero(), Quat::Identity(), Vec3(v, 0, 0)),
+           box_body("B", Vec3::Ones(), 2, Vec3(0, 0, 10), Quat::Identity(), Vec3(v, 0, 0))});
+  const RunResult r = w.run();
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.steps_taken, 1) << r.message;
+  EXPECT_EQ(r.message.rfind("non-finite total energy (inf J", 0), 0u) << r.message;
+}
+
+TEST(World, EnergyGuardMessageShowsTheRatioAsGiven) {
+  // Explicit Euler in free fall gains m g^2 dt^2 / 2 = 0.0048 J on the first step, far past a
+  // budget of 1e-6 times the gravity work scale; the ratio must print as 1.000001, not as "1".
+  SimSettings s = sim_with(1e-2, 1.0, 1.0);
+  s.integrator = Integrator::Euler;
+  s.gravity = Vec3(0, 0, -9.81);
+  s.max_energy_ratio = 1.000001;
+  World w(s, {box_body("A", Vec3::Ones(), 1, Vec3::Zero())});
+  const RunResult r = w.run();
+  ASSERT_FALSE(r.ok);
+  EXPECT_NE(r.message.find("(more than max_energy_ratio = 1.000001 times the budget) at step 1"),
+            std::string::npos)
+      << r.message;
+}
+
 TEST(World, StaticPairsAndDistantPairsProduceNoEvents) {
   std::vector<RigidBody> bodies = {
       box_body("A", Vec3::Ones(), 1, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true),

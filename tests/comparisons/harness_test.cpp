@@ -1,0 +1,100 @@
+// The harness: a backend that throws or returns an error is reported as such, and every other
+// backend still runs and is measured.
+#include "comparisons/harness.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "comparisons/scene_file.h"
+#include "reference/backend.h"
+
+namespace rbx {
+namespace {
+
+// The registry's custom and exact backends, between one that throws from every call (first, so
+// the others run after it) and one that returns status error.
+std::vector<Backend> table_with_failing_backends() {
+  Backend thrower{"thrower", "test: throws from every call",
+                  [](const RigidBody&, const RigidBody&) -> ContactResult {
+                    throw std::runtime_error("thrower: contact query failed");
+                  },
+                  [](const Scene&, const DynamicsOptions&) -> DynamicsResult {
+                    throw std::runtime_error("thrower: dynamics run failed");
+                  }};
+  Backend failer{"failer", "test: returns error from every call",
+                 [](const RigidBody&, const RigidBody&) {
+                   return ContactResult{Status::Error, "failer: gave up", {}};
+                 },
+                 [](const Scene&, const DynamicsOptions&) {
+                   return DynamicsResult{Status::Error, "failer: diverged", {}, {}, {}};
+                 }};
+  return {thrower, *find_backend("custom"), *find_backend("exact"), failer};
+}
+
+// True when some metric of `backend` is named `name`.
+bool has_metric(const SceneEvaluation& ev, const std::string& backend, const std::string& name) {
+  return std::any_of(ev.metrics.begin(), ev.metrics.end(),
+                     [&](const Metric& m) { return m.backend == backend && m.name == name; });
+}
+
+TEST(Harness, AThrowingContactBackendDoesNotStopTheOthers) {
+  // Two unit cubes overlapping by 0.1 along x: every working backend finds the contact.
+  const Scene scene = parse_scene(
+      "checks = [\"contact\"]\n[sim]\nduration = 0\n[[body]]\nname = \"A\"\n"
+      "[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n",
+      "pair.toml");
+  const std::vector<Backend> table = table_with_failing_backends();
+  HarnessOptions opt;
+  opt.registry = &table;
+  opt.sweep = false;
+  const SceneEvaluation ev = evaluate_scene(scene, opt);
+  const Json& b = ev.json["backends"];
+  EXPECT_EQ(b["thrower"]["status"], "error");
+  EXPECT_EQ(b["thrower"]["message"], "thrower: contact query failed");
+  EXPECT_EQ(b["failer"]["status"], "error");
+  EXPECT_EQ(b["failer"]["message"], "failer: gave up");
+  for (const char* name : {"custom", "exact"}) {
+    EXPECT_EQ(b[name]["status"], "ok") << name << ": " << b[name]["message"];
+    EXPECT_FALSE(b[name]["contacts"].empty()) << name;
+    EXPECT_TRUE(has_metric(ev, name, "depth_err")) << name;
+  }
+  EXPECT_FALSE(has_metric(ev, "thrower", "depth_err"));
+}
+
+TEST(Harness, AThrowingDynamicsBackendDoesNotStopTheOthers) {
+  // The seed's face-face pair, shortened: custom runs and gets its conservation metrics.
+  const Scene scene = parse_scene(
+      "checks = [\"impulse\"]\n[sim]\nduration = 0.6\n[[body]]\nname = \"A\"\n"
+      "position = [-1, 0, 0]\nvelocity = [1, 0, 0]\n[[body]]\nname = \"B\"\n"
+      "position = [1, 0, 0]\nvelocity = [-1, 0, 0]\n",
+      "face_face.toml");
+  const std::vector<Backend> table = table_with_failing_backends();
+  HarnessOptions opt;
+  opt.registry = &table;
+  opt.sweep = false;
+  const SceneEvaluation ev = evaluate_scene(scene, opt);
+  const Json& b = ev.json["backends"];
+  EXPECT_EQ(b["thrower"]["status"], "error");
+  EXPECT_EQ(b["thrower"]["message"], "thrower: dynamics run failed");
+  EXPECT_EQ(b["failer"]["status"], "error");
+  EXPECT_EQ(b["failer"]["message"], "failer: diverged");
+  EXPECT_EQ(b["custom"]["status"], "ok") << b["custom"]["message"];
+  EXPECT_TRUE(has_metric(ev, "custom", "energy_err"));
+  // exact has no dynamics: selected by default only where it serves, so it is not listed.
+  EXPECT_FALSE(b.contains("exact"));
+}
+
+TEST(Harness, WithoutATableTheRegistryIsUsed) {
+  // The seam changes nothing by default: --backends names come from the registry.
+  const Scene scene = parse_scene("checks = [\"contact\"]\n[[body]]\nname = \"A\"\n", "one.toml");
+  HarnessOptions opt;
+  opt.backends = "thrower";
+  EXPECT_THROW(evaluate_scene(scene, opt), InputError);
+  opt.backends = "exact";
+  EXPECT_NO_THROW(evaluate_scene(scene, opt));
+}
+
+}  // namespace
+}  // namespace rbx
