@@ -141,6 +141,28 @@ ContactResult fcl_contact(const RigidBody& a, const RigidBody& b) {
                                   "fcl::collide (GST_LIBCCD, libccd MPR)");
 }
 
+ContactResult fcl_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  // A small cache of (shape, its fcl::Convex). Keyed by the shared_ptr itself, which keeps the
+  // shape alive, so an address reused by a later shape can never hit a stale entry.
+  using Entry =
+      std::pair<std::shared_ptr<const ConvexPolyhedron>, std::shared_ptr<fcl::CollisionGeometryd>>;
+  thread_local std::vector<Entry> cache;
+  auto geometry = [](const std::shared_ptr<const ConvexPolyhedron>& shape) {
+    for (const Entry& e : cache)
+      if (e.first == shape) return e.second;
+    if (cache.size() >= 4) cache.erase(cache.begin());
+    cache.emplace_back(shape, make_convex(*shape));
+    return cache.back().second;
+  };
+  return reject_undefined_normals(guarded("fcl::collide (GST_LIBCCD)",
+                                          [&] {
+                                            return collide(geometry(a.shape), to_fcl(a.pose()),
+                                                           geometry(b.shape), to_fcl(b.pose()),
+                                                           fcl::GST_LIBCCD, "mpr");
+                                          }),
+                                  "fcl::collide (GST_LIBCCD, libccd MPR)");
+}
+
 ContactResult fcl_epa_contact(const RigidBody& a, const RigidBody& b) {
   return guarded("fcl::distance (signed, GST_LIBCCD)", [&]() -> ContactResult {
     fcl::CollisionObjectd object_a(convex_geometry(a), to_fcl(a.pose()));
