@@ -9,6 +9,7 @@
 
 #include "comparisons/commands.h"
 #include "comparisons/contact_eval.h"
+#include "comparisons/metrics.h"
 #include "comparisons/table.h"
 #include "engine/bounding.h"
 #include "engine/detect.h"
@@ -50,56 +51,9 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
   return run;
 }
 
-// Velocity error in the kinetic-energy norm: sqrt(sum m|dv|^2 + dw.I.dw) / sqrt(2 E_ref). Only
-// the bodies (and quantities) present in `ref` count; static bodies never do.
-struct RefState {
-  std::optional<Vec3> velocity, angular_velocity;
-};
-
-double ke_norm_error(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& finals,
-                     const std::vector<std::optional<RefState>>& ref, double fallback_energy) {
-  double num = 0.0, e_ref = 0.0;
-  for (size_t i = 0; i < inputs.size() && i < finals.size(); ++i) {
-    if (!ref[i] || inputs[i].is_static) continue;
-    const RigidBody& b = inputs[i];
-    const Mat3 rot = finals[i].orientation.toRotationMatrix();
-    const Mat3 inertia = rot * b.inertia_body * rot.transpose();
-    if (ref[i]->velocity) {
-      num += b.mass * (finals[i].velocity - *ref[i]->velocity).squaredNorm();
-      e_ref += 0.5 * b.mass * ref[i]->velocity->squaredNorm();
-    }
-    if (ref[i]->angular_velocity) {
-      const Vec3 dw = finals[i].angular_velocity - *ref[i]->angular_velocity;
-      num += dw.dot(inertia * dw);
-      e_ref += 0.5 * ref[i]->angular_velocity->dot(inertia * *ref[i]->angular_velocity);
-    }
-  }
-  // A reference at rest (e = 0 head-on in the centre-of-mass frame) has no energy to compare
-  // with: fall back to the initial kinetic energy.
-  if (e_ref < 1e-12 * fallback_energy) e_ref = fallback_energy;
-  if (!(e_ref > 0.0)) return std::sqrt(num);
-  return std::sqrt(num / (2.0 * e_ref));
-}
-
 double kinetic_energy(const std::vector<RigidBody>& inputs) {
   double e = 0.0;
   for (const RigidBody& b : inputs) e += b.kinetic_energy();
-  return e;
-}
-
-// Total energy (kinetic + gravitational potential) of a set of final states.
-double total_energy(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& s,
-                    const Vec3& gravity) {
-  double e = 0.0;
-  for (size_t i = 0; i < inputs.size() && i < s.size(); ++i) {
-    const RigidBody& b = inputs[i];
-    if (b.is_static) continue;
-    const Mat3 rot = s[i].orientation.toRotationMatrix();
-    e += 0.5 * b.mass * s[i].velocity.squaredNorm() +
-         0.5 * s[i].angular_velocity.dot(rot * b.inertia_body * rot.transpose() *
-                                         s[i].angular_velocity) -
-         b.mass * gravity.dot(s[i].position);
-  }
   return e;
 }
 
@@ -127,36 +81,6 @@ std::vector<BodyFinal> initial_states(const std::vector<RigidBody>& inputs) {
   for (const RigidBody& b : inputs)
     s.push_back({b.name, b.position, b.orientation, b.velocity, b.angular_velocity});
   return s;
-}
-
-// Distance from p to the convex planar polygon `poly` (or segment or point), in 3-D.
-double distance_to_region(const Vec3& p, const std::vector<Vec3>& poly) {
-  if (poly.empty()) return std::numeric_limits<double>::infinity();
-  double best = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < poly.size(); ++i) {
-    const Vec3& a = poly[i];
-    const Vec3& b = poly[(i + 1) % poly.size()];
-    const Vec3 ab = b - a;
-    const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-    best = std::min(best, (a + t * ab - p).norm());
-  }
-  if (poly.size() >= 3) {
-    // Inside the polygon's outline: the distance is the height above its plane.
-    Vec3 c = Vec3::Zero();
-    for (const Vec3& v : poly) c += v;
-    c /= static_cast<double>(poly.size());
-    Vec3 n = Vec3::Zero();
-    for (size_t i = 0; i < poly.size(); ++i) n += (poly[i] - c).cross(poly[(i + 1) % poly.size()] - c);
-    if (n.norm() > 0) {
-      n.normalize();
-      const Vec3 q = p - n * n.dot(p - c);
-      bool inside = true;
-      for (size_t i = 0; i < poly.size() && inside; ++i)
-        inside = (poly[(i + 1) % poly.size()] - poly[i]).cross(q - poly[i]).dot(n) >= -1e-12;
-      if (inside) best = std::min(best, std::abs(n.dot(p - c)));
-    }
-  }
-  return best;
 }
 
 // Size of a body: its bounding-box diagonal (m).
@@ -305,7 +229,7 @@ class Evaluator {
 
       const ContactPoint* c = deepest(run.result);
       const bool touch = c != nullptr;
-      metric("contact", name, pair, "touching_err", touch == true_touch ? 0.0 : 1.0,
+      metric("contact", name, pair, "touching_err", touching_error(run.result, true_touch),
              ex && ex->touching ? "analytic" : "exact");
       if (touch != true_touch)
         out_.disagreements.push_back(name + " on " + pair + ": " +
@@ -501,11 +425,9 @@ class Evaluator {
       const double e1 = total_energy(inputs_, f, scene_.sim.gravity);
       const double e_scale = std::max(std::abs(e0), e0_kin);
       if (e_scale > 0) {
-        const double change = (e1 - e0) / e_scale;
-        metric(primary_check(), name, "", "energy_change_rel", change, "initial");
-        // e = 1 allows no change; e < 1 allows a loss but never a gain.
-        const double err = scene_.sim.restitution >= 1.0 ? std::abs(change) : std::max(change, 0.0);
-        metric(primary_check(), name, "", "energy_err", err, "invariant");
+        metric(primary_check(), name, "", "energy_change_rel", (e1 - e0) / e_scale, "initial");
+        metric(primary_check(), name, "", "energy_err",
+               energy_error(e0, e1, scene_.sim.restitution, e_scale), "invariant");
       }
       // [expect.body] binds the custom engine.
       if (name == "custom" && scene_.expect) check_expect_bodies(main.result.finals);
@@ -563,7 +485,6 @@ class Evaluator {
   void stability(const std::string& name, const DynRun& run, double e0, const Vec3& p0,
                  const Vec3& h0, bool closed, double p_scale, double h_scale) {
     Json s;
-    std::vector<std::string> why;
     const auto& samples = run.result.samples;
     bool nonfinite = run.result.status == Status::Error &&
                      run.result.message.find("non-finite") != std::string::npos;
@@ -662,16 +583,19 @@ class Evaluator {
     s["max_penetration_rel"] = pen_max;
     s["tunnelled_pairs"] = tunnelled;
     if (scene_.sim.gravity.norm() > 0) s["jitter_rms_mps"] = jitter;
-    // Verdict: unstable on non-finite states, energy gained beyond 1 % (no energy source exists
-    // in these scenes: e <= 1, no motors), tunnelling, or a run stopped by the engine's guard.
-    if (nonfinite) why.push_back("non-finite state");
-    if (growth > 0.01) why.push_back("energy grew by " + fmt_num(100 * growth, 3) + " %");
-    if (tunnelled) why.push_back(std::to_string(tunnelled) + " pair(s) tunnelled");
-    if (run.result.status == Status::Error) why.push_back(run.result.message);
-    if (closed && drift > 1e-6) why.push_back("momentum drift " + fmt_num(drift, 3));
-    if (pen_max > 0.5) why.push_back("penetration " + fmt_num(100 * pen_max, 3) + " % of body size");
-    s["verdict"] = why.empty() ? "stable" : "unstable";
-    s["why"] = why;
+    // Verdict: the rules of stability_verdict (metrics.h).
+    StabilityFacts facts;
+    facts.nonfinite = nonfinite;
+    facts.stopped = run.result.status == Status::Error;
+    facts.stop_message = run.result.message;
+    facts.energy_growth = growth;
+    facts.closed = closed;
+    facts.momentum_drift = drift;
+    facts.max_penetration = pen_max;
+    facts.tunnelled_pairs = tunnelled;
+    const StabilityVerdict verdict = stability_verdict(facts);
+    s["verdict"] = verdict.verdict;
+    s["why"] = verdict.why;
     stability_json_[name] = s;
     metric("stability", name, "", "energy_growth_err", std::max(growth, 0.0), "invariant");
     metric("stability", name, "", "max_penetration_rel_err", pen_max, "exact");
