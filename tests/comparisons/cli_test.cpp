@@ -4,11 +4,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -179,6 +183,49 @@ TEST(Cli, ReportWritesEverythingIntoItsFolder) {
   int entries = 0;
   for (const auto& e : fs::directory_iterator(dir)) (void)e, ++entries;
   EXPECT_EQ(entries, 1);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+
+namespace {
+
+// Text of a library scene with one substitution applied (sed-like, first match of a line).
+std::string scene_text(const std::string& file, const std::string& from = "", const std::string& to = "") {
+  std::ifstream in(std::string(RBX_SOURCE_DIR) + "/" + file);
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  if (!from.empty()) {
+    const size_t at = text.find(from);
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+  }
+  return text;
+}
+
+TEST(CompareExpect, ContactExpectationIsCheckedWithoutTheExactBackend) {
+  // axis_x with a wrong depth (0.2 instead of 0.1), exact not among the backends: the oracle's
+  // answer is computed anyway and must contradict the scene.
+  const fs::path dir = temp_dir("expect_noexact");
+  std::ofstream(dir / "w.toml") << scene_text("scenes/contact/axis_x.toml", "\ndepth = 0.1", "\ndepth = 0.2");
+  const CmdResult r = rbx("compare '" + (dir / "w.toml").string() + "' --backends custom,fcl");
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("[expect] FAILED: exact: contact depth"), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
+TEST(CompareExpect, ContactExpectationBindsCustomUnlessAKnownFailure) {
+  // fcl_rotated_45: custom's face test answers along a face of the turned cube (45 deg off).
+  // As committed (known_failure set) compare passes and says why; without the marker it fails.
+  const CmdResult known = rbx("compare scenes/contact/fcl_rotated_45.toml --backends custom");
+  EXPECT_EQ(known.code, 0) << known.out;
+  EXPECT_NE(known.out.find("[expect] FAILED: custom: contact normal"), std::string::npos) << known.out;
+  EXPECT_NE(known.out.find("[expect] known failure:"), std::string::npos) << known.out;
+  const fs::path dir = temp_dir("expect_custom");
+  std::ofstream(dir / "w.toml") << scene_text("scenes/contact/fcl_rotated_45.toml", "\nknown_failure", "\n# known_failure");
+  const CmdResult r = rbx("compare '" + (dir / "w.toml").string() + "' --backends custom");
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("[expect] FAILED: custom: contact normal"), std::string::npos) << r.out;
   fs::remove_all(dir);
 }
 
