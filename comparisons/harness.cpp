@@ -338,20 +338,32 @@ class Evaluator {
     const std::vector<double> dts = sweep_steps(scene_);
     const double finest = dts.back();
 
+    // Every backend's main run first: whether the angular metrics apply is decided from the
+    // scene and from all results before any metric is emitted, so that every backend gets the
+    // same metric set whatever the order of the backends.
+    std::vector<std::pair<std::string, DynRun>> mains;
     for (const std::string& name : names) {
       const Backend& be = *find_backend(name);
       if (!be.dynamics) {
         set_status(name, Status::Unsupported, name + " has no dynamics (contact queries only)");
         continue;
       }
-      const DynRun main = run_dynamics(be, scene_, scene_.sim.dt, sample_every);
+      mains.emplace_back(name, run_dynamics(be, scene_, scene_.sim.dt, sample_every));
+    }
+    for (const auto& [name, run] : mains)
+      if (run.result.status == Status::Ok)
+        for (const BodyFinal& f : run.result.finals) angular = angular || f.angular_velocity.norm() > 1e-12;
+
+    for (const auto& entry : mains) {
+      const std::string& name = entry.first;  // (not a structured binding: lambdas below)
+      const DynRun& main = entry.second;
+      const Backend& be = *find_backend(name);
       Json& bj = backend_json(name);
       bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
       if (main.result.status != Status::Ok) {
         if (scene_.has_check("stability")) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
         continue;
       }
-      for (const BodyFinal& f : main.result.finals) angular = angular || f.angular_velocity.norm() > 1e-12;
 
       // Self-consistency reference: the same backend at the finest step of the sweep.
       std::optional<DynRun> fine;

@@ -229,4 +229,16 @@ TEST(CompareExpect, ContactExpectationBindsCustomUnlessAKnownFailure) {
   fs::remove_all(dir);
 }
 
+TEST(CompareMetrics, EveryDynamicsBackendGetsTheSameMetricNames) {
+  // headon_e05: pure translation for custom; the references rotate by round-off. Whatever the
+  // backend order, the metric set must be the scene's, not the loop's.
+  const CmdResult r = rbx("compare scenes/analytic/headon_e05.toml --json -");
+  ASSERT_LE(r.code, 1) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  std::map<std::string, std::set<std::string>> names;
+  for (const auto& m : j["scenes"][0]["metrics"]) names[m["backend"]].insert(m["name"].get<std::string>());
+  ASSERT_GE(names.size(), 2u);
+  for (const auto& [backend, set] : names) EXPECT_EQ(set, names.begin()->second) << backend;
+}
+
 }  // namespace
