@@ -172,7 +172,7 @@ class Evaluator {
   Json& backend_json(const std::string& name) {
     if (!backends_json_.contains(name))
       backends_json_[name] = {{"status", "ok"}, {"message", ""}, {"runtime_s", 0.0},
-                              {"contacts", Json::array()}};
+                              {"contacts", Json::array()}, {"bodies", bodies_json(inputs_)}};
     return backends_json_[name];
   }
 

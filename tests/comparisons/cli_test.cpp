@@ -241,4 +241,36 @@ TEST(CompareMetrics, EveryDynamicsBackendGetsTheSameMetricNames) {
   for (const auto& [backend, set] : names) EXPECT_EQ(set, names.begin()->second) << backend;
 }
 
+TEST(ResultsJson, EveryBackendCarriesTheBodiesBlockOnContactAndMassScenes) {
+  // Contract: bodies.NAME.{mass, center_of_mass, inertia} at t = 0, world frame; no `final`
+  // without a dynamics run. axis_x: two unit cubes of 1 kg, A at the origin, B at (0.9, 0.3, -0.2);
+  // inertia of a unit cube of 1 kg: diag(1/6).
+  const auto check = [](const nlohmann::json& backends, const std::string& what) {
+    ASSERT_FALSE(backends.empty()) << what;
+    for (const auto& [name, b] : backends.items()) {
+      ASSERT_TRUE(b.contains("bodies")) << what << " " << name;
+      const auto& bodies = b["bodies"];
+      for (const char* body : {"A", "B"}) {
+        ASSERT_TRUE(bodies.contains(body)) << what << " " << name;
+        EXPECT_FALSE(bodies[body].contains("final")) << what << " " << name;
+        EXPECT_EQ(bodies[body]["mass"].get<double>(), 1.0);
+        EXPECT_NEAR(bodies[body]["inertia"][0][0].get<double>(), 1.0 / 6.0, 1e-15);
+        EXPECT_NEAR(bodies[body]["inertia"][0][1].get<double>(), 0.0, 1e-15);
+      }
+      EXPECT_EQ(bodies["B"]["center_of_mass"], nlohmann::json::parse("[0.9, 0.3, -0.2]")) << name;
+    }
+  };
+  const CmdResult c = rbx("compare scenes/contact/axis_x.toml --json -");
+  ASSERT_EQ(c.code, 0) << c.err;
+  check(nlohmann::json::parse(c.out)["scenes"][0]["backends"], "compare");
+  const CmdResult q = rbx("contacts scenes/contact/axis_x.toml --json -");
+  ASSERT_EQ(q.code, 0) << q.err;
+  check(nlohmann::json::parse(q.out)["backends"], "contacts");
+  // A mass scene: every backend entry has the body too.
+  const CmdResult m = rbx("compare scenes/mass/box_1x2x3.toml --json -");
+  ASSERT_LE(m.code, 1) << m.err;
+  for (const auto& [name, b] : nlohmann::json::parse(m.out)["scenes"][0]["backends"].items())
+    EXPECT_TRUE(b.contains("bodies") && !b["bodies"].empty()) << name;
+}
+
 }  // namespace
