@@ -72,13 +72,36 @@ TEST(KeNormError, StaticBodiesNeverCount) {
   EXPECT_EQ(ke_norm_error(in, fin, ref, 1.0), 0.0);
 }
 
-TEST(EnergyError, ElasticAllowsNoChangeInelasticNoGain) {
+TEST(EnergyError, InvariantRuleWithoutAClosedForm) {
   // e = 1: a loss of 0.2 of the scale is an error of 0.2; a gain likewise.
-  EXPECT_NEAR(energy_error(10.0, 8.0, 1.0, 10.0), 0.2, kRoundOff);
-  EXPECT_NEAR(energy_error(10.0, 12.0, 1.0, 10.0), 0.2, kRoundOff);
+  EXPECT_NEAR(energy_error(10.0, 8.0, 8.0, std::nullopt, 1.0, 10.0).value, 0.2, kRoundOff);
+  EXPECT_NEAR(energy_error(10.0, 12.0, 12.0, std::nullopt, 1.0, 10.0).value, 0.2, kRoundOff);
   // e < 1: a loss is allowed, a gain is not.
-  EXPECT_EQ(energy_error(10.0, 8.0, 0.5, 10.0), 0.0);
-  EXPECT_NEAR(energy_error(10.0, 11.0, 0.5, 10.0), 0.1, kRoundOff);
+  EXPECT_EQ(energy_error(10.0, 8.0, 8.0, std::nullopt, 0.5, 10.0).value, 0.0);
+  EXPECT_NEAR(energy_error(10.0, 11.0, 11.0, std::nullopt, 0.5, 10.0).value, 0.1, kRoundOff);
+  EXPECT_EQ(energy_error(10.0, 11.0, 11.0, std::nullopt, 0.5, 10.0).against, "invariant");
+}
+
+TEST(EnergyError, AgainstTheClosedFormALossBeyondWhatEAllowsCounts) {
+  // headon_e05 by hand: E0 = 2 J, the closed form keeps 0.875 J (56.25 % lost). A backend that
+  // keeps 0.79 J (60.5 % lost) is 0.085 / 2 = 4.25 % off, though it gained nothing.
+  const EnergyError err = energy_error(2.0, 0.79, 0.79, 0.875, 0.5, 2.0);
+  EXPECT_NEAR(err.value, 0.0425, kRoundOff);
+  EXPECT_EQ(err.against, "analytic");
+}
+
+TEST(ExpectedKineticEnergy, NeedsBothVelocitiesOfEveryMovingBody) {
+  // A: 1 kg unit cube (I = diag(1/6)); C: static. A at v = (1, 2, 0), w = (0, 0, 6):
+  // 0.5 * 1 * 5 + 0.5 * 36 / 6 = 2.5 + 3 = 5.5 J.
+  const auto in = bodies_of("[[body]]\nname = \"A\"\n[[body]]\nname = \"C\"\nstatic = true\n"
+                            "position = [5, 0, 0]\n");
+  const std::vector<BodyFinal> fin = {final_state(in[0], Vec3::Zero()), final_state(in[1], Vec3::Zero())};
+  const auto e = expected_kinetic_energy(in, fin, {RefState{Vec3(1, 2, 0), Vec3(0, 0, 6)}, std::nullopt});
+  ASSERT_TRUE(e.has_value());
+  EXPECT_NEAR(*e, 5.5, kRoundOff);
+  // Without A's angular velocity the closed form says nothing about its energy.
+  EXPECT_FALSE(expected_kinetic_energy(in, fin, {RefState{Vec3(1, 2, 0), std::nullopt}, std::nullopt}));
+  EXPECT_FALSE(expected_kinetic_energy(in, fin, {std::nullopt, std::nullopt}));
 }
 
 TEST(DistanceToRegion, SquareSegmentPointAndEmpty) {
@@ -94,6 +117,22 @@ TEST(DistanceToRegion, SquareSegmentPointAndEmpty) {
   EXPECT_NEAR(distance_to_region({3.0, 0.0, 0.0}, segment), 1.0, kRoundOff);
   EXPECT_NEAR(distance_to_region({0, 3, 4}, {Vec3(0, 0, 0)}), 5.0, kRoundOff);
   EXPECT_TRUE(std::isinf(distance_to_region({0, 0, 0}, {})));
+}
+
+TEST(ContactPointError, ZeroInsideBothBodiesElseTheDistanceToTheManifold) {
+  // Two unit cubes overlapping 0.1 along x (A at the origin, B at x = 0.9): the intersection
+  // is the slab 0.4 <= x <= 0.5, |y|, |z| <= 0.5. Take as manifold the square on A's face x = 0.5.
+  const auto in = bodies_of("[[body]]\nname = \"A\"\n[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n");
+  const std::vector<Vec3> face = {{0.5, -0.5, -0.5}, {0.5, 0.5, -0.5}, {0.5, 0.5, 0.5}, {0.5, -0.5, 0.5}};
+  // Inside the overlap, 0.05 from the manifold's plane: on the true contact region.
+  EXPECT_EQ(contact_point_error({0.45, 0.1, 0.0}, in[0], in[1], face), 0.0);
+  // On the overlap's boundary (A's face): inside both within the round-off tolerance.
+  EXPECT_EQ(contact_point_error({0.5, 0.0, 0.0}, in[0], in[1], face), 0.0);
+  EXPECT_EQ(contact_point_error({0.4, 0.5, -0.5}, in[0], in[1], face), 0.0);
+  // Inside A only (x = 0.3 < 0.4): the distance to the manifold, 0.2.
+  EXPECT_NEAR(contact_point_error({0.3, 0.0, 0.0}, in[0], in[1], face), 0.2, kRoundOff);
+  // Outside both, beside the overlap: distance to the manifold's edge, sqrt(0.1^2 + 0.5^2).
+  EXPECT_NEAR(contact_point_error({0.4, 1.0, 0.0}, in[0], in[1], face), std::sqrt(0.26), kRoundOff);
 }
 
 TEST(TouchingError, ZeroExactlyWhenTheAnswerMatchesTheTruth) {
@@ -114,6 +153,42 @@ TEST(StabilityVerdict, StableWhenNoRuleFires) {
   const StabilityVerdict v = stability_verdict(f);
   EXPECT_EQ(v.verdict, "stable");
   EXPECT_TRUE(v.why.empty());
+}
+
+TEST(StabilityVerdict, SinksWhenStillPenetratingAtRest) {
+  StabilityFacts f;
+  f.restitution = 0.0;
+  f.max_penetration = 0.3;     // a deep transient alone is not sinking
+  f.rest_penetration = 0.009;  // below 1 % of the smaller body
+  EXPECT_EQ(stability_verdict(f).verdict, "stable");
+  f.rest_penetration = 0.011;
+  const StabilityVerdict v = stability_verdict(f);
+  EXPECT_EQ(v.verdict, "sinks");
+  ASSERT_EQ(v.why.size(), 1u);
+  EXPECT_NE(v.why[0].find("at rest"), std::string::npos);
+  // Worse words win, and every reason is listed.
+  f.tunnelled_pairs = 1;
+  EXPECT_EQ(stability_verdict(f).verdict, "unstable");
+  EXPECT_EQ(stability_verdict(f).why.size(), 2u);
+}
+
+TEST(StabilityVerdict, DissipativeOnlyWithElasticFrictionlessContact) {
+  StabilityFacts f;
+  f.restitution = 1.0;
+  f.energy_final = -0.009;  // lost 0.9 %: round-off and soft-contact storage
+  EXPECT_EQ(stability_verdict(f).verdict, "stable");
+  f.energy_final = -0.02;  // lost 2 % with e = 1 and no friction
+  EXPECT_EQ(stability_verdict(f).verdict, "dissipative");
+  f.friction = 0.5;  // friction may take energy out
+  EXPECT_EQ(stability_verdict(f).verdict, "stable");
+  f.friction = 0.0;
+  f.restitution = 0.9;  // so may e < 1
+  EXPECT_EQ(stability_verdict(f).verdict, "stable");
+  // A sinking run that also loses energy is reported as sinking, with both reasons.
+  f.restitution = 1.0;
+  f.rest_penetration = 0.05;
+  EXPECT_EQ(stability_verdict(f).verdict, "sinks");
+  EXPECT_EQ(stability_verdict(f).why.size(), 2u);
 }
 
 TEST(StabilityVerdict, EachUnstableRuleFiresAlone) {
