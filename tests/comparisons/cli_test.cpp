@@ -361,4 +361,31 @@ TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSinksOnTheStack) {
   fs::remove_all(dir);
 }
 
+TEST(CheckOutput, AWorseMetricShowsDistinctNumbersAndTheRelativeChange) {
+  // A baseline 1e-8 (relative) below the current value: worse by more than the 1e-9 margin, yet
+  // equal to six digits. The line must show two different numbers and the relative change.
+  const fs::path dir = temp_dir("check_digits");
+  const std::string base = (dir / "baseline.json").string();
+  ASSERT_EQ(rbx("check scenes/seed/face_face.toml --baseline '" + base + "' --update").code, 0);
+  nlohmann::json b;
+  std::ifstream(base) >> b;
+  std::string key;
+  for (auto& [k, v] : b["metrics"].items())
+    if (v.is_number() && v.get<double>() > 1e-6) {
+      v = v.get<double>() * (1 - 1e-8);
+      key = k;
+      break;
+    }
+  ASSERT_FALSE(key.empty());
+  std::ofstream(base) << b.dump(2);
+  const CmdResult r = rbx("check scenes/seed/face_face.toml --baseline '" + base + "'");
+  EXPECT_EQ(r.code, 1);
+  std::smatch m;
+  const std::regex line("worse: [^\\n]*: (\\S+) -> (\\S+) \\(([-+0-9.e]+) relative\\)");
+  ASSERT_TRUE(std::regex_search(r.out, m, line)) << r.out;
+  EXPECT_NE(m[1].str(), m[2].str()) << r.out;
+  EXPECT_NEAR(std::stod(m[3].str()), 1e-8, 1e-10) << r.out;
+  fs::remove_all(dir);
+}
+
 }  // namespace
