@@ -86,7 +86,10 @@ int check_command(const ReportOptions& opt) {
     const bool was_nan = std::isnan(old), is_nan = std::isnan(cur);
     if ((!was_nan && is_nan) || cur > old + kRelativeMargin * std::abs(old) + kAbsoluteMargin) {
       ++worse;
-      std::cout << "worse: " << k << ": " << fmt_num(old, 6) << " -> " << fmt_num(cur, 6) << "\n";
+      // Every digit (17 significant: the double round-trips) and the relative change, so a
+      // change beyond the margin never prints as two equal numbers.
+      std::cout << "worse: " << k << ": " << fmt_num(old, 17) << " -> " << fmt_num(cur, 17) << " ("
+                << fmt_num(old != 0 ? (cur - old) / std::abs(old) : HUGE_VAL, 3) << " relative)\n";
     } else if (cur < old - kRelativeMargin * std::abs(old) - kAbsoluteMargin) {
       ++better;
     }

@@ -42,7 +42,8 @@ int contacts_command(const SceneCommandOptions& opt);
 
 namespace rbx {
 
-/// `rbx compare SCENE...`: each scene's checks, side by side; exit 1 on a violated [expect].
+/// `rbx compare SCENE...`: each scene's checks, side by side; exit 1 on a violated [expect],
+/// unless every violation is the custom engine's and the scene sets expect.known_failure.
 int compare_command(const SceneCommandOptions& opt);
 
 /// Options of `rbx report` and `rbx check`.

@@ -20,7 +20,8 @@ int contacts_command(const SceneCommandOptions& opt) {
   Json backends_json = Json::object();
   for (const std::string& name : names) {
     backends_json[name] = {{"status", "ok"}, {"message", ""}, {"runtime_s", 0.0},
-                           {"contacts", Json::array()}, {"pairs", Json::array()}};
+                           {"contacts", Json::array()}, {"pairs", Json::array()},
+                           {"bodies", bodies_json(bodies)}};
   }
   int pairs_shown = 0;
   for (size_t i = 0; i < bodies.size(); ++i) {

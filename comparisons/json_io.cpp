@@ -79,14 +79,18 @@ Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsRe
   Json events = Json::array();
   for (const CollisionEvent& e : r.events) events.push_back(event_json(e));
   j["contacts"] = events;
+  j["bodies"] = bodies_json(inputs, &r.finals);
+  return j;
+}
+
+Json bodies_json(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>* finals) {
   Json bodies = Json::object();
   for (size_t i = 0; i < inputs.size(); ++i) {
     Json b = body_inputs_json(inputs[i]);
-    if (i < r.finals.size()) b["final"] = final_json(r.finals[i]);
+    if (finals && i < finals->size()) b["final"] = final_json((*finals)[i]);
     bodies[inputs[i].name] = b;
   }
-  j["bodies"] = bodies;
-  return j;
+  return bodies;
 }
 
 void write_text(const std::string& path, const std::string& text) {

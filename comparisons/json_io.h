@@ -27,6 +27,10 @@ Json contact_json(const std::string& a, const std::string& b, double time, const
 Json event_json(const CollisionEvent& e);
 /// Mass properties at t = 0 in the world frame (mass, center_of_mass, inertia about the COM).
 Json body_inputs_json(const RigidBody& b);
+/// The contract's `bodies` block: NAME -> body_inputs_json, plus `final` from `finals` (same
+/// order as `inputs`) when given. Every backend gets the same inputs, so contact and mass
+/// results carry the scene's bodies without `final`.
+Json bodies_json(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>* finals = nullptr);
 /// {"position", "orientation", "velocity", "angular_velocity"}.
 Json final_json(const BodyFinal& f);
 /// The scene's settings as written into results (every tunable, for reproducibility).
