@@ -136,6 +136,41 @@ Json geometry_json(const Scene& scene) {
   return g;
 }
 
+// Why the references disagree: each cause below is pinned by a test under tests/reference/
+// (a library upgrade that changes it fails there) or measured by a scene; the adapters convert
+// conventions only, so these are the libraries' answers.
+constexpr const char* kWhy =
+    "Why (each cause pinned by a test in `tests/reference/` or shown by a scene):\n\n"
+    "- **fcl-indep**: FCL 0.7's GST_INDEP leaves the EPA normal in A's local frame and returns "
+    "the depth negated (`FclIndep.*`); its signed distance on Box-Convex aborts on an assertion "
+    "(`FclIndepDistance.*`, run in a forked process).\n"
+    "- **fcl, libccd, ode, mujoco on `small_on_diagonal`**: MPR follows the ray between the "
+    "centres, not the minimum-translation axis (FCL issue 545): n = (1, 1, 1)/sqrt(3), depth "
+    "0.26 for a true 0.15 (`FclMpr.*`, `Libccd.DiagonalCubeMprWrongEpaRight`, "
+    "`MujocoKnownWrongAnswer.*`). Debian's ODE runs convex-convex through libccd MPR too, so it "
+    "shares FCL's answers bit for bit.\n"
+    "- **fcl, libccd, ode at exact touching**: libccd's MPR zeroes its direction below CCD_EPS "
+    "of depth; the adapters report that as `error` (no normal), not as a 180 deg miss.\n"
+    "- **bullet-sat**: the SAT + clipping path measures each point's depth to the first body's "
+    "reference face, reported along the separating normal: too deep when A touches with an edge "
+    "or a vertex; the normal is right (`BulletContact.KnownDefectSatDepth*`).\n"
+    "- **bullet (contacts and dynamics)**: EPA on cubes with coplanar side faces returns a "
+    "diagonal normal, so aligned face-face impacts (head-on, seed face-face, mass ratios, "
+    "scales) spin and lose energy (`KnownDefectEpaCoplanarSides`, "
+    "`KnownDefectAlignedFaceFaceSpins`); at exactly zero depth its normal is left in A's frame "
+    "(`offcentre_vertex`, `KnownDefectZeroDepthNormal`). Led by a corner "
+    "(`headon_vertex_e05`) it is exact.\n"
+    "- **mujoco (dynamics)**: no coefficient of restitution: a soft contact calibrated through "
+    "a negative `solref` spans several steps, so e comes out within a few % and the impact is "
+    "spread in time; mesh-mesh contacts are one MPR point per step.\n"
+    "- **ode (dynamics)**: one MPR point per step on face-face pairs, and its error reduction "
+    "(ERP) turns penetration into separating velocity (`headon_e0`, `zero_relative_velocity`); "
+    "corner-led impacts match to 1e-7.\n"
+    "- **mass**: Bullet's hull inertia is its bounding box's; FCL 0.7's Convex inertia is off on "
+    "every hull here, the box included (relative 0.5 to 5); MuJoCo's mesh inertia is exact to float round-off "
+    "(`LibraryMass.*`, `scenes/mass/`).\n";
+
+
 std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs,
                            double total_s, bool figures_ok, const std::string& figures_msg) {
   std::ostringstream md;
@@ -202,7 +237,7 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
     if (list.size() > 6) md << "; and " << list.size() - 6 << " more (see the scene details)";
     md << "\n";
   }
-  md << "\n";
+  md << "\n" << kWhy << "\n";
 
   // Error against run time.
   md << "## Error against run time\n\n";
