@@ -344,7 +344,9 @@ TEST(ResultsJson, EveryBackendCarriesTheBodiesBlockOnContactAndMassScenes) {
   // A mass scene: every backend entry has the body too.
   const CmdResult m = rbx("compare scenes/mass/box_1x2x3.toml --json -");
   ASSERT_LE(m.code, 1) << m.err;
-  for (const auto& [name, b] : nlohmann::json::parse(m.out)["scenes"][0]["backends"].items())
+  // Parsed into a local first: a range-for over .items() of a temporary would dangle.
+  const nlohmann::json mass_scene = nlohmann::json::parse(m.out);
+  for (const auto& [name, b] : mass_scene["scenes"][0]["backends"].items())
     EXPECT_TRUE(b.contains("bodies") && !b["bodies"].empty()) << name;
 }
 
