@@ -6,6 +6,9 @@
 # build-fuzz/ and runs each for SECONDS (default 60) from its seed corpus.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+# Paths on the command line are the caller's: remember where the caller stands, build from the
+# repository, and run the compiled rbx from the caller's directory.
+caller="$(pwd)"
 cd "$here"
 
 packages=(cmake g++ pkg-config libeigen3-dev libbullet-dev libfcl-dev libccd-dev libgtest-dev
@@ -73,20 +76,57 @@ if [ "${1:-}" = "fuzz" ]; then
   exit 0
 fi
 
-# Configure once per build flavour, then build incrementally.
+# Configure once per build flavour, then build incrementally. The build is quiet: one line on
+# stderr while something is compiled, the whole log when the build fails, nothing when up to date.
 build_dir=build
 cmake_flags=(-DCMAKE_BUILD_TYPE=Release)
-if [ "${1:-}" = "test" ] && [ "${2:-}" = "--sanitize" ]; then
-  build_dir=build-sanitize
-  cmake_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DRBX_SANITIZE=ON)
+targets=(--target rbx)  # the scene commands need the rbx executable only; `test` builds everything
+if [ "${1:-}" = "test" ]; then
+  targets=()
+  if [ "${2:-}" = "--sanitize" ]; then
+    build_dir=build-sanitize
+    cmake_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DRBX_SANITIZE=ON)
+  fi
 fi
+mkdir -p "$build_dir"
+log="$build_dir/rbx-build.log"
+
+# A build folder configured for another source tree (a copied repository: `cp -a` keeps the
+# CMake cache, whose home directory still names the original) would build the original's sources.
+if [ -f "$build_dir/CMakeCache.txt" ]; then
+  home=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$build_dir/CMakeCache.txt")
+  if [ "$home" != "$here" ]; then
+    echo "rbx: $build_dir/ was configured for $home; reconfiguring for $here" >&2
+    rm -rf "${build_dir:?}/CMakeCache.txt" "${build_dir:?}/CMakeFiles"
+  fi
+fi
+
+# Runs one build step with its output in the log; announces itself once if it does any work.
+announced=0
+quiet() {
+  "$@" >"$log" 2>&1 &
+  local pid=$!
+  while kill -0 "$pid" 2>/dev/null; do
+    if [ $announced -eq 0 ] && grep -qE 'Building|Linking|Configuring|Generating' "$log" 2>/dev/null; then
+      echo "rbx: building (log: $here/$log)" >&2
+      announced=1
+    fi
+    sleep 0.2
+  done
+  if ! wait "$pid"; then
+    cat "$log" >&2
+    echo "rbx: build failed (log: $here/$log)" >&2
+    exit 2
+  fi
+}
 if [ ! -f "$build_dir/CMakeCache.txt" ]; then
-  cmake -S . -B "$build_dir" "${cmake_flags[@]}" >&2
+  quiet cmake -S . -B "$build_dir" "${cmake_flags[@]}"
 fi
-cmake --build "$build_dir" -j "$jobs" >&2
+quiet cmake --build "$build_dir" -j "$jobs" "${targets[@]}"
 
 if [ "${1:-}" = "test" ]; then
   cd "$build_dir"
   exec ctest --output-on-failure -j "$jobs"
 fi
-exec "$build_dir/comparisons/rbx" "$@"
+cd "$caller"
+exec "$here/$build_dir/comparisons/rbx" "$@"
