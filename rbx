@@ -2,6 +2,7 @@
 # rbx: one entry point. First use installs missing Debian packages, configures CMake (Release,
 # build/), builds incrementally, then runs the compiled `rbx` with the same arguments.
 # `./rbx test [--sanitize]` builds and runs the whole test suite with ctest.
+# `./rbx format [--check]` applies (or checks) clang-format on every tracked C++ source.
 # `./rbx fuzz [SECONDS]` builds the libFuzzer targets (tests/fuzz) with clang, ASan and UBSan in
 # build-fuzz/ and runs each for SECONDS (default 60) from its seed corpus.
 set -euo pipefail
@@ -14,6 +15,10 @@ cd "$here"
 packages=(cmake g++ pkg-config libeigen3-dev libbullet-dev libfcl-dev libccd-dev libgtest-dev
           libbenchmark-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libmujoco-dev
           libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib)
+# `./rbx format [--check]` needs clang-format (Debian's `clang-format`, version 14 here).
+if [ "${1:-}" = "format" ]; then
+  packages+=(clang-format)
+fi
 # Fuzzing needs clang and libFuzzer, which Debian ships in libclang-rt-14-dev (only recommended
 # by clang-14, so not always there).
 if [ "${1:-}" = "fuzz" ]; then
@@ -38,6 +43,30 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 jobs=$(nproc 2>/dev/null || echo 2)
+
+# Formatting: every tracked C++ source through clang-format (.clang-format at the root).
+# `--check` changes nothing and exits 1 naming the files that are not formatted.
+if [ "${1:-}" = "format" ]; then
+  mapfile -t sources < <(git ls-files '*.cpp' '*.h')
+  if [ "${2:-}" = "--check" ]; then
+    bad=()
+    for f in "${sources[@]}"; do
+      clang-format --dry-run --Werror "$f" >/dev/null 2>&1 || bad+=("$f")
+    done
+    if [ ${#bad[@]} -gt 0 ]; then
+      echo "rbx format: not formatted (run ./rbx format): ${bad[*]}" >&2
+      exit 1
+    fi
+    echo "rbx format: ${#sources[@]} files formatted"
+    exit 0
+  elif [ $# -gt 1 ]; then
+    echo "rbx: usage: ./rbx format [--check]" >&2
+    exit 2
+  fi
+  clang-format -i "${sources[@]}"
+  echo "rbx format: ${#sources[@]} files formatted"
+  exit 0
+fi
 
 # Fuzzing: its own build folder and compiler; a crash leaves its input in
 # build-fuzz/crashes/<target>/ (copy it to tests/fuzz/regressions/<target>/ once fixed) and
