@@ -161,7 +161,7 @@ ConvexPolyhedron sphere_hull(int n, std::mt19937_64& rng) {
 RigidBody body_of(const std::string& name, const ConvexPolyhedron& shape, bool box) {
   BodySpec spec;
   spec.name = name;
-  spec.shape_kind = box ? "box" : "convex";
+  spec.shape_kind = box ? ShapeKind::Box : ShapeKind::Convex;
   spec.box_size = Vec3::Constant(kSize);
   spec.shape = std::make_shared<const ConvexPolyhedron>(shape);
   return make_body(spec);
@@ -511,7 +511,7 @@ int bench_command(const BenchOptions& opt) {
         {"custom", "seed",
          [](const Scene& s) {
            // The seed's detector and all-pairs bounding check.
-           World w(s.sim, make_bodies(s), DetectorVariant::Seed, BroadPhaseMethod::AllPairs);
+           World w(s.sim, make_bodies(s), DetectorVariant::Faithful, BroadPhaseMethod::AllPairs);
            const RunResult r = w.run();
            return r.ok ? std::string() : r.message;
          }},

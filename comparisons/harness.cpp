@@ -129,15 +129,15 @@ class Evaluator {
     j["file"] = scene_.file;
     j["family"] = out_.family;
     j["description"] = scene_.description;
-    j["checks"] = scene_.checks;
+    j["checks"] = scene_.check_names();
     j["settings"] = settings_json(scene_);
     backends_json_ = Json::object();
     if (scene_.checks.empty()) out_.skipped.push_back("scene lists no checks: nothing to run");
-    if (scene_.has_check("contact")) contact_check();
-    const bool dynamics = scene_.has_check("impulse") || scene_.has_check("trajectory") ||
-                          scene_.has_check("stability");
+    if (scene_.has_check(CheckKind::Contact)) contact_check();
+    const bool dynamics = scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory) ||
+                          scene_.has_check(CheckKind::Stability);
     if (dynamics) dynamics_checks();
-    if (scene_.has_check("mass")) mass_check();
+    if (scene_.has_check(CheckKind::Mass)) mass_check();
     j["backends"] = backends_json_;
     Json metrics = Json::array();
     for (const Metric& m : out_.metrics)
@@ -346,7 +346,7 @@ class Evaluator {
 
     const long steps = scene_.sim.steps();
     const long sample_every = std::max<long>(1, steps / 400);
-    const bool wants_sweep = opt_.sweep && (scene_.has_check("impulse") || scene_.has_check("trajectory"));
+    const bool wants_sweep = opt_.sweep && (scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory));
     const std::vector<double> dts = sweep_steps(scene_);
     const double finest = dts.back();
 
@@ -373,7 +373,7 @@ class Evaluator {
       Json& bj = backend_json(name);
       bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
       if (main.result.status != Status::Ok) {
-        if (scene_.has_check("stability")) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
+        if (scene_.has_check(CheckKind::Stability)) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
         continue;
       }
 
@@ -382,15 +382,15 @@ class Evaluator {
       std::vector<DynRun> sweep_runs;
       // Velocity errors belong to the impulse and trajectory checks: a stability-only scene
       // does not pay for the self-consistency run.
-      const bool wants_velocity = scene_.has_check("impulse") || scene_.has_check("trajectory");
-      if (wants_sweep || (!have_expect && wants_velocity) || scene_.has_check("trajectory")) {
+      const bool wants_velocity = scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory);
+      if (wants_sweep || (!have_expect && wants_velocity) || scene_.has_check(CheckKind::Trajectory)) {
         // Without a sweep only the finest step is needed (the self-consistency reference).
         const std::vector<double> to_run = wants_sweep ? dts : std::vector<double>{finest};
         for (double dt : to_run) {
           if (std::abs(dt - scene_.sim.dt) <= 1e-15 * dt) sweep_runs.push_back(main);
           else {
             // The finest run of a trajectory check is sampled at the same times as the main run.
-            const bool sample = scene_.has_check("trajectory") && dt == finest;
+            const bool sample = scene_.has_check(CheckKind::Trajectory) && dt == finest;
             const long every = sample ? std::max<long>(1, std::lround(sample_every * scene_.sim.dt / dt)) : 0;
             sweep_runs.push_back(run_dynamics(be, scene_, dt, every));
           }
@@ -431,7 +431,7 @@ class Evaluator {
       // State divergence over time: how far any point of a body is from where the finest-step
       // run puts it at the same sample time, |dx| + (size / 2) * rotation angle (an upper bound),
       // relative to the body's size.
-      if (scene_.has_check("trajectory") && fine && !fine->result.samples.empty() &&
+      if (scene_.has_check(CheckKind::Trajectory) && fine && !fine->result.samples.empty() &&
           std::abs(finest - scene_.sim.dt) > 1e-15) {
         double worst = 0.0;
         size_t k = 0;
@@ -483,14 +483,14 @@ class Evaluator {
       if (scene_.expect)
         mark_expect_disagreement(name, main.result.finals,
                                  have_expect ? ke_norm_error(inputs_, main.result.finals, expected, e0_kin) : 0.0);
-      if (scene_.has_check("stability")) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
+      if (scene_.has_check(CheckKind::Stability)) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
     }
     if (!angular) out_.skipped.push_back("angular metrics: nothing rotates in this scene");
   }
 
   std::string primary_check() const {
-    if (scene_.has_check("impulse")) return "impulse";
-    if (scene_.has_check("trajectory")) return "trajectory";
+    if (scene_.has_check(CheckKind::Impulse)) return "impulse";
+    if (scene_.has_check(CheckKind::Trajectory)) return "trajectory";
     return "stability";
   }
 

@@ -204,7 +204,7 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
     std::string against;
     std::vector<std::string> row = {evs[i].family + "/" + scenes[i].name, "", ""};
     std::string checks;
-    for (const std::string& c : scenes[i].checks) checks += (checks.empty() ? "" : ", ") + c;
+    for (const std::string& c : scenes[i].check_names()) checks += (checks.empty() ? "" : ", ") + c;
     row[1] = checks;
     for (const std::string& c : cols) {
       std::string a;
@@ -309,10 +309,10 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
     if (scenes[i].expect && !scenes[i].expect->known_failure.empty())
       md << "  - known failure: " << scenes[i].expect->known_failure << "\n";
     if (figures_ok) {
-      if (scenes[i].has_check("contact") && !ev.json["geometry"].empty())
+      if (scenes[i].has_check(CheckKind::Contact) && !ev.json["geometry"].empty())
         md << "\n![contacts](figures/contact_" << slug << ".png)\n";
       if (find_metric(ev, "custom", "velocity_err_ke") || ev.json["backends"].contains("bullet"))
-        if (scenes[i].has_check("impulse"))
+        if (scenes[i].has_check(CheckKind::Impulse))
           md << "\n![velocities](figures/velocity_" << slug << ".png)\n";
     }
     md << "\n";
@@ -337,7 +337,7 @@ int report_command(const ReportOptions& opt) {
   for (size_t i = 0; i < scenes.size(); ++i) {
     progress.show(i + 1, scenes.size(), scenes[i].file, clock.seconds());
     evs.push_back(evaluate_scene(scenes[i], hopt));
-    if (scenes[i].has_check("contact")) evs.back().json["geometry"] = geometry_json(scenes[i]);
+    if (scenes[i].has_check(CheckKind::Contact)) evs.back().json["geometry"] = geometry_json(scenes[i]);
   }
   progress.done();
 

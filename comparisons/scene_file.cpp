@@ -642,15 +642,15 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
   r.check_keys(t, p, keys_under("body."), false);
 
   // Shape, then keys that belong to other shapes.
-  if (const toml::node* n = t.get("shape")) b.shape_kind = one_of(r, *n, p + "shape", "body.shape", kShapes, "shape");
+  if (const toml::node* n = t.get("shape")) b.shape_kind = *shape_kind_from_string(one_of(r, *n, p + "shape", "body.shape", kShapes, "shape"));
   for (const auto& [key, node] : in_file_order(t)) {
     std::vector<std::string> owners;  // shapes that take this key (none: any shape)
     for (const auto& [k, shape] : kShapeKeys)
       if (k == key) owners.push_back(shape);
-    if (!owners.empty() && std::find(owners.begin(), owners.end(), b.shape_kind) == owners.end())
+    if (!owners.empty() && std::find(owners.begin(), owners.end(), to_string(b.shape_kind)) == owners.end())
       r.fail(key_line(t, key), p + key,
              "only valid for shape = \"" + join_quoted(owners) + "\", but this body's shape is \"" +
-                 b.shape_kind + "\"",
+                 to_string(b.shape_kind) + "\"",
              "remove it, or set shape = \"" + owners.front() + "\"");
   }
 
@@ -672,7 +672,7 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
   };
   auto shape_line = [&]() { return t.get("shape") ? line_of(t.get("shape")) : table_line; };
   try {
-    if (b.shape_kind == "box") {
+    if (b.shape_kind == ShapeKind::Box) {
       if (const toml::node* n = t.get("size")) {
         b.box_size = r.vec3(*n, p + "size", "body.size");
         if (!(b.box_size.minCoeff() > 0))
@@ -686,7 +686,7 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
                  "give full extents in metres, e.g. size = [1, 1, 1]");
       }
       b.shape = std::make_shared<const ConvexPolyhedron>(make_box(b.box_size));
-    } else if (b.shape_kind == "icosphere") {
+    } else if (b.shape_kind == ShapeKind::Icosphere) {
       const double radius = positive("radius", 0.5, "radius");
       long subdivisions = 2;
       if (const toml::node* n = t.get("subdivisions")) {
@@ -698,7 +698,7 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
       }
       b.shape = std::make_shared<const ConvexPolyhedron>(
           make_icosphere(radius, static_cast<int>(subdivisions)));
-    } else if (b.shape_kind == "prism") {
+    } else if (b.shape_kind == ShapeKind::Prism) {
       const double radius = positive("radius", 0.5, "radius");
       const double height = positive("height", 1.0, "height");
       long sides = 6;
@@ -710,7 +710,7 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
       }
       b.shape = std::make_shared<const ConvexPolyhedron>(
           make_prism(radius, height, static_cast<int>(sides)));
-    } else if (b.shape_kind == "convex") {
+    } else if (b.shape_kind == ShapeKind::Convex) {
       const toml::node* n = t.get("vertices");
       if (!n)
         r.fail(table_line, p + "vertices", "missing for shape = \"convex\"",
@@ -960,7 +960,9 @@ Scene parse_scene(const std::string& text, const std::string& path,
   }
   if (const toml::node* n = root.get("description"))
     scene.description = r.string(*n, "description", "description");
-  if (const toml::node* n = root.get("checks")) scene.checks = names_from(r, *n, "checks", kChecks, "check");
+  if (const toml::node* n = root.get("checks"))
+    for (const std::string& c : names_from(r, *n, "checks", kChecks, "check"))
+      scene.checks.push_back(*check_kind_from_string(c));
   if (const toml::node* n = root.get("backends"))
     scene.backends = names_from(r, *n, "backends", kBackends, "backend");
 

@@ -17,23 +17,23 @@ std::string scene_table_markdown(const std::vector<std::string>& inputs) {
   for (const std::string& f : files) {
     const Scene s = load_scene(f);
     std::string checks;
-    for (const std::string& c : s.checks) checks += (checks.empty() ? "" : ", ") + c;
+    for (const std::string& c : s.check_names()) checks += (checks.empty() ? "" : ", ") + c;
     // Backends that serve the scene's checks (fcl-box only where the first pair is two boxes).
     std::vector<std::string> names;
     auto add = [&](const std::vector<std::string>& list) {
       for (const std::string& n : list)
         if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
     };
-    if (s.has_check("contact")) {
+    if (s.has_check(CheckKind::Contact)) {
       std::vector<std::string> c = select_backends(s, "", Capability::Contact);
-      const bool boxes = s.bodies.size() >= 2 && s.bodies[0].shape_kind == "box" &&
-                         s.bodies[1].shape_kind == "box";
+      const bool boxes = s.bodies.size() >= 2 && s.bodies[0].shape_kind == ShapeKind::Box &&
+                         s.bodies[1].shape_kind == ShapeKind::Box;
       if (!boxes) c.erase(std::remove(c.begin(), c.end(), "fcl-box"), c.end());
       add(c);
     }
-    if (s.has_check("impulse") || s.has_check("trajectory") || s.has_check("stability"))
+    if (s.has_check(CheckKind::Impulse) || s.has_check(CheckKind::Trajectory) || s.has_check(CheckKind::Stability))
       add(select_backends(s, "", Capability::Dynamics));
-    if (s.has_check("mass")) add({"custom"});
+    if (s.has_check(CheckKind::Mass)) add({"custom"});
     std::string list;
     for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
     std::string file = f;

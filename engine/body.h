@@ -14,7 +14,7 @@ namespace rbx {
 /// the pose (position, orientation) is that of the centre of mass.
 struct RigidBody {
   std::string name;
-  std::string shape_kind = "box";
+  ShapeKind shape_kind = ShapeKind::Box;
   Vec3 box_size = Vec3::Ones();                    // m, full extents (box only)
   std::shared_ptr<const ConvexPolyhedron> shape;   // body frame: centre of mass at the origin
   Vec3 shape_origin_offset = Vec3::Zero();         // m, the scene's local origin in the body frame

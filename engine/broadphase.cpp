@@ -120,50 +120,10 @@ void BroadPhase::sweep_and_prune() {
 void BroadPhase::tree() {
   const int n = static_cast<int>(spheres_.size());
   if (n < 2) return;
-  // Build: top-down median splits of the box centres along the longest axis.
-  order_.resize(n);
-  for (int i = 0; i < n; ++i) order_[i] = i;
-  sap_axis_ = -1;  // the order no longer belongs to a sweep
-  nodes_.clear();
-  nodes_.push_back({});
-  nodes_[0].begin = 0;
-  nodes_[0].end = n;
-  std::vector<int> work = {0};
-  while (!work.empty()) {
-    const int k = work.back();
-    work.pop_back();
-    const int b = nodes_[k].begin, e = nodes_[k].end;
-    Vec3 lo = box_min_[order_[b]], hi = box_max_[order_[b]];
-    Vec3 c_lo = spheres_[order_[b]].center, c_hi = c_lo;
-    for (int i = b + 1; i < e; ++i) {
-      const int body = order_[i];
-      lo = lo.cwiseMin(box_min_[body]);
-      hi = hi.cwiseMax(box_max_[body]);
-      c_lo = c_lo.cwiseMin(spheres_[body].center);
-      c_hi = c_hi.cwiseMax(spheres_[body].center);
-    }
-    nodes_[k].min = lo;
-    nodes_[k].max = hi;
-    if (e - b <= kLeafSize) continue;
-    int axis = 0;
-    (c_hi - c_lo).maxCoeff(&axis);
-    const int mid = (b + e) / 2;
-    std::nth_element(order_.begin() + b, order_.begin() + mid, order_.begin() + e,
-                     [&](int x, int y) {
-                       return spheres_[x].center[axis] < spheres_[y].center[axis] ||
-                              (spheres_[x].center[axis] == spheres_[y].center[axis] && x < y);
-                     });
-    const int child = static_cast<int>(nodes_.size());
-    nodes_[k].child = child;
-    nodes_.push_back({});
-    nodes_.push_back({});
-    nodes_[child].begin = b;
-    nodes_[child].end = mid;
-    nodes_[child + 1].begin = mid;
-    nodes_[child + 1].end = e;
-    work.push_back(child);
-    work.push_back(child + 1);
-  }
+  // Build: the shared hierarchy (engine/bvh.h) over the padded boxes.
+  tree_ = Bvh::build(box_min_, box_max_, kLeafSize);
+  const std::vector<int>& order = tree_.order;
+  const std::vector<BvhNode>& nodes = tree_.nodes;
   // Query: the tree against itself (a dual traversal). A node is paired with itself (its two
   // children with themselves and with each other) and two nodes whose boxes overlap are opened,
   // the larger first; two leaves test their bodies' boxes, then the seed's sphere test. Every
@@ -177,19 +137,19 @@ void BroadPhase::tree() {
   leaf_max_.resize(n);
   leaf_spheres_.resize(n);
   for (int m = 0; m < n; ++m) {
-    leaf_min_[m] = box_min_[order_[m]];
-    leaf_max_[m] = box_max_[order_[m]];
-    leaf_spheres_[m] = spheres_[order_[m]];
+    leaf_min_[m] = box_min_[order[m]];
+    leaf_max_[m] = box_max_[order[m]];
+    leaf_spheres_[m] = spheres_[order[m]];
   }
   // Boxes at tree positions m and q overlap: the seed's test on the same spheres, written with
   // the lower body index first as bounding_check(bodies[i], bodies[j]) is, i < j.
   auto test_leaves = [&](int m, int q) {
     if (!overlap(leaf_min_[m], leaf_max_[m], leaf_min_[q], leaf_max_[q])) return;
-    if (order_[m] > order_[q]) std::swap(m, q);
+    if (order[m] > order[q]) std::swap(m, q);
     const BoundingSphere& sa = leaf_spheres_[m];
     const BoundingSphere& sb = leaf_spheres_[q];
     if ((sa.center - sb.center).norm() <= sa.radius + sb.radius)
-      pairs_.push_back({order_[m], order_[q]});
+      pairs_.push_back({order[m], order[q]});
   };
   std::vector<std::pair<int, int>>& stack = node_pairs_;
   stack.clear();
@@ -197,8 +157,8 @@ void BroadPhase::tree() {
   while (!stack.empty()) {
     const auto [ka, kb] = stack.back();
     stack.pop_back();
-    const Node& a = nodes_[ka];
-    const Node& b = nodes_[kb];
+    const BvhNode& a = nodes[ka];
+    const BvhNode& b = nodes[kb];
     if (ka == kb) {
       if (a.child < 0) {
         for (int m = a.begin; m < a.end; ++m)

@@ -20,6 +20,7 @@
 
 #include "engine/body.h"
 #include "engine/bounding.h"
+#include "engine/bvh.h"
 
 namespace rbx {
 
@@ -45,13 +46,6 @@ class BroadPhase {
   BroadPhaseMethod method() const { return method_; }
 
  private:
-  // A node of the tree over body boxes.
-  struct Node {
-    Vec3 min = Vec3::Zero(), max = Vec3::Zero();  // m, world
-    int child = -1;          // first child (the second is child + 1); -1 for a leaf
-    int begin = 0, end = 0;  // bodies order_[begin, end)
-  };
-
   void all_pairs();
   void sweep_and_prune();
   void tree();
@@ -63,9 +57,9 @@ class BroadPhase {
   BroadPhaseMethod method_;
   std::vector<BoundingSphere> spheres_;  // this call's bounding spheres (bounding_sphere())
   std::vector<Vec3> box_min_, box_max_;  // m, padded boxes around them
-  std::vector<int> order_;               // sweep and prune: sorted along sap_axis_; tree: leaves
+  std::vector<int> order_;               // sweep and prune: sorted along sap_axis_
   int sap_axis_ = -1;                    // axis of the last sweep (-1: none yet)
-  std::vector<Node> nodes_;              // tree
+  Bvh tree_;                             // tree: over the padded boxes
   std::vector<std::pair<int, int>> node_pairs_;  // tree: traversal stack
   std::vector<Vec3> leaf_min_, leaf_max_;        // tree: boxes in tree order
   std::vector<BoundingSphere> leaf_spheres_;     // tree: spheres in tree order

@@ -12,12 +12,32 @@
 
 namespace rbx {
 
+/// Which of the custom detector's tests found a contact (Moore & Wilhelms).
+enum class Feature {
+  Face,    ///< a triangle centroid of one shape inside the other
+  Vertex,  ///< a vertex of one shape inside the other
+  Edge,    ///< a point of an edge of one shape inside the other
+};
+
+/// "face" | "vertex" | "edge": the label the custom detector writes into ContactPoint::feature.
+inline const char* to_string(Feature feature) {
+  switch (feature) {
+    case Feature::Face: return "face";
+    case Feature::Vertex: return "vertex";
+    case Feature::Edge: return "edge";
+  }
+  return "face";
+}
+
 /// One contact point between two bodies, in the convention above.
 struct ContactPoint {
   Vec3 point = Vec3::Zero();    // m, world
   Vec3 normal = Vec3::UnitZ();  // unit, world, from B toward A
   double depth = 0.0;           // m, >= 0
-  std::string feature;          // "face" | "vertex" | "edge" (custom), or a backend's own label
+  // What found the point, as written into results: to_string(Feature) for the custom detector,
+  // a library's own label ("mpr", "gjk-epa", ...) for a reference backend. A label, not a type:
+  // the backends' labels are open-ended, and the custom engine dispatches on Feature.
+  std::string feature;
 };
 
 }  // namespace rbx

@@ -4,8 +4,13 @@
 // Every function here is a pure function of two shapes and two poses (no world). Shapes are in
 // their body frames; poses map them to the world. Results follow engine/contact.h: the normal is
 // unit, in the world frame, from B toward A; depth >= 0.
+//
+// Files: this entry point switches between two implementations of the same tests, written once
+// in engine/features.h: the faithful loops (engine/detect_faithful.*) and the accelerated
+// queries (engine/detect_accelerated.*), which return the same answers bit for bit.
 #pragma once
 
+#include <memory>
 #include <optional>
 
 #include "engine/contact.h"
@@ -13,9 +18,39 @@
 
 namespace rbx {
 
-/// Which implementation of the tests to run. `Seed` is the faithful loop-over-everything
-/// version and the oracle; `Fast` must return the same answers (to round-off).
-enum class DetectorVariant { Seed, Fast };
+/// Which implementation of the tests to run. `Faithful` loops over every primitive as the seed
+/// does and is the oracle; `Accelerated` culls with bounding volume trees and must return the
+/// same answers bit for bit (tests/engine/fast_detect_test.cpp).
+enum class DetectorVariant { Faithful, Accelerated };
+
+/// "faithful" | "accelerated".
+const char* to_string(DetectorVariant variant);
+
+/// The detector's state for one pair of shapes, passed in explicitly: both shapes placed at
+/// their poses (prepared once, then shared by the face, vertex and edge tests) and reusable
+/// scratch lists. Owned by the caller (the World keeps one); two caches never share state, so
+/// interleaved queries on one thread do not interfere. The shapes must outlive the prepared pair.
+class DetectionCache {
+ public:
+  DetectionCache();
+  ~DetectionCache();
+  DetectionCache(DetectionCache&&) noexcept;
+  DetectionCache& operator=(DetectionCache&&) noexcept;
+
+  /// Places a and b at pa and pb for the tests that follow, with the given implementation.
+  void prepare(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+               const Pose& pb, DetectorVariant variant);
+  /// One kind of test in both orders on the prepared pair: (A, B), then (B, A) with the normal
+  /// flipped (SEED_NOTES 8). Throws std::logic_error when nothing was prepared.
+  std::optional<ContactPoint> test(Feature feature);
+  /// The full detector on the prepared pair: face, vertex, edge, each in both orders; the first
+  /// hit. Throws std::logic_error when nothing was prepared.
+  std::optional<ContactPoint> detect();
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 /// Tolerance (m) for point-in-mesh, relative to the larger shape: points within this distance
 /// outside a face plane count as inside, so exactly touching bodies are seen.
@@ -31,40 +66,48 @@ bool point_in_mesh(const ConvexPolyhedron& mesh, const Pose& pose, const Vec3& p
 double overlap_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                      const Pose& pb, const Vec3& n);
 
-/// Face test, one order: centroids of A's triangles that lie inside B, averaged (the seed's
-/// "better collision point"); normal = minus the outward normal of the first such triangle of A
-/// (SEED_NOTES 9). feature = "face".
+/// Face test, one order (faithful): centroids of A's triangles that lie inside B, averaged (the
+/// seed's "better collision point"); normal = minus the outward normal of the first such
+/// triangle of A (SEED_NOTES 9). feature = "face".
 std::optional<ContactPoint> face_test(const ConvexPolyhedron& a, const Pose& pa,
                                       const ConvexPolyhedron& b, const Pose& pb);
 
-/// Vertex test, one order: the first vertex of A inside B; normal = outward normal of B's face
-/// closest to it. Departure from the seed: the point is the average of every vertex of A inside
-/// B whose closest face of B has that same normal (an edge or face landing flat gets its
-/// impulse at its middle, not at one end). feature = "vertex".
+/// Vertex test, one order (faithful): the first vertex of A inside B; normal = outward normal of
+/// B's face closest to it. Departure from the seed: the point is the average of every vertex of
+/// A inside B whose closest face of B has that same normal (an edge or face landing flat gets
+/// its impulse at its middle, not at one end). feature = "vertex".
 std::optional<ContactPoint> vertex_test(const ConvexPolyhedron& a, const Pose& pa,
                                         const ConvexPolyhedron& b, const Pose& pb);
 
-/// Edge test, one order: each edge of A is cut where it crosses the planes of B's triangles
-/// (SEED_NOTES 2), the crossing parameters sorted with 0 and 1, and the midpoint of each
-/// consecutive pair tested in B; the first inside is the point. Normal: e_a x e_b, e_b the edge
-/// of B's crossed triangle nearest the point, oriented from B toward A (SEED_NOTES 10).
+/// Edge test, one order (faithful): each edge of A is cut where it crosses the planes of B's
+/// triangles (SEED_NOTES 2), the crossing parameters sorted with 0 and 1, and the midpoint of
+/// each consecutive pair tested in B; the first inside is the point. Normal: e_a x e_b, e_b the
+/// edge of B's crossed triangle nearest the point, oriented from B toward A (SEED_NOTES 10).
 /// Departure: where the crossed triangle's outward normal separates the shapes with a smaller
 /// translation than e_a x e_b (an edge piercing a face, not an edge), that face normal is
 /// taken. feature = "edge".
 std::optional<ContactPoint> edge_test(const ConvexPolyhedron& a, const Pose& pa,
                                       const ConvexPolyhedron& b, const Pose& pb);
 
-/// One kind of test ("face", "vertex" or "edge") in both orders: (A, B), then (B, A) with the
-/// normal flipped (SEED_NOTES 8). The point and depth are symmetric.
-std::optional<ContactPoint> detect_feature(const std::string& feature, const ConvexPolyhedron& a,
+/// One kind of test in both orders (see DetectionCache::test), on the caller's cache.
+std::optional<ContactPoint> detect_feature(Feature feature, const ConvexPolyhedron& a,
+                                           const Pose& pa, const ConvexPolyhedron& b,
+                                           const Pose& pb, DetectorVariant variant,
+                                           DetectionCache& cache);
+/// The same with a cache of its own (convenient; a caller making many queries keeps one).
+std::optional<ContactPoint> detect_feature(Feature feature, const ConvexPolyhedron& a,
                                            const Pose& pa, const ConvexPolyhedron& b,
                                            const Pose& pb,
-                                           DetectorVariant variant = DetectorVariant::Fast);
+                                           DetectorVariant variant = DetectorVariant::Accelerated);
 
 /// The full detector in the seed's order (face, vertex, edge; each in both orders): the first
-/// hit, or nothing when the shapes do not touch.
+/// hit, or nothing when the shapes do not touch. On the caller's cache.
 std::optional<ContactPoint> detect(const ConvexPolyhedron& a, const Pose& pa,
                                    const ConvexPolyhedron& b, const Pose& pb,
-                                   DetectorVariant variant = DetectorVariant::Fast);
+                                   DetectorVariant variant, DetectionCache& cache);
+/// The same with a cache of its own.
+std::optional<ContactPoint> detect(const ConvexPolyhedron& a, const Pose& pa,
+                                   const ConvexPolyhedron& b, const Pose& pb,
+                                   DetectorVariant variant = DetectorVariant::Accelerated);
 
 }  // namespace rbx

@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <utility>
 #include <vector>
+
+#include "engine/bvh.h"
+#include "engine/shape_hierarchy.h"
 
 namespace rbx {
 
@@ -15,44 +19,6 @@ std::string fmt_vec(const Vec3& v) {
   std::ostringstream s;
   s << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
   return s.str();
-}
-
-// A node of a bounding-box tree over the vertices: leaves hold at most 16 of them.
-struct VertexNode {
-  Vec3 min = Vec3::Zero(), max = Vec3::Zero();
-  int left = -1, right = -1;  // children (-1: a leaf)
-  int begin = 0, end = 0;     // leaf: its vertices order[begin, end)
-};
-
-// Builds the tree by median splits along the widest axis; `order` receives the vertex order.
-std::vector<VertexNode> vertex_tree(const std::vector<Vec3>& vertices, std::vector<int>& order) {
-  order.resize(vertices.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  std::vector<VertexNode> nodes(1);
-  nodes[0].end = static_cast<int>(order.size());
-  for (size_t n = 0; n < nodes.size(); ++n) {  // nodes are appended as they are split
-    const int begin = nodes[n].begin, end = nodes[n].end;
-    Vec3 lo = vertices[order[begin]], hi = lo;
-    for (int k = begin; k < end; ++k) {
-      lo = lo.cwiseMin(vertices[order[k]]);
-      hi = hi.cwiseMax(vertices[order[k]]);
-    }
-    nodes[n].min = lo;
-    nodes[n].max = hi;
-    if (end - begin <= 16) continue;
-    int axis = 0;
-    (hi - lo).maxCoeff(&axis);
-    const int mid = begin + (end - begin) / 2;
-    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
-                     [&](int a, int b) { return vertices[a][axis] < vertices[b][axis]; });
-    nodes[n].left = static_cast<int>(nodes.size());
-    nodes[n].right = nodes[n].left + 1;
-    VertexNode l, r;
-    l.begin = begin, l.end = mid, r.begin = mid, r.end = end;
-    nodes.push_back(l);
-    nodes.push_back(r);
-  }
-  return nodes;
 }
 
 }  // namespace
@@ -136,26 +102,19 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
   // A box tree over the vertices prunes: a box lying behind a face plane by more than tol / 2
   // (far above the round-off of the two dot products) cannot hold an outside vertex, so only
   // the boxes the plane cuts are opened, and only their leaves are tested vertex by vertex.
-  std::vector<int> order;
-  const std::vector<VertexNode> tree = vertex_tree(p.vertices_, order);
+  const Bvh tree = Bvh::build(p.vertices_, p.vertices_, 16);
   auto vertex_outside = [&](size_t f, int i) { return p.planes_[f].distance(p.vertices_[i]) > tol; };
-  std::vector<int> stack;
   for (size_t f = 0; f < p.planes_.size(); ++f) {
     const Plane& plane = p.planes_[f];
-    bool outside = false;
-    stack.assign(1, 0);
-    while (!stack.empty() && !outside) {
-      const VertexNode& node = tree[stack.back()];
-      stack.pop_back();
+    // Height of a node's box corner furthest along the normal: skipped when <= tol / 2.
+    auto reach = [&](int k) {
+      const BvhNode& node = tree.nodes[k];
       const Vec3 corner = (plane.normal.array() > 0).select(node.max, node.min);
-      if (plane.normal.dot(corner) - plane.offset <= 0.5 * tol) continue;
-      if (node.left >= 0) {
-        stack.push_back(node.left);
-        stack.push_back(node.right);
-        continue;
-      }
-      for (int k = node.begin; k < node.end && !outside; ++k) outside = vertex_outside(f, order[k]);
-    }
+      return plane.normal.dot(corner) - plane.offset;
+    };
+    const bool outside = tree.search(
+        reach, [&](double r) { return r <= 0.5 * tol; },
+        [&](int i) { return vertex_outside(f, i); });
     if (!outside) continue;
     // Name the lowest-numbered outside vertex of the first face that has one.
     for (int i = 0; i < nv; ++i) {
@@ -167,7 +126,14 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
                           " (use hull = true for its convex hull)");
     }
   }
+  p.build_hierarchy();
   return p;
+}
+
+void ConvexPolyhedron::build_hierarchy() {
+  hierarchy_.reset();
+  if (static_cast<int>(triangles_.size()) > kSmallTriangles)
+    hierarchy_ = std::make_shared<const ShapeHierarchy>(ShapeHierarchy::build(*this));
 }
 
 double ConvexPolyhedron::volume() const {
@@ -196,6 +162,7 @@ ConvexPolyhedron ConvexPolyhedron::translated(const Vec3& offset) const {
   for (Plane& pl : p.planes_) pl.offset += pl.normal.dot(offset);
   p.bounds_.min += offset;
   p.bounds_.max += offset;
+  p.build_hierarchy();
   return p;
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -9,6 +10,8 @@
 #include "engine/math.h"
 
 namespace rbx {
+
+struct ShapeHierarchy;
 
 /// Raised when a mesh is not a valid closed convex polyhedron; the message names the feature.
 class GeometryError : public std::runtime_error {
@@ -69,6 +72,9 @@ class ConvexPolyhedron {
   const std::vector<Plane>& planes() const { return planes_; }
   /// Axis-aligned bounds of the vertices, in the shape's frame.
   const Aabb& bounds() const { return bounds_; }
+  /// The accelerated detector's trees over this shape (engine/shape_hierarchy.h), built with it;
+  /// null for shapes of at most kSmallTriangles triangles, which are tested with plain loops.
+  const ShapeHierarchy* hierarchy() const { return hierarchy_.get(); }
 
   /// Enclosed volume (m^3), by the divergence theorem.
   double volume() const;
@@ -83,6 +89,10 @@ class ConvexPolyhedron {
   std::vector<Edge> edges_;
   std::vector<Plane> planes_;
   Aabb bounds_;
+  std::shared_ptr<const ShapeHierarchy> hierarchy_;  // shared by copies: the shape is immutable
+
+  // Builds hierarchy_ from the shape's current geometry (or clears it for a small shape).
+  void build_hierarchy();
 };
 
 /// Box with full extents `size`, centred at the origin (12 triangles).

@@ -44,10 +44,38 @@ struct SimSettings {
   long steps() const;
 };
 
+/// How a body's shape was given in the scene ([[body]] shape = ...).
+enum class ShapeKind {
+  Box,        ///< box of full extents `size`
+  Icosphere,  ///< subdivided icosahedron on a sphere
+  Prism,      ///< regular n-gon prism
+  Convex,     ///< listed vertices (and optionally triangles, or their hull)
+  Mesh,       ///< a mesh file
+};
+
+/// "box" | "icosphere" | "prism" | "convex" | "mesh", as written in scene files.
+const char* to_string(ShapeKind kind);
+/// The kind named by a scene file's text; nothing for an unknown name.
+std::optional<ShapeKind> shape_kind_from_string(const std::string& name);
+
+/// What a scene asks the harness to evaluate ([checks] in a scene file).
+enum class CheckKind {
+  Contact,     ///< contact at the t = 0 poses
+  Impulse,     ///< velocities after a collision
+  Trajectory,  ///< states along a run
+  Stability,   ///< long-run energy and momentum
+  Mass,        ///< mass properties
+};
+
+/// "contact" | "impulse" | "trajectory" | "stability" | "mass", as written in scene files.
+const char* to_string(CheckKind check);
+/// The check named by a scene file's text; nothing for an unknown name.
+std::optional<CheckKind> check_kind_from_string(const std::string& name);
+
 /// One [[body]] of a scene, before mass properties are derived.
 struct BodySpec {
   std::string name;
-  std::string shape_kind = "box";        // box | icosphere | prism | convex | mesh
+  ShapeKind shape_kind = ShapeKind::Box;
   Vec3 box_size = Vec3::Ones();          // m, full extents (box only)
   std::shared_ptr<const ConvexPolyhedron> shape;  // in the scene's local frame
   double mass = 1.0;                     // kg
@@ -88,14 +116,16 @@ struct Scene {
   std::string name;
   std::string description;
   std::string file;                     // path it was read from, as given
-  std::vector<std::string> checks;      // contact | impulse | trajectory | stability | mass
+  std::vector<CheckKind> checks;        // in the order the scene lists them
   std::vector<std::string> backends;    // empty: every backend that serves the checks
   SimSettings sim;
   std::vector<BodySpec> bodies;
   std::optional<Expect> expect;
 
-  /// True when `checks` names c.
-  bool has_check(const std::string& c) const;
+  /// True when `checks` holds c.
+  bool has_check(CheckKind c) const;
+  /// The checks as their scene-file names, in order (for output).
+  std::vector<std::string> check_names() const;
 };
 
 }  // namespace rbx

@@ -42,8 +42,10 @@ void World::collide_pair(int i, int j, bool bounded) {
   // The seed's order: face, vertex, edge; each resolved as soon as it hits. After the first
   // impulse the pair separates at the contact, so later hits add an impulse only if the new
   // velocities still approach at their own point.
-  for (const char* feature : {"face", "vertex", "edge"}) {
-    const auto contact = detect_feature(feature, *a.shape, a.pose(), *b.shape, b.pose(), variant_);
+  // Responses change velocities only, so the pair is placed once for the three tests.
+  detection_.prepare(*a.shape, a.pose(), *b.shape, b.pose(), variant_);
+  for (Feature feature : {Feature::Face, Feature::Vertex, Feature::Edge}) {
+    const auto contact = detection_.test(feature);
     if (!contact) continue;
     const double j_mag = apply_impulse(a, b, *contact, sim_.restitution);
     if (j_mag > 0.0) events_.push_back({time_, step_, a.name, b.name, *contact, j_mag});

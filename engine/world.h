@@ -37,7 +37,7 @@ class World {
   /// finds the same pairs and the world resolves them in the seed's (i, j) order, so results
   /// do not depend on it (AllPairs is the seed's double loop).
   World(SimSettings sim, std::vector<RigidBody> bodies,
-        DetectorVariant variant = DetectorVariant::Fast,
+        DetectorVariant variant = DetectorVariant::Accelerated,
         BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree);
 
   /// Advances one step of sim.dt: for every pair passing the bounding check (in (i, j) order),
@@ -71,6 +71,7 @@ class World {
   SimSettings sim_;
   std::vector<RigidBody> bodies_;
   DetectorVariant variant_;
+  DetectionCache detection_;  // the pair being resolved: placed once per pair per step
   BroadPhase broad_phase_;
   std::vector<CollisionEvent> events_;
   double time_ = 0.0;
@@ -81,7 +82,7 @@ class World {
 };
 
 /// Builds every body of the scene and runs it with the custom engine.
-RunResult run_scene(const Scene& scene, DetectorVariant variant = DetectorVariant::Fast,
+RunResult run_scene(const Scene& scene, DetectorVariant variant = DetectorVariant::Accelerated,
                     BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree);
 
 }  // namespace rbx

@@ -22,11 +22,11 @@ BodyFinal final_of(const RigidBody& b) {
 }  // namespace
 
 ContactResult custom_contact(const RigidBody& a, const RigidBody& b) {
-  return contact_with(a, b, DetectorVariant::Fast);
+  return contact_with(a, b, DetectorVariant::Accelerated);
 }
 
 ContactResult custom_seed_contact(const RigidBody& a, const RigidBody& b) {
-  return contact_with(a, b, DetectorVariant::Seed);
+  return contact_with(a, b, DetectorVariant::Faithful);
 }
 
 DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt) {

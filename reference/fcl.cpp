@@ -224,9 +224,10 @@ ContactResult fcl_indep_contact(const RigidBody& a, const RigidBody& b) {
 }
 
 ContactResult fcl_box_contact(const RigidBody& a, const RigidBody& b) {
-  if (a.shape_kind != "box" || b.shape_kind != "box") {
+  if (a.shape_kind != ShapeKind::Box || b.shape_kind != ShapeKind::Box) {
     return {Status::Unsupported,
-            "fcl-box needs two box bodies; got '" + a.shape_kind + "' and '" + b.shape_kind + "'",
+            std::string("fcl-box needs two box bodies; got '") + to_string(a.shape_kind) + "' and '" +
+                to_string(b.shape_kind) + "'",
             {}};
   }
   return guarded("fcl::collide (Box-Box)", [&] {

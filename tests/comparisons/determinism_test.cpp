@@ -93,7 +93,7 @@ Scene built_scene(Integrator integrator) {
   s.sim.integrator = integrator;
 
   auto add = [&](const std::string& name, std::shared_ptr<const ConvexPolyhedron> shape,
-                 const std::string& kind) -> BodySpec& {
+                 ShapeKind kind) -> BodySpec& {
     BodySpec b;
     b.name = name;
     b.shape_kind = kind;
@@ -107,7 +107,7 @@ Scene built_scene(Integrator integrator) {
       Vec3 size = Vec3::Constant(3.4);
       size[axis] = 0.2;
       BodySpec& w = add("wall" + std::to_string(2 * axis + (side > 0)),
-                        std::make_shared<const ConvexPolyhedron>(make_box(size)), "box");
+                        std::make_shared<const ConvexPolyhedron>(make_box(size)), ShapeKind::Box);
       w.box_size = size;
       w.is_static = true;
       w.position[axis] = side * 1.6;
@@ -123,7 +123,7 @@ Scene built_scene(Integrator integrator) {
       for (int k = 0; k < 5; ++k, ++n) {
         const int kind = n % 3;
         BodySpec& b = add("b" + std::to_string(n), kind == 0 ? box : kind == 1 ? sphere : prism,
-                          kind == 0 ? "box" : kind == 1 ? "icosphere" : "prism");
+                          kind == 0 ? ShapeKind::Box : kind == 1 ? ShapeKind::Icosphere : ShapeKind::Prism);
         if (kind == 0) b.box_size = Vec3(0.3, 0.25, 0.2);
         b.mass = 1.0 + 0.5 * kind;
         b.position = Vec3(-0.55 + 0.55 * i, -0.825 + 0.55 * j, -1.1 + 0.55 * k);

@@ -234,9 +234,9 @@ TEST(SceneFile, ReadsEveryKey) {
   EXPECT_EQ(s.name, "full");
   EXPECT_EQ(s.file, "tests/data/full.toml");
   EXPECT_EQ(s.description, "every key");
-  EXPECT_EQ(s.checks, (std::vector<std::string>{"contact", "impulse"}));
+  EXPECT_EQ(s.checks, (std::vector<CheckKind>{CheckKind::Contact, CheckKind::Impulse}));
   EXPECT_EQ(s.backends, (std::vector<std::string>{"custom", "fcl-epa"}));
-  EXPECT_TRUE(s.has_check("impulse"));
+  EXPECT_TRUE(s.has_check(CheckKind::Impulse));
 
   EXPECT_EQ(s.sim.dt, 2e-3);
   EXPECT_EQ(s.sim.duration, 0.5);
@@ -250,7 +250,7 @@ TEST(SceneFile, ReadsEveryKey) {
   ASSERT_EQ(s.bodies.size(), 6u);
   const BodySpec& a = s.bodies[0];
   EXPECT_EQ(a.name, "A");
-  EXPECT_EQ(a.shape_kind, "box");
+  EXPECT_EQ(a.shape_kind, ShapeKind::Box);
   EXPECT_EQ(a.box_size, Vec3(1, 2, 3));
   EXPECT_NEAR(a.shape->volume(), 6.0, kRoundOff);  // 1 * 2 * 3
   EXPECT_EQ(a.mass, 2.5);
@@ -265,7 +265,7 @@ TEST(SceneFile, ReadsEveryKey) {
   // Icosphere, one subdivision: 12 + 30 edge midpoints = 42 vertices, 20 * 4 = 80 triangles,
   // all at the radius. Quaternion [0, 1, 0, 0] is 180 deg about x: y -> -y.
   const BodySpec& b = s.bodies[1];
-  EXPECT_EQ(b.shape_kind, "icosphere");
+  EXPECT_EQ(b.shape_kind, ShapeKind::Icosphere);
   EXPECT_EQ(b.shape->vertices().size(), 42u);
   EXPECT_EQ(b.shape->triangles().size(), 80u);
   for (const Vec3& v : b.shape->vertices()) EXPECT_NEAR(v.norm(), 0.25, kRoundOff);
@@ -331,7 +331,7 @@ TEST(SceneFile, DefaultsAreTheContracts) {
 
   // Box: 1 m cube, mass 1, solid, at rest at the origin.
   const BodySpec& a = s.bodies[0];
-  EXPECT_EQ(a.shape_kind, "box");
+  EXPECT_EQ(a.shape_kind, ShapeKind::Box);
   EXPECT_EQ(a.box_size, Vec3::Ones());
   EXPECT_NEAR(a.shape->volume(), 1.0, kRoundOff);
   EXPECT_EQ(a.mass, 1.0);

@@ -21,7 +21,7 @@ std::shared_ptr<const ConvexPolyhedron> pyramid() {
 BodySpec pyramid_spec(MassModel model, bool is_static) {
   BodySpec s;
   s.name = "P";
-  s.shape_kind = "convex";
+  s.shape_kind = ShapeKind::Convex;
   s.shape = pyramid();
   s.mass = 2.0;
   s.mass_model = model;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 namespace rbx {
@@ -179,8 +180,8 @@ TEST(Detect, EdgePiercingAFaceTakesTheFaceNormal) {
 
 TEST(Detect, CrossedBarsAreAnEdgeHit) {
   const CrossedBars s;
-  EXPECT_FALSE(detect_feature("face", s.a, s.pa, s.b, s.pb).has_value());
-  EXPECT_FALSE(detect_feature("vertex", s.a, s.pa, s.b, s.pb).has_value());
+  EXPECT_FALSE(detect_feature(Feature::Face, s.a, s.pa, s.b, s.pb).has_value());
+  EXPECT_FALSE(detect_feature(Feature::Vertex, s.a, s.pa, s.b, s.pb).has_value());
   // A's first edge (0,1) runs from (-2, -0.5, 0.4) to (2, -0.5, 0.4). It crosses B's planes
   // x = -0.5 and x = 0.5 at t = 1.5/4 and 2.5/4; the midpoint of that interval, (0, -0.5, 0.4),
   // is inside B. e_a = x and e_b = y (B's top edge of the crossed x = -0.5 face, 0.51 from the
@@ -197,8 +198,8 @@ TEST(Detect, CrossedBarsAreAnEdgeHit) {
 
 TEST(Detect, TiltedEdgeNormalIsEaCrossEb) {
   const TiltedBar s;
-  EXPECT_FALSE(detect_feature("face", s.a, s.pa, s.b, s.pb).has_value());
-  EXPECT_FALSE(detect_feature("vertex", s.a, s.pa, s.b, s.pb).has_value());
+  EXPECT_FALSE(detect_feature(Feature::Face, s.a, s.pa, s.b, s.pb).has_value());
+  EXPECT_FALSE(detect_feature(Feature::Vertex, s.a, s.pa, s.b, s.pb).has_value());
   // A's edge (0,1) is the line (0.5, -0.5, 0.5) - 0.1 n + tau e_a. It enters B's top face
   // (z = 0.5) at tau = -0.1 cos(a) / sin(a) and leaves the +x face (x = 0.5) at
   // tau = 0.1 sin(a) / cos(a); no other plane of B is crossed in between, so the point is at
@@ -365,8 +366,8 @@ TEST(Detect, RotatedPosesGiveWorldFrameResults) {
 TEST(Detect, FastVariantMatchesSeed) {
   // One hand-built pose here; tests/engine/fast_detect_test.cpp holds the randomised check.
   const CrossedBars s;
-  const auto seed = detect(s.a, s.pa, s.b, s.pb, DetectorVariant::Seed);
-  const auto fast = detect(s.a, s.pa, s.b, s.pb, DetectorVariant::Fast);
+  const auto seed = detect(s.a, s.pa, s.b, s.pb, DetectorVariant::Faithful);
+  const auto fast = detect(s.a, s.pa, s.b, s.pb, DetectorVariant::Accelerated);
   ASSERT_TRUE(seed.has_value() && fast.has_value());
   expect_vec_near(fast->point, seed->point, kRoundOff);
   expect_vec_near(fast->normal, seed->normal, kRoundOff);
@@ -374,9 +375,10 @@ TEST(Detect, FastVariantMatchesSeed) {
   EXPECT_EQ(fast->feature, seed->feature);
 }
 
-TEST(Detect, UnknownFeatureIsRejected) {
-  const FaceFace s;
-  EXPECT_THROW(detect_feature("corner", s.a, s.pa, s.b, s.pb), std::invalid_argument);
+TEST(Detect, TestBeforePrepareIsRejected) {
+  DetectionCache cache;
+  EXPECT_THROW(cache.test(Feature::Face), std::logic_error);
+  EXPECT_THROW(cache.detect(), std::logic_error);
 }
 
 // ---- One test per seed correction ----------------------------------------------------------
@@ -431,7 +433,7 @@ TEST(SeedCorrection, BothOrdersSeeAVertexOfBInAFaceOfA) {
   // flipped to -z: from B (above) toward A.
   const CornerIntoFace s;
   EXPECT_FALSE(vertex_test(s.b, s.pb, s.a, s.pa).has_value());  // the seed's single order
-  const auto hit = detect_feature("vertex", s.b, s.pb, s.a, s.pa);
+  const auto hit = detect_feature(Feature::Vertex, s.b, s.pb, s.a, s.pa);
   ASSERT_TRUE(hit.has_value());
   expect_vec_near(hit->point, Vec3(0, 0, 0.4), kRoundOff);
   expect_vec_near(hit->normal, Vec3(0, 0, -1), kRoundOff);

@@ -60,6 +60,8 @@ double support(const ConvexPolyhedron& s, const Pose& p, const Vec3& d) {
   return h;
 }
 
+constexpr Feature kFeatures[] = {Feature::Face, Feature::Vertex, Feature::Edge};
+
 struct Tally {
   int hits = 0, misses = 0;
   std::map<std::string, int> features;
@@ -68,8 +70,8 @@ struct Tally {
 // Compares the two variants at one pose: the full detector and each feature test alone.
 void compare_at(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                 const Pose& pb, const std::string& where, Tally& tally) {
-  const auto seed = detect(a, pa, b, pb, DetectorVariant::Seed);
-  const auto fast = detect(a, pa, b, pb, DetectorVariant::Fast);
+  const auto seed = detect(a, pa, b, pb, DetectorVariant::Faithful);
+  const auto fast = detect(a, pa, b, pb, DetectorVariant::Accelerated);
   expect_same(fast, seed, where);
   if (seed) {
     ++tally.hits;
@@ -77,10 +79,10 @@ void compare_at(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedro
   } else {
     ++tally.misses;
   }
-  for (const char* feature : {"face", "vertex", "edge"})
-    expect_same(detect_feature(feature, a, pa, b, pb, DetectorVariant::Fast),
-                detect_feature(feature, a, pa, b, pb, DetectorVariant::Seed),
-                where + " feature " + feature);
+  for (Feature feature : kFeatures)
+    expect_same(detect_feature(feature, a, pa, b, pb, DetectorVariant::Accelerated),
+                detect_feature(feature, a, pa, b, pb, DetectorVariant::Faithful),
+                where + " feature " + to_string(feature));
 }
 
 // Random poses of a pair: B placed along a random direction d at the support-plane distance
@@ -186,8 +188,8 @@ TEST(FastDetect, IcospheresMatchSeed) {
   expect_representative(t, "icospheres");
 }
 
-// Many distinct shapes alive at once and shapes destroyed and rebuilt at reused addresses: the
-// cached hierarchies always belong to the shape asked about.
+// Shapes destroyed and rebuilt, likely at reused addresses: the hierarchies each shape carries
+// (built with it) always belong to the shape asked about.
 TEST(FastDetect, CacheFollowsShapes) {
   Tally t;
   for (int round = 0; round < 20; ++round) {
@@ -199,9 +201,9 @@ TEST(FastDetect, CacheFollowsShapes) {
   expect_representative(t, "rebuilt shapes");
 }
 
-// The fast path keeps the last pair's world data for the next test of the same pair (the world
-// asks for the face, vertex and edge tests in turn): a different shape at the same poses must
-// not reuse it. Boxes of growing size, at the same fixed poses, one after the other.
+// A different shape at the same poses must give its own answer, never the last pair's (the
+// accelerated path once reused the last pair's world data when poses matched). Boxes of growing
+// size, at the same fixed poses, one after the other.
 TEST(FastDetect, SamePosesNewShapes) {
   Pose pa, pb;
   pb.position = Vec3(1.0, 0.1, 0.05);
@@ -210,12 +212,12 @@ TEST(FastDetect, SamePosesNewShapes) {
   for (int k = 0; k < 20; ++k) {
     const ConvexPolyhedron a = make_box(Vec3::Constant(0.5 + 0.05 * k));
     const ConvexPolyhedron b = make_box(Vec3(1.0, 0.8, 0.6));
-    for (const char* feature : {"face", "vertex", "edge"})
-      expect_same(detect_feature(feature, a, pa, b, pb, DetectorVariant::Fast),
-                  detect_feature(feature, a, pa, b, pb, DetectorVariant::Seed),
-                  "size " + std::to_string(k) + " " + feature);
-    const auto seed = detect(a, pa, b, pb, DetectorVariant::Seed);
-    expect_same(detect(a, pa, b, pb, DetectorVariant::Fast), seed, "size " + std::to_string(k));
+    for (Feature feature : kFeatures)
+      expect_same(detect_feature(feature, a, pa, b, pb, DetectorVariant::Accelerated),
+                  detect_feature(feature, a, pa, b, pb, DetectorVariant::Faithful),
+                  "size " + std::to_string(k) + " " + to_string(feature));
+    const auto seed = detect(a, pa, b, pb, DetectorVariant::Faithful);
+    expect_same(detect(a, pa, b, pb, DetectorVariant::Accelerated), seed, "size " + std::to_string(k));
     hits += seed ? 1 : 0;
   }
   // B (half extents 0.5, 0.4, 0.3, any rotation) lies within its circumsphere of radius
@@ -227,7 +229,7 @@ TEST(FastDetect, SamePosesNewShapes) {
   EXPECT_LT(hits, 20);
 }
 
-// The reused preparation of the last pair must not keep pointing at the last pair's shapes:
+// A preparation must not keep pointing at an earlier pair's shapes:
 // equal shapes at the same poses, the first ones destroyed before the second query (found by
 // the convex_detect fuzzer: a read of a dead shape, reported by ASan, which `./rbx test
 // --sanitize` turns into a failure here).
@@ -237,17 +239,61 @@ TEST(FastDetect, EqualShapesAfterTheFirstAreDestroyed) {
   pb.orientation = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
   auto a = std::make_unique<ConvexPolyhedron>(make_box(Vec3::Constant(1.0)));
   auto b = std::make_unique<ConvexPolyhedron>(make_box(Vec3(1.0, 0.8, 0.6)));
-  const auto first = detect(*a, pa, *b, pb, DetectorVariant::Fast);
+  const auto first = detect(*a, pa, *b, pb, DetectorVariant::Accelerated);
   ASSERT_TRUE(first.has_value());
   // New objects, built while the old ones are alive so that they get other addresses.
   auto a2 = std::make_unique<ConvexPolyhedron>(make_box(Vec3::Constant(1.0)));
   auto b2 = std::make_unique<ConvexPolyhedron>(make_box(Vec3(1.0, 0.8, 0.6)));
   a.reset();
   b.reset();
-  for (const char* feature : {"face", "vertex", "edge"})
-    expect_same(detect_feature(feature, *a2, pa, *b2, pb, DetectorVariant::Fast),
-                detect_feature(feature, *a2, pa, *b2, pb, DetectorVariant::Seed), feature);
-  expect_same(detect(*a2, pa, *b2, pb, DetectorVariant::Fast), first, "equal shapes");
+  for (Feature feature : kFeatures)
+    expect_same(detect_feature(feature, *a2, pa, *b2, pb, DetectorVariant::Accelerated),
+                detect_feature(feature, *a2, pa, *b2, pb, DetectorVariant::Faithful),
+                to_string(feature));
+  expect_same(detect(*a2, pa, *b2, pb, DetectorVariant::Accelerated), first, "equal shapes");
+}
+
+// The detector's state is passed in (DetectionCache), not kept per thread: two pairs prepared
+// in two caches and queried alternately on one thread give exactly the answers each gives on
+// its own. The pairs differ in size class (a hierarchy-carrying icosphere against a box, two
+// small boxes), so both paths of the accelerated view hold state at the same time.
+TEST(FastDetect, InterleavedQueriesOnTwoCachesDoNotInterfere) {
+  const ConvexPolyhedron sphere = sheared_icosphere(2);
+  const ConvexPolyhedron box = make_box(Vec3(1.0, 0.8, 0.6));
+  const ConvexPolyhedron cube = make_box(Vec3::Constant(0.7));
+  std::mt19937_64 rng(7);
+  int hits = 0;
+  for (int i = 0; i < 40; ++i) {
+    Pose p1a, p1b, p2a, p2b;
+    p1b.orientation = random_rotation(rng);
+    p1b.position = 0.7 * random_direction(rng);
+    p2b.orientation = random_rotation(rng);
+    p2b.position = 0.8 * random_direction(rng);
+    for (DetectorVariant v : {DetectorVariant::Accelerated, DetectorVariant::Faithful}) {
+      // Alone: each pair on a fresh cache.
+      std::optional<ContactPoint> alone1[3], alone2[3];
+      for (int f = 0; f < 3; ++f) {
+        alone1[f] = detect_feature(kFeatures[f], sphere, p1a, box, p1b, v);
+        alone2[f] = detect_feature(kFeatures[f], cube, p2a, box, p2b, v);
+      }
+      // Interleaved: both prepared first, then the tests alternate between the caches.
+      DetectionCache c1, c2;
+      c1.prepare(sphere, p1a, box, p1b, v);
+      c2.prepare(cube, p2a, box, p2b, v);
+      for (int f = 0; f < 3; ++f) {
+        const std::string where = "pose " + std::to_string(i) + " " + to_string(kFeatures[f]) +
+                                  " " + to_string(v);
+        expect_same(c1.test(kFeatures[f]), alone1[f], where + " pair 1");
+        expect_same(c2.test(kFeatures[f]), alone2[f], where + " pair 2");
+        hits += alone1[f].has_value() + alone2[f].has_value();
+      }
+      expect_same(c2.detect(), detect(cube, p2a, box, p2b, v), "full, pair 2");
+      expect_same(c1.detect(), detect(sphere, p1a, box, p1b, v), "full, pair 1");
+    }
+  }
+  // Centres 0.7-0.8 m apart with half sizes ~0.3-0.5 m: some feature tests hit, some miss.
+  EXPECT_GT(hits, 0);
+  EXPECT_LT(hits, 40 * 2 * 3 * 2);
 }
 
 }  // namespace

@@ -90,8 +90,8 @@ void convex_detect(const uint8_t* data, size_t size) {
   const Pose pa = decode_pose(in, reach);
   const Pose pb = decode_pose(in, reach);
 
-  const std::optional<ContactPoint> seed = detect(*a, pa, *b, pb, DetectorVariant::Seed);
-  const std::optional<ContactPoint> fast = detect(*a, pa, *b, pb, DetectorVariant::Fast);
+  const std::optional<ContactPoint> seed = detect(*a, pa, *b, pb, DetectorVariant::Faithful);
+  const std::optional<ContactPoint> fast = detect(*a, pa, *b, pb, DetectorVariant::Accelerated);
   if (seed) check_contact(*seed, "Seed");
   if (fast) check_contact(*fast, "Fast");
 

@@ -26,7 +26,7 @@ BodySpec box_spec(const std::string& name, const Vec3& size, const Vec3& positio
                   double mass = 1.0, const Quat& orientation = Quat::Identity()) {
   BodySpec s;
   s.name = name;
-  s.shape_kind = "box";
+  s.shape_kind = ShapeKind::Box;
   s.box_size = size;
   s.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
   s.mass = mass;
@@ -424,7 +424,7 @@ BodySpec turned_box(const Quat& local) {
   std::vector<Vec3> v;
   for (const Vec3& p : box.vertices()) v.push_back(local * p);
   BodySpec s = box_spec("T", Vec3(1, 2, 3), Vec3(0.2, -0.1, 0.3));
-  s.shape_kind = "convex";
+  s.shape_kind = ShapeKind::Convex;
   s.shape = std::make_shared<const ConvexPolyhedron>(
       ConvexPolyhedron::from_triangles(v, box.triangles()));
   return s;

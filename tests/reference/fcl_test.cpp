@@ -34,7 +34,7 @@ RigidBody box_body(const std::string& name, const Vec3& size, const Vec3& positi
                    MassModel mass_model = MassModel::Solid) {
   BodySpec spec;
   spec.name = name;
-  spec.shape_kind = "box";
+  spec.shape_kind = ShapeKind::Box;
   spec.box_size = size;
   spec.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
   spec.mass_model = mass_model;
@@ -482,7 +482,7 @@ TEST(FclBox, VertexMassModelGivesTheSameBoxFrame) {
 
 TEST(FclBox, UnsupportedUnlessBothAreBoxes) {
   RigidBody hull = unit_cube("B", kFaceOffset);
-  hull.shape_kind = "convex";  // same hull, declared as a general convex shape
+  hull.shape_kind = ShapeKind::Convex;  // same hull, declared as a general convex shape
   const ContactResult r = fcl_box_contact(unit_cube("A", Vec3::Zero()), hull);
   EXPECT_EQ(r.status, Status::Unsupported);
   EXPECT_FALSE(r.message.empty());

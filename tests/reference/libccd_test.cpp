@@ -28,7 +28,7 @@ RigidBody box_body(const std::string& name, const Vec3& size, const Vec3& positi
                    const Quat& orientation = Quat::Identity()) {
   BodySpec spec;
   spec.name = name;
-  spec.shape_kind = "box";
+  spec.shape_kind = ShapeKind::Box;
   spec.box_size = size;
   spec.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
   spec.position = position;

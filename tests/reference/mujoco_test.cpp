@@ -33,7 +33,7 @@ BodySpec box_spec(const std::string& name, const Vec3& size, const Vec3& positio
                   double mass = 1.0, const Quat& orientation = Quat::Identity()) {
   BodySpec s;
   s.name = name;
-  s.shape_kind = "box";
+  s.shape_kind = ShapeKind::Box;
   s.box_size = size;
   s.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
   s.mass = mass;
@@ -46,7 +46,7 @@ BodySpec box_spec(const std::string& name, const Vec3& size, const Vec3& positio
 BodySpec pyramid_spec(const std::string& name, const Vec3& position, const Quat& orientation) {
   BodySpec s;
   s.name = name;
-  s.shape_kind = "convex";
+  s.shape_kind = ShapeKind::Convex;
   s.shape = std::make_shared<const ConvexPolyhedron>(ConvexPolyhedron::from_triangles(
       {Vec3(-0.5, -0.5, 0), Vec3(0.5, -0.5, 0), Vec3(0.5, 0.5, 0), Vec3(-0.5, 0.5, 0),
        Vec3(0, 0, 1)},

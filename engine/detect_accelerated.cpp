@@ -1,0 +1,548 @@
+// The accelerated view (see the design note in engine/detect_accelerated.h).
+#include "engine/detect_accelerated.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "engine/detect.h"
+
+namespace rbx::detail {
+
+namespace {
+
+// Safety margin of every bound, relative to the query's coordinate scale (m): the exact and the
+// bounding computations each carry a few ulps (~1e-16) of the coordinates; 1e-10 is far above
+// both and still far below any distance that decides a test.
+constexpr double kMarginScale = 1e-10;
+
+// (p - q) . n, written out in the order Eigen's dot product of 3-vectors adds the terms,
+// ((x + y) + z): bit-identical to the seed's Eigen expression (the equivalence test compares
+// the two exactly), in fewer instructions than Eigen's shuffles of unaligned 3-vectors.
+__attribute__((always_inline)) inline double plane_dist(const Vec3& p, const Vec3& q,
+                                                        const Vec3& n) {
+  return ((p.x() - q.x()) * n.x() + (p.y() - q.y()) * n.y()) + (p.z() - q.z()) * n.z();
+}
+// v . n in the same order as Eigen's dot.
+__attribute__((always_inline)) inline double dot3(const Vec3& v, const Vec3& n) {
+  return (v.x() * n.x() + v.y() * n.y()) + v.z() * n.z();
+}
+
+// The seed's plane distance of p from face f of y: (p - q_f) . n_f, q_f its first vertex.
+__attribute__((always_inline)) inline double plane_distance(const AcceleratedView& y, int f,
+                                                            const Vec3& p) {
+  if (y.world_vertices)
+    return plane_dist(p, y.world_vertices[y.shape->triangles()[f][0]], y.world_normals[f]);
+  return plane_dist(p, y.vertex(y.shape->triangles()[f][0]), y.normal(f));
+}
+
+// Size (m) of a shape: the diagonal of its local bounding box.
+double shape_size(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
+
+// Places a shape: small shapes get world copies in workspace slot `slot`.
+AcceleratedView place(const ConvexPolyhedron& shape, const Pose& pose, const Limits& lim,
+                      AcceleratedWorkspace& ws, int slot) {
+  AcceleratedView p;
+  p.shape = &shape;
+  p.accel = shape.hierarchy();
+  p.r = pose.rotation();
+  p.rt = p.r.transpose();
+  p.position = pose.position;
+  p.tol = lim.tol;
+  p.margin = lim.margin;
+  if (p.accel) return p;
+  std::vector<Vec3>& wv = ws.vertices[slot];
+  std::vector<Vec3>& wn = ws.normals[slot];
+  // The seed's world copies, into reused buffers.
+  wv.resize(shape.vertices().size());
+  for (std::size_t i = 0; i < wv.size(); ++i) wv[i] = p.r * shape.vertices()[i] + pose.position;
+  wn.resize(shape.planes().size());
+  // Coplanar triangles (a box face is two) share their normal bit for bit; the same input
+  // gives the same product, so it is computed once.
+  const auto& planes = shape.planes();
+  std::vector<unsigned char>& distinct = ws.distinct[slot];
+  distinct.resize(wn.size());
+  for (std::size_t f = 0; f < wn.size(); ++f) {
+    distinct[f] = f == 0 || planes[f].normal != planes[f - 1].normal;
+    wn[f] = distinct[f] ? Vec3(p.r * planes[f].normal) : wn[f - 1];
+  }
+  p.world_vertices = wv.data();
+  p.world_normals = wn.data();
+  p.distinct = distinct.data();
+  return p;
+}
+
+// A face plane of y used to cull x's primitives: every point p of a hit must have
+// s(p) = (p - q) . n <= tol for it (the seed's inside() checks every face). Precomputed for x's
+// body frame: s(x.r c + x.position) = c . m + c0, with m = x.rt n and c0 = (x.position - q) . n.
+struct CullPlane {
+  Vec3 m = Vec3::Zero();
+  Vec3 m_abs = Vec3::Zero();
+  double c0 = 0.0;
+  Vec3 normal = Vec3::Zero();  // world, the seed's n_f
+  Vec3 point = Vec3::Zero();   // m, world, the seed's q_f
+  // The seed's plane distance (p - q_f) . n_f of a world point.
+  double distance(const Vec3& p) const { return (p - point).dot(normal); }
+};
+
+// The face of y whose outward normal is most along the direction from y's centre (of its
+// bounding box) to x's: for shapes in contact, the face plane most likely to have x's points
+// outside it. -1 when the centres coincide.
+int facing_face(const AcceleratedView& y, const AcceleratedView& x) {
+  const Vec3 cy = y.r * y.shape->bounds().center() + y.position;
+  const Vec3 cx = x.r * x.shape->bounds().center() + x.position;
+  const Vec3 d = cx - cy;
+  if (!(d.norm() > 0.0)) return -1;
+  const Vec3 dl = y.rt * d.normalized();
+  const auto& pl = y.shape->planes();
+  if (!y.accel) {
+    int best = 0;
+    for (int f = 1; f < y.num_triangles(); ++f)
+      if (pl[f].normal.dot(dl) > pl[best].normal.dot(dl)) best = f;
+    return best;
+  }
+  const ShapeHierarchy& acc = *y.accel;
+  // Branch and bound on the cone bounds: the exact best face, ties to the first found.
+  auto reach = [&](int k) {
+    const FaceCone& c = acc.cones[k];
+    const double along = c.axis.dot(dl), across = c.axis.cross(dl).norm();
+    return along >= c.cos_half ? 1.0 : along * c.cos_half + across * c.sin_half;
+  };
+  int best = acc.triangles.order[0];
+  double best_dot = -2.0;
+  acc.triangles.search(
+      reach, [&](double r) { return r <= best_dot; },
+      [&](int f) {
+        if (pl[f].normal.dot(dl) > best_dot) {
+          best_dot = pl[f].normal.dot(dl);
+          best = f;
+        }
+        return false;
+      });
+  return best;
+}
+
+// False when no point of x can be inside y: x lies wholly outside one face plane of y (by
+// more than tol + margin), tried on y's facing face, then on every distinct face plane of a
+// small y or the axis faces of a larger one. Every point a test derives from x (a centroid, a
+// vertex, a point on an edge) is a convex combination of x's vertices, so its plane distance
+// exceeds the smallest of theirs less round-off, which the margin covers; x's vertices are
+// tested one by one (small x) or through its bounding box (larger x).
+bool may_enter(const AcceleratedView& x, const AcceleratedView& y, const Limits& lim) {
+  const double limit = lim.tol + lim.margin;
+  const auto& tris = y.shape->triangles();
+  auto separates = [&](int f) {
+    const Vec3 n = y.normal(f);
+    const Vec3 q = y.vertex(tris[f][0]);
+    if (!x.accel) {
+      const int nv = static_cast<int>(x.shape->vertices().size());
+      for (int i = 0; i < nv; ++i)
+        if ((x.vertex(i) - q).dot(n) <= limit) return false;
+      return true;
+    }
+    const BvhNode& root = x.accel->vertices.nodes[0];
+    const Vec3 m = x.rt * n;
+    return root.center.dot(m) + (x.position - q).dot(n) - root.half.dot(m.cwiseAbs()) > limit;
+  };
+  if (y.facing >= 0 && separates(y.facing)) return false;
+  if (!y.accel) {
+    for (int f = 0; f < y.num_triangles(); ++f)
+      if (y.distinct[f] && f != y.facing && separates(f)) return false;
+    return true;
+  }
+  for (int f : y.accel->axis_faces)
+    if (separates(f)) return false;
+  return true;
+}
+
+// Two small shapes: fills x's plane table against y (see AcceleratedView::plane_table) and
+// decides whether x may enter y from it (the same rule as may_enter(), on every distinct plane
+// of y).
+void fill_plane_table(AcceleratedView& x, const AcceleratedView& y, const Limits& lim,
+                      std::vector<double>& table) {
+  const int nv = static_cast<int>(x.shape->vertices().size());
+  const auto& tris = y.shape->triangles();
+  int planes[kSmallTriangles];
+  int count = 0;
+  for (int f = 0; f < y.num_triangles(); ++f)
+    if (y.distinct[f]) planes[count++] = f;
+  table.resize(static_cast<std::size_t>(nv) * count);
+  const double limit = lim.tol + lim.margin;
+  bool separated[kSmallTriangles];
+  for (int k = 0; k < count; ++k) separated[k] = true;
+  for (int i = 0; i < nv; ++i)
+    for (int k = 0; k < count; ++k) {
+      const int f = planes[k];
+      const double d = plane_dist(x.world_vertices[i], y.world_vertices[tris[f][0]],
+                                  y.world_normals[f]);
+      table[static_cast<std::size_t>(i) * count + k] = d;
+      if (d <= limit) separated[k] = false;
+    }
+  x.plane_table = table.data();
+  x.table_planes = count;
+  x.enters = true;
+  for (int k = 0; k < count; ++k)
+    if (separated[k]) x.enters = false;
+}
+
+// The cull planes of y against x: y's facing face, and the faces most along y's body axes (for
+// a box, its faces).
+int cull_planes(const AcceleratedView& x, const AcceleratedView& y, CullPlane* planes) {
+  const auto& tris = y.shape->triangles();
+  int faces[7];
+  int count = 0;
+  if (y.facing >= 0) faces[count++] = y.facing;
+  // The faces most along the body axes.
+  if (y.accel) {
+    for (int f : y.accel->axis_faces) faces[count++] = f;
+  } else {
+    const auto& pl = y.shape->planes();
+    for (int k = 0; k < 6; ++k) {
+      const Vec3 dir = (k % 2 == 0 ? 1.0 : -1.0) * Vec3::Unit(k / 2);
+      int best = 0;
+      for (int f = 1; f < y.num_triangles(); ++f)
+        if (pl[f].normal.dot(dir) > pl[best].normal.dot(dir)) best = f;
+      faces[count++] = best;
+    }
+  }
+  for (int i = 0; i < count; ++i) {
+    const Vec3 n = y.normal(faces[i]);
+    const Vec3 q = y.vertex(tris[faces[i]][0]);
+    planes[i].m = x.rt * n;
+    planes[i].m_abs = planes[i].m.cwiseAbs();
+    planes[i].c0 = (x.position - q).dot(n);
+    planes[i].normal = n;
+    planes[i].point = q;
+  }
+  return count;
+}
+
+// True when every point of the box (x's body frame) is outside one of the planes by more than
+// tol + margin, so no point of it can be inside y.
+bool culled(const CullPlane* planes, int count, const Vec3& center, const Vec3& half,
+            double limit) {
+  for (int i = 0; i < count; ++i)
+    if (center.dot(planes[i].m) + planes[i].c0 - half.dot(planes[i].m_abs) > limit) return true;
+  return false;
+}
+
+// True when the points a test derives from primitive i of x all lie outside one of the planes
+// (by more than the tolerance), so none of them can be inside y. Vertices and triangle
+// centroids are tested with the seed's exact expressions (a point outside one face plane is
+// outside y for the seed's inside() too); an edge needs both ends beyond the same plane by
+// tol + margin, which keeps every point between them beyond tol.
+bool primitive_culled(const AcceleratedView& x, Primitive kind, int i, const CullPlane* planes,
+                      int count) {
+  if (kind == Primitive::Edges) {
+    const Edge& e = x.shape->edges()[i];
+    const Vec3 v_i = x.vertex(e.a), v_j = x.vertex(e.b);
+    const double limit = x.tol + x.margin;
+    for (int k = 0; k < count; ++k)
+      if (planes[k].distance(v_i) > limit && planes[k].distance(v_j) > limit) return true;
+    return false;
+  }
+  Vec3 p;
+  if (kind == Primitive::Vertices) {
+    p = x.vertex(i);
+  } else {
+    const auto& t = x.shape->triangles()[i];
+    p = (x.vertex(t[0]) + x.vertex(t[1]) + x.vertex(t[2])) / 3.0;  // the seed's centroid
+  }
+  for (int k = 0; k < count; ++k)
+    if (planes[k].distance(p) > x.tol) return true;
+  return false;
+}
+
+// The plane-table culling of two small shapes (see AcceleratedView::candidates).
+void table_candidates(const AcceleratedView& x, Primitive kind, int n, std::vector<int>& out) {
+  const int m = x.table_planes;
+  const double limit = x.tol + x.margin;
+  auto row = [&](int v) { return x.plane_table + static_cast<std::size_t>(v) * m; };
+  for (int i = 0; i < n; ++i) {
+    bool out_of_y = false;
+    if (kind == Primitive::Vertices) {
+      const double* r = row(i);
+      for (int k = 0; k < m && !out_of_y; ++k) out_of_y = r[k] > x.tol;
+    } else if (kind == Primitive::Triangles) {
+      const auto& t = x.shape->triangles()[i];
+      const double *r0 = row(t[0]), *r1 = row(t[1]), *r2 = row(t[2]);
+      for (int k = 0; k < m && !out_of_y; ++k) out_of_y = (r0[k] + r1[k] + r2[k]) / 3.0 > limit;
+    } else {
+      const Edge& e = x.shape->edges()[i];
+      const double *r0 = row(e.a), *r1 = row(e.b);
+      double lo = 0.0, hi = 1.0;  // the parameters t in [0, 1] still possibly inside
+      for (int k = 0; k < m && !out_of_y; ++k) {
+        const double s0 = r0[k] - limit, s1 = r1[k] - limit;
+        if (s0 > 0.0 && s1 > 0.0) {
+          out_of_y = true;
+        } else if (s0 > 0.0) {
+          lo = std::max(lo, s0 / (s0 - s1));  // no cancellation: s0 > 0 >= s1
+        } else if (s1 > 0.0) {
+          hi = std::min(hi, s0 / (s0 - s1));
+        }
+      }
+      // The parameters carry a few ulps; 1e-9 is far above them.
+      out_of_y = out_of_y || lo > hi + 1e-9;
+    }
+    if (!out_of_y) out.push_back(i);
+  }
+}
+
+}  // namespace
+
+// Indices of x's primitives of `kind` that may lie (in part) inside y, in increasing order.
+// Every point a test derives from a primitive (a centroid, a vertex, a point on an edge) lies
+// in the primitive's box, so a box outside one of y's face planes holds no hit; the primitives
+// of the remaining leaves are then culled one by one (primitive_culled).
+void AcceleratedView::candidates(Primitive kind, const AcceleratedView& y,
+                                 std::vector<int>& out) const {
+  const AcceleratedView& x = *this;
+  out.clear();
+  if (!x.accel) {
+    const int n = kind == Primitive::Triangles  ? x.num_triangles()
+                  : kind == Primitive::Vertices ? static_cast<int>(x.shape->vertices().size())
+                                                : static_cast<int>(x.shape->edges().size());
+    // Two small shapes: culled on the plane table. A vertex outside one plane by more than
+    // tol is outside y for the seed's inside() (the table holds the seed's own value for that
+    // face). Plane distances are affine along a triangle or an edge, so a centroid's is the
+    // mean of its vertices' (to round-off), and the part of an edge within tol + margin of
+    // every plane is an interval of its parameter clipped plane by plane (Cyrus-Beck); a
+    // centroid beyond one plane by tol + margin, or an edge whose interval is empty, holds no
+    // point inside y.
+    if (x.plane_table) return table_candidates(x, kind, n, out);
+    CullPlane planes[7];
+    const int count = cull_planes(x, y, planes);
+    for (int i = 0; i < n; ++i)
+      if (!primitive_culled(x, kind, i, planes, count)) out.push_back(i);
+    return;
+  }
+  CullPlane planes[7];
+  const int count = cull_planes(x, y, planes);
+  const double limit = tol + margin;
+  const Bvh& tree = kind == Primitive::Triangles  ? x.accel->triangles
+                    : kind == Primitive::Vertices ? x.accel->vertices
+                                                  : x.accel->edges;
+  tree.search(
+      [&](int k) {
+        const BvhNode& node = tree.nodes[k];
+        return culled(planes, count, node.center, node.half, limit) ? 1.0 : 0.0;
+      },
+      [](double cut) { return cut > 0.0; },
+      [&](int i) {
+        if (!primitive_culled(x, kind, i, planes, count)) out.push_back(i);
+        return false;
+      });
+  std::sort(out.begin(), out.end());
+}
+
+// SEED_NOTES 1 point in mesh, the seed's predicate exactly: (p - q_f) . n_f <= tol for every
+// face. Small shapes: the seed's loop. Others: clusters of faces whose bound is at most
+// tol - margin are certified without evaluating them; the rest are evaluated exactly, and the
+// first face found outside ends the search (the answer is an AND, so order does not matter).
+bool AcceleratedView::inside(const Vec3& p) const {
+  // The face toward the other shape first: most points of the other shape are outside it.
+  if (facing >= 0 && plane_distance(*this, facing, p) > tol) return false;
+  if (!accel) {
+    // The seed's loop on the world copies.
+    const auto& tris = shape->triangles();
+    const Vec3* wv = world_vertices;
+    const Vec3* wn = world_normals;
+    const int n = num_triangles();
+    for (int f = 0; f < n; ++f)
+      if (plane_dist(p, wv[tris[f][0]], wn[f]) > tol) return false;
+    return true;
+  }
+  const Vec3 pl = to_local(p);
+  const double certified = tol - margin;
+  // Visit first the cluster more likely to hold an outside face (the larger bound).
+  const bool outside = accel->triangles.search(
+      [&](int k) {
+        double lo, hi;
+        accel->plane_bounds(k, pl, lo, hi);
+        return hi;
+      },
+      [&](double hi) { return hi <= certified; },
+      [&](int f) { return plane_distance(*this, f, p) > tol; });
+  return !outside;
+}
+
+// max over the world vertices of v . n, the seed's expression. Branch and bound: a node's
+// bound is the max of n . x over its box, in world terms.
+double AcceleratedView::support_max(const Vec3& n) const {
+  double best = -std::numeric_limits<double>::infinity();
+  const int nv = static_cast<int>(shape->vertices().size());
+  if (!accel) {
+    for (int i = 0; i < nv; ++i) best = std::max(best, dot3(world_vertices[i], n));
+    return best;
+  }
+  const Bvh& tree = accel->vertices;
+  const Vec3 nl = rt * n;
+  const double offset = position.dot(n);
+  tree.search(
+      [&](int k) {
+        const BvhNode& node = tree.nodes[k];
+        return node.center.dot(nl) + node.half.dot(nl.cwiseAbs()) + offset;
+      },
+      [&](double b) { return b + margin < best; },
+      [&](int i) {
+        best = std::max(best, vertex(i).dot(n));
+        return false;
+      });
+  return best;
+}
+
+// min over the world vertices of v . n. Negating n negates every product and sum exactly, so
+// this is exactly minus the max along -n.
+double AcceleratedView::support_min(const Vec3& n) const { return -support_max(-n); }
+
+// argmin over faces of |s_f(v)|, ties to the lowest index.
+int AcceleratedView::closest_face(const Vec3& v) const {
+  int closest = 0;
+  double best = std::numeric_limits<double>::infinity();
+  auto consider = [&](int f) {
+    const double d = std::abs(plane_distance(*this, f, v));
+    if (d < best || (d == best && f < closest)) {
+      best = d;
+      closest = f;
+    }
+    return false;
+  };
+  if (!accel) {
+    for (int f = 0; f < num_triangles(); ++f) consider(f);
+    return closest;
+  }
+  const Vec3 vl = to_local(v);
+  // Lower bound of |s_f| over a node from the bounds on s_f; nearer clusters first.
+  accel->triangles.search(
+      [&](int k) {
+        double lo, hi;
+        accel->plane_bounds(k, vl, lo, hi);
+        return lo > 0.0 ? lo : (hi < 0.0 ? -hi : 0.0);
+      },
+      [&](double b) { return b - margin > best; },  // cannot reach (or tie) the best
+      consider, false);
+  return closest;
+}
+
+// The seed's crossings of the segment [v_i, v_j] with the planes of the triangles, in face
+// order. Clusters whose two ends are certainly on the same side of every plane are skipped.
+void AcceleratedView::crossings(const Vec3& v_i, const Vec3& v_j,
+                                std::vector<Crossing>& out) const {
+  out.clear();
+  if (!accel) {
+    for (int f = 0; f < num_triangles(); ++f) crossing_of(*this, f, v_i, v_j, out);
+    return;
+  }
+  const Vec3 pi = to_local(v_i), pj = to_local(v_j);
+  accel->triangles.search(
+      [&](int k) {
+        double lo_i, hi_i, lo_j, hi_j;
+        accel->plane_bounds(k, pi, lo_i, hi_i);
+        accel->plane_bounds(k, pj, lo_j, hi_j);
+        // Both ends strictly inside every plane of the cluster, or both strictly outside.
+        const bool same_side = (hi_i + margin < 0.0 && hi_j + margin < 0.0) ||
+                               (lo_i - margin > 0.0 && lo_j - margin > 0.0);
+        return same_side ? 1.0 : 0.0;
+      },
+      [](double same_side) { return same_side > 0.0; },
+      [&](int f) {
+        crossing_of(*this, f, v_i, v_j, out);
+        return false;
+      });
+  std::sort(out.begin(), out.end(),
+            [](const Crossing& x, const Crossing& z) { return x.face < z.face; });
+}
+
+// argmin of triangle_distance, ties to the lowest index. Branch and bound on the distance to
+// node boxes, nearer first.
+int AcceleratedView::nearest_triangle(const Vec3& p) const {
+  int face = -1;
+  double best = std::numeric_limits<double>::infinity();
+  auto consider = [&](int f) {
+    const double d = triangle_distance(*this, f, p);
+    if (face < 0 || d < best || (d == best && f < face)) {
+      best = d;
+      face = f;
+    }
+    return false;
+  };
+  if (!accel) {
+    for (int f = 0; f < num_triangles(); ++f) consider(f);
+    return face;
+  }
+  const Vec3 pl = to_local(p);
+  accel->triangles.search(
+      [&](int k) {
+        const BvhNode& node = accel->triangles.nodes[k];
+        return ((pl - node.center).cwiseAbs() - node.half).cwiseMax(0.0).norm();
+      },
+      [&](double b) { return b - margin > best; }, consider, false);
+  return face;
+}
+
+// True when one face plane of this shape has both ends of the segment [v_i, v_j] beyond
+// tol + margin: then no point of the segment is inside, and the edge can have no hit whatever
+// its plane crossings. Two small shapes: always false (x's plane table already culled the edge).
+bool AcceleratedView::segment_outside(const AcceleratedView& x, const Vec3& v_i,
+                                      const Vec3& v_j) const {
+  if (x.plane_table) return false;
+  const double limit = tol + margin;
+  if (facing >= 0 && plane_distance(*this, facing, v_i) > limit &&
+      plane_distance(*this, facing, v_j) > limit)
+    return true;
+  if (!accel) {
+    // Small shapes: every distinct face plane (coplanar triangles share one).
+    for (int f = 0; f < num_triangles(); ++f)
+      if (distinct[f] && f != facing && plane_distance(*this, f, v_i) > limit &&
+          plane_distance(*this, f, v_j) > limit)
+        return true;
+    return false;
+  }
+  const Vec3 pi = to_local(v_i), pj = to_local(v_j);
+  // Upper bound on min(s_f(v_i), s_f(v_j)) over a cluster; clusters far outside first.
+  return accel->triangles.search(
+      [&](int k) {
+        double lo, hi_i, hi_j;
+        accel->plane_bounds(k, pi, lo, hi_i);
+        accel->plane_bounds(k, pj, lo, hi_j);
+        return std::min(hi_i, hi_j);
+      },
+      [&](double b) { return b <= limit; },
+      [&](int f) {
+        return plane_distance(*this, f, v_i) > limit && plane_distance(*this, f, v_j) > limit;
+      });
+}
+
+void AcceleratedPair::prepare(const ConvexPolyhedron& sa, const Pose& pa,
+                              const ConvexPolyhedron& sb, const Pose& pb,
+                              AcceleratedWorkspace& ws) {
+  // The query's constants: the seed's tolerance, and the margin scaled by the coordinates.
+  Limits lim;
+  lim.tol = point_in_mesh_tolerance(sa, sb);
+  const double scale = pa.position.norm() + pb.position.norm() + 2.0 * shape_size(sa) +
+                       2.0 * shape_size(sb);
+  lim.margin = kMarginScale * scale;
+  a = place(sa, pa, lim, ws, 0);
+  b = place(sb, pb, lim, ws, 1);
+  // Each shape's facing face, and whether its points can enter the other.
+  a.facing = facing_face(a, b);
+  b.facing = facing_face(b, a);
+  if (!a.accel && !b.accel) {
+    fill_plane_table(a, b, lim, ws.tables[0]);
+    fill_plane_table(b, a, lim, ws.tables[1]);
+    return;
+  }
+  a.enters = may_enter(a, b, lim);
+  b.enters = may_enter(b, a, lim);
+}
+
+std::optional<ContactPoint> AcceleratedPair::test(Feature feature,
+                                                  FeatureScratch& scratch) const {
+  return both_orders(feature, a, b, scratch);
+}
+
+std::optional<ContactPoint> AcceleratedPair::detect(FeatureScratch& scratch) const {
+  return all_features(a, b, scratch);
+}
+
+}  // namespace rbx::detail
