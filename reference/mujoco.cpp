@@ -30,6 +30,8 @@
 #include <sstream>
 #include <utility>
 
+#include "engine/format.h"
+
 namespace {
 
 // Error state of the calling thread: where to jump, and the last messages (plain char arrays:
@@ -124,11 +126,12 @@ struct ModelOptions {
   ContactParams contact;
 };
 
-// Prints a double so that it reads back exactly.
+// Prints a double so that it reads back exactly (17 significant digits).
 std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", x);
-  return buf;
+  NumberFormat f;
+  f.digits = 17;
+  f.signed_zero = true;
+  return format_number(x, f);
 }
 
 std::string vec_text(const Vec3& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
