@@ -21,7 +21,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <csetjmp>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -30,13 +29,13 @@
 #include <sstream>
 #include <utility>
 
+#include "engine/format.h"
+#include "reference/c_error_trap.h"
+
 namespace {
 
-// Error state of the calling thread: where to jump, and the last messages (plain char arrays:
-// the handlers run inside MuJoCo's C frames and must not allocate or throw).
-thread_local std::jmp_buf* t_jump = nullptr;
-thread_local char t_error[512];
-thread_local char t_warning[512];
+// MuJoCo's error state on the calling thread (reference/c_error_trap.h).
+thread_local rbx::CErrorTrap t_trap;
 
 }  // namespace
 
@@ -45,15 +44,13 @@ extern "C" {
 // mju_user_error: copy the message and jump back to guarded(). Outside guarded() there is no
 // safe place to return to, so behave as MuJoCo would (print, terminate).
 static void rbx_mujoco_on_error(const char* msg) {
-  std::snprintf(t_error, sizeof(t_error), "%s", msg ? msg : "");
-  if (t_jump) std::longjmp(*t_jump, 1);
-  std::fprintf(stderr, "MuJoCo error outside a guarded call: %s\n", t_error);
-  std::abort();
+  rbx::trap_printf(t_trap.error, "%s", msg ? msg : "");
+  rbx::trap_jump_or_abort(t_trap, "MuJoCo error outside a guarded call: %s\n");
 }
 
 // mju_user_warning: keep the first message; the caller turns it into Status::Error.
 static void rbx_mujoco_on_warning(const char* msg) {
-  if (t_warning[0] == '\0') std::snprintf(t_warning, sizeof(t_warning), "%s", msg ? msg : "");
+  if (!t_trap.has_warning()) rbx::trap_printf(t_trap.warning, "%s", msg ? msg : "");
 }
 
 }  // extern "C"
@@ -77,21 +74,12 @@ void install_handlers() {
   mju_user_warning = rbx_mujoco_on_warning;
 }
 
-// Runs f() so that a MuJoCo error returns false (message in t_error) instead of exiting.
+// Runs f() so that a MuJoCo error returns false (message in t_trap.error) instead of exiting.
 // f must own no object with a non-trivial destructor (the longjmp skips its frame).
 template <class F>
 bool guarded(F&& f) {
   install_handlers();
-  std::jmp_buf env;
-  std::jmp_buf* const outer = t_jump;
-  t_jump = &env;
-  if (setjmp(env) != 0) {
-    t_jump = outer;
-    return false;
-  }
-  f();
-  t_jump = outer;
-  return true;
+  return rbx::guarded(t_trap, std::forward<F>(f));
 }
 
 // Owners of MuJoCo's C objects.
@@ -124,11 +112,12 @@ struct ModelOptions {
   ContactParams contact;
 };
 
-// Prints a double so that it reads back exactly.
+// Prints a double so that it reads back exactly (17 significant digits).
 std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", x);
-  return buf;
+  NumberFormat f;
+  f.digits = 17;
+  f.signed_zero = true;
+  return format_number(x, f);
 }
 
 std::string vec_text(const Vec3& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
@@ -220,7 +209,7 @@ ModelPtr load_model(const std::string& xml, std::string* error) {
   const int size = static_cast<int>(xml.size());
   int made = -1;
   if (!guarded([&] { made = mj_makeEmptyFileVFS(v, name, size); })) {
-    *error = std::string("MuJoCo mj_makeEmptyFileVFS: ") + t_error;
+    *error = std::string("MuJoCo mj_makeEmptyFileVFS: ") + t_trap.error;
     return nullptr;
   }
   if (made != 0) {
@@ -231,7 +220,7 @@ ModelPtr load_model(const std::string& xml, std::string* error) {
   std::memcpy(vfs->filedata[idx], xml.data(), xml.size());
   // Compiler errors come back in `buf` (the compiler installs its own handler while it runs).
   char buf[1024] = "";
-  t_warning[0] = '\0';
+  t_trap.clear_warning();
   install_handlers();
   ModelPtr m(mj_loadXML(name, vfs.get(), buf, sizeof(buf)));
   if (!m) *error = std::string("MuJoCo mj_loadXML: ") + buf;
@@ -293,7 +282,7 @@ std::pair<ModelPtr, DataPtr> make_simulation(const std::vector<RigidBody>& bodie
   mjData* raw = nullptr;
   const mjModel* mc = m.get();
   if (!guarded([&] { raw = mj_makeData(mc); }) || !raw) {
-    *error = std::string("MuJoCo mj_makeData: ") + t_error;
+    *error = std::string("MuJoCo mj_makeData: ") + t_trap.error;
     return {};
   }
   return {std::move(m), DataPtr(raw)};
@@ -437,10 +426,10 @@ ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b) {
   set_state(m.get(), d.get(), bodies);
   const mjModel* mc = m.get();
   mjData* dd = d.get();
-  t_warning[0] = '\0';
+  t_trap.clear_warning();
   if (!guarded([&] { mj_forward(mc, dd); }))
-    return {Status::Error, std::string("MuJoCo mj_forward: ") + t_error, {}};
-  if (t_warning[0] != '\0') return {Status::Error, std::string("MuJoCo warning: ") + t_warning, {}};
+    return {Status::Error, std::string("MuJoCo mj_forward: ") + t_trap.error, {}};
+  if (t_trap.has_warning()) return {Status::Error, std::string("MuJoCo warning: ") + t_trap.warning, {}};
   const int body_a = m->geom_bodyid[geom_of(mc, 0)];
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& c = d->contact[i];
@@ -497,17 +486,17 @@ DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   // Collision events: one per contact episode of a pair (the soft impact spans several steps),
   // at its first step with a pushing force; the impulse sums force * dt over the episode.
   std::map<std::pair<int, int>, size_t> open_episode;  // pair -> index in r.events
-  t_warning[0] = '\0';
+  t_trap.clear_warning();
   for (long step = 0; step < steps; ++step) {
     if (opt.sample_every > 0 && step % opt.sample_every == 0) sample(step * dt);
     if (!guarded([&] { mj_step(mc, dd); })) {
       r.status = Status::Error;
-      r.message = "MuJoCo mj_step at step " + std::to_string(step) + ": " + t_error;
+      r.message = "MuJoCo mj_step at step " + std::to_string(step) + ": " + t_trap.error;
       return r;
     }
-    if (t_warning[0] != '\0') {
+    if (t_trap.has_warning()) {
       r.status = Status::Error;
-      r.message = "MuJoCo warning at step " + std::to_string(step) + ": " + t_warning;
+      r.message = "MuJoCo warning at step " + std::to_string(step) + ": " + t_trap.warning;
       return r;
     }
     // d->contact and efc_force describe the state at the start of this step.

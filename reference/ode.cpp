@@ -18,7 +18,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <csetjmp>
 #include <cstdarg>
 #include <cstdint>
 #include <cstdio>
@@ -29,13 +28,12 @@
 #include <mutex>
 #include <utility>
 
+#include "reference/c_error_trap.h"
+
 namespace {
 
-// Error state of the calling thread (plain char arrays: the handlers run inside ODE).
-thread_local std::jmp_buf* t_jump = nullptr;
-thread_local char t_error[512];
-thread_local char t_warning[512];
-thread_local long t_message_count = 0;
+// ODE's error state on the calling thread (reference/c_error_trap.h).
+thread_local rbx::CErrorTrap t_trap;
 
 }  // namespace
 
@@ -45,19 +43,17 @@ extern "C" {
 static void rbx_ode_on_error(int errnum, const char* msg, va_list ap) {
   char text[400];
   std::vsnprintf(text, sizeof(text), msg ? msg : "", ap);
-  std::snprintf(t_error, sizeof(t_error), "ODE error %d: %s", errnum, text);
-  if (t_jump) std::longjmp(*t_jump, 1);
-  std::fprintf(stderr, "%s (outside a guarded call)\n", t_error);
-  std::abort();
+  rbx::trap_printf(t_trap.error, "ODE error %d: %s", errnum, text);
+  rbx::trap_jump_or_abort(t_trap, "%s (outside a guarded call)\n");
 }
 
 // dMessage: count, and keep the first message; the caller reports it.
 static void rbx_ode_on_message(int errnum, const char* msg, va_list ap) {
-  ++t_message_count;
-  if (t_warning[0] != '\0') return;
+  ++t_trap.warning_count;
+  if (t_trap.has_warning()) return;
   char text[400];
   std::vsnprintf(text, sizeof(text), msg ? msg : "", ap);
-  std::snprintf(t_warning, sizeof(t_warning), "ODE message %d: %s", errnum, text);
+  rbx::trap_printf(t_trap.warning, "ODE message %d: %s", errnum, text);
 }
 
 }  // extern "C"
@@ -89,20 +85,11 @@ void init_ode() {
   }
 }
 
-// Runs f() so that an ODE error returns false (message in t_error) instead of exiting.
+// Runs f() so that an ODE error returns false (message in t_trap.error) instead of exiting.
 // f must own no object with a non-trivial destructor (the longjmp skips its frame).
 template <class F>
 bool guarded(F&& f) {
-  std::jmp_buf env;
-  std::jmp_buf* const outer = t_jump;
-  t_jump = &env;
-  if (setjmp(env) != 0) {
-    t_jump = outer;
-    return false;
-  }
-  f();
-  t_jump = outer;
-  return true;
+  return rbx::guarded(t_trap, std::forward<F>(f));
 }
 
 // The arrays dCreateConvex reads. ODE keeps pointers to them, so they must outlive the geom.
@@ -324,14 +311,14 @@ ContactResult ode_contact(const RigidBody& a, const RigidBody& b) {
   place_geom(gb.geom, b);
   dContactGeom contacts[kMaxContacts];
   int n = 0;
-  t_warning[0] = '\0';
+  t_trap.clear_warning();
   const dGeomID g1 = ga.geom, g2 = gb.geom;
   const bool ok =
       guarded([&] { n = dCollide(g1, g2, kMaxContacts, contacts, sizeof(dContactGeom)); });
   dGeomDestroy(ga.geom);
   dGeomDestroy(gb.geom);
-  if (!ok) return {Status::Error, t_error, {}};
-  if (t_warning[0] != '\0') r.message = t_warning;
+  if (!ok) return {Status::Error, t_trap.error, {}};
+  if (t_trap.has_warning()) r.message = t_trap.warning;
   for (int i = 0; i < n; ++i) r.contacts.push_back(convert_contact(contacts[i]));
   // Debian's ODE routes convex-convex to libccd MPR (dCollideConvexConvexCCD): at depth below
   // CCD_EPS its direction, hence ODE's normal, is zero. Labelled, not scored as a 180 deg miss.
@@ -383,7 +370,7 @@ DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
     // dBodySetMass checks the mass (dMassCheck) and calls dDebug on failure.
     if (!guarded([&] { dBodySetMass(body, &mass); })) {
       r.status = Status::Error;
-      r.message = std::string("ODE dBodySetMass (") + b.name + "): " + t_error;
+      r.message = std::string("ODE dBodySetMass (") + b.name + "): " + t_trap.error;
       return r;
     }
     const Quat o = b.orientation.normalized();
@@ -413,8 +400,8 @@ DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   ctx.group = w.contacts;
   ctx.restitution = scene.sim.restitution;
   ctx.friction = scene.sim.friction;
-  t_warning[0] = '\0';
-  t_message_count = 0;
+  t_trap.clear_warning();
+  t_trap.warning_count = 0;
   long first_message_step = -1;
   for (long step = 0; step < steps; ++step) {
     if (opt.sample_every > 0 && step % opt.sample_every == 0) sample(step * dt);
@@ -428,10 +415,10 @@ DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
           dWorldStep(world, dt);
         })) {
       r.status = Status::Error;
-      r.message = "ODE at step " + std::to_string(step) + ": " + t_error;
+      r.message = "ODE at step " + std::to_string(step) + ": " + t_trap.error;
       return r;
     }
-    if (t_warning[0] != '\0' && first_message_step < 0) first_message_step = step;
+    if (t_trap.has_warning() && first_message_step < 0) first_message_step = step;
     // Events: one per pair and step where the bodies were closing at some contact point and
     // the contact pushed; point and normal averaged over the pair's points, depth the largest,
     // impulse the sum of the normal impulses f . n dt.
@@ -475,9 +462,9 @@ DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
     dJointGroupEmpty(w.contacts);
   }
   if (opt.sample_every > 0 && steps % opt.sample_every == 0) sample(steps * dt);
-  if (t_message_count > 0)
-    r.message = std::to_string(t_message_count) + " ODE message(s), the first at step " +
-                std::to_string(first_message_step) + ": " + t_warning;
+  if (t_trap.warning_count > 0)
+    r.message = std::to_string(t_trap.warning_count) + " ODE message(s), the first at step " +
+                std::to_string(first_message_step) + ": " + t_trap.warning;
 
   for (size_t i = 0; i < bodies.size(); ++i) {
     BodyFinal f = read_state(bodies[i], ode_bodies[i]);

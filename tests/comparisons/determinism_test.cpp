@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "comparisons/json_io.h"
-#include "comparisons/scene_file.h"
+#include "comparisons/eval/json_io.h"
+#include "comparisons/scene/scene_file.h"
 #include "engine/world.h"
 #include "reference/backend.h"
 

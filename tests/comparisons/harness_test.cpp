@@ -1,13 +1,13 @@
 // The harness: a backend that throws or returns an error is reported as such, and every other
 // backend still runs and is measured.
-#include "comparisons/harness.h"
+#include "comparisons/eval/harness.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <stdexcept>
 
-#include "comparisons/scene_file.h"
+#include "comparisons/scene/scene_file.h"
 #include "reference/backend.h"
 
 namespace rbx {

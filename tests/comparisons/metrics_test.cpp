@@ -7,8 +7,8 @@
 #include <functional>
 #include <limits>
 
-#include "comparisons/metrics.h"
-#include "comparisons/scene_file.h"
+#include "comparisons/eval/metrics.h"
+#include "comparisons/scene/scene_file.h"
 #include "reference/backend.h"
 
 namespace rbx {

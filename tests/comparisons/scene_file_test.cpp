@@ -1,6 +1,6 @@
 // Scene files: the bad-input catalogue (tests/bad_input/), every key of good scenes, defaults,
 // rotation order, --set overrides, and the mesh readers (Qhull hulls, OBJ files).
-#include "comparisons/scene_file.h"
+#include "comparisons/scene/scene_file.h"
 
 #include <grp.h>
 #include <gtest/gtest.h>
@@ -17,7 +17,7 @@
 #include <random>
 #include <sstream>
 
-#include "comparisons/mesh_io.h"
+#include "comparisons/scene/mesh_io.h"
 
 namespace rbx {
 namespace {

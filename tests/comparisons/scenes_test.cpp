@@ -5,9 +5,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "comparisons/commands.h"
-#include "comparisons/harness.h"
-#include "comparisons/scene_file.h"
+#include "comparisons/cli/commands.h"
+#include "comparisons/eval/harness.h"
+#include "comparisons/scene/scene_file.h"
 
 namespace rbx {
 namespace {

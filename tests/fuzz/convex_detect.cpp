@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "comparisons/mesh_io.h"
+#include "comparisons/scene/mesh_io.h"
 #include "engine/detect.h"
 #include "tests/fuzz/byte_reader.h"
 #include "tests/fuzz/targets.h"

@@ -9,7 +9,7 @@
 
 #include <toml++/toml.h>
 
-#include "comparisons/scene_file.h"
+#include "comparisons/scene/scene_file.h"
 #include "tests/fuzz/targets.h"
 
 namespace rbx::fuzz {

@@ -2,9 +2,9 @@
 #include <cstdio>
 #include <iostream>
 
-#include "comparisons/commands.h"
-#include "comparisons/json_io.h"
-#include "comparisons/table.h"
+#include "comparisons/cli/commands.h"
+#include "comparisons/eval/json_io.h"
+#include "comparisons/output/table.h"
 
 namespace rbx {
 

@@ -4,7 +4,7 @@
 // validation pass covers them); then each table is checked for unknown keys and each value is
 // read through a typed reader that knows the key's dotted name and line. Every failure is an
 // InputError with one line: "<file>:<line>: <key>: <what is wrong>; <what would fix it>".
-#include "comparisons/scene_file.h"
+#include "comparisons/scene/scene_file.h"
 
 #include <algorithm>
 #include <cctype>
@@ -18,7 +18,8 @@
 
 #include <toml++/toml.h>
 
-#include "comparisons/mesh_io.h"
+#include "comparisons/scene/mesh_io.h"
+#include "engine/format.h"
 
 namespace rbx {
 
@@ -170,28 +171,22 @@ std::string join(const std::vector<std::string>& words) {
   return out;
 }
 
-// Shortest decimal that reads back as the same double ("0.1", "1e-05", "nan", "-inf").
+// Shortest decimal that reads back as the same double ("0.1", "1e-05", "nan", "-inf"); below a
+// million, all integer digits ("604800", not "6.048e+05").
 std::string num(double v) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buffer[40];
-  int precision = 1;
-  for (; precision < 17; ++precision) {
-    std::snprintf(buffer, sizeof buffer, "%.*g", precision, v);
-    if (std::strtod(buffer, nullptr) == v) break;
-  }
-  // Below a million, write all integer digits ("604800", not "6.048e+05").
-  const double a = std::abs(v);
-  if (a >= 1 && a < 1e6) precision = std::max(precision, 1 + static_cast<int>(std::log10(a)));
-  std::snprintf(buffer, sizeof buffer, "%.*g", precision, v);
-  return buffer;
+  NumberFormat f;
+  f.digits = 0;
+  f.signed_zero = true;
+  f.integer_digits = true;
+  return format_number(v, f);
 }
 
 // Ten significant digits: enough to show how far from 1 a norm is.
 std::string fixed10(double v) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.10g", v);
-  return buffer;
+  NumberFormat f;
+  f.digits = 10;
+  f.signed_zero = true;
+  return format_number(v, f);
 }
 
 std::string vec_text(const Vec3& v) {

@@ -11,36 +11,15 @@
 #include <set>
 #include <sstream>
 
-#include "comparisons/commands.h"
-#include "comparisons/harness.h"
-#include "comparisons/scene_file.h"
-#include "comparisons/table.h"
+#include "comparisons/cli/commands.h"
+#include "comparisons/eval/harness.h"
+#include "comparisons/scene/scene_collection.h"
+#include "comparisons/scene/scene_file.h"
+#include "comparisons/output/table.h"
 
 namespace fs = std::filesystem;
 
 namespace rbx {
-
-std::vector<std::string> collect_scene_files(const std::vector<std::string>& inputs) {
-  std::vector<std::string> roots = inputs;
-  if (roots.empty()) roots.push_back("scenes");
-  std::vector<std::string> files;
-  for (const std::string& root : roots) {
-    std::error_code ec;
-    if (fs::is_directory(root, ec)) {
-      std::vector<std::string> found;
-      for (const auto& e : fs::recursive_directory_iterator(root))
-        if (e.is_regular_file() && e.path().extension() == ".toml") found.push_back(e.path().string());
-      std::sort(found.begin(), found.end());
-      files.insert(files.end(), found.begin(), found.end());
-    } else if (fs::exists(root, ec)) {
-      files.push_back(root);
-    } else {
-      throw InputError(root + ": no such scene file or folder");
-    }
-  }
-  if (files.empty()) throw InputError("no scene files (*.toml) found under the given inputs");
-  return files;
-}
 
 namespace {
 
@@ -389,7 +368,7 @@ int report_command(const ReportOptions& opt) {
     write_text((tmp / "stability.csv").string(), stab.str());
 
     // Figures: matplotlib from Debian, through /usr/bin/python3.
-    const std::string script = std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/plots.py";
+    const std::string script = std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/plots.py";
     bool figures_ok = false;
     std::string figures_msg;
     if (!fs::exists("/usr/bin/python3")) {

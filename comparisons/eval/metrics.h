@@ -1,6 +1,6 @@
 // The harness's metric functions: pure functions of body inputs, final states, contact results
 // and shapes, so each rule can be tested by hand (tests/comparisons/metrics_test.cpp) without a
-// scene or a backend. comparisons/harness.cpp applies them to every backend.
+// scene or a backend. comparisons/eval/harness.cpp applies them to every backend.
 #pragma once
 
 #include <optional>

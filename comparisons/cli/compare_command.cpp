@@ -3,9 +3,9 @@
 #include <map>
 #include <set>
 
-#include "comparisons/commands.h"
-#include "comparisons/harness.h"
-#include "comparisons/table.h"
+#include "comparisons/cli/commands.h"
+#include "comparisons/eval/harness.h"
+#include "comparisons/output/table.h"
 
 namespace rbx {
 

@@ -18,7 +18,7 @@
 // Output, into --out (default reports/latest, beside `rbx report`'s files, which that command
 // carries over when it replaces the folder), each file written atomically next to whatever the
 // folder holds already: perf.md, perf.json, perf.csv and figures/perf_*.{png,svg}
-// (comparisons/bench_plots.py, matplotlib). Without --out, reports/perf.md (the path
+// (comparisons/output/bench_plots.py, matplotlib). Without --out, reports/perf.md (the path
 // CONTRACT.md names) gets a copy of perf.md whose figure links point into latest/.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
@@ -38,10 +38,10 @@
 #include <string>
 #include <vector>
 
-#include "comparisons/commands.h"
-#include "comparisons/json_io.h"
-#include "comparisons/mesh_io.h"
-#include "comparisons/scene_file.h"
+#include "comparisons/cli/commands.h"
+#include "comparisons/eval/json_io.h"
+#include "comparisons/scene/mesh_io.h"
+#include "comparisons/scene/scene_file.h"
 #include "engine/body.h"
 #include "engine/broadphase.h"
 #include "engine/world.h"
@@ -823,7 +823,7 @@ int bench_command(const BenchOptions& opt) {
   try {
     write_json((tmp / "perf.json").string(), j);
     write_text((tmp / "perf.csv").string(), csv.str());
-    const std::string script = std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/bench_plots.py";
+    const std::string script = std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/bench_plots.py";
     std::string figures_note;
     if (!fs::exists("/usr/bin/python3")) {
       figures_note = "Figures not drawn: /usr/bin/python3 not found.";

@@ -5,8 +5,8 @@
 #include <exception>
 #include <iostream>
 
-#include "comparisons/commands.h"
-#include "comparisons/scene_file.h"
+#include "comparisons/cli/commands.h"
+#include "comparisons/scene/scene_file.h"
 #include "engine/polyhedron.h"
 
 namespace {

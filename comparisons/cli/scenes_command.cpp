@@ -4,10 +4,10 @@
 #include <iostream>
 #include <sstream>
 
-#include "comparisons/commands.h"
-#include "comparisons/harness.h"
-#include "comparisons/scene_file.h"
-#include "comparisons/table.h"
+#include "comparisons/cli/commands.h"
+#include "comparisons/eval/harness.h"
+#include "comparisons/scene/scene_file.h"
+#include "comparisons/output/table.h"
 
 namespace rbx {
 

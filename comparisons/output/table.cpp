@@ -1,23 +1,8 @@
-#include "comparisons/table.h"
+#include "comparisons/output/table.h"
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
 
 namespace rbx {
-
-std::string fmt_num(double x, int digits) {
-  if (std::isnan(x)) return "nan";
-  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, x == 0.0 ? 0.0 : x);  // no "-0"
-  return buf;
-}
-
-std::string fmt_vec(const Vec3& v, int digits) {
-  return "(" + fmt_num(v.x(), digits) + ", " + fmt_num(v.y(), digits) + ", " +
-         fmt_num(v.z(), digits) + ")";
-}
 
 Table::Table(std::vector<std::string> header) { rows_.push_back(std::move(header)); }
 

@@ -1,4 +1,4 @@
-#include "comparisons/json_io.h"
+#include "comparisons/eval/json_io.h"
 
 #include <unistd.h>
 

@@ -1,8 +1,9 @@
+#include "comparisons/eval/select_backends.h"
+
 #include <algorithm>
 #include <sstream>
 
-#include "comparisons/commands.h"
-#include "comparisons/scene_file.h"
+#include "comparisons/scene/scene_file.h"
 
 namespace rbx {
 
@@ -53,12 +54,6 @@ std::vector<std::string> select_backends(const Scene& scene, const std::string& 
     if (wanted.empty() ? serves(b, cap) : named) out.push_back(b.name);
   }
   return out;
-}
-
-Scene load_scene_for_command(const std::string& path, const SceneCommandOptions& opt) {
-  std::vector<std::string> sets = opt.sets;
-  if (opt.force) sets.push_back("force=true");
-  return load_scene(path, sets);
 }
 
 }  // namespace rbx

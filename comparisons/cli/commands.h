@@ -5,8 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "comparisons/eval/select_backends.h"
+#include "comparisons/scene/scene_collection.h"
 #include "engine/scene.h"
-#include "reference/backend.h"
 
 namespace rbx {
 
@@ -18,17 +19,6 @@ struct SceneCommandOptions {
   std::string backends;                // --backends LIST ("" : the scene's, or every one)
   bool force = false;                  // --force: accept absurd step counts
 };
-
-/// What a backend is asked for.
-enum class Capability { Contact, Dynamics };
-
-/// Backends to run for a scene: --backends if given (unknown names are an InputError), else the
-/// scene's `backends`, else every backend with the capability. Names are kept in registry order.
-std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
-                                         Capability cap);
-/// The same, choosing from `table` instead of the registry (the harness's seam for tests).
-std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
-                                         Capability cap, const std::vector<Backend>& table);
 
 /// Loads a scene applying --set and --force (InputError on bad input).
 Scene load_scene_for_command(const std::string& path, const SceneCommandOptions& opt);
@@ -65,9 +55,6 @@ int check_command(const ReportOptions& opt);
 std::string scene_table_markdown(const std::vector<std::string>& inputs);
 /// `rbx scenes`: prints scene_table_markdown.
 int scenes_command(const std::vector<std::string>& inputs);
-
-/// Scene files under the inputs (folders searched recursively for *.toml, sorted).
-std::vector<std::string> collect_scene_files(const std::vector<std::string>& inputs);
 
 }  // namespace rbx
 

@@ -1,6 +1,6 @@
 // Meshes from outside: convex hulls with Qhull (reentrant C API) and OBJ files with
 // tinyobjloader (double build). Both end in ConvexPolyhedron::from_triangles, the one validator.
-#include "comparisons/mesh_io.h"
+#include "comparisons/scene/mesh_io.h"
 
 #include <cerrno>
 #include <cmath>

@@ -1,18 +1,13 @@
-// Plain-text tables and number formatting for the terminal.
+// Plain-text and markdown tables for the terminal and the reports.
 #pragma once
 
 #include <ostream>
 #include <string>
 #include <vector>
 
-#include "engine/math.h"
+#include "engine/format.h"  // fmt_num and fmt_vec, for the cells
 
 namespace rbx {
-
-/// Number with `digits` significant digits ("%.*g"); "nan"/"inf" spelled out.
-std::string fmt_num(double x, int digits = 6);
-/// "(x, y, z)" with fmt_num.
-std::string fmt_vec(const Vec3& v, int digits = 4);
 
 /// A table with a header row, columns padded to width.
 class Table {

@@ -1,11 +1,11 @@
-#include "comparisons/contact_eval.h"
+#include "comparisons/eval/contact_eval.h"
 
 #include <algorithm>
 #include <cmath>
 #include <exception>
 #include <vector>
 
-#include "comparisons/json_io.h"
+#include "comparisons/eval/json_io.h"
 
 namespace rbx {
 

@@ -1,12 +1,12 @@
-#include "comparisons/metrics.h"
+#include "comparisons/eval/metrics.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "comparisons/contact_eval.h"
-#include "comparisons/table.h"
+#include "comparisons/eval/contact_eval.h"
 #include "engine/detect.h"
+#include "engine/format.h"
 
 namespace rbx {
 

@@ -1,4 +1,4 @@
-#include "comparisons/harness.h"
+#include "comparisons/eval/harness.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,12 +7,13 @@
 #include <map>
 #include <sstream>
 
-#include "comparisons/commands.h"
-#include "comparisons/contact_eval.h"
-#include "comparisons/metrics.h"
-#include "comparisons/table.h"
+#include "comparisons/eval/contact_eval.h"
+#include "comparisons/eval/metrics.h"
+#include "comparisons/eval/select_backends.h"
+#include "comparisons/scene/scene_collection.h"
 #include "engine/bounding.h"
 #include "engine/detect.h"
+#include "engine/format.h"
 #include "reference/exact.h"
 
 namespace rbx {
@@ -101,12 +102,6 @@ std::vector<double> sweep_steps(const Scene& scene) {
 }
 
 }  // namespace
-
-std::string scene_family(const std::string& file) {
-  const std::filesystem::path p(file);
-  const std::string parent = p.parent_path().filename().string();
-  return parent.empty() ? "scenes" : parent;
-}
 
 // ---------------------------------------------------------------------------------------------
 // The checks

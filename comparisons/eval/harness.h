@@ -7,7 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "comparisons/json_io.h"
+#include "comparisons/eval/json_io.h"
+#include "comparisons/scene/scene_collection.h"  // scene_family, for the harness's users
 #include "engine/scene.h"
 #include "reference/backend.h"
 
@@ -67,8 +68,5 @@ constexpr double kMarkVelocityErr = 1e-3;
 /// Runs every check of the scene. Never throws for a backend's failure (that backend's status
 /// becomes error); throws InputError only for bad options.
 SceneEvaluation evaluate_scene(const Scene& scene, const HarnessOptions& opt);
-
-/// The family of a scene file: its folder name under scenes/ ("seed", "analytic", ...).
-std::string scene_family(const std::string& file);
 
 }  // namespace rbx

@@ -2,10 +2,10 @@
 // the angle and depth differences against the `exact` oracle.
 #include <iostream>
 
-#include "comparisons/commands.h"
-#include "comparisons/contact_eval.h"
-#include "comparisons/json_io.h"
-#include "comparisons/table.h"
+#include "comparisons/cli/commands.h"
+#include "comparisons/eval/contact_eval.h"
+#include "comparisons/eval/json_io.h"
+#include "comparisons/output/table.h"
 #include "engine/bounding.h"
 
 namespace rbx {

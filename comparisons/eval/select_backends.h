@@ -1,0 +1,24 @@
+// Which backends run for a scene: the --backends list, the scene's own list, or every backend
+// that can serve the check.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "engine/scene.h"
+#include "reference/backend.h"
+
+namespace rbx {
+
+/// What a backend is asked for.
+enum class Capability { Contact, Dynamics };
+
+/// Backends to run for a scene: --backends if given (unknown names are an InputError), else the
+/// scene's `backends`, else every backend with the capability. Names are kept in registry order.
+std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
+                                         Capability cap);
+/// The same, choosing from `table` instead of the registry (the harness's seam for tests).
+std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
+                                         Capability cap, const std::vector<Backend>& table);
+
+}  // namespace rbx
