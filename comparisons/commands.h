@@ -51,7 +51,9 @@ struct ReportOptions {
   std::vector<std::string> inputs;  // scene files or folders ("" : scenes/)
   std::string out;                  // report folder (report) ("" : reports/latest)
   std::string baseline;             // baseline file (check) ("" : reports/baseline.json)
-  bool update = false;              // check --update: rewrite the baseline
+  bool update = false;              // check --update: merge this run into the baseline
+  bool accept_worse = false;        // check --update --accept-worse: record worse metrics too
+  bool no_cache = false;            // check --no-cache: rerun every reference library
   std::string backends;             // --backends LIST
   bool quiet = false;               // no progress line
 };

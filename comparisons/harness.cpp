@@ -10,6 +10,7 @@
 #include "comparisons/commands.h"
 #include "comparisons/contact_eval.h"
 #include "comparisons/metrics.h"
+#include "comparisons/result_cache.h"
 #include "comparisons/table.h"
 #include "engine/bounding.h"
 #include "engine/detect.h"
@@ -29,11 +30,26 @@ struct DynRun {
   DynamicsResult result;
   double runtime_s = 0.0;
   double dt = 0.0;
+  bool cached = false;  // from the reference-result cache
 };
 
-DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every) {
+// A reference backend's run comes from the cache when it holds this very call (the bodies as
+// built from the scene, the settings, dt and sampling); otherwise it runs and is stored.
+DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every,
+                    const ResultCache& cache, const std::vector<RigidBody>& bodies) {
   DynRun run;
   run.dt = dt;
+  const bool cacheable = cache.enabled() && ResultCache::caches(b.name);
+  const std::string key = cacheable ? ResultCache::dynamics_key(b.name, scene, bodies,
+                                                                DynamicsOptions{dt, sample_every})
+                                    : std::string();
+  if (cacheable)
+    if (auto hit = cache.load_dynamics(key)) {
+      run.result = std::move(hit->result);
+      run.runtime_s = hit->runtime_s;
+      run.cached = true;
+      return run;
+    }
   Stopwatch clock;
   try {
     run.result = b.dynamics(scene, DynamicsOptions{dt, sample_every});
@@ -48,6 +64,7 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
     run.result.message = "backend returned " + std::to_string(run.result.finals.size()) +
                          " final states for " + std::to_string(scene.bodies.size()) + " bodies";
   }
+  if (cacheable) cache.store(key, run.result, run.runtime_s);
   return run;
 }
 
@@ -119,7 +136,8 @@ class Evaluator {
       : scene_(scene),
         opt_(opt),
         table_(opt.registry ? *opt.registry : backends()),
-        inputs_(make_bodies(scene)) {
+        inputs_(make_bodies(scene)),
+        cache_(opt.cache_dir) {
     out_.family = scene_family(scene.file);
   }
 
@@ -235,15 +253,11 @@ class Evaluator {
 
     for (const std::string& name : names) {
       const Backend& be = backend(name);
-      // Time each query for about timing_budget_s (median of the repeats).
-      ContactRun probe = name == "exact" ? run_contact(exact, a, b) : run_contact(be, a, b);
-      int repeats = 1;
-      if (probe.result.status == Status::Ok && probe.runtime_s > 0)
-        repeats = static_cast<int>(std::clamp(opt_.timing_budget_s / probe.runtime_s, 1.0, 200.0));
-      const ContactRun run = repeats > 1 ? run_contact(be, a, b, repeats) : probe;
+      const ContactRun run = timed_contact(name == "exact" ? exact : be, a, b);
       set_status(name, run.result.status, run.result.message);
       Json& bj = backend_json(name);
       bj["runtime_s"] = bj["runtime_s"].get<double>() + run.runtime_s;
+      if (run.cached) bj["cached"] = true;
       for (const ContactPoint& p : run.result.contacts)
         bj["contacts"].push_back(contact_json(a.name, b.name, 0.0, p));
       if (run.result.status != Status::Ok) continue;
@@ -286,6 +300,28 @@ class Evaluator {
       // fails the scene unless the scene documents it as a known failure.
       if (name == "custom" && ex) check_expect_contact("custom", *ex, touch, c->normal, c->depth, tol);
     }
+  }
+
+  // A contact query timed for about timing_budget_s (median of the repeats), or the cached
+  // result of the same query (a reference backend's, see result_cache.h).
+  ContactRun timed_contact(const Backend& be, const RigidBody& a, const RigidBody& b) {
+    const bool cacheable = cache_.enabled() && ResultCache::caches(be.name);
+    const std::string key = cacheable ? ResultCache::contact_key(be.name, a, b) : std::string();
+    if (cacheable)
+      if (auto hit = cache_.load_contact(key)) {
+        ContactRun run;
+        run.result = std::move(hit->result);
+        run.runtime_s = hit->runtime_s;
+        run.cached = true;
+        return run;
+      }
+    ContactRun probe = run_contact(be, a, b);
+    int repeats = 1;
+    if (probe.result.status == Status::Ok && probe.runtime_s > 0)
+      repeats = static_cast<int>(std::clamp(opt_.timing_budget_s / probe.runtime_s, 1.0, 200.0));
+    ContactRun run = repeats > 1 ? run_contact(be, a, b, repeats) : probe;
+    if (cacheable) cache_.store(key, run.result, run.runtime_s);
+    return run;
   }
 
   // Violations of [expect.contact] by one subject's answer: touching, then (where it touches)
@@ -360,7 +396,7 @@ class Evaluator {
         set_status(name, Status::Unsupported, name + " has no dynamics (contact queries only)");
         continue;
       }
-      mains.emplace_back(name, run_dynamics(be, scene_, scene_.sim.dt, sample_every));
+      mains.emplace_back(name, run_dynamics(be, scene_, scene_.sim.dt, sample_every, cache_, inputs_));
     }
     for (const auto& [name, run] : mains)
       if (run.result.status == Status::Ok)
@@ -372,6 +408,7 @@ class Evaluator {
       const Backend& be = backend(name);
       Json& bj = backend_json(name);
       bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
+      if (main.cached) bj["cached"] = true;
       if (main.result.status != Status::Ok) {
         if (scene_.has_check("stability")) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
         continue;
@@ -392,7 +429,7 @@ class Evaluator {
             // The finest run of a trajectory check is sampled at the same times as the main run.
             const bool sample = scene_.has_check("trajectory") && dt == finest;
             const long every = sample ? std::max<long>(1, std::lround(sample_every * scene_.sim.dt / dt)) : 0;
-            sweep_runs.push_back(run_dynamics(be, scene_, dt, every));
+            sweep_runs.push_back(run_dynamics(be, scene_, dt, every, cache_, inputs_));
           }
         }
         if (sweep_runs.back().result.status == Status::Ok) fine = sweep_runs.back();
@@ -728,11 +765,21 @@ class Evaluator {
       record("custom", {Status::Ok, "", seed.mass, -1.0, seed.center_of_mass, seed.inertia});
       for (const Backend* b : libs) {
         MassResult r;
-        try {
-          r = b->mass(body);
-        } catch (const std::exception& e) {
-          r.status = Status::Error;
-          r.message = e.what();
+        const bool cacheable = cache_.enabled() && ResultCache::caches(b->name);
+        const std::string key = cacheable ? ResultCache::mass_key(b->name, body) : std::string();
+        std::optional<CachedResult<MassResult>> hit;
+        if (cacheable) hit = cache_.load_mass(key);
+        if (hit) {
+          r = hit->result;
+          backend_json(b->name)["cached"] = true;
+        } else {
+          try {
+            r = b->mass(body);
+          } catch (const std::exception& e) {
+            r.status = Status::Error;
+            r.message = e.what();
+          }
+          if (cacheable) cache_.store(key, r, 0.0);
         }
         record(b->name, r);
       }
@@ -752,6 +799,7 @@ class Evaluator {
   const HarnessOptions& opt_;
   const std::vector<Backend>& table_;  // the backends to choose from
   std::vector<RigidBody> inputs_;
+  ResultCache cache_;  // reference results on disk (disabled when opt.cache_dir is empty)
   SceneEvaluation out_;
   Json backends_json_;
   Json stability_json_;

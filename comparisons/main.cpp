@@ -46,7 +46,11 @@ int main(int argc, char** argv) {
   CLI::App* check = app.add_subcommand("check", "regression check against reports/baseline.json");
   check->add_option("inputs", check_opt.inputs, "scene files or folders (default: scenes/)");
   check->add_option("--baseline", check_opt.baseline, "baseline file");
-  check->add_flag("--update", check_opt.update, "rewrite the baseline from this run");
+  check->add_option("--backends", check_opt.backends, "comma-separated backend names: only their metrics are compared");
+  check->add_flag("--update", check_opt.update,
+                  "merge this run into the baseline (scenes and backends not run stay); refused while anything is worse");
+  check->add_flag("--accept-worse", check_opt.accept_worse, "with --update: record worse metrics too");
+  check->add_flag("--no-cache", check_opt.no_cache, "rerun every reference library (no build/cache)");
   rbx::BenchOptions bench_opt;
   CLI::App* bench = app.add_subcommand("bench", "performance comparison (default: reports/latest, and reports/perf.md)");
   bench->add_option("--out", bench_opt.out, "output folder");

@@ -13,6 +13,7 @@
 
 #include "comparisons/commands.h"
 #include "comparisons/harness.h"
+#include "comparisons/repo_path.h"
 #include "comparisons/scene_file.h"
 #include "comparisons/table.h"
 
@@ -22,7 +23,7 @@ namespace rbx {
 
 std::vector<std::string> collect_scene_files(const std::vector<std::string>& inputs) {
   std::vector<std::string> roots = inputs;
-  if (roots.empty()) roots.push_back("scenes");
+  if (roots.empty()) roots.push_back(default_repo_path("scenes"));
   std::vector<std::string> files;
   for (const std::string& root : roots) {
     std::error_code ec;
@@ -327,7 +328,7 @@ int report_command(const ReportOptions& opt) {
   // Every scene is read and validated before anything runs or is written.
   std::vector<Scene> scenes;
   for (const std::string& f : files) scenes.push_back(load_scene(f));
-  const std::string out = opt.out.empty() ? "reports/latest" : opt.out;
+  const std::string out = opt.out.empty() ? default_repo_path("reports/latest") : opt.out;
 
   HarnessOptions hopt;
   hopt.backends = opt.backends;
