@@ -97,6 +97,7 @@ int check_command(const ReportOptions& opt) {
   HarnessOptions hopt;
   hopt.backends = opt.backends;
   hopt.sweep = false;
+  hopt.registry = opt.registry;
   if (!opt.no_cache) hopt.cache_dir = ResultCache::default_dir();
   Stopwatch clock;
   std::map<std::string, double> now;
@@ -185,7 +186,7 @@ int check_command(const ReportOptions& opt) {
   std::cout << "check: " << now.size() << " metrics over " << scenes.size() << " scenes: " << worse + missing
             << " worse, " << better << " better, " << added << " new; run time " << fmt_num(runtime, 3)
             << " s (baseline " << fmt_num(base_rt, 3) << " s; timings never fail the check";
-  if (cacheable > 0)
+  if (hopt.cache_dir.size() && cacheable > 0)
     std::cout << "; " << cached << " of " << cacheable << " reference runs from the cache, "
               << ResultCache::default_dir();
   std::cout << ")\n";

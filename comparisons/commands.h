@@ -17,6 +17,7 @@ struct SceneCommandOptions {
   std::vector<std::string> sets;       // --set KEY=VALUE
   std::string backends;                // --backends LIST ("" : the scene's, or every one)
   bool force = false;                  // --force: accept absurd step counts
+  std::string at;                      // contacts --at: "" (t = 0) | "first-contact"
 };
 
 /// What a backend is asked for.
@@ -54,6 +55,8 @@ struct ReportOptions {
   bool update = false;              // check --update: merge this run into the baseline
   bool accept_worse = false;        // check --update --accept-worse: record worse metrics too
   bool no_cache = false;            // check --no-cache: rerun every reference library
+  /// Backends to choose from (nullptr: the registry); tests pass a table with a broken engine.
+  const std::vector<Backend>* registry = nullptr;
   std::string backends;             // --backends LIST
   bool quiet = false;               // no progress line
 };

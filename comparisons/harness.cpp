@@ -40,7 +40,7 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
   DynRun run;
   run.dt = dt;
   const bool cacheable = cache.enabled() && ResultCache::caches(b.name);
-  const std::string key = cacheable ? ResultCache::dynamics_key(b.name, scene, bodies,
+  const std::string key = cacheable ? cache.dynamics_key(b.name, scene, bodies,
                                                                 DynamicsOptions{dt, sample_every})
                                     : std::string();
   if (cacheable)
@@ -175,8 +175,10 @@ class Evaluator {
         scene_.expect && !scene_.expect->known_failure.empty() && !out_.expect_failures.empty() &&
         std::all_of(out_.expect_failures.begin(), out_.expect_failures.end(),
                     [](const std::string& f) { return f.rfind("custom:", 0) == 0; });
-    j["expect"] = {{"checked", scene_.expect.has_value()},
-                   {"passed", out_.expect_failures.empty()},
+    expect_binding();
+    j["expect"] = {{"checked", out_.expect_checked},
+                   {"passed", out_.expect_checked && out_.expect_failures.empty()},
+                   {"unchecked", out_.expect_unchecked},
                    {"failures", out_.expect_failures},
                    {"known_failure", scene_.expect ? scene_.expect->known_failure : ""},
                    {"excused", out_.expect_known}};
@@ -186,6 +188,35 @@ class Evaluator {
   }
 
  private:
+  // Which parts of [expect] were bound: [expect.contact] by the oracle's query of the first pair
+  // (it runs whenever the contact check does), [expect.body] by the custom engine's completed
+  // run. A reference outside the closed form is marked (disagrees), it does not bind it.
+  void expect_binding() {
+    if (!scene_.expect) return;
+    const Expect& e = *scene_.expect;
+    if (e.contact && !expect_contact_bound_)
+      out_.expect_unchecked.push_back("[expect.contact]: the scene runs no contact check");
+    if (!e.bodies.empty() && !expect_bodies_bound_) {
+      const bool dynamics = scene_.has_check("impulse") || scene_.has_check("trajectory") ||
+                            scene_.has_check("stability");
+      out_.expect_unchecked.push_back(
+          !dynamics ? "[expect.body]: the scene runs no dynamics check"
+          : backends_json_.contains("custom")
+              ? "[expect.body]: custom's run did not complete (" +
+                    backends_json_["custom"].value("message", std::string()) + ")"
+              : "[expect.body]: binds the custom engine, which was not run (backends: " +
+                    join_names() + ")");
+    }
+    out_.expect_checked = (e.contact && expect_contact_bound_) || (!e.bodies.empty() && expect_bodies_bound_);
+    if (!e.contact && e.bodies.empty()) out_.expect_unchecked.push_back("[expect] gives nothing to check");
+  }
+
+  std::string join_names() const {
+    std::string s;
+    for (const auto& [name, bj] : backends_json_.items()) s += (s.empty() ? "" : ", ") + name;
+    return s.empty() ? "none" : s;
+  }
+
   void metric(const std::string& check, const std::string& backend, const std::string& pair,
               const std::string& name, double value, const std::string& against) {
     out_.metrics.push_back({check, backend, pair, name, value, against});
@@ -250,6 +281,7 @@ class Evaluator {
     // [expect.contact] binds the oracle, whatever backends run: if the exact answer (computed
     // here anyway) disagrees with the closed form, the derivation or the oracle is wrong.
     if (ex) check_expect_contact("exact", *ex, sat.touching, sat.normal, std::max(sat.depth, 0.0), tol);
+    if (ex) expect_contact_bound_ = true;
 
     for (const std::string& name : names) {
       const Backend& be = backend(name);
@@ -306,7 +338,7 @@ class Evaluator {
   // result of the same query (a reference backend's, see result_cache.h).
   ContactRun timed_contact(const Backend& be, const RigidBody& a, const RigidBody& b) {
     const bool cacheable = cache_.enabled() && ResultCache::caches(be.name);
-    const std::string key = cacheable ? ResultCache::contact_key(be.name, a, b) : std::string();
+    const std::string key = cacheable ? cache_.contact_key(be.name, a, b) : std::string();
     if (cacheable)
       if (auto hit = cache_.load_contact(key)) {
         ContactRun run;
@@ -517,6 +549,7 @@ class Evaluator {
       // [expect.body] binds the custom engine; every backend, custom included, is marked by the
       // same rule where it misses the closed form.
       if (name == "custom" && scene_.expect) check_expect_bodies(main.result.finals);
+      if (name == "custom" && scene_.expect) expect_bodies_bound_ = true;
       if (scene_.expect)
         mark_expect_disagreement(name, main.result.finals,
                                  have_expect ? ke_norm_error(inputs_, main.result.finals, expected, e0_kin) : 0.0);
@@ -766,7 +799,7 @@ class Evaluator {
       for (const Backend* b : libs) {
         MassResult r;
         const bool cacheable = cache_.enabled() && ResultCache::caches(b->name);
-        const std::string key = cacheable ? ResultCache::mass_key(b->name, body) : std::string();
+        const std::string key = cacheable ? cache_.mass_key(b->name, body) : std::string();
         std::optional<CachedResult<MassResult>> hit;
         if (cacheable) hit = cache_.load_mass(key);
         if (hit) {
@@ -800,6 +833,8 @@ class Evaluator {
   const std::vector<Backend>& table_;  // the backends to choose from
   std::vector<RigidBody> inputs_;
   ResultCache cache_;  // reference results on disk (disabled when opt.cache_dir is empty)
+  bool expect_contact_bound_ = false;  // [expect.contact] compared with the oracle's answer
+  bool expect_bodies_bound_ = false;   // [expect.body] compared with custom's final states
   SceneEvaluation out_;
   Json backends_json_;
   Json stability_json_;

@@ -56,6 +56,9 @@ struct SceneEvaluation {
   std::vector<std::string> skipped;    // what was left out, and why
   std::vector<std::string> expect_failures;  // violated [expect] entries, "SUBJECT: what"
                                              // (custom: the engine; exact: the oracle)
+  bool expect_checked = false;  // some part of [expect] was bound by a backend that ran: never
+                                // "passed" otherwise
+  std::vector<std::string> expect_unchecked;  // parts of [expect] no backend run could bind, why
   bool expect_known = false;  // failures are all custom's and the scene's known_failure explains
                               // them: compare does not fail on them
   std::vector<std::string> disagreements;    // clearly different from the truth (see kMark*)

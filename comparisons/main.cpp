@@ -32,8 +32,12 @@ int main(int argc, char** argv) {
   rbx::ReportOptions report_opt, check_opt;
   scene_options(app.add_subcommand("run", "custom engine only: collision events and final state"),
                 run_opt, false, true);
-  scene_options(app.add_subcommand("contacts", "contact query at the t=0 poses, every backend"),
-                contacts_opt, false, true);
+  CLI::App* contacts = app.add_subcommand("contacts", "contact query at the t=0 poses, every backend");
+  scene_options(contacts, contacts_opt, false, true);
+  contacts->add_option("--at", contacts_opt.at,
+                       "first-contact: query at the first step where a pair touches (the custom "
+                       "engine's motion, the exact oracle's test)")
+      ->check(CLI::IsMember({"first-contact"}));
   scene_options(app.add_subcommand("compare", "the scenes' checks, side by side"), compare_opt,
                 true, true);
   CLI::App* report = app.add_subcommand("report", "accuracy report (default: scenes/ -> reports/latest)");

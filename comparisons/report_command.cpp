@@ -305,7 +305,10 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
     for (const std::string& d : ev.deviations) md << "- deviates (within the ✗ bounds): " << d << "\n";
     for (const std::string& s : ev.skipped) md << "- left out: " << s << "\n";
     if (scenes[i].expect)
-      md << "- [expect]: " << (ev.expect_failures.empty() ? "passed" : "FAILED") << "\n";
+      md << "- [expect]: "
+         << (!ev.expect_failures.empty() ? "FAILED" : ev.expect_checked ? "passed" : "not checked")
+         << "\n";
+    for (const std::string& f : ev.expect_unchecked) md << "  - not checked: " << f << "\n";
     for (const std::string& f : ev.expect_failures) md << "  - " << f << "\n";
     if (scenes[i].expect && !scenes[i].expect->known_failure.empty())
       md << "  - known failure: " << scenes[i].expect->known_failure << "\n";

@@ -96,10 +96,10 @@ void put_body(Writer& w, const RigidBody& b) {
 }
 
 // Common head of every key: what kind of call, which backend, which code.
-Writer key_head(const char* kind, const std::string& backend) {
+Writer key_head(const std::string& code, const char* kind, const std::string& backend) {
   Writer w;
   w.put("rbx result cache v1");
-  w.put(ResultCache::code_fingerprint());
+  w.put(code);
   w.put(kind);
   w.put(backend);
   return w;
@@ -170,8 +170,8 @@ std::string ResultCache::code_fingerprint() {
 }
 
 std::string ResultCache::contact_key(const std::string& backend, const RigidBody& a,
-                                     const RigidBody& b) {
-  Writer w = key_head("contact", backend);
+                                     const RigidBody& b) const {
+  Writer w = key_head(code_, "contact", backend);
   put_body(w, a);
   put_body(w, b);
   return w.str();
@@ -179,8 +179,8 @@ std::string ResultCache::contact_key(const std::string& backend, const RigidBody
 
 std::string ResultCache::dynamics_key(const std::string& backend, const Scene& scene,
                                       const std::vector<RigidBody>& bodies,
-                                      const DynamicsOptions& opt) {
-  Writer w = key_head("dynamics", backend);
+                                      const DynamicsOptions& opt) const {
+  Writer w = key_head(code_, "dynamics", backend);
   const SimSettings& s = scene.sim;
   w.put(s.dt);
   w.put(s.duration);
@@ -210,8 +210,8 @@ std::string ResultCache::dynamics_key(const std::string& backend, const Scene& s
   return w.str();
 }
 
-std::string ResultCache::mass_key(const std::string& backend, const RigidBody& body) {
-  Writer w = key_head("mass", backend);
+std::string ResultCache::mass_key(const std::string& backend, const RigidBody& body) const {
+  Writer w = key_head(code_, "mass", backend);
   put_body(w, body);
   return w.str();
 }

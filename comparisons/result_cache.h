@@ -32,7 +32,9 @@ struct CachedResult {
 /// The reference-result cache in one folder ("" : disabled; nothing is read or written).
 class ResultCache {
  public:
-  explicit ResultCache(std::string dir = "") : dir_(std::move(dir)) {}
+  /// `code`: what identifies the reference code (tests pass another to see a miss).
+  explicit ResultCache(std::string dir = "", std::string code = code_fingerprint())
+      : dir_(std::move(dir)), code_(std::move(code)) {}
 
   /// True when results of `backend` may be cached: every backend except ours (custom*, exact).
   static bool caches(const std::string& backend);
@@ -44,10 +46,10 @@ class ResultCache {
   bool enabled() const { return !dir_.empty(); }
 
   /// Fingerprints of the three kinds of call.
-  static std::string contact_key(const std::string& backend, const RigidBody& a, const RigidBody& b);
-  static std::string dynamics_key(const std::string& backend, const Scene& scene,
-                                  const std::vector<RigidBody>& bodies, const DynamicsOptions& opt);
-  static std::string mass_key(const std::string& backend, const RigidBody& body);
+  std::string contact_key(const std::string& backend, const RigidBody& a, const RigidBody& b) const;
+  std::string dynamics_key(const std::string& backend, const Scene& scene,
+                           const std::vector<RigidBody>& bodies, const DynamicsOptions& opt) const;
+  std::string mass_key(const std::string& backend, const RigidBody& body) const;
 
   /// Lookups: nullopt on a miss (no file, another fingerprint, an unreadable file).
   std::optional<CachedResult<ContactResult>> load_contact(const std::string& key) const;
@@ -64,6 +66,7 @@ class ResultCache {
   std::optional<std::string> read(const std::string& key) const;
   void write(const std::string& key, const std::string& value) const;
   std::string dir_;
+  std::string code_;
 };
 
 }  // namespace rbx
