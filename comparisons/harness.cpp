@@ -196,6 +196,10 @@ class Evaluator {
     const Expect& e = *scene_.expect;
     if (e.contact && !expect_contact_bound_)
       out_.expect_unchecked.push_back("[expect.contact]: the scene runs no contact check");
+    if (e.contact && e.contact->point)
+      out_.expect_unchecked.push_back(
+          "[expect.contact] point: read but not compared (models place the point on A, on B or "
+          "between; the oracle's point error is measured against its manifold instead)");
     if (!e.bodies.empty() && !expect_bodies_bound_) {
       const bool dynamics = scene_.has_check("impulse") || scene_.has_check("trajectory") ||
                             scene_.has_check("stability");
