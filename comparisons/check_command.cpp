@@ -2,6 +2,7 @@
 // with the committed baseline; exit 1 on any regression. Timings never fail the check.
 // Every changed metric is named, worse and better, grouped by scene and backend; `--update`
 // merges this run into the baseline and refuses while anything is worse (--accept-worse).
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -89,13 +90,22 @@ int check_command(const ReportOptions& opt) {
   for (const std::string& f : collect_scene_files(opt.inputs)) scenes.push_back(load_scene(f));
   // With --backends only those backends' metrics are compared (and merged by --update).
   const std::vector<std::string> only = split_list(opt.backends);
+  const std::vector<Backend>& table = opt.registry ? *opt.registry : backends();
+  for (const std::string& name : only)
+    if (std::none_of(table.begin(), table.end(), [&](const Backend& b) { return b.name == name; })) {
+      std::string names;
+      for (const Backend& b : table) names += (names.empty() ? "" : ", ") + b.name;
+      throw InputError("--backends: unknown backend '" + name + "'; known: " + names);
+    }
   const auto selected = [&](const std::string& backend) {
     return only.empty() || std::find(only.begin(), only.end(), backend) != only.end();
   };
 
   // Current metrics: every error metric of every scene (no sweep: accuracy at the scene's dt).
+  // Every scene runs its own backends even with --backends: which metrics a backend gets can
+  // depend on the others' results (angular metrics where any backend's bodies rotate), so only
+  // a whole run measures each metric as the baseline did. The references come from the cache.
   HarnessOptions hopt;
-  hopt.backends = opt.backends;
   hopt.sweep = false;
   hopt.registry = opt.registry;
   if (!opt.no_cache) hopt.cache_dir = ResultCache::default_dir();

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   CLI::App* check = app.add_subcommand("check", "regression check against reports/baseline.json");
   check->add_option("inputs", check_opt.inputs, "scene files or folders (default: scenes/)");
   check->add_option("--baseline", check_opt.baseline, "baseline file");
-  check->add_option("--backends", check_opt.backends, "comma-separated backend names: only their metrics are compared");
+  check->add_option("--backends", check_opt.backends, "comma-separated backend names: only their metrics are compared (and updated)");
   check->add_flag("--update", check_opt.update,
                   "merge this run into the baseline (scenes and backends not run stay); refused while anything is worse");
   check->add_flag("--accept-worse", check_opt.accept_worse, "with --update: record worse metrics too");

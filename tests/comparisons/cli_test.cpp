@@ -490,6 +490,16 @@ TEST(CliElsewhere, DefaultPathsResolveInsideTheRepository) {
   fs::remove_all(dir);
 }
 
+// check takes --backends (it was refused as an unknown option): only those metrics compared.
+TEST(CliElsewhere, CheckTakesBackends) {
+  const CmdResult r = rbx("check scenes/seed/face_face.toml --backends custom");
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("0 worse"), std::string::npos) << r.out;
+  const CmdResult bad = rbx("check scenes/seed/face_face.toml --backends nope");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--backends: unknown backend 'nope'"), std::string::npos) << bad.err;
+}
+
 // An [expect] no selected backend can bind is "not checked", never "passed".
 TEST(CompareExpect, AnExpectationNoBackendRunCanBindIsNotChecked) {
   const fs::path dir = temp_dir("unbound");
