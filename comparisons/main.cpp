@@ -51,9 +51,11 @@ int main(int argc, char** argv) {
   check->add_option("inputs", check_opt.inputs, "scene files or folders (default: scenes/)");
   check->add_option("--baseline", check_opt.baseline, "baseline file");
   check->add_option("--backends", check_opt.backends, "comma-separated backend names: only their metrics are compared (and updated)");
-  check->add_flag("--update", check_opt.update,
-                  "merge this run into the baseline (scenes and backends not run stay); refused while anything is worse");
-  check->add_flag("--accept-worse", check_opt.accept_worse, "with --update: record worse metrics too");
+  CLI::Option* update = check->add_flag(
+      "--update", check_opt.update,
+      "merge this run into the baseline (scenes and backends not run stay); refused while anything is worse");
+  check->add_flag("--accept-worse", check_opt.accept_worse, "with --update: record worse metrics too")
+      ->needs(update);
   check->add_flag("--no-cache", check_opt.no_cache, "rerun every reference library (no build/cache)");
   rbx::BenchOptions bench_opt;
   CLI::App* bench = app.add_subcommand("bench", "performance comparison (default: reports/latest, and reports/perf.md)");

@@ -495,6 +495,7 @@ TEST(CliElsewhere, CheckTakesBackends) {
   const CmdResult r = rbx("check scenes/seed/face_face.toml --backends custom");
   EXPECT_EQ(r.code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("0 worse"), std::string::npos) << r.out;
+  EXPECT_EQ(rbx("check scenes/seed/face_face.toml --accept-worse").code, 2);  // needs --update
   const CmdResult bad = rbx("check scenes/seed/face_face.toml --backends nope");
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("--backends: unknown backend 'nope'"), std::string::npos) << bad.err;
