@@ -41,6 +41,7 @@
 #include "comparisons/cli/commands.h"
 #include "comparisons/eval/json_io.h"
 #include "comparisons/scene/mesh_io.h"
+#include "comparisons/scene/repo_path.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/body.h"
 #include "engine/broadphase.h"
@@ -342,7 +343,7 @@ double find_time(const std::vector<NarrowRow>& rows, const std::string& backend,
 
 int bench_command(const BenchOptions& opt) {
   const Plan plan = make_plan(opt.quick);
-  const std::string out = opt.out.empty() ? "reports/latest" : opt.out;
+  const std::string out = opt.out.empty() ? default_repo_path("reports/latest") : opt.out;
   Stopwatch clock;
   std::mt19937_64 rng(20240606);
 

@@ -18,6 +18,7 @@ struct SceneCommandOptions {
   std::vector<std::string> sets;       // --set KEY=VALUE
   std::string backends;                // --backends LIST ("" : the scene's, or every one)
   bool force = false;                  // --force: accept absurd step counts
+  std::string at;                      // contacts --at: "" (t = 0) | "first-contact"
 };
 
 /// Loads a scene applying --set and --force (InputError on bad input).
@@ -41,7 +42,11 @@ struct ReportOptions {
   std::vector<std::string> inputs;  // scene files or folders ("" : scenes/)
   std::string out;                  // report folder (report) ("" : reports/latest)
   std::string baseline;             // baseline file (check) ("" : reports/baseline.json)
-  bool update = false;              // check --update: rewrite the baseline
+  bool update = false;              // check --update: merge this run into the baseline
+  bool accept_worse = false;        // check --update --accept-worse: record worse metrics too
+  bool no_cache = false;            // check --no-cache: rerun every reference library
+  /// Backends to choose from (nullptr: the registry); tests pass a table with a broken engine.
+  const std::vector<Backend>* registry = nullptr;
   std::string backends;             // --backends LIST
   bool quiet = false;               // no progress line
 };

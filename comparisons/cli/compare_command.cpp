@@ -64,8 +64,11 @@ int compare_command(const SceneCommandOptions& opt) {
     for (const std::string& s : ev.deviations) out << "  deviates: " << s << "\n";
     for (const std::string& s : ev.skipped) out << "  left out: " << s << "\n";
     if (scene.expect) {
-      if (ev.expect_failures.empty())
+      if (!ev.expect_checked)
+        out << "  [expect]: not checked\n";
+      else if (ev.expect_failures.empty())
         out << "  [expect]: passed\n";
+      for (const std::string& s : ev.expect_unchecked) out << "  [expect] not checked: " << s << "\n";
       for (const std::string& s : ev.expect_failures) out << "  [expect] FAILED: " << s << "\n";
       if (ev.expect_known) out << "  [expect] known failure: " << scene.expect->known_failure << "\n";
     }

@@ -32,8 +32,12 @@ int main(int argc, char** argv) {
   rbx::ReportOptions report_opt, check_opt;
   scene_options(app.add_subcommand("run", "custom engine only: collision events and final state"),
                 run_opt, false, true);
-  scene_options(app.add_subcommand("contacts", "contact query at the t=0 poses, every backend"),
-                contacts_opt, false, true);
+  CLI::App* contacts = app.add_subcommand("contacts", "contact query at the t=0 poses, every backend");
+  scene_options(contacts, contacts_opt, false, true);
+  contacts->add_option("--at", contacts_opt.at,
+                       "first-contact: query at the first step where a pair touches (the custom "
+                       "engine's motion, the exact oracle's test)")
+      ->check(CLI::IsMember({"first-contact"}));
   scene_options(app.add_subcommand("compare", "the scenes' checks, side by side"), compare_opt,
                 true, true);
   CLI::App* report = app.add_subcommand("report", "accuracy report (default: scenes/ -> reports/latest)");
@@ -46,7 +50,13 @@ int main(int argc, char** argv) {
   CLI::App* check = app.add_subcommand("check", "regression check against reports/baseline.json");
   check->add_option("inputs", check_opt.inputs, "scene files or folders (default: scenes/)");
   check->add_option("--baseline", check_opt.baseline, "baseline file");
-  check->add_flag("--update", check_opt.update, "rewrite the baseline from this run");
+  check->add_option("--backends", check_opt.backends, "comma-separated backend names: only their metrics are compared (and updated)");
+  CLI::Option* update = check->add_flag(
+      "--update", check_opt.update,
+      "merge this run into the baseline (scenes and backends not run stay); refused while anything is worse");
+  check->add_flag("--accept-worse", check_opt.accept_worse, "with --update: record worse metrics too")
+      ->needs(update);
+  check->add_flag("--no-cache", check_opt.no_cache, "rerun every reference library (no build/cache)");
   rbx::BenchOptions bench_opt;
   CLI::App* bench = app.add_subcommand("bench", "performance comparison (default: reports/latest, and reports/perf.md)");
   bench->add_option("--out", bench_opt.out, "output folder");

@@ -16,6 +16,7 @@
 #include "comparisons/scene/scene_collection.h"
 #include "comparisons/scene/scene_file.h"
 #include "comparisons/output/table.h"
+#include "comparisons/scene/repo_path.h"
 
 namespace fs = std::filesystem;
 
@@ -283,7 +284,10 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
     for (const std::string& d : ev.deviations) md << "- deviates (within the ✗ bounds): " << d << "\n";
     for (const std::string& s : ev.skipped) md << "- left out: " << s << "\n";
     if (scenes[i].expect)
-      md << "- [expect]: " << (ev.expect_failures.empty() ? "passed" : "FAILED") << "\n";
+      md << "- [expect]: "
+         << (!ev.expect_failures.empty() ? "FAILED" : ev.expect_checked ? "passed" : "not checked")
+         << "\n";
+    for (const std::string& f : ev.expect_unchecked) md << "  - not checked: " << f << "\n";
     for (const std::string& f : ev.expect_failures) md << "  - " << f << "\n";
     if (scenes[i].expect && !scenes[i].expect->known_failure.empty())
       md << "  - known failure: " << scenes[i].expect->known_failure << "\n";
@@ -306,7 +310,7 @@ int report_command(const ReportOptions& opt) {
   // Every scene is read and validated before anything runs or is written.
   std::vector<Scene> scenes;
   for (const std::string& f : files) scenes.push_back(load_scene(f));
-  const std::string out = opt.out.empty() ? "reports/latest" : opt.out;
+  const std::string out = opt.out.empty() ? default_repo_path("reports/latest") : opt.out;
 
   HarnessOptions hopt;
   hopt.backends = opt.backends;

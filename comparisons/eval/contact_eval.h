@@ -11,6 +11,7 @@ namespace rbx {
 struct ContactRun {
   ContactResult result;
   double runtime_s = 0.0;  // median over the repeats
+  bool cached = false;     // read from the reference-result cache (runtime_s is the stored one)
 };
 
 /// Runs backend `b` on (A, B) `repeats` times (median time); a thrown exception becomes status

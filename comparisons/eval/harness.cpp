@@ -2,15 +2,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <map>
 #include <sstream>
+#include <thread>
 
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/metrics.h"
 #include "comparisons/eval/select_backends.h"
 #include "comparisons/scene/scene_collection.h"
+#include "comparisons/eval/result_cache.h"
 #include "engine/bounding.h"
 #include "engine/detect.h"
 #include "engine/format.h"
@@ -30,11 +34,26 @@ struct DynRun {
   DynamicsResult result;
   double runtime_s = 0.0;
   double dt = 0.0;
+  bool cached = false;  // from the reference-result cache
 };
 
-DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every) {
+// A reference backend's run comes from the cache when it holds this very call (the bodies as
+// built from the scene, the settings, dt and sampling); otherwise it runs and is stored.
+DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every,
+                    const ResultCache& cache, const std::vector<RigidBody>& bodies) {
   DynRun run;
   run.dt = dt;
+  const bool cacheable = cache.enabled() && ResultCache::caches(b.name);
+  const std::string key = cacheable ? cache.dynamics_key(b.name, scene, bodies,
+                                                                DynamicsOptions{dt, sample_every})
+                                    : std::string();
+  if (cacheable)
+    if (auto hit = cache.load_dynamics(key)) {
+      run.result = std::move(hit->result);
+      run.runtime_s = hit->runtime_s;
+      run.cached = true;
+      return run;
+    }
   Stopwatch clock;
   try {
     run.result = b.dynamics(scene, DynamicsOptions{dt, sample_every});
@@ -49,6 +68,7 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
     run.result.message = "backend returned " + std::to_string(run.result.finals.size()) +
                          " final states for " + std::to_string(scene.bodies.size()) + " bodies";
   }
+  if (cacheable) cache.store(key, run.result, run.runtime_s);
   return run;
 }
 
@@ -90,6 +110,33 @@ double body_size(const RigidBody& b) { return 2.0 * bounding_sphere(b).radius; }
 
 std::string fmt_dt(double dt) { return "self dt=" + fmt_num(dt, 3); }
 
+// f(0), ..., f(n - 1) on two threads (the machine's two cores), interleaved. Each value is
+// computed as it would be on one thread, so results are the same; f must not share mutable
+// state (the exact oracle does not). A thrown exception is rethrown here.
+template <class F>
+std::vector<double> parallel_map(size_t n, const F& f) {
+  std::vector<double> out(n, 0.0);
+  std::exception_ptr failure[2];
+  auto work = [&](size_t first, std::exception_ptr& error) {
+    try {
+      for (size_t t = first; t < n; t += 2) out[t] = f(t);
+    } catch (...) {
+      error = std::current_exception();
+    }
+  };
+  if (n < 8) {
+    work(0, failure[0]);
+    work(1, failure[1]);
+  } else {
+    std::thread helper(work, 1, std::ref(failure[1]));
+    work(0, failure[0]);
+    helper.join();
+  }
+  for (const std::exception_ptr& e : failure)
+    if (e) std::rethrow_exception(e);
+  return out;
+}
+
 // Default time steps for the sweep: the scene's dt scaled by 4, 2, 1, 1/2, 1/4.
 std::vector<double> sweep_steps(const Scene& scene) {
   if (!scene.sim.sweep_dt.empty()) {
@@ -114,7 +161,8 @@ class Evaluator {
       : scene_(scene),
         opt_(opt),
         table_(opt.registry ? *opt.registry : backends()),
-        inputs_(make_bodies(scene)) {
+        inputs_(make_bodies(scene)),
+        cache_(opt.cache_dir) {
     out_.family = scene_family(scene.file);
   }
 
@@ -152,8 +200,10 @@ class Evaluator {
         scene_.expect && !scene_.expect->known_failure.empty() && !out_.expect_failures.empty() &&
         std::all_of(out_.expect_failures.begin(), out_.expect_failures.end(),
                     [](const std::string& f) { return f.rfind("custom:", 0) == 0; });
-    j["expect"] = {{"checked", scene_.expect.has_value()},
-                   {"passed", out_.expect_failures.empty()},
+    expect_binding();
+    j["expect"] = {{"checked", out_.expect_checked},
+                   {"passed", out_.expect_checked && out_.expect_failures.empty()},
+                   {"unchecked", out_.expect_unchecked},
                    {"failures", out_.expect_failures},
                    {"known_failure", scene_.expect ? scene_.expect->known_failure : ""},
                    {"excused", out_.expect_known}};
@@ -163,6 +213,37 @@ class Evaluator {
   }
 
  private:
+  // Which parts of [expect] were bound: [expect.contact] by the oracle's query of the first pair
+  // (it runs whenever the contact check does), [expect.body] by the custom engine's completed
+  // run. A reference outside the closed form is marked (disagrees), it does not bind it.
+  void expect_binding() {
+    if (!scene_.expect) return;
+    const Expect& e = *scene_.expect;
+    if (e.contact && !expect_contact_bound_)
+      out_.expect_unchecked.push_back("[expect.contact]: the scene runs no contact check");
+    if (e.contact && e.contact->point)
+      out_.expect_unchecked.push_back(
+          "[expect.contact] point: read but not compared (models place the point on A, on B or "
+          "between; the oracle's point error is measured against its manifold instead)");
+    if (!e.bodies.empty() && !expect_bodies_bound_) {
+      const bool dynamics = scene_.has_check(CheckKind::Impulse) ||
+                            scene_.has_check(CheckKind::Trajectory) ||
+                            scene_.has_check(CheckKind::Stability);
+      out_.expect_unchecked.push_back(
+          !dynamics ? "[expect.body]: the scene runs no dynamics check"
+                    : "[expect.body]: binds the custom engine, which was not run (backends: " +
+                          join_names() + ")");
+    }
+    out_.expect_checked = (e.contact && expect_contact_bound_) || (!e.bodies.empty() && expect_bodies_bound_);
+    if (!e.contact && e.bodies.empty()) out_.expect_unchecked.push_back("[expect] gives nothing to check");
+  }
+
+  std::string join_names() const {
+    std::string s;
+    for (const auto& [name, bj] : backends_json_.items()) s += (s.empty() ? "" : ", ") + name;
+    return s.empty() ? "none" : s;
+  }
+
   void metric(const std::string& check, const std::string& backend, const std::string& pair,
               const std::string& name, double value, const std::string& against) {
     out_.metrics.push_back({check, backend, pair, name, value, against});
@@ -227,18 +308,15 @@ class Evaluator {
     // [expect.contact] binds the oracle, whatever backends run: if the exact answer (computed
     // here anyway) disagrees with the closed form, the derivation or the oracle is wrong.
     if (ex) check_expect_contact("exact", *ex, sat.touching, sat.normal, std::max(sat.depth, 0.0), tol);
+    if (ex) expect_contact_bound_ = true;
 
     for (const std::string& name : names) {
       const Backend& be = backend(name);
-      // Time each query for about timing_budget_s (median of the repeats).
-      ContactRun probe = name == "exact" ? run_contact(exact, a, b) : run_contact(be, a, b);
-      int repeats = 1;
-      if (probe.result.status == Status::Ok && probe.runtime_s > 0)
-        repeats = static_cast<int>(std::clamp(opt_.timing_budget_s / probe.runtime_s, 1.0, 200.0));
-      const ContactRun run = repeats > 1 ? run_contact(be, a, b, repeats) : probe;
+      const ContactRun run = timed_contact(name == "exact" ? exact : be, a, b);
       set_status(name, run.result.status, run.result.message);
       Json& bj = backend_json(name);
       bj["runtime_s"] = bj["runtime_s"].get<double>() + run.runtime_s;
+      if (run.cached) bj["cached"] = true;
       for (const ContactPoint& p : run.result.contacts)
         bj["contacts"].push_back(contact_json(a.name, b.name, 0.0, p));
       if (run.result.status != Status::Ok) continue;
@@ -281,6 +359,28 @@ class Evaluator {
       // fails the scene unless the scene documents it as a known failure.
       if (name == "custom" && ex) check_expect_contact("custom", *ex, touch, c->normal, c->depth, tol);
     }
+  }
+
+  // A contact query timed for about timing_budget_s (median of the repeats), or the cached
+  // result of the same query (a reference backend's, see result_cache.h).
+  ContactRun timed_contact(const Backend& be, const RigidBody& a, const RigidBody& b) {
+    const bool cacheable = cache_.enabled() && ResultCache::caches(be.name);
+    const std::string key = cacheable ? cache_.contact_key(be.name, a, b) : std::string();
+    if (cacheable)
+      if (auto hit = cache_.load_contact(key)) {
+        ContactRun run;
+        run.result = std::move(hit->result);
+        run.runtime_s = hit->runtime_s;
+        run.cached = true;
+        return run;
+      }
+    ContactRun probe = run_contact(be, a, b);
+    int repeats = 1;
+    if (probe.result.status == Status::Ok && probe.runtime_s > 0)
+      repeats = static_cast<int>(std::clamp(opt_.timing_budget_s / probe.runtime_s, 1.0, 200.0));
+    ContactRun run = repeats > 1 ? run_contact(be, a, b, repeats) : probe;
+    if (cacheable) cache_.store(key, run.result, run.runtime_s);
+    return run;
   }
 
   // Violations of [expect.contact] by one subject's answer: touching, then (where it touches)
@@ -355,7 +455,7 @@ class Evaluator {
         set_status(name, Status::Unsupported, name + " has no dynamics (contact queries only)");
         continue;
       }
-      mains.emplace_back(name, run_dynamics(be, scene_, scene_.sim.dt, sample_every));
+      mains.emplace_back(name, run_dynamics(be, scene_, scene_.sim.dt, sample_every, cache_, inputs_));
     }
     for (const auto& [name, run] : mains)
       if (run.result.status == Status::Ok)
@@ -367,8 +467,16 @@ class Evaluator {
       const Backend& be = backend(name);
       Json& bj = backend_json(name);
       bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
+      if (main.cached) bj["cached"] = true;
       if (main.result.status != Status::Ok) {
         if (scene_.has_check(CheckKind::Stability)) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
+        // The engine under test stopped before t = duration: it fails [expect.body] (no final
+        // state to compare is not a pass).
+        if (name == "custom" && scene_.expect && !scene_.expect->bodies.empty()) {
+          out_.expect_failures.push_back("custom: the run stopped before t = duration: " +
+                                         main.result.message);
+          expect_bodies_bound_ = true;
+        }
         continue;
       }
 
@@ -387,7 +495,7 @@ class Evaluator {
             // The finest run of a trajectory check is sampled at the same times as the main run.
             const bool sample = scene_.has_check(CheckKind::Trajectory) && dt == finest;
             const long every = sample ? std::max<long>(1, std::lround(sample_every * scene_.sim.dt / dt)) : 0;
-            sweep_runs.push_back(run_dynamics(be, scene_, dt, every));
+            sweep_runs.push_back(run_dynamics(be, scene_, dt, every, cache_, inputs_));
           }
         }
         if (sweep_runs.back().result.status == Status::Ok) fine = sweep_runs.back();
@@ -475,6 +583,7 @@ class Evaluator {
       // [expect.body] binds the custom engine; every backend, custom included, is marked by the
       // same rule where it misses the closed form.
       if (name == "custom" && scene_.expect) check_expect_bodies(main.result.finals);
+      if (name == "custom" && scene_.expect) expect_bodies_bound_ = true;
       if (scene_.expect)
         mark_expect_disagreement(name, main.result.finals,
                                  have_expect ? ke_norm_error(inputs_, main.result.finals, expected, e0_kin) : 0.0);
@@ -570,6 +679,30 @@ class Evaluator {
         watch.emplace_back(i, k, sat.normal, reach);
       }
     std::vector<bool> passed(watch.size(), false);
+    // Penetration: exact depth of every pair in bounding range, relative to the smaller body;
+    // the deepest per sample, for the samples before the first non-finite one.
+    auto deepest_overlap = [&](const StateSample& smp) {
+      double pen_sample = 0.0;
+      for (size_t i = 0; i < inputs_.size(); ++i) {
+        for (size_t k = i + 1; k < inputs_.size(); ++k) {
+          if (inputs_[i].is_static && inputs_[k].is_static) continue;
+          const Pose pa{smp.bodies[i].position, smp.bodies[i].orientation};
+          const Pose pb{smp.bodies[k].position, smp.bodies[k].orientation};
+          const double reach = radius[i] + radius[k];
+          if ((pa.position - pb.position).norm() > reach + 1e-9 * reach) continue;
+          const SatResult sat = sat_query(sat_shapes[i], pa, sat_shapes[k], pb);
+          if (!sat.touching) continue;
+          pen_sample = std::max(pen_sample, sat.depth / std::min(body_size(inputs_[i]), body_size(inputs_[k])));
+        }
+      }
+      return pen_sample;
+    };
+    size_t finite_samples = samples.size();
+    for (size_t t = 0; t < samples.size() && finite_samples == samples.size(); ++t)
+      for (const BodyFinal& b : samples[t].bodies)
+        if (!b.position.allFinite() || !b.velocity.allFinite() || !b.angular_velocity.allFinite())
+          finite_samples = t;
+    const std::vector<double> overlaps = parallel_map(finite_samples, [&](size_t t) { return deepest_overlap(samples[t]); });
     // "At rest": the last fifth of the run, as for the jitter below.
     const size_t rest_from = samples.size() * 4 / 5;
     size_t sample_index = 0;
@@ -587,22 +720,8 @@ class Evaluator {
         drift = std::max(drift, (linear_momentum(inputs_, smp.bodies) - p0).norm() / p_scale);
         hdrift = std::max(hdrift, (angular_momentum(inputs_, smp.bodies) - h0).norm() / h_scale);
       }
-      // Penetration: exact depth of every pair in bounding range, relative to the smaller body.
-      double pen_sample = 0.0;
-      for (size_t i = 0; i < inputs_.size(); ++i) {
-        for (size_t k = i + 1; k < inputs_.size(); ++k) {
-          if (inputs_[i].is_static && inputs_[k].is_static) continue;
-          const Pose pa{smp.bodies[i].position, smp.bodies[i].orientation};
-          const Pose pb{smp.bodies[k].position, smp.bodies[k].orientation};
-          const double reach = radius[i] + radius[k];
-          if ((pa.position - pb.position).norm() > reach + 1e-9 * reach) continue;
-          const SatResult sat = sat_query(sat_shapes[i], pa, sat_shapes[k], pb);
-          if (!sat.touching) continue;
-          const double rel = sat.depth / std::min(body_size(inputs_[i]), body_size(inputs_[k]));
-          pen_max = std::max(pen_max, rel);
-          pen_sample = std::max(pen_sample, rel);
-        }
-      }
+      const double pen_sample = overlaps[sample_index - 1];
+      pen_max = std::max(pen_max, pen_sample);
       if (at_rest) pen_rest = std::min(pen_rest, pen_sample);
       // Tunnelling: a pair that started apart and now lies fully on the other side of its
       // initial separating plane, while too close sideways to have gone round: passed through.
@@ -723,11 +842,21 @@ class Evaluator {
       record("custom", {Status::Ok, "", seed.mass, -1.0, seed.center_of_mass, seed.inertia});
       for (const Backend* b : libs) {
         MassResult r;
-        try {
-          r = b->mass(body);
-        } catch (const std::exception& e) {
-          r.status = Status::Error;
-          r.message = e.what();
+        const bool cacheable = cache_.enabled() && ResultCache::caches(b->name);
+        const std::string key = cacheable ? cache_.mass_key(b->name, body) : std::string();
+        std::optional<CachedResult<MassResult>> hit;
+        if (cacheable) hit = cache_.load_mass(key);
+        if (hit) {
+          r = hit->result;
+          backend_json(b->name)["cached"] = true;
+        } else {
+          try {
+            r = b->mass(body);
+          } catch (const std::exception& e) {
+            r.status = Status::Error;
+            r.message = e.what();
+          }
+          if (cacheable) cache_.store(key, r, 0.0);
         }
         record(b->name, r);
       }
@@ -747,6 +876,9 @@ class Evaluator {
   const HarnessOptions& opt_;
   const std::vector<Backend>& table_;  // the backends to choose from
   std::vector<RigidBody> inputs_;
+  ResultCache cache_;  // reference results on disk (disabled when opt.cache_dir is empty)
+  bool expect_contact_bound_ = false;  // [expect.contact] compared with the oracle's answer
+  bool expect_bodies_bound_ = false;   // [expect.body] compared with custom's final states
   SceneEvaluation out_;
   Json backends_json_;
   Json stability_json_;

@@ -22,6 +22,10 @@ struct HarnessOptions {
   /// Backends to choose from; nullptr: the registry (reference/registry.cpp). Tests pass their
   /// own table to add a failing backend without touching the registry.
   const std::vector<Backend>* registry = nullptr;
+  /// Reference-result cache folder (comparisons/result_cache.h); "" : no cache. Results are
+  /// byte-identical either way; a cached backend's JSON says "cached": true (its timings are
+  /// those of the run that filled the cache).
+  std::string cache_dir;
 };
 
 /// One measured number.
@@ -53,6 +57,9 @@ struct SceneEvaluation {
   std::vector<std::string> skipped;    // what was left out, and why
   std::vector<std::string> expect_failures;  // violated [expect] entries, "SUBJECT: what"
                                              // (custom: the engine; exact: the oracle)
+  bool expect_checked = false;  // some part of [expect] was bound by a backend that ran: never
+                                // "passed" otherwise
+  std::vector<std::string> expect_unchecked;  // parts of [expect] no backend run could bind, why
   bool expect_known = false;  // failures are all custom's and the scene's known_failure explains
                               // them: compare does not fail on them
   std::vector<std::string> disagreements;    // clearly different from the truth (see kMark*)

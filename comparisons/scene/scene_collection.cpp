@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "comparisons/scene/repo_path.h"
 #include "comparisons/scene/scene_file.h"
 
 namespace fs = std::filesystem;
@@ -11,7 +12,7 @@ namespace rbx {
 
 std::vector<std::string> collect_scene_files(const std::vector<std::string>& inputs) {
   std::vector<std::string> roots = inputs;
-  if (roots.empty()) roots.push_back("scenes");
+  if (roots.empty()) roots.push_back(default_repo_path("scenes"));
   std::vector<std::string> files;
   for (const std::string& root : roots) {
     std::error_code ec;

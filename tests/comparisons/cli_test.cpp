@@ -28,11 +28,11 @@ struct CmdResult {
   std::string out, err;
 };
 
-// Runs the built rbx binary from the source folder with stdout and stderr captured.
-CmdResult rbx(const std::string& args) {
+// Runs the built rbx binary from the folder `where` with stdout and stderr captured.
+CmdResult rbx_in(const std::string& where, const std::string& args) {
   const fs::path tmp = fs::temp_directory_path() / ("rbx_cli_" + std::to_string(getpid()));
   fs::create_directories(tmp);
-  const std::string cmd = "cd '" RBX_SOURCE_DIR "' && '" RBX_BINARY_DIR "/comparisons/rbx' " + args +
+  const std::string cmd = "cd '" + where + "' && '" RBX_BINARY_DIR "/comparisons/rbx' " + args +
                           " > '" + (tmp / "out").string() + "' 2> '" + (tmp / "err").string() + "'";
   CmdResult r;
   const int status = std::system(cmd.c_str());
@@ -46,6 +46,9 @@ CmdResult rbx(const std::string& args) {
   fs::remove_all(tmp);
   return r;
 }
+
+// Runs the built rbx binary from the source folder.
+CmdResult rbx(const std::string& args) { return rbx_in(RBX_SOURCE_DIR, args); }
 
 fs::path temp_dir(const std::string& name) {
   const fs::path p = fs::temp_directory_path() / ("rbx_" + name + "_" + std::to_string(getpid()));
@@ -223,7 +226,7 @@ TEST(Cli, CheckPassesOnItsOwnBaselineAndFailsOnOneClaimingSmallerErrors) {
   std::ofstream(base) << b.dump(2);
   const CmdResult worse = rbx("check " + scenes + " --baseline '" + base + "'");
   EXPECT_EQ(worse.code, 1);
-  EXPECT_NE(worse.out.find("worse: "), std::string::npos) << worse.out;
+  EXPECT_NE(worse.out.find("    worse   "), std::string::npos) << worse.out;
   fs::remove_all(dir);
 }
 
@@ -440,9 +443,9 @@ TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSinksOnTheStack) {
   fs::remove_all(dir);
 }
 
-TEST(CheckOutput, AWorseMetricShowsDistinctNumbersAndTheRelativeChange) {
+TEST(CheckOutput, AWorseMetricShowsDistinctNumbersAndTheAbsoluteChange) {
   // A baseline 1e-8 (relative) below the current value: worse by more than the 1e-9 margin, yet
-  // equal to six digits. The line must show two different numbers and the relative change.
+  // equal to six digits. The line must show two different numbers and the change.
   const fs::path dir = temp_dir("check_digits");
   const std::string base = (dir / "baseline.json").string();
   ASSERT_EQ(rbx("check scenes/seed/face_face.toml --baseline '" + base + "' --update").code, 0);
@@ -460,11 +463,101 @@ TEST(CheckOutput, AWorseMetricShowsDistinctNumbersAndTheRelativeChange) {
   const CmdResult r = rbx("check scenes/seed/face_face.toml --baseline '" + base + "'");
   EXPECT_EQ(r.code, 1);
   std::smatch m;
-  const std::regex line("worse: [^\\n]*: (\\S+) -> (\\S+) \\(([-+0-9.e]+) relative\\)");
+  // "worse   CHECK [PAIR] NAME: OLD -> NEW (+CHANGE UNIT)": as few digits as tell them apart.
+  const std::regex line("worse   [^\\n]*: (\\S+) -> (\\S+) \\(\\+([-+0-9.e]+)[^)]*\\)");
   ASSERT_TRUE(std::regex_search(r.out, m, line)) << r.out;
   EXPECT_NE(m[1].str(), m[2].str()) << r.out;
-  EXPECT_NEAR(std::stod(m[3].str()), 1e-8, 1e-10) << r.out;
+  EXPECT_GT(m[1].str().size(), 6u) << "more than 3 digits were needed: " << r.out;
+  const double old = std::stod(m[1].str()), cur = std::stod(m[2].str());
+  // The printed change is the absolute one, 1e-8 of the value (3 digits: 1 % of it).
+  EXPECT_NEAR(std::stod(m[3].str()), cur - old, 0.01 * (cur - old) + 1e-3 * 1e-8 * cur) << r.out;
+  EXPECT_NEAR(std::stod(m[3].str()) / cur, 1e-8, 1e-10) << r.out;
   fs::remove_all(dir);
+}
+
+// Default paths (scenes/, reports/baseline.json) are the repository's, wherever rbx runs from.
+TEST(CliElsewhere, DefaultPathsResolveInsideTheRepository) {
+  const fs::path dir = temp_dir("elsewhere");
+  const CmdResult here = rbx("scenes");
+  const CmdResult there = rbx_in(dir.string(), "scenes");
+  EXPECT_EQ(there.code, 0) << there.err;
+  EXPECT_EQ(there.out, here.out);
+  // The committed baseline is found from another directory (a scene path given by the caller
+  // stays the caller's).
+  const CmdResult check = rbx_in(dir.string(), "check '" RBX_SOURCE_DIR "/scenes/seed/face_face.toml'");
+  EXPECT_EQ(check.code, 0) << check.out << check.err;
+  EXPECT_NE(check.out.find("0 worse"), std::string::npos) << check.out;
+  fs::remove_all(dir);
+}
+
+// check takes --backends (it was refused as an unknown option): only those metrics compared.
+TEST(CliElsewhere, CheckTakesBackends) {
+  const CmdResult r = rbx("check scenes/seed/face_face.toml --backends custom");
+  EXPECT_EQ(r.code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("0 worse"), std::string::npos) << r.out;
+  EXPECT_EQ(rbx("check scenes/seed/face_face.toml --accept-worse").code, 2);  // needs --update
+  const CmdResult bad = rbx("check scenes/seed/face_face.toml --backends nope");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--backends: unknown backend 'nope'"), std::string::npos) << bad.err;
+}
+
+// An [expect] no selected backend can bind is "not checked", never "passed".
+TEST(CompareExpect, AnExpectationNoBackendRunCanBindIsNotChecked) {
+  const fs::path dir = temp_dir("unbound");
+  // Head-on, equal unit masses at e = 1: they swap velocities. The scene claims they stop.
+  std::ofstream(dir / "wrong.toml")
+      << "checks = [\"impulse\"]\n[[body]]\nname = \"A\"\nposition = [-1, 0, 0]\nvelocity = [1, 0, 0]\n"
+         "[[body]]\nname = \"B\"\nposition = [1, 0, 0]\nvelocity = [-1, 0, 0]\n"
+         "[expect]\ntolerance = 1e-6\n[expect.body.A]\nvelocity = [0, 0, 0]\n";
+  const std::string scene = "'" + (dir / "wrong.toml").string() + "'";
+  for (const std::string& list : {"mujoco,bullet", "fcl"}) {
+    const CmdResult r = rbx("compare " + scene + " --backends " + list + " --json -");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.find("[expect]: passed"), std::string::npos) << list << ": " << r.err;
+    EXPECT_NE(r.err.find("[expect]: not checked"), std::string::npos) << list << ": " << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out)["scenes"][0]["expect"];
+    EXPECT_FALSE(j["checked"].get<bool>()) << list;
+    EXPECT_FALSE(j["passed"].get<bool>()) << list;
+    EXPECT_FALSE(j["unchecked"].empty()) << list;
+  }
+  // With custom the same scene is checked, and fails.
+  const CmdResult bound = rbx("compare " + scene + " --backends custom --json -");
+  EXPECT_EQ(bound.code, 1);
+  EXPECT_TRUE(nlohmann::json::parse(bound.out)["scenes"][0]["expect"]["checked"].get<bool>());
+  fs::remove_all(dir);
+}
+
+TEST(CliContacts, FirstContactQueriesWhereAPairFirstTouches) {
+  // headon_e05: faces 1 m apart closing at 2 m/s touch at t = 0.5 s, step 500 of dt = 1e-3
+  // (or one step later if the round-off of 500 position updates leaves a gap of ~1e-16 m).
+  const CmdResult t0 = rbx("contacts scenes/analytic/headon_e05.toml");
+  EXPECT_NE(t0.out.find("no pair of bodies touches at t = 0"), std::string::npos) << t0.out;
+  const CmdResult r = rbx("contacts scenes/analytic/headon_e05.toml --at first-contact --json -");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const long step = j["at"]["step"].get<long>();
+  EXPECT_TRUE(step == 500 || step == 501) << step;
+  EXPECT_NEAR(j["at"]["time"].get<double>(), 0.5, 1.5e-3);
+  EXPECT_NE(r.err.find("first contact: step"), std::string::npos) << r.err;
+  // Every backend was queried there and found the face contact with normal -x.
+  for (const char* name : {"exact", "bullet", "mujoco"}) {
+    ASSERT_FALSE(j["backends"][name]["contacts"].empty()) << name;
+    EXPECT_NEAR(j["backends"][name]["contacts"][0]["normal"][0].get<double>(), -1.0, 1e-9) << name;
+  }
+  EXPECT_EQ(rbx("contacts scenes/analytic/headon_e05.toml --at never").code, 2);
+}
+
+TEST(CliContacts, DisagreementsAreFlaggedAsCompareFlagsThem) {
+  // fcl_rotated_45: fcl-indep returns the normal in A's local frame, 45 deg off (a known defect).
+  const CmdResult r = rbx("contacts scenes/contact/fcl_rotated_45.toml --backends exact,fcl-indep,ode --json -");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["disagreements"].size(), 1u) << j["disagreements"];
+  EXPECT_EQ(j["disagreements"][0].get<std::string>().rfind("fcl-indep on A-B: normal off by 45", 0), 0u)
+      << j["disagreements"];
+  EXPECT_NE(r.err.find("disagrees: fcl-indep on A-B"), std::string::npos) << r.err;
+  EXPECT_EQ(j["backends"]["fcl-indep"]["pairs"][0]["mark"], "disagrees");
+  EXPECT_EQ(j["backends"]["ode"]["pairs"][0]["mark"], "");
 }
 
 }  // namespace

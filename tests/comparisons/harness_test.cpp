@@ -96,5 +96,38 @@ TEST(Harness, WithoutATableTheRegistryIsUsed) {
   EXPECT_NO_THROW(evaluate_scene(scene, opt));
 }
 
+TEST(HarnessExpect, AnEngineRunThatStopsFailsItsExpectationAndReferencesDoNotBindIt) {
+  // Head-on equal masses, e = 1: they swap velocities (A ends at -1 m/s), as [expect] says.
+  const Scene scene = parse_scene(
+      "checks = [\"impulse\"]\n[[body]]\nname = \"A\"\nposition = [-1, 0, 0]\nvelocity = [1, 0, 0]\n"
+      "[[body]]\nname = \"B\"\nposition = [1, 0, 0]\nvelocity = [-1, 0, 0]\n"
+      "[expect]\n[expect.body.A]\nvelocity = [-1, 0, 0]\n",
+      "headon.toml");
+  HarnessOptions opt;
+  opt.sweep = false;
+  // The engine: checked and passed.
+  opt.backends = "custom";
+  SceneEvaluation ev = evaluate_scene(scene, opt);
+  EXPECT_TRUE(ev.json["expect"]["checked"].get<bool>());
+  EXPECT_TRUE(ev.json["expect"]["passed"].get<bool>()) << ev.json["expect"];
+  // An engine whose run stops early: failed, not passed and not "not checked".
+  std::vector<Backend> table = {*find_backend("custom")};
+  table[0].dynamics = [](const Scene&, const DynamicsOptions&) {
+    return DynamicsResult{Status::Error, "energy grew past the guard", {}, {}, {}};
+  };
+  opt.registry = &table;
+  ev = evaluate_scene(scene, opt);
+  EXPECT_TRUE(ev.json["expect"]["checked"].get<bool>());
+  EXPECT_FALSE(ev.json["expect"]["passed"].get<bool>());
+  ASSERT_EQ(ev.expect_failures.size(), 1u);
+  EXPECT_NE(ev.expect_failures[0].find("energy grew past the guard"), std::string::npos);
+  // Only a reference: nothing binds [expect.body].
+  opt.registry = nullptr;
+  opt.backends = "bullet";
+  ev = evaluate_scene(scene, opt);
+  EXPECT_FALSE(ev.json["expect"]["checked"].get<bool>());
+  EXPECT_FALSE(ev.json["expect"]["passed"].get<bool>());
+}
+
 }  // namespace
 }  // namespace rbx

@@ -1,0 +1,72 @@
+// On-disk cache of the reference libraries' results, so that a check after an engine-only edit
+// reruns only the engine under test.
+//
+// Design: one file per call, named by a hash of the call's fingerprint; the file holds the whole
+// fingerprint and is used only when it matches byte for byte (no hash collision can return a
+// wrong result). The fingerprint is a canonical binary serialization of everything the call
+// reads: the bodies as the adapter receives them (hull vertices and triangles, mass properties,
+// pose, velocities), the scene's [sim] settings and the call's options, plus the backend's name,
+// a hash of the adapters' sources (reference/, and the engine geometry they call, computed at
+// build time) and the libraries' versions. Values are stored bit-exact, so a cached result is
+// byte-identical to the run it came from. `custom` (and its variants) and `exact` are ours and
+// under test: never cached.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/body.h"
+#include "engine/scene.h"
+#include "reference/backend.h"
+
+namespace rbx {
+
+/// A cached result with the run time measured when it was computed (s).
+template <class Result>
+struct CachedResult {
+  Result result;
+  double runtime_s = 0.0;
+};
+
+/// The reference-result cache in one folder ("" : disabled; nothing is read or written).
+class ResultCache {
+ public:
+  /// `code`: what identifies the reference code (tests pass another to see a miss).
+  explicit ResultCache(std::string dir = "", std::string code = code_fingerprint())
+      : dir_(std::move(dir)), code_(std::move(code)) {}
+
+  /// True when results of `backend` may be cached: every backend except ours (custom*, exact).
+  static bool caches(const std::string& backend);
+  /// The folder used by `rbx check` unless --no-cache: build/cache in the build tree.
+  static std::string default_dir();
+  /// What identifies the reference code: the adapters' source hash, library versions, compiler.
+  static std::string code_fingerprint();
+
+  bool enabled() const { return !dir_.empty(); }
+
+  /// Fingerprints of the three kinds of call.
+  std::string contact_key(const std::string& backend, const RigidBody& a, const RigidBody& b) const;
+  std::string dynamics_key(const std::string& backend, const Scene& scene,
+                           const std::vector<RigidBody>& bodies, const DynamicsOptions& opt) const;
+  std::string mass_key(const std::string& backend, const RigidBody& body) const;
+
+  /// Lookups: nullopt on a miss (no file, another fingerprint, an unreadable file).
+  std::optional<CachedResult<ContactResult>> load_contact(const std::string& key) const;
+  std::optional<CachedResult<DynamicsResult>> load_dynamics(const std::string& key) const;
+  std::optional<CachedResult<MassResult>> load_mass(const std::string& key) const;
+
+  /// Stores (atomically: a temporary file renamed into place); failures to write are ignored
+  /// (the cache only saves time).
+  void store(const std::string& key, const ContactResult& r, double runtime_s) const;
+  void store(const std::string& key, const DynamicsResult& r, double runtime_s) const;
+  void store(const std::string& key, const MassResult& r, double runtime_s) const;
+
+ private:
+  std::optional<std::string> read(const std::string& key) const;
+  void write(const std::string& key, const std::string& value) const;
+  std::string dir_;
+  std::string code_;
+};
+
+}  // namespace rbx

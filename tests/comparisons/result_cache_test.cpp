@@ -1,0 +1,129 @@
+// The reference-result cache: results read back are byte-identical to an uncached run, ours
+// (custom, exact) are never cached, and a change of the reference code misses.
+#include "comparisons/eval/result_cache.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "comparisons/eval/harness.h"
+#include "comparisons/scene/scene_file.h"
+
+namespace rbx {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("rbx_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+// The evaluation without what may differ between runs: timings and the "cached" labels.
+Json without_timings(Json j) {
+  if (j.is_object()) {
+    j.erase("runtime_s");
+    j.erase("cached");
+    for (auto& [k, v] : j.items()) v = without_timings(v);
+  } else if (j.is_array()) {
+    for (auto& v : j) v = without_timings(v);
+  }
+  return j;
+}
+
+class CacheScenes : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(CacheScenes, CachedResultsAreByteIdenticalToAnUncachedRun) {
+  const fs::path dir = temp_dir("cache_identical");
+  const Scene scene = load_scene(std::string(RBX_SOURCE_DIR) + "/scenes/" + GetParam());
+  HarnessOptions opt;
+  opt.sweep = false;
+  const std::string plain = without_timings(evaluate_scene(scene, opt).json).dump();
+  opt.cache_dir = dir.string();
+  const SceneEvaluation cold = evaluate_scene(scene, opt);  // fills the cache
+  const SceneEvaluation warm = evaluate_scene(scene, opt);  // reads it
+  EXPECT_EQ(without_timings(cold.json).dump(), plain);
+  EXPECT_EQ(without_timings(warm.json).dump(), plain);
+  int cached = 0;
+  for (const auto& [name, bj] : warm.json["backends"].items()) {
+    if (!ResultCache::caches(name)) {
+      EXPECT_FALSE(bj.contains("cached")) << name << ": ours, under test, never cached";
+    } else if (bj.value("cached", false)) {
+      ++cached;
+    }
+    EXPECT_FALSE(cold.json["backends"][name].contains("cached")) << name;
+  }
+  EXPECT_GT(cached, 0) << "no reference result came from the cache";
+  fs::remove_all(dir);
+}
+
+// Contact, impact with a closed form, trajectory, mass and stability scenes.
+INSTANTIATE_TEST_SUITE_P(Library, CacheScenes,
+                         ::testing::Values("contact/fcl_rotated_45.toml", "analytic/headon_e05.toml",
+                                           "seed/edge_drop.toml", "mass/box_1x2x3.toml",
+                                           "stress/resting_stack.toml"));
+
+TEST(ResultCache, OursAreNeverCached) {
+  EXPECT_FALSE(ResultCache::caches("custom"));
+  EXPECT_FALSE(ResultCache::caches("custom-seed"));
+  EXPECT_FALSE(ResultCache::caches("exact"));
+  EXPECT_TRUE(ResultCache::caches("bullet"));
+}
+
+TEST(ResultCache, AnotherReferenceCodeOrOtherInputsMiss) {
+  const fs::path dir = temp_dir("cache_code");
+  const Scene scene = parse_scene(
+      "[[body]]\nname = \"A\"\n[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n", "pair.toml");
+  const std::vector<RigidBody> bodies = make_bodies(scene);
+  const ResultCache before(dir.string(), "adapters 1111"), after(dir.string(), "adapters 2222");
+  ContactResult r{Status::Ok, "note", {ContactPoint{Vec3(0.45, 0, 0), Vec3(-1, 0, 0), 0.1, "face"}}};
+  before.store(before.contact_key("fcl", bodies[0], bodies[1]), r, 1.5e-6);
+  const auto hit = before.load_contact(before.contact_key("fcl", bodies[0], bodies[1]));
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->runtime_s, 1.5e-6);
+  ASSERT_EQ(hit->result.contacts.size(), 1u);
+  EXPECT_EQ(hit->result.contacts[0].depth, 0.1);
+  EXPECT_EQ(hit->result.message, "note");
+  // An edited adapter (another source hash), another backend, other bodies: misses.
+  EXPECT_FALSE(after.load_contact(after.contact_key("fcl", bodies[0], bodies[1])));
+  EXPECT_FALSE(before.load_contact(before.contact_key("bullet", bodies[0], bodies[1])));
+  std::vector<RigidBody> moved = bodies;
+  moved[1].position.x() = std::nextafter(0.9, 1.0);
+  EXPECT_FALSE(before.load_contact(before.contact_key("fcl", moved[0], moved[1])));
+  // A truncated file is a miss, not a crash.
+  for (const auto& e : fs::directory_iterator(dir)) fs::resize_file(e.path(), fs::file_size(e.path()) - 3);
+  EXPECT_FALSE(before.load_contact(before.contact_key("fcl", bodies[0], bodies[1])));
+  fs::remove_all(dir);
+}
+
+// The build-time half: the source hash (comparisons/hash_sources.cmake) changes with one byte
+// of an adapter, so an edited adapter's cached results are never used.
+TEST(ResultCache, EditingAnAdapterChangesTheSourceHash) {
+  const fs::path dir = temp_dir("cache_hash");
+  std::ofstream(dir / "fcl.cpp") << "int answer() { return 42; }\n";
+  std::ofstream(dir / "ode.cpp") << "int other() { return 1; }\n";
+  const auto hash = [&] {
+    const std::string cmd = "cmake -DOUT='" + (dir / "h.h").string() + "' '-DFILES=" +
+                            (dir / "fcl.cpp").string() + "|" + (dir / "ode.cpp").string() +
+                            "' -DROOT='" + dir.string() + "' -P '" RBX_SOURCE_DIR
+                            "/comparisons/hash_sources.cmake'";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    std::ifstream in(dir / "h.h");
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string first = hash();
+  ASSERT_NE(first.find("RBX_REFERENCE_SOURCE_HASH"), std::string::npos) << first;
+  EXPECT_EQ(hash(), first);  // deterministic
+  std::ofstream(dir / "fcl.cpp") << "int answer() { return 43; }\n";
+  EXPECT_NE(hash(), first);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rbx
