@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -35,6 +36,7 @@ struct DynRun {
   double runtime_s = 0.0;
   double dt = 0.0;
   bool cached = false;  // from the reference-result cache
+  std::string cache_key;  // the run's cache key ("" : not cacheable)
 };
 
 // A reference backend's run comes from the cache when it holds this very call (the bodies as
@@ -47,6 +49,7 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
   const std::string key = cacheable ? cache.dynamics_key(b.name, scene, bodies,
                                                                 DynamicsOptions{dt, sample_every})
                                     : std::string();
+  run.cache_key = key;
   if (cacheable)
     if (auto hit = cache.load_dynamics(key)) {
       run.result = std::move(hit->result);
@@ -702,7 +705,15 @@ class Evaluator {
       for (const BodyFinal& b : samples[t].bodies)
         if (!b.position.allFinite() || !b.velocity.allFinite() || !b.angular_velocity.allFinite())
           finite_samples = t;
-    const std::vector<double> overlaps = parallel_map(finite_samples, [&](size_t t) { return deepest_overlap(samples[t]); });
+    // A cached reference run's overlaps are cached with it (they cost more than the run).
+    std::optional<std::vector<double>> stored;
+    if (!run.cache_key.empty()) stored = cache_.load_derived(run.cache_key, "stability overlaps");
+    const std::vector<double> overlaps =
+        stored && stored->size() == finite_samples
+            ? *stored
+            : parallel_map(finite_samples, [&](size_t t) { return deepest_overlap(samples[t]); });
+    if (!run.cache_key.empty() && !(stored && stored->size() == finite_samples))
+      cache_.store_derived(run.cache_key, "stability overlaps", overlaps);
     // "At rest": the last fifth of the run, as for the jitter below.
     const size_t rest_from = samples.size() * 4 / 5;
     size_t sample_index = 0;

@@ -10,7 +10,8 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "reference_source_hash.h"  // generated at build time: RBX_REFERENCE_SOURCE_HASH
+#include "evaluation_source_hash.h"  // generated at build time: RBX_EVALUATION_SOURCE_HASH
+#include "reference_source_hash.h"   // generated at build time: RBX_REFERENCE_SOURCE_HASH
 
 namespace rbx {
 
@@ -331,6 +332,39 @@ void ResultCache::store(const std::string& key, const DynamicsResult& d, double 
     for (const BodyFinal& f : s.bodies) put_final(w, f);
   }
   write(key, w.str());
+}
+
+namespace {
+std::string derived_key(const std::string& run_key, const std::string& what) {
+  Writer w;
+  w.put(run_key);
+  w.put("derived");
+  w.put(RBX_EVALUATION_SOURCE_HASH);
+  w.put(what);
+  return w.str();
+}
+}  // namespace
+
+std::optional<std::vector<double>> ResultCache::load_derived(const std::string& run_key,
+                                                             const std::string& what) const {
+  const auto c = decode<std::vector<double>>(read(derived_key(run_key, what)), [](Reader& r, std::vector<double>& v) {
+    long n;
+    r.get(n);
+    if (n < 0) throw std::runtime_error("bad count");
+    v.resize(n);
+    for (double& x : v) r.get(x);
+  });
+  if (!c) return std::nullopt;
+  return c->result;
+}
+
+void ResultCache::store_derived(const std::string& run_key, const std::string& what,
+                                const std::vector<double>& v) const {
+  Writer w;
+  w.put(0.0);  // no run time: derived numbers
+  w.put(static_cast<long>(v.size()));
+  for (double x : v) w.put(x);
+  write(derived_key(run_key, what), w.str());
 }
 
 std::optional<CachedResult<MassResult>> ResultCache::load_mass(const std::string& key) const {
