@@ -47,6 +47,22 @@ inline ContactResult reject_undefined_normals(ContactResult r, const std::string
   return r;
 }
 
+/// True when a library's native box primitive describes the body exactly: a box body (full
+/// extents `box_size`, axes the body axes) whose centre is its centre of mass (true for both mass
+/// models, up to round-off; checked so a shifted box falls back to its hull) and whose inertia
+/// is diagonal in its body axes (so a library storing principal moments needs no rotation).
+/// The one place every adapter decides "native box or hull".
+inline bool is_native_box(const RigidBody& body) {
+  if (body.shape_kind != "box") return false;
+  // Round-off of the centre of mass and of the inertia integrals: 1e-12 of the size / trace.
+  const double size = body.box_size.norm();
+  const Mat3& inertia = body.inertia_body;
+  const double off_diagonal = std::abs(inertia(0, 1)) + std::abs(inertia(0, 2)) +
+                              std::abs(inertia(1, 2));
+  return body.shape->bounds().center().norm() <= 1e-12 * size &&
+         off_diagonal <= 1e-12 * std::abs(inertia.trace());
+}
+
 /// Final state of one body after a dynamics run.
 struct BodyFinal {
   std::string name;
