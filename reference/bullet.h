@@ -11,7 +11,8 @@ namespace rbx {
 /// measured against its alternatives in tests/reference/fair_settings_test.cpp.
 struct BulletSettings {
   bool native_boxes = true;      // btBoxShape for is_native_box bodies; false: every body a hull
-  bool polyhedral_hulls = true;  // initializePolyhedralFeatures + m_enableSatConvex (manifolds)
+  bool polyhedral_hulls = true;  // initializePolyhedralFeatures: hulls clipped (manifolds)
+  bool sat_convex = false;       // polyhedral hulls: the axis by SAT (false: by GJK + EPA)
   double box_margin = 0.04;      // m, btBoxShape's margin (inside the box: extents unchanged)
   double hull_margin = 0.0;      // m, btConvexHullShape's margin (outside the hull: inflates it)
   bool fair_world = true;        // the solver settings below; false: Bullet's defaults throughout
@@ -20,13 +21,14 @@ struct BulletSettings {
   double processing_threshold = 0.0;       // m; contacts solved once closer than this
 };
 
-/// `bullet`: native boxes, polyhedral hulls with SAT, zero hull margin, the fair world.
+/// `bullet`: native boxes, polyhedral hulls (GJK + EPA axis, clipped manifold), zero hull
+/// margin, the fair world.
 BulletSettings bullet_native_settings();
 /// `bullet-hull`: every body a zero-margin btConvexHullShape through GJK + EPA, the fair world.
 BulletSettings bullet_hull_settings();
 
-/// `bullet`: contactPairTest on the native shapes (box-box: btBoxBoxDetector; otherwise SAT +
-/// clipping on the polyhedral hulls).
+/// `bullet`: contactPairTest on the native shapes (box-box: btBoxBoxDetector; otherwise the
+/// polyhedral hulls clipped against each other about the GJK + EPA axis).
 ContactResult bullet_contact(const RigidBody& a, const RigidBody& b);
 /// `bullet-hull`: btConvexHullShape (margin 0) pair through GJK + EPA, one point.
 ContactResult bullet_hull_contact(const RigidBody& a, const RigidBody& b);

@@ -6,6 +6,8 @@
 // dynamics because 2.2.2's box-box collider reports half the depth; otherwise mesh geoms with
 // multi-point convex collision (mjENBL_MULTICCD). Box geoms only when all are boxes: a box-mesh
 // pair runs MPR at the full depth, so one global stiffness factor would be wrong for it.
+// Contact queries of `mujoco` use the multiccd meshes for every body (the halved box-box depth
+// would be passed on as a wrong answer, and no stiffness makes up for it there).
 //
 // The model is written as MJCF text into MuJoCo's virtual file system and compiled with
 // mj_loadXML. Three MuJoCo habits need care:
@@ -494,7 +496,12 @@ MujocoSettings mujoco_hull_settings() {
 }
 
 ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b) {
-  return mujoco_contact_with(a, b, MujocoSettings{});
+  // Contact queries take meshes with multiccd even for boxes: box geoms report half the depth
+  // (0.05 for a true 0.1), the meshes the full depth to float precision. Only the dynamics,
+  // whose stiffness can make up for the halving, use box geoms.
+  MujocoSettings s;
+  s.box_geoms = false;
+  return mujoco_contact_with(a, b, s);
 }
 
 ContactResult mujoco_hull_contact(const RigidBody& a, const RigidBody& b) {

@@ -1,6 +1,6 @@
-// MuJoCo 2.2.2: box geoms or meshes with multi-point collision (`mujoco`), or one mesh geom per
-// hull (`mujoco-hull`); contacts from mj_forward, stepping with restitution mapped to a
-// negative solref.
+// MuJoCo 2.2.2: box geoms (dynamics) or meshes with multi-point collision (`mujoco`), or one
+// mesh geom per hull (`mujoco-hull`); contacts from mj_forward, stepping with restitution mapped
+// to a negative solref.
 #pragma once
 
 #include "reference/backend.h"
@@ -18,7 +18,8 @@ struct MujocoSettings {
 /// `mujoco-hull`: every body a mesh geom, single-point MPR.
 MujocoSettings mujoco_hull_settings();
 
-/// `mujoco`: contacts from mj_forward on box geoms (all-box pairs) or meshes with multiccd.
+/// `mujoco`: contacts from mj_forward on mesh geoms with multiccd (boxes too: MuJoCo 2.2.2's box
+/// geoms report half the depth).
 ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b);
 /// `mujoco-hull`: contacts of mesh geoms from mj_forward.
 ContactResult mujoco_hull_contact(const RigidBody& a, const RigidBody& b);

@@ -36,7 +36,7 @@ const std::vector<Backend>& backends() {
       {"fcl-epa", "FCL 0.7 signed distance (GJK + EPA)", fcl_epa_contact, nullptr},
       {"fcl-indep", "FCL 0.7 Convex, GST_INDEP (known defects shown)", fcl_indep_contact, nullptr},
       {"libccd", "libccd 2.1 on our support function: MPR and GJK + EPA", libccd_contact, nullptr},
-      {"bullet", "Bullet 3.24 double: btBoxShape (box-box) or polyhedral hull (SAT); fair world",
+      {"bullet", "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
        bullet_contact, bullet_dynamics, bullet_mass},
       {"bullet-hull", "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",
        bullet_hull_contact, bullet_hull_dynamics, bullet_hull_mass},
