@@ -349,7 +349,13 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
     };
     if (opt.sample_every > 0) sample(0.0);
 
+    std::vector<BodyFinal> before;  // states before the step, until the first impulse
     for (long k = 0; k < steps; ++k) {
+      const size_t events_before = result.events.size();
+      if (!result.first_impulse.seen) {
+        before.clear();
+        for (size_t i = 0; i < bodies.size(); ++i) before.push_back(final_state(names[i], bodies[i]));
+      }
       // One internal step of exactly dt (maxSubSteps = 0: no fixed 1/60 s sub-stepping and no
       // interpolated motion states).
       world.stepSimulation(dt, 0, dt);
@@ -386,6 +392,12 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
           result.events.push_back(ev);
         }
       }
+
+      // The first impulse: one event per manifold point, so the count is the events'.
+      if (!result.first_impulse.seen && result.events.size() > events_before)
+        result.first_impulse = first_impulse_of(
+            {result.events.begin() + static_cast<long>(events_before), result.events.end()}, before,
+            dt);
 
       // A non-finite state is an error, not a result.
       for (size_t i = 0; i < bodies.size(); ++i) {

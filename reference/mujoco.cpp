@@ -551,7 +551,7 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
                                     const MujocoSettings& settings) {
   DynamicsResult r;
   const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
-  if (!(dt > 0.0)) return {Status::Error, "MuJoCo: time step must be > 0", {}, {}, {}};
+  if (!(dt > 0.0)) return {Status::Error, "MuJoCo: time step must be > 0", {}, {}, {}, {}};
   const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
   std::vector<RigidBody> bodies;
   bodies.reserve(scene.bodies.size());
@@ -601,8 +601,14 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
   // at its first step with a pushing force; the impulse sums force * dt over the episode.
   std::map<std::pair<int, int>, size_t> open_episode;  // pair -> index in r.events
   t_warning[0] = '\0';
+  std::vector<BodyFinal> before;  // states before the step, until the first impulse
   for (long step = 0; step < steps; ++step) {
     if (opt.sample_every > 0 && step % opt.sample_every == 0) sample(step * dt);
+    const size_t events_before = r.events.size();
+    if (!r.first_impulse.seen) {
+      before.clear();
+      for (size_t i = 0; i < bodies.size(); ++i) before.push_back(read_state(mc, dd, bodies[i], i));
+    }
     if (!guarded([&] { mj_step(mc, dd); })) {
       r.status = Status::Error;
       r.message = "MuJoCo mj_step at step " + std::to_string(step) + ": " + t_error;
@@ -615,6 +621,8 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
     }
     // d->contact and efc_force describe the state at the start of this step.
     std::map<std::pair<int, int>, size_t> still_open;
+    std::map<std::pair<int, int>, int> points;     // pushing contacts per pair this step
+    std::map<std::pair<int, int>, double> deepest;  // m, per pair this step
     for (int c = 0; c < dd->ncon; ++c) {
       const mjContact& con = dd->contact[c];
       if (con.efc_address < 0) continue;
@@ -625,24 +633,39 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
       const int g1 = scene_of_geom[con.geom1], g2 = scene_of_geom[con.geom2];
       const int ia = std::min(g1, g2), ib = std::max(g1, g2);
       const std::pair<int, int> key{ia, ib};
-      auto it = open_episode.find(key);
+      // The pair's episode: opened by another of its contact points this step (a multi-point
+      // manifold is one episode, not one per point), open since an earlier step, or new.
       size_t idx;
-      if (it == open_episode.end()) {
+      if (auto in_step = still_open.find(key); in_step != still_open.end()) {
+        idx = in_step->second;
+      } else if (auto earlier = open_episode.find(key); earlier != open_episode.end()) {
+        idx = earlier->second;
+      } else {
         CollisionEvent ev;
         ev.time = step * dt;
         ev.step = step;
         ev.body_a = bodies[ia].name;
         ev.body_b = bodies[ib].name;
         ev.contact = convert_contact(con, g1 == ia);
+        ev.contact.feature = mo.box_geoms ? "box-box" : "mesh";
         r.events.push_back(ev);
         idx = r.events.size() - 1;
-      } else {
-        idx = it->second;
       }
       r.events[idx].impulse += force * dt;
       still_open[key] = idx;
+      ++points[key];
+      deepest[key] = std::max(deepest[key], -con.dist);
     }
     open_episode = std::move(still_open);
+    // The first impulse: the episode's event holds one contact; count and depth are the step's.
+    if (!r.first_impulse.seen && r.events.size() > events_before) {
+      const CollisionEvent& first = r.events[events_before];
+      std::pair<int, int> key{-1, -1};
+      for (const auto& [k, idx] : open_episode)
+        if (idx == events_before) key = k;
+      r.first_impulse = first_impulse_of({first}, before, dt, points[key]);
+      r.first_impulse.depth = deepest[key];
+    }
   }
   if (opt.sample_every > 0 && steps % opt.sample_every == 0) sample(steps * dt);
 

@@ -384,7 +384,7 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
   init_ode();
   DynamicsResult r;
   const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
-  if (!(dt > 0.0)) return {Status::Error, "ODE: time step must be > 0", {}, {}, {}};
+  if (!(dt > 0.0)) return {Status::Error, "ODE: time step must be > 0", {}, {}, {}, {}};
   const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
   std::vector<RigidBody> bodies;
   bodies.reserve(scene.bodies.size());
@@ -460,8 +460,14 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
   t_warning[0] = '\0';
   t_message_count = 0;
   long first_message_step = -1;
+  std::vector<BodyFinal> before;  // states before the step, until the first impulse
   for (long step = 0; step < steps; ++step) {
     if (opt.sample_every > 0 && step % opt.sample_every == 0) sample(step * dt);
+    const size_t events_before = r.events.size();
+    if (!r.first_impulse.seen) {
+      before.clear();
+      for (size_t i = 0; i < bodies.size(); ++i) before.push_back(read_state(bodies[i], ode_bodies[i]));
+    }
     ctx.contacts.clear();
     ctx.feedback.clear();
     CollideContext* c = &ctx;
@@ -515,6 +521,15 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
       ev.contact.point /= pair_points[key];
       if (ev.contact.normal.norm() > 0.0) ev.contact.normal.normalize();
       r.events.push_back(ev);
+    }
+    // The first impulse: ODE's events merge a pair's points, so the count is ODE's own.
+    if (!r.first_impulse.seen && r.events.size() > events_before) {
+      const CollisionEvent& first = r.events[events_before];
+      int points = 0;
+      for (const StepContact& sc : ctx.contacts)
+        if (bodies[sc.a].name == first.body_a && bodies[sc.b].name == first.body_b) ++points;
+      r.first_impulse = first_impulse_of({first}, before, dt, points);
+      // The deepest of the pair's points (the event keeps the largest depth already).
     }
     dJointGroupEmpty(w.contacts);
   }

@@ -554,5 +554,46 @@ TEST(FairReferences, OneHelperDecidesWhatIsABox) {
   EXPECT_FALSE(is_native_box(shifted));
 }
 
+TEST(FairReferences, FirstImpulseRecordsWhatEachLibrarySaw) {
+  // headon_e05: the 1 m gap closes at 2 m/s exactly at t = 0.5 s, a step boundary, so the
+  // contact is first seen touching (depth round-off, phase ~0), closing at 2 m/s, normal -x
+  // (from B toward A). Native boxes see the 4-corner face; the hulls one point.
+  const Case c = box_cases()[0];
+  struct Row {
+    const char* name;
+    DynamicsResult r;
+    int min_points, max_points;
+  };
+  const Row rows[] = {{"custom", find_backend("custom")->dynamics(c.scene, {}), 1, 1},
+                      {"bullet", bullet_dynamics(c.scene, {}), 4, 5},
+                      {"bullet-hull", bullet_hull_dynamics(c.scene, {}), 1, 1},
+                      {"ode", ode_dynamics(c.scene, {}), 4, 4},
+                      {"ode-hull", ode_hull_dynamics(c.scene, {}), 1, 1},
+                      {"mujoco", mujoco_dynamics(c.scene, {}), 2, 8},
+                      {"mujoco-hull", mujoco_hull_dynamics(c.scene, {}), 1, 1}};
+  for (const Row& row : rows) {
+    const FirstImpulse& f = row.r.first_impulse;
+    std::printf("[measured] first impulse %-12s points %d normal (%.3g %.3g %.3g) depth %.3g "
+                "approach %.6g phase %.3g step %ld\n",
+                row.name, f.contact_points, f.normal.x(), f.normal.y(), f.normal.z(), f.depth,
+                f.approach_speed, f.entry_phase, f.step);
+    ASSERT_TRUE(f.seen) << row.name;
+    EXPECT_EQ(f.body_a, "A") << row.name;
+    EXPECT_EQ(f.body_b, "B") << row.name;
+    EXPECT_GE(f.contact_points, row.min_points) << row.name;
+    EXPECT_LE(f.contact_points, row.max_points) << row.name;
+    // Detected at the start of step 500 or, for libraries that wait for overlap, the next.
+    EXPECT_GE(f.step, 499) << row.name;
+    EXPECT_LE(f.step, 501) << row.name;
+    // Closing at 2 m/s before the impact; at most v dt = 2 mm deep when first seen.
+    EXPECT_NEAR(f.approach_speed, 2.0, 1e-6) << row.name;
+    EXPECT_LE(f.depth, 2e-3 + kExact) << row.name;
+  }
+  // Seen touching, every path has the true normal (bullet-hull's diagonal EPA normal comes
+  // only once the cubes overlap, after this first impulse).
+  for (const Row& row : rows)
+    EXPECT_LT((row.r.first_impulse.normal - Vec3(-1, 0, 0)).norm(), 1e-6) << row.name;
+}
+
 }  // namespace
 }  // namespace rbx
