@@ -6,6 +6,7 @@
 // Conventions are converted here and nowhere else; a library's wrong answers are passed on.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <string>
@@ -47,6 +48,22 @@ inline ContactResult reject_undefined_normals(ContactResult r, const std::string
   return r;
 }
 
+/// True when a library's native box primitive describes the body exactly: a box body (full
+/// extents `box_size`, axes the body axes) whose centre is its centre of mass (true for both mass
+/// models, up to round-off; checked so a shifted box falls back to its hull) and whose inertia
+/// is diagonal in its body axes (so a library storing principal moments needs no rotation).
+/// The one place every adapter decides "native box or hull".
+inline bool is_native_box(const RigidBody& body) {
+  if (body.shape_kind != ShapeKind::Box) return false;
+  // Round-off of the centre of mass and of the inertia integrals: 1e-12 of the size / trace.
+  const double size = body.box_size.norm();
+  const Mat3& inertia = body.inertia_body;
+  const double off_diagonal = std::abs(inertia(0, 1)) + std::abs(inertia(0, 2)) +
+                              std::abs(inertia(1, 2));
+  return body.shape->bounds().center().norm() <= 1e-12 * size &&
+         off_diagonal <= 1e-12 * std::abs(inertia.trace());
+}
+
 /// Final state of one body after a dynamics run.
 struct BodyFinal {
   std::string name;
@@ -62,6 +79,20 @@ struct StateSample {
   std::vector<BodyFinal> bodies;
 };
 
+/// What a dynamics run's first contact impulse saw, so that a backend's error can be explained
+/// from measurement (one point or a manifold, the normal, how deep the contact was first seen).
+/// Filled by each adapter at the first step that applied an impulse.
+struct FirstImpulse {
+  bool seen = false;                 // false: no impulse in the run
+  std::string body_a, body_b;        // the pair, in scene order
+  long step = -1;                    // the step whose start-of-step poses detected it
+  int contact_points = 0;            // points the library solved for the pair in that step
+  Vec3 normal = Vec3::Zero();        // unit, from B toward A (mean over the points)
+  double depth = 0.0;                // m, deepest point at detection
+  double approach_speed = 0.0;       // m/s, closing normal speed before the step (>= 0)
+  double entry_phase = -1.0;         // depth / (approach_speed * dt); -1: not closing
+};
+
 /// Result of a dynamics run over a whole scene.
 struct DynamicsResult {
   Status status = Status::Ok;
@@ -69,7 +100,45 @@ struct DynamicsResult {
   std::vector<CollisionEvent> events;  // as resolved by the backend (may be empty if unknown)
   std::vector<BodyFinal> finals;       // same order as scene.bodies
   std::vector<StateSample> samples;    // filled when `sample_every` > 0
+  FirstImpulse first_impulse;          // what the first impulse saw
 };
+
+/// The first impulse of a run from the events one step added (`step_events`: those of the
+/// first event's pair count) and every body's state before that step (`before`, matched by
+/// name). `points` >= 0 overrides the point count where a library's events aggregate points.
+inline FirstImpulse first_impulse_of(const std::vector<CollisionEvent>& step_events,
+                                     const std::vector<BodyFinal>& before, double dt,
+                                     int points = -1) {
+  FirstImpulse f;
+  if (step_events.empty()) return f;
+  const CollisionEvent& first = step_events.front();
+  f.seen = true;
+  f.body_a = first.body_a;
+  f.body_b = first.body_b;
+  f.step = first.step;
+  Vec3 normal = Vec3::Zero(), point = Vec3::Zero();
+  int count = 0;
+  for (const CollisionEvent& ev : step_events) {
+    if (ev.body_a != f.body_a || ev.body_b != f.body_b) continue;
+    normal += ev.contact.normal;
+    point += ev.contact.point;
+    f.depth = std::max(f.depth, ev.contact.depth);
+    ++count;
+  }
+  f.contact_points = points >= 0 ? points : count;
+  if (normal.norm() > 0) f.normal = normal.normalized();
+  point /= count;
+  // Relative velocity of the two material points at the contact point, before the step.
+  auto point_velocity = [&](const std::string& name) {
+    for (const BodyFinal& b : before)
+      if (b.name == name) return Vec3(b.velocity + b.angular_velocity.cross(point - b.position));
+    return Vec3(Vec3::Zero());
+  };
+  const double closing = -(point_velocity(f.body_a) - point_velocity(f.body_b)).dot(f.normal);
+  f.approach_speed = std::max(0.0, closing);
+  if (f.approach_speed * dt > 0) f.entry_phase = f.depth / (f.approach_speed * dt);
+  return f;
+}
 
 /// Options for a dynamics run.
 struct DynamicsOptions {

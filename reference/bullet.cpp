@@ -1,16 +1,25 @@
 // Bullet 3.24, double build (BT_USE_DOUBLE_PRECISION from `pkg-config bullet-float64`).
 //
-// Contact queries: two btConvexHullShape built from the engine's body-frame hull vertices with
-// margin 0 (a margin inflates the shape by that much), one btCollisionObject each at the body's
-// pose, and btCollisionWorld::contactPairTest. Without polyhedral features the convex-convex
-// algorithm runs GJK and, on overlap, EPA (`bullet`: one point); with
-// initializePolyhedralFeatures it finds the axis by SAT and clips the hulls against each other
-// (`bullet-sat`: a manifold of several points).
+// Shapes (BulletSettings, each choice measured in tests/reference/fair_settings_test.cpp):
+//  - `bullet`: a box body is a btBoxShape (Bullet's own margin, which sits inside the box, so
+//    its extents are exact); two boxes then meet in btBoxBoxCollisionAlgorithm (the ODE-derived
+//    box-box detector, up to 4 points). Any other body is a btConvexHullShape with
+//    initializePolyhedralFeatures: the axis by GJK + EPA, then the hulls clipped against each
+//    other (a manifold of several points). Not m_enableSatConvex: with the axis by SAT two
+//    face-to-face hexagonal prisms came out spinning (velocity error 0.26 against 7e-16).
+//    Margin 0: a hull's margin lies outside it and inflates it.
+//  - `bullet-hull`: every body a zero-margin btConvexHullShape without polyhedral features:
+//    GJK and, on overlap, EPA, one point: the input every other backend gets.
+//  - `bullet-sat`: every body (boxes too) a polyhedral hull, the axis by SAT
+//    (m_enableSatConvex), then clipping.
+// Contact queries put one btCollisionObject per body at its pose and call
+// btCollisionWorld::contactPairTest.
 //
 // Known wrong answer, passed on (pinned in tests/reference/bullet_test.cpp): when the hulls have
 // coplanar side faces (two equal axis-aligned cubes offset along one axis), EPA
 // (btGjkEpaSolver2::Penetration) returns a diagonal normal and depth 0.1/sqrt(3) for a true
-// 0.1 along x. The fair world meets it too, since it solves contacts only after overlap.
+// 0.1 along x. The `bullet-hull` world meets it too, since it solves contacts only after
+// overlap; `bullet` does not (box-box detector).
 //
 // Dynamics: btDiscreteDynamicsWorld with the settings of REFERENCES.md that turn it into a fair
 // single-impulse reference; each setting carries its reason where it is made.
@@ -56,18 +65,49 @@ Mat3 from_bt_basis(const btMatrix3x3& m) {
   return r;
 }
 
-/// Zero-margin hull of `vertices` mapped by `frame` (shape frame <- body frame). With
-/// `polyhedral`, Bullet also builds its face/edge structure so the clipping path runs.
+/// Hull of `vertices` mapped by `frame` (shape frame <- body frame), with collision margin
+/// `margin` (m). With `polyhedral`, Bullet also builds its face/edge structure so the SAT and
+/// clipping path runs.
 std::unique_ptr<btConvexHullShape> make_hull(const std::vector<Vec3>& vertices, const Mat3& frame,
-                                             bool polyhedral) {
+                                             bool polyhedral, double margin = 0.0) {
   auto hull = std::make_unique<btConvexHullShape>();
   // Margin first: recalcLocalAabb pads the cached box by the current margin.
-  hull->setMargin(0.0);
+  hull->setMargin(margin);
   for (const Vec3& v : vertices) hull->addPoint(to_bt(Vec3(frame * v)), false);
   hull->recalcLocalAabb();
   if (polyhedral && !hull->initializePolyhedralFeatures())
     throw std::runtime_error("btConvexHullShape::initializePolyhedralFeatures failed");
   return hull;
+}
+
+/// True when `body` becomes a btBoxShape under `settings`.
+bool native_box(const RigidBody& body, const BulletSettings& settings) {
+  return settings.native_boxes && is_native_box(body);
+}
+
+/// The body's Bullet shape: a btBoxShape in the body axes (`frame` is then ignored: the caller
+/// keeps a box in its body axes) or a hull of its vertices mapped by `frame`.
+std::unique_ptr<btConvexShape> make_shape(const RigidBody& body, const Mat3& frame,
+                                          const BulletSettings& settings) {
+  if (!native_box(body, settings))
+    return make_hull(body.shape->vertices(), frame, settings.polyhedral_hulls,
+                     settings.hull_margin);
+  // The constructor keeps Bullet's default margin (0.04 m), lowered to a tenth of the smallest
+  // half extent for small boxes (setSafeMargin); the margin is inside the box either way.
+  auto box = std::make_unique<btBoxShape>(to_bt(0.5 * body.box_size));
+  if (settings.box_margin >= 0) box->setMargin(settings.box_margin);
+  // Polyhedral features let a box meet a polyhedral hull through SAT (box-box pairs use the
+  // box-box algorithm whatever this says).
+  if (settings.polyhedral_hulls && !box->initializePolyhedralFeatures())
+    throw std::runtime_error("btBoxShape::initializePolyhedralFeatures failed");
+  return box;
+}
+
+/// Label of the contact path a pair takes.
+const char* pair_feature(bool box_a, bool box_b, const BulletSettings& settings) {
+  if (box_a && box_b) return "box-box";
+  if (!settings.polyhedral_hulls) return "gjk-epa";
+  return settings.sat_convex ? "sat-clip" : "gjk-clip";
 }
 
 /// Bullet transform of a body whose shape is expressed in `frame` axes: world = R * frame^T.
@@ -122,21 +162,22 @@ struct QueryContext {
   btCollisionWorld world{&dispatcher, &broadphase, &configuration};
 };
 
-ContactResult pair_query(const RigidBody& a, const RigidBody& b, bool polyhedral) {
+ContactResult pair_query(const RigidBody& a, const RigidBody& b, const BulletSettings& settings) {
   try {
     thread_local QueryContext ctx;
     const Mat3 identity = Mat3::Identity();
-    auto hull_a = make_hull(a.shape->vertices(), identity, polyhedral);
-    auto hull_b = make_hull(b.shape->vertices(), identity, polyhedral);
+    auto hull_a = make_shape(a, identity, settings);
+    auto hull_b = make_shape(b, identity, settings);
     btCollisionObject obj_a, obj_b;
     obj_a.setCollisionShape(hull_a.get());
     obj_b.setCollisionShape(hull_b.get());
     obj_a.setWorldTransform(body_transform(a, identity));
     obj_b.setWorldTransform(body_transform(b, identity));
     // With polyhedral features the algorithm takes its axis from SAT when m_enableSatConvex is
-    // set, otherwise from GJK/EPA before clipping; `bullet-sat` is the SAT variant.
-    ctx.world.getDispatchInfo().m_enableSatConvex = polyhedral;
-    PairCallback callback(&obj_a, polyhedral ? "sat-clip" : "gjk-epa");
+    // set, otherwise from GJK/EPA before clipping.
+    ctx.world.getDispatchInfo().m_enableSatConvex = settings.polyhedral_hulls && settings.sat_convex;
+    PairCallback callback(&obj_a, pair_feature(native_box(a, settings), native_box(b, settings),
+                                               settings));
     ctx.world.contactPairTest(&obj_a, &obj_b, callback);
     return {Status::Ok, "", std::move(callback.contacts)};
   } catch (const std::exception& e) {
@@ -147,10 +188,11 @@ ContactResult pair_query(const RigidBody& a, const RigidBody& b, bool polyhedral
 // ---------------------------------------------------------------------------------------------
 // Dynamics
 
-/// One scene body in Bullet: the hull in the principal frame of its inertia.
+/// One scene body in Bullet: its shape in the principal frame of its inertia.
 struct BulletBody {
   Mat3 principal = Mat3::Identity();  // Q: principal axes (columns) in body axes, det +1
-  std::unique_ptr<btConvexHullShape> shape;
+  bool box = false;                   // a btBoxShape
+  std::unique_ptr<btConvexShape> shape;
   std::unique_ptr<btRigidBody> body;
 };
 
@@ -181,10 +223,12 @@ BodyFinal final_state(const std::string& name, const BulletBody& bb) {
   return f;
 }
 
-/// Runs the scene in a btDiscreteDynamicsWorld. `fair`: the single-impulse settings of
-/// REFERENCES.md; otherwise Bullet's defaults for the world, solver and bodies (the scene's
-/// hulls, masses, inertia, restitution and gravity are used either way).
-DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt, bool fair) {
+/// Runs the scene in a btDiscreteDynamicsWorld. `settings.fair_world`: the single-impulse
+/// settings of REFERENCES.md; otherwise Bullet's defaults for the world, solver and bodies (the
+/// scene's shapes, masses, inertia, restitution and gravity are used either way).
+DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
+                         const BulletSettings& settings) {
+  const bool fair = settings.fair_world;
   DynamicsResult result;
   try {
     const double dt = opt.dt > 0 ? opt.dt : scene.sim.dt;  // s
@@ -198,18 +242,20 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt, bool fa
     btDbvtBroadphase broadphase;
     btSequentialImpulseConstraintSolver solver;
     btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration);
+    // Polyhedral hulls take their axis from SAT (see make_shape).
+    world.getDispatchInfo().m_enableSatConvex = settings.polyhedral_hulls && settings.sat_convex;
     // Bullet's default gravity is (0, -10, 0); the scene's is the input in both modes.
     world.setGravity(to_bt(scene.sim.gravity));
 
     if (fair) {
       btContactSolverInfo& info = world.getSolverInfo();
       // Restitution applies at any approach speed (default: none below 0.2 m/s).
-      info.m_restitutionVelocityThreshold = 0;
+      info.m_restitutionVelocityThreshold = settings.restitution_threshold;
       // Split impulse for every penetration depth (default: only below -0.04 m; shallower
       // penetration is fixed by Baumgarte, m_erp2 * depth / dt added to the velocity target):
       // position error is then removed by a separate push that adds no velocity.
       info.m_splitImpulse = 1;
-      info.m_splitImpulsePenetrationThreshold = BT_LARGE_FLOAT;
+      info.m_splitImpulsePenetrationThreshold = settings.split_impulse_threshold;
       // No warm starting: each step's solve starts from zero impulse, not 0.85 of the last
       // step's. Done by the factor, not by clearing SOLVER_USE_WARMSTARTING: without that flag
       // solveGroupCacheFriendlyFinish skips writeBackContacts, so the manifold points would
@@ -241,9 +287,15 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt, bool fa
       // Bullet stores a diagonal local inertia only, so the hull is placed in the principal
       // frame of I_body (vertices Q^T v) and the body's rotation becomes R * Q. Bullet's own
       // calculateLocalInertia is the hull's bounding box's, hence supplied here.
+      // A native box keeps the body axes: is_native_box guarantees a diagonal inertia there.
       Vec3 moments = Vec3::Zero();
-      if (!rb.is_static) principal_axes(rb.inertia_body, &bb.principal, &moments);
-      bb.shape = make_hull(rb.shape->vertices(), bb.principal.transpose(), false);
+      bb.box = native_box(rb, settings);
+      if (bb.box) {
+        if (!rb.is_static) moments = rb.inertia_body.diagonal();
+      } else if (!rb.is_static) {
+        principal_axes(rb.inertia_body, &bb.principal, &moments);
+      }
+      bb.shape = make_shape(rb, bb.principal.transpose(), settings);
       // Static bodies: mass 0 and zero inertia make Bullet's static object.
       const double mass = rb.is_static ? 0.0 : rb.mass;
       btRigidBody::btRigidBodyConstructionInfo ci(mass, nullptr, bb.shape.get(), to_bt(moments));
@@ -281,7 +333,7 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt, bool fa
         bb.body->setActivationState(DISABLE_DEACTIVATION);
         // Contacts are solved only once the hulls overlap (default: any point within the
         // breaking threshold, i.e. before touching), so the impulse acts at contact.
-        bb.body->setContactProcessingThreshold(0);
+        bb.body->setContactProcessingThreshold(settings.processing_threshold);
       }
       world.addRigidBody(bb.body.get());
       bodies.push_back(std::move(bb));
@@ -297,7 +349,13 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt, bool fa
     };
     if (opt.sample_every > 0) sample(0.0);
 
+    std::vector<BodyFinal> before;  // states before the step, until the first impulse
     for (long k = 0; k < steps; ++k) {
+      const size_t events_before = result.events.size();
+      if (!result.first_impulse.seen) {
+        before.clear();
+        for (size_t i = 0; i < bodies.size(); ++i) before.push_back(final_state(names[i], bodies[i]));
+      }
       // One internal step of exactly dt (maxSubSteps = 0: no fixed 1/60 s sub-stepping and no
       // interpolated motion states).
       world.stepSimulation(dt, 0, dt);
@@ -329,11 +387,17 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt, bool fa
           ev.contact.depth = std::max(0.0, -static_cast<double>(cp.getDistance()));
           ev.contact.point =
               0.5 * (from_bt(cp.getPositionWorldOnA()) + from_bt(cp.getPositionWorldOnB()));
-          ev.contact.feature = "gjk-epa";
+          ev.contact.feature = pair_feature(bodies[i0].box, bodies[i1].box, settings);
           ev.impulse = cp.getAppliedImpulse();  // N s, along the normal
           result.events.push_back(ev);
         }
       }
+
+      // The first impulse: one event per manifold point, so the count is the events'.
+      if (!result.first_impulse.seen && result.events.size() > events_before)
+        result.first_impulse = first_impulse_of(
+            {result.events.begin() + static_cast<long>(events_before), result.events.end()}, before,
+            dt);
 
       // A non-finite state is an error, not a result.
       for (size_t i = 0; i < bodies.size(); ++i) {
@@ -360,23 +424,69 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt, bool fa
 
 }  // namespace
 
+BulletSettings bullet_native_settings() { return {}; }
+
+BulletSettings bullet_hull_settings() {
+  BulletSettings s;
+  s.native_boxes = false;
+  s.polyhedral_hulls = false;
+  return s;
+}
+
+ContactResult bullet_contact_with(const RigidBody& a, const RigidBody& b,
+                                  const BulletSettings& settings) {
+  return pair_query(a, b, settings);
+}
+
 ContactResult bullet_contact(const RigidBody& a, const RigidBody& b) {
-  return pair_query(a, b, false);
+  return pair_query(a, b, bullet_native_settings());
+}
+
+ContactResult bullet_hull_contact(const RigidBody& a, const RigidBody& b) {
+  return pair_query(a, b, bullet_hull_settings());
 }
 
 ContactResult bullet_sat_contact(const RigidBody& a, const RigidBody& b) {
-  return pair_query(a, b, true);
+  BulletSettings s;
+  s.native_boxes = false;
+  s.sat_convex = true;
+  return pair_query(a, b, s);
+}
+
+DynamicsResult bullet_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+                                    const BulletSettings& settings) {
+  return run_world(scene, opt, settings);
 }
 
 DynamicsResult bullet_dynamics(const Scene& scene, const DynamicsOptions& opt) {
-  return run_world(scene, opt, true);
+  return run_world(scene, opt, bullet_native_settings());
+}
+
+DynamicsResult bullet_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return run_world(scene, opt, bullet_hull_settings());
 }
 
 DynamicsResult bullet_dynamics_default_world(const Scene& scene, const DynamicsOptions& opt) {
-  return run_world(scene, opt, false);
+  BulletSettings s = bullet_hull_settings();
+  s.fair_world = false;
+  return run_world(scene, opt, s);
 }
 
 MassResult bullet_mass(const RigidBody& body) {
+  if (!is_native_box(body)) return bullet_hull_mass(body);
+  MassResult r;
+  // Bullet's default margin is inside the box, so the routine sees the full extents.
+  btBoxShape box(to_bt(0.5 * body.box_size));
+  btVector3 inertia(0, 0, 0);
+  box.calculateLocalInertia(body.mass, inertia);
+  r.mass = body.mass;
+  r.center_of_mass = Vec3::Zero();  // the box centre, which is_native_box puts at the origin
+  r.inertia = from_bt(inertia).asDiagonal();
+  r.message = "btBoxShape::calculateLocalInertia (solid box)";
+  return r;
+}
+
+MassResult bullet_hull_mass(const RigidBody& body) {
   MassResult r;
   btConvexHullShape hull;
   for (const Vec3& v : body.shape->vertices()) hull.addPoint(to_bt(v), false);

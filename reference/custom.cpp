@@ -42,8 +42,21 @@ DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt) {
       r.samples.push_back(std::move(s));
     };
     if (opt.sample_every > 0) sample();
-    while (world.steps_taken() < steps && world.step())
+    // States before each step until the first impulse (the engine resolves one point per pair).
+    std::vector<BodyFinal> before;
+    while (world.steps_taken() < steps) {
+      const size_t events_before = world.events().size();
+      if (!r.first_impulse.seen) {
+        before.clear();
+        for (const RigidBody& b : world.bodies()) before.push_back(final_of(b));
+      }
+      if (!world.step()) break;
+      if (!r.first_impulse.seen && world.events().size() > events_before)
+        r.first_impulse = first_impulse_of(
+            {world.events().begin() + static_cast<long>(events_before), world.events().end()},
+            before, sim.dt);
       if (opt.sample_every > 0 && world.steps_taken() % opt.sample_every == 0) sample();
+    }
     if (!world.failure().empty()) {
       r.status = Status::Error;
       r.message = world.failure();

@@ -1,5 +1,7 @@
-// FCL 0.7.0 adapters (double): Convex with GST_LIBCCD (libccd MPR), signed distance (GJK + EPA),
-// Convex with GST_INDEP (defects passed on), and the Box-Box path (boxBoxIntersect).
+// FCL 0.7.0 adapters (double): `fcl` (fcl::Box for box bodies, so two boxes meet in
+// boxBoxIntersect, up to 4 points; Convex otherwise; GST_LIBCCD), `fcl-hull` (every body a
+// Convex, GST_LIBCCD: libccd MPR), signed distance (GJK + EPA), Convex with GST_INDEP (defects
+// passed on). The former `fcl-box` (Box-Box only) is what `fcl` now runs on two boxes.
 //
 // FCL's conventions, read from the 0.7.0 headers and confirmed by probes (see
 // tests/reference/fcl_test.cpp):
@@ -127,9 +129,38 @@ std::shared_ptr<fcl::CollisionGeometryd> convex_geometry(const RigidBody& body) 
   return make_convex(*body.shape);
 }
 
+/// The body as FCL's users would give it: an fcl::Box for a box body (axes the body axes), its
+/// Convex hull otherwise. `tf` receives the geometry's world pose.
+std::shared_ptr<fcl::CollisionGeometryd> native_geometry(const RigidBody& body,
+                                                         fcl::Transform3d& tf) {
+  tf = to_fcl(body.pose());
+  if (!is_native_box(body)) return convex_geometry(body);
+  // The box centre is taken from the hull's bounds (zero up to round-off for both mass models),
+  // so that round-off in the centre-of-mass shift cannot move it.
+  tf.translation() += body.pose().rotation() * body.shape->bounds().center();
+  return std::make_shared<fcl::Boxd>(body.box_size);
+}
+
 }  // namespace
 
 ContactResult fcl_contact(const RigidBody& a, const RigidBody& b) {
+  // GST_LIBCCD: with two Box shapes both solvers dispatch to boxBoxIntersect (the table in
+  // gjk_solver_libccd-inl.h); with a Convex in the pair it runs libccd MPR.
+  const bool boxes = is_native_box(a) && is_native_box(b);
+  return reject_undefined_normals(guarded(boxes ? "fcl::collide (Box-Box)"
+                                                : "fcl::collide (GST_LIBCCD)",
+                                          [&] {
+                                            fcl::Transform3d tf_a, tf_b;
+                                            auto geom_a = native_geometry(a, tf_a);
+                                            auto geom_b = native_geometry(b, tf_b);
+                                            return collide(geom_a, tf_a, geom_b, tf_b,
+                                                           fcl::GST_LIBCCD,
+                                                           boxes ? "box-box" : "mpr");
+                                          }),
+                                  "fcl::collide (GST_LIBCCD)");
+}
+
+ContactResult fcl_hull_contact(const RigidBody& a, const RigidBody& b) {
   // At depth below CCD_EPS libccd's MPR sets its direction to zero ("can be anything",
   // mpr.c findPenetr) and FCL copies it as the normal: labelled as no normal, not a 180 deg miss.
   return reject_undefined_normals(guarded("fcl::collide (GST_LIBCCD)",
@@ -223,33 +254,20 @@ ContactResult fcl_indep_contact(const RigidBody& a, const RigidBody& b) {
   return r;
 }
 
-ContactResult fcl_box_contact(const RigidBody& a, const RigidBody& b) {
-  if (a.shape_kind != ShapeKind::Box || b.shape_kind != ShapeKind::Box) {
-    return {Status::Unsupported,
-            std::string("fcl-box needs two box bodies; got '") + to_string(a.shape_kind) + "' and '" +
-                to_string(b.shape_kind) + "'",
-            {}};
-  }
-  return guarded("fcl::collide (Box-Box)", [&] {
-    // A box body is make_box(size) shifted by minus its centre of mass; that shift is zero for
-    // both mass models (solid: the centroid; vertices: the average of the 8 corners), but the
-    // box centre is taken from the hull's bounds so that round-off in the shift cannot move it.
-    // The box axes are the body axes (make_box is axis-aligned in the shape frame).
-    auto box_geometry = [](const RigidBody& body, fcl::Transform3d& tf) {
-      tf = to_fcl(body.pose());
-      tf.translation() += body.pose().rotation() * body.shape->bounds().center();
-      return std::make_shared<fcl::Boxd>(body.box_size);
-    };
-    fcl::Transform3d tf_a, tf_b;
-    auto box_a = box_geometry(a, tf_a);
-    auto box_b = box_geometry(b, tf_b);
-    // GST_LIBCCD: with two Box shapes both solvers dispatch to boxBoxIntersect (the table in
-    // gjk_solver_libccd-inl.h), so the choice does not matter; the default is kept.
-    return collide(box_a, tf_a, box_b, tf_b, fcl::GST_LIBCCD, "box-box");
-  });
+MassResult fcl_mass(const RigidBody& body) {
+  if (!is_native_box(body)) return fcl_hull_mass(body);
+  MassResult r;
+  const fcl::Boxd box(body.box_size);
+  r.volume = box.computeVolume();
+  r.mass = body.mass;
+  r.center_of_mass = Vec3::Zero();  // the box centre, which is_native_box puts at the origin
+  // Box's inertia is at unit density: scaled by the density mass / volume.
+  r.inertia = box.computeMomentofInertia() * (body.mass / r.volume);
+  r.message = "fcl::Box, unit-density inertia scaled to the mass";
+  return r;
 }
 
-MassResult fcl_mass(const RigidBody& body) {
+MassResult fcl_hull_mass(const RigidBody& body) {
   MassResult r;
   try {
     const auto convex = make_convex(*body.shape);

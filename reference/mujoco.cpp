@@ -1,5 +1,13 @@
-// MuJoCo 2.2.2 adapter: every body becomes a free-joint body holding one mesh geom built from
-// its body-frame hull; static bodies become geoms of the world body.
+// MuJoCo 2.2.2 adapter: every body becomes a free-joint body holding one geom; static bodies
+// become geoms of the world body. `mujoco-hull`: every geom a mesh of the body-frame hull (MPR,
+// one contact point per pair). `mujoco` (MujocoSettings, each choice measured in
+// tests/reference/fair_settings_test.cpp): box geoms when every body of the model is a box (so
+// every pair meets in mjc_BoxBox, several points), with the contact stiffness doubled for the
+// dynamics because 2.2.2's box-box collider reports half the depth; otherwise mesh geoms with
+// multi-point convex collision (mjENBL_MULTICCD). Box geoms only when all are boxes: a box-mesh
+// pair runs MPR at the full depth, so one global stiffness factor would be wrong for it.
+// Contact queries of `mujoco` use the multiccd meshes for every body (the halved box-box depth
+// would be passed on as a wrong answer, and no stiffness makes up for it there).
 //
 // The model is written as MJCF text into MuJoCo's virtual file system and compiled with
 // mj_loadXML. Three MuJoCo habits need care:
@@ -110,6 +118,8 @@ struct ModelOptions {
   double dt = 1e-3;  // s
   Vec3 gravity = Vec3::Zero();
   ContactParams contact;
+  bool box_geoms = false;  // box geoms for the (all box) bodies; false: mesh geoms
+  bool multiccd = false;   // multi-point convex collision for mesh pairs
 };
 
 // Prints a double so that it reads back exactly (17 significant digits).
@@ -125,6 +135,21 @@ std::string vec_text(const Vec3& v) { return num(v.x()) + " " + num(v.y()) + " "
 // MuJoCo quaternions are (w, x, y, z).
 std::string quat_text(const Quat& q) {
   return num(q.w()) + " " + num(q.x()) + " " + num(q.y()) + " " + num(q.z());
+}
+
+// True when the model of `bodies` under `settings` uses box geoms: every body a native box.
+bool use_box_geoms(const std::vector<RigidBody>& bodies, const MujocoSettings& settings) {
+  if (!settings.box_geoms) return false;
+  for (const RigidBody& b : bodies)
+    if (!is_native_box(b)) return false;
+  return true;
+}
+
+// Geom element attributes of body i's shape: a box of the body's half extents (centred on the
+// body origin, by is_native_box) or its hull mesh.
+std::string shape_attributes(const RigidBody& b, size_t i, bool box) {
+  if (box) return " type=\"box\" size=\"" + vec_text(0.5 * b.box_size) + "\"";
+  return " type=\"mesh\" mesh=\"hull" + std::to_string(i) + "\"";
 }
 
 // <mesh> of a body's hull in its body frame (vertices and the outward triangles).
@@ -162,7 +187,8 @@ std::string build_mjcf(const std::vector<RigidBody>& bodies, bool all_free,
   // MPR tolerance tightened from 1e-6 so that depths are limited by MuJoCo's float vertices,
   // not by the iteration stopping early.
   s << "<option timestep=\"" << num(opt.dt) << "\" gravity=\"" << vec_text(opt.gravity)
-    << "\" integrator=\"Euler\" mpr_tolerance=\"1e-12\" mpr_iterations=\"500\"/>\n";
+    << "\" integrator=\"Euler\" mpr_tolerance=\"1e-12\" mpr_iterations=\"500\">"
+    << (opt.multiccd ? "<flag multiccd=\"enable\"/>" : "") << "</option>\n";
   // Contact buffers: 8 points per pair for small scenes; for many bodies, where a body touches
   // only its neighbours, 16 per body (8 per pair over all pairs of 100 bodies is more memory
   // than mj_makeData will allocate).
@@ -170,14 +196,15 @@ std::string build_mjcf(const std::vector<RigidBody>& bodies, bool all_free,
   const size_t ncon = std::max<size_t>(100, std::min(8 * pairs, 16 * n));
   s << "<size nconmax=\"" << ncon << "\" njmax=\"" << 3 * ncon << "\"/>\n";
   s << "<asset>\n";
-  for (size_t i = 0; i < n; ++i) s << mesh_element("hull" + std::to_string(i), *bodies[i].shape);
+  if (!opt.box_geoms)
+    for (size_t i = 0; i < n; ++i) s << mesh_element("hull" + std::to_string(i), *bodies[i].shape);
   s << "</asset>\n<worldbody>\n";
   const std::string contact = geom_contact_attributes(opt.contact);
   for (size_t i = 0; i < n; ++i) {
     const RigidBody& b = bodies[i];
-    const std::string mesh = "hull" + std::to_string(i);
+    const std::string shape = shape_attributes(b, i, opt.box_geoms);
     if (b.is_static && !all_free) {
-      s << "<geom name=\"g" << i << "\" type=\"mesh\" mesh=\"" << mesh << "\" pos=\""
+      s << "<geom name=\"g" << i << "\"" << shape << " pos=\""
         << vec_text(b.position) << "\" quat=\"" << quat_text(b.orientation) << "\"" << contact
         << "/>\n";
       continue;
@@ -190,7 +217,7 @@ std::string build_mjcf(const std::vector<RigidBody>& bodies, bool all_free,
     s << "  <inertial pos=\"0 0 0\" mass=\"" << num(b.mass) << "\" fullinertia=\"" << num(I(0, 0))
       << " " << num(I(1, 1)) << " " << num(I(2, 2)) << " " << num(I(0, 1)) << " " << num(I(0, 2))
       << " " << num(I(1, 2)) << "\"/>\n";
-    s << "  <geom name=\"g" << i << "\" type=\"mesh\" mesh=\"" << mesh << "\"" << contact << "/>\n";
+    s << "  <geom name=\"g" << i << "\"" << shape << contact << "/>\n";
     s << "</body>\n";
   }
   s << "</worldbody>\n</mujoco>\n";
@@ -241,6 +268,16 @@ std::string check_geometry(const mjModel* m, const std::vector<RigidBody>& bodie
     if (g < 0) return "geom g" + std::to_string(i) + " missing after compiling";
     const bool world = m->geom_bodyid[g] == 0;
     const RigidBody& b = bodies[i];
+    if (m->geom_type[g] == mjGEOM_BOX) {
+      // A box geom is stored in double and never recentred: its size and place must be ours.
+      const Vec3 size(m->geom_size[3 * g], m->geom_size[3 * g + 1], m->geom_size[3 * g + 2]);
+      const Vec3 pos(m->geom_pos[3 * g], m->geom_pos[3 * g + 1], m->geom_pos[3 * g + 2]);
+      const Vec3 expected_pos = world ? b.position : Vec3::Zero();
+      const double tol = 1e-12 * (b.box_size.norm() + expected_pos.norm());
+      if ((size - 0.5 * b.box_size).norm() > tol || (pos - expected_pos).norm() > tol)
+        return "box geom of " + b.name + " is not our box after compiling";
+      continue;
+    }
     const auto& hull = b.shape->vertices();
     const int mesh = m->geom_dataid[g];
     const int nv = m->mesh_vertnum[mesh];
@@ -414,12 +451,66 @@ double restitution_damping_ratio(double e) {
   return 0.5 * (lo + hi);
 }
 
+// The library's own mass properties of a box geom (`box`) or of the hull mesh.
+MassResult mass_of_geom(const RigidBody& body, bool box) {
+  MassResult r;
+  std::ostringstream xml;
+  xml << "<mujoco model=\"rbx_mass\">\n<compiler inertiafromgeom=\"true\"/>\n<asset>\n"
+      << (box ? "" : mesh_element("hull0", *body.shape)) << "</asset>\n<worldbody>\n"
+      << "<body name=\"b\">\n<freejoint/>\n<geom" << shape_attributes(body, 0, box)
+      << " mass=\"" << num(body.mass) << "\"/>\n</body>\n</worldbody>\n</mujoco>\n";
+  std::string error;
+  ModelPtr m = load_model(xml.str(), &error);
+  if (!m) return {Status::Error, error, 0.0, -1.0, Vec3::Zero(), Mat3::Zero()};
+  const int b = 1;  // body 0 is the world
+  r.mass = m->body_mass[b];
+  r.center_of_mass = Vec3(m->body_ipos[3 * b], m->body_ipos[3 * b + 1], m->body_ipos[3 * b + 2]);
+  const Quat q(m->body_iquat[4 * b], m->body_iquat[4 * b + 1], m->body_iquat[4 * b + 2],
+               m->body_iquat[4 * b + 3]);
+  const Vec3 moments(m->body_inertia[3 * b], m->body_inertia[3 * b + 1], m->body_inertia[3 * b + 2]);
+  const Mat3 rot = q.normalized().toRotationMatrix();
+  r.inertia = rot * moments.asDiagonal() * rot.transpose();
+  r.message = box ? "box geom, inertiafromgeom" : "mesh geom, inertiafromgeom";
+  return r;
+}
+
 }  // namespace
 
+MujocoSettings mujoco_hull_settings() {
+  MujocoSettings s;
+  s.box_geoms = false;
+  s.multiccd = false;
+  return s;
+}
+
 ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b) {
+  // Contact queries take meshes with multiccd even for boxes: box geoms report half the depth
+  // (0.05 for a true 0.1), the meshes the full depth to float precision. Only the dynamics,
+  // whose stiffness can make up for the halving, use box geoms.
+  MujocoSettings s;
+  s.box_geoms = false;
+  return mujoco_contact_with(a, b, s);
+}
+
+ContactResult mujoco_hull_contact(const RigidBody& a, const RigidBody& b) {
+  return mujoco_contact_with(a, b, mujoco_hull_settings());
+}
+
+DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return mujoco_dynamics_with(scene, opt, MujocoSettings{});
+}
+
+DynamicsResult mujoco_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return mujoco_dynamics_with(scene, opt, mujoco_hull_settings());
+}
+
+ContactResult mujoco_contact_with(const RigidBody& a, const RigidBody& b,
+                                  const MujocoSettings& settings) {
   ContactResult r;
   const std::vector<RigidBody> bodies{a, b};
   ModelOptions opt;
+  opt.box_geoms = use_box_geoms(bodies, settings);
+  opt.multiccd = settings.multiccd;
   std::string error;
   auto [m, d] = make_simulation(bodies, /*all_free=*/true, opt, &error);
   if (!m) return {Status::Error, error, {}};
@@ -435,14 +526,20 @@ ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b) {
     const mjContact& c = d->contact[i];
     if (c.dist > 0.0) continue;  // inside the margin only (margin is 0: does not happen)
     r.contacts.push_back(convert_contact(c, m->geom_bodyid[c.geom1] == body_a));
+    r.contacts.back().feature = opt.box_geoms ? "box-box" : "mesh";
   }
+  // 2.2.2's box-box collider reports half the depth (pinned in tests/reference/mujoco_test.cpp):
+  // passed on, labelled.
+  if (opt.box_geoms && !r.contacts.empty())
+    r.message = "MuJoCo 2.2.2 box-box: depth reported at half its true value (known defect)";
   return r;
 }
 
-DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+                                    const MujocoSettings& settings) {
   DynamicsResult r;
   const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
-  if (!(dt > 0.0)) return {Status::Error, "MuJoCo: time step must be > 0", {}, {}, {}};
+  if (!(dt > 0.0)) return {Status::Error, "MuJoCo: time step must be > 0", {}, {}, {}, {}};
   const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
   std::vector<RigidBody> bodies;
   bodies.reserve(scene.bodies.size());
@@ -456,6 +553,11 @@ DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   mo.contact.stiffness = contact_stiffness(dt);
   mo.contact.damping = 2.0 * zeta * std::sqrt(mo.contact.stiffness);
   mo.contact.friction = scene.sim.friction;
+  mo.box_geoms = use_box_geoms(bodies, settings);
+  mo.multiccd = settings.multiccd;
+  // Box-box depth is reported halved (see the file comment): the stiffness makes up for it, so
+  // that the contact force per true penetration is the mesh's.
+  if (mo.box_geoms) mo.contact.stiffness *= settings.box_stiffness_factor;
   if (const double reached = soft_contact_restitution(zeta, 0.5);
       reached > scene.sim.restitution + 1e-9)
     r.message = "restitution " + num(scene.sim.restitution) +
@@ -487,8 +589,14 @@ DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   // at its first step with a pushing force; the impulse sums force * dt over the episode.
   std::map<std::pair<int, int>, size_t> open_episode;  // pair -> index in r.events
   t_trap.clear_warning();
+  std::vector<BodyFinal> before;  // states before the step, until the first impulse
   for (long step = 0; step < steps; ++step) {
     if (opt.sample_every > 0 && step % opt.sample_every == 0) sample(step * dt);
+    const size_t events_before = r.events.size();
+    if (!r.first_impulse.seen) {
+      before.clear();
+      for (size_t i = 0; i < bodies.size(); ++i) before.push_back(read_state(mc, dd, bodies[i], i));
+    }
     if (!guarded([&] { mj_step(mc, dd); })) {
       r.status = Status::Error;
       r.message = "MuJoCo mj_step at step " + std::to_string(step) + ": " + t_trap.error;
@@ -501,6 +609,8 @@ DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
     }
     // d->contact and efc_force describe the state at the start of this step.
     std::map<std::pair<int, int>, size_t> still_open;
+    std::map<std::pair<int, int>, int> points;     // pushing contacts per pair this step
+    std::map<std::pair<int, int>, double> deepest;  // m, per pair this step
     for (int c = 0; c < dd->ncon; ++c) {
       const mjContact& con = dd->contact[c];
       if (con.efc_address < 0) continue;
@@ -511,24 +621,39 @@ DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
       const int g1 = scene_of_geom[con.geom1], g2 = scene_of_geom[con.geom2];
       const int ia = std::min(g1, g2), ib = std::max(g1, g2);
       const std::pair<int, int> key{ia, ib};
-      auto it = open_episode.find(key);
+      // The pair's episode: opened by another of its contact points this step (a multi-point
+      // manifold is one episode, not one per point), open since an earlier step, or new.
       size_t idx;
-      if (it == open_episode.end()) {
+      if (auto in_step = still_open.find(key); in_step != still_open.end()) {
+        idx = in_step->second;
+      } else if (auto earlier = open_episode.find(key); earlier != open_episode.end()) {
+        idx = earlier->second;
+      } else {
         CollisionEvent ev;
         ev.time = step * dt;
         ev.step = step;
         ev.body_a = bodies[ia].name;
         ev.body_b = bodies[ib].name;
         ev.contact = convert_contact(con, g1 == ia);
+        ev.contact.feature = mo.box_geoms ? "box-box" : "mesh";
         r.events.push_back(ev);
         idx = r.events.size() - 1;
-      } else {
-        idx = it->second;
       }
       r.events[idx].impulse += force * dt;
       still_open[key] = idx;
+      ++points[key];
+      deepest[key] = std::max(deepest[key], -con.dist);
     }
     open_episode = std::move(still_open);
+    // The first impulse: the episode's event holds one contact; count and depth are the step's.
+    if (!r.first_impulse.seen && r.events.size() > events_before) {
+      const CollisionEvent& first = r.events[events_before];
+      std::pair<int, int> key{-1, -1};
+      for (const auto& [k, idx] : open_episode)
+        if (idx == events_before) key = k;
+      r.first_impulse = first_impulse_of({first}, before, dt, points[key]);
+      r.first_impulse.depth = deepest[key];
+    }
   }
   if (opt.sample_every > 0 && steps % opt.sample_every == 0) sample(steps * dt);
 
@@ -544,25 +669,10 @@ DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
 }
 
 MassResult mujoco_mass(const RigidBody& body) {
-  MassResult r;
-  std::ostringstream xml;
-  xml << "<mujoco model=\"rbx_mass\">\n<compiler inertiafromgeom=\"true\"/>\n<asset>\n"
-      << mesh_element("hull", *body.shape) << "</asset>\n<worldbody>\n<body name=\"b\">\n"
-      << "<freejoint/>\n<geom type=\"mesh\" mesh=\"hull\" mass=\"" << num(body.mass)
-      << "\"/>\n</body>\n</worldbody>\n</mujoco>\n";
-  std::string error;
-  ModelPtr m = load_model(xml.str(), &error);
-  if (!m) return {Status::Error, error, 0.0, -1.0, Vec3::Zero(), Mat3::Zero()};
-  const int b = 1;  // body 0 is the world
-  r.mass = m->body_mass[b];
-  r.center_of_mass = Vec3(m->body_ipos[3 * b], m->body_ipos[3 * b + 1], m->body_ipos[3 * b + 2]);
-  const Quat q(m->body_iquat[4 * b], m->body_iquat[4 * b + 1], m->body_iquat[4 * b + 2],
-               m->body_iquat[4 * b + 3]);
-  const Vec3 moments(m->body_inertia[3 * b], m->body_inertia[3 * b + 1], m->body_inertia[3 * b + 2]);
-  const Mat3 rot = q.normalized().toRotationMatrix();
-  r.inertia = rot * moments.asDiagonal() * rot.transpose();
-  r.message = "mesh geom, inertiafromgeom";
-  return r;
+  return is_native_box(body) ? mass_of_geom(body, true) : mujoco_hull_mass(body);
 }
+
+MassResult mujoco_hull_mass(const RigidBody& body) { return mass_of_geom(body, false); }
+
 
 }  // namespace rbx

@@ -1,6 +1,8 @@
-// ODE 0.16.2 adapter: every body becomes a dCreateConvex geom built from its body-frame hull
-// (coplanar triangles merged into polygons), attached to a dBody with our mass and inertia;
-// static bodies are geoms without a body. Debian builds ODE with libccd
+// ODE 0.16.2 adapter. `ode`: a box body becomes a dCreateBox geom (two boxes meet in dBoxBox,
+// ODE's own box-box test, up to 4 points); any other body, and every body under `ode-hull`, a
+// dCreateConvex geom built from its body-frame hull (coplanar triangles merged into polygons).
+// Geoms are attached to a dBody with our mass and inertia; static bodies are geoms without a
+// body. Debian builds ODE with libccd
 // (dLIBCCD_CONVEX_CONVEX: libode links libccd), so convex-convex pairs run dCollideConvexConvexCCD,
 // libccd's MPR with one contact point, not ODE's own convex SAT: its depths and points match the
 // `fcl` backend's (both MPR) bit for bit on the same pair.
@@ -160,9 +162,14 @@ struct ConvexGeom {
   dGeomID geom = nullptr;
 };
 
-// Creates the convex geom of a body in `space` (may be 0).
-ConvexGeom make_geom(dSpaceID space, const RigidBody& b) {
+// Creates the geom of a body in `space` (may be 0): a box when `native` and the body is one
+// (is_native_box: centred on the body origin, axes the body axes), else its convex hull.
+ConvexGeom make_geom(dSpaceID space, const RigidBody& b, bool native) {
   ConvexGeom g;
+  if (native && is_native_box(b)) {
+    g.geom = dCreateBox(space, b.box_size.x(), b.box_size.y(), b.box_size.z());
+    return g;
+  }
   g.data = std::make_unique<ConvexData>(make_convex_data(*b.shape));
   const ConvexData& d = *g.data;
   g.geom = dCreateConvex(space, d.planes.data(), d.face_count, d.points.data(),
@@ -180,12 +187,12 @@ void place_geom(dGeomID g, const RigidBody& b) {
 
 // Our contact from ODE's: the normal points into g1 (from g2 toward g1), depth positive. With
 // g1 = A that is already ours.
-ContactPoint convert_contact(const dContactGeom& c) {
+ContactPoint convert_contact(const dContactGeom& c, const char* feature) {
   ContactPoint p;
   p.point = Vec3(c.pos[0], c.pos[1], c.pos[2]);
   p.normal = Vec3(c.normal[0], c.normal[1], c.normal[2]);
   p.depth = c.depth;
-  p.feature = "convex";
+  p.feature = feature;
   return p;
 }
 
@@ -207,10 +214,16 @@ struct WorldOwner {
 // One contact joint created in a step, with what we need to report it.
 struct StepContact {
   int a = 0, b = 0;       // scene indices, a < b
+  const char* feature = "convex";
   dContactGeom geom{};    // g1 belongs to a
   double approach = 0.0;  // m/s, relative normal velocity before the step (< 0: closing)
   dJointFeedback* feedback = nullptr;
 };
+
+// Label of the collider a pair of geoms takes.
+const char* pair_feature(dGeomID a, dGeomID b) {
+  return dGeomGetClass(a) == dBoxClass && dGeomGetClass(b) == dBoxClass ? "box-box" : "convex";
+}
 
 // State passed through dSpaceCollide to the near callback.
 struct CollideContext {
@@ -273,6 +286,7 @@ void near_callback(void* data, dGeomID o1, dGeomID o2) {
     sc.a = scene_index(o1);
     sc.b = scene_index(o2);
     sc.geom = c.geom;
+    sc.feature = pair_feature(o1, o2);
     const Vec3 n_ours(c.geom.normal[0], c.geom.normal[1], c.geom.normal[2]);
     sc.approach = (point_velocity(b1, c.geom.pos) - point_velocity(b2, c.geom.pos)).dot(n_ours);
     sc.feedback = &ctx->feedback.back();
@@ -302,11 +316,14 @@ BodyFinal read_state(const RigidBody& b, dBodyID body) {
 
 }  // namespace
 
-ContactResult ode_contact(const RigidBody& a, const RigidBody& b) {
+namespace {
+
+ContactResult contact_query(const RigidBody& a, const RigidBody& b, bool native) {
   init_ode();
   ContactResult r;
-  ConvexGeom ga = make_geom(nullptr, a);
-  ConvexGeom gb = make_geom(nullptr, b);
+  ConvexGeom ga = make_geom(nullptr, a, native);
+  ConvexGeom gb = make_geom(nullptr, b, native);
+  const char* feature = pair_feature(ga.geom, gb.geom);
   place_geom(ga.geom, a);
   place_geom(gb.geom, b);
   dContactGeom contacts[kMaxContacts];
@@ -319,23 +336,48 @@ ContactResult ode_contact(const RigidBody& a, const RigidBody& b) {
   dGeomDestroy(gb.geom);
   if (!ok) return {Status::Error, t_trap.error, {}};
   if (t_trap.has_warning()) r.message = t_trap.warning;
-  for (int i = 0; i < n; ++i) r.contacts.push_back(convert_contact(contacts[i]));
+  for (int i = 0; i < n; ++i) r.contacts.push_back(convert_contact(contacts[i], feature));
   // Debian's ODE routes convex-convex to libccd MPR (dCollideConvexConvexCCD): at depth below
   // CCD_EPS its direction, hence ODE's normal, is zero. Labelled, not scored as a 180 deg miss.
-  return reject_undefined_normals(std::move(r), "dCollide (convex-convex via libccd MPR)");
+  return reject_undefined_normals(std::move(r), std::string("dCollide (") + feature + ")");
+}
+
+}  // namespace
+
+OdeSettings ode_hull_settings() {
+  OdeSettings s;
+  s.native_boxes = false;
+  return s;
+}
+
+ContactResult ode_contact(const RigidBody& a, const RigidBody& b) {
+  return contact_query(a, b, true);
+}
+
+ContactResult ode_hull_contact(const RigidBody& a, const RigidBody& b) {
+  return contact_query(a, b, false);
 }
 
 DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return ode_dynamics_with(scene, opt, OdeSettings{});
+}
+
+DynamicsResult ode_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return ode_dynamics_with(scene, opt, ode_hull_settings());
+}
+
+DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+                                 const OdeSettings& settings) {
   init_ode();
   DynamicsResult r;
   const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
-  if (!(dt > 0.0)) return {Status::Error, "ODE: time step must be > 0", {}, {}, {}};
+  if (!(dt > 0.0)) return {Status::Error, "ODE: time step must be > 0", {}, {}, {}, {}};
   const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
   std::vector<RigidBody> bodies;
   bodies.reserve(scene.bodies.size());
   for (const BodySpec& spec : scene.bodies) bodies.push_back(make_body(spec));
 
-  // World: gravity from the scene; ERP and CFM at ODE's defaults (0.2, 1e-10).
+  // World: gravity from the scene; ERP and CFM from the settings, ODE's defaults (0.2, 1e-10).
   //  - CFM softens each contact by a relative CFM / (dt * inverse effective mass), ~1e-7 here.
   //  - Position correction: a contact's target separation speed is
   //    max(e * approach speed, ERP * depth / dt), so a contact first seen at depth d leaves at
@@ -350,12 +392,14 @@ DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   w.contacts = dJointGroupCreate(0);
   const Vec3& g = scene.sim.gravity;
   dWorldSetGravity(w.world, g.x(), g.y(), g.z());
+  dWorldSetERP(w.world, settings.erp);
+  dWorldSetCFM(w.world, settings.cfm);
 
   // Bodies: our mass and inertia about the centre of mass at the body origin.
   std::vector<dBodyID> ode_bodies(bodies.size(), nullptr);
   for (size_t i = 0; i < bodies.size(); ++i) {
     const RigidBody& b = bodies[i];
-    w.geoms.push_back(make_geom(w.space, b));
+    w.geoms.push_back(make_geom(w.space, b, settings.native_boxes));
     dGeomID geom = w.geoms.back().geom;
     dGeomSetData(geom, reinterpret_cast<void*>(static_cast<std::intptr_t>(i)));
     if (b.is_static) {
@@ -403,8 +447,14 @@ DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   t_trap.clear_warning();
   t_trap.warning_count = 0;
   long first_message_step = -1;
+  std::vector<BodyFinal> before;  // states before the step, until the first impulse
   for (long step = 0; step < steps; ++step) {
     if (opt.sample_every > 0 && step % opt.sample_every == 0) sample(step * dt);
+    const size_t events_before = r.events.size();
+    if (!r.first_impulse.seen) {
+      before.clear();
+      for (size_t i = 0; i < bodies.size(); ++i) before.push_back(read_state(bodies[i], ode_bodies[i]));
+    }
     ctx.contacts.clear();
     ctx.feedback.clear();
     CollideContext* c = &ctx;
@@ -427,7 +477,7 @@ DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
     std::map<std::pair<int, int>, bool> pair_closing;
     for (const StepContact& sc : ctx.contacts) {
       const std::pair<int, int> key{sc.a, sc.b};
-      const ContactPoint cp = convert_contact(sc.geom);
+      const ContactPoint cp = convert_contact(sc.geom, sc.feature);
       // Force along the normal (N). With two bodies f1 acts on a; with one, ODE moves the
       // body into the first slot, so take whichever slot is filled (the push is >= 0).
       const dJointFeedback& fb = *sc.feedback;
@@ -458,6 +508,15 @@ DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
       ev.contact.point /= pair_points[key];
       if (ev.contact.normal.norm() > 0.0) ev.contact.normal.normalize();
       r.events.push_back(ev);
+    }
+    // The first impulse: ODE's events merge a pair's points, so the count is ODE's own.
+    if (!r.first_impulse.seen && r.events.size() > events_before) {
+      const CollisionEvent& first = r.events[events_before];
+      int points = 0;
+      for (const StepContact& sc : ctx.contacts)
+        if (bodies[sc.a].name == first.body_a && bodies[sc.b].name == first.body_b) ++points;
+      r.first_impulse = first_impulse_of({first}, before, dt, points);
+      // The deepest of the pair's points (the event keeps the largest depth already).
     }
     dJointGroupEmpty(w.contacts);
   }

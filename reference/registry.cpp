@@ -21,22 +21,35 @@ const char* to_string(Status s) {
 
 const std::vector<Backend>& backends() {
   // name, description, contact query, dynamics run.
+  // Plain names: the library as its experts use it (native primitives where a body is one);
+  // `-hull`: every body the same convex hull the custom engine gets. The former `fcl-box`
+  // (Box-Box only) is what `fcl` runs on two boxes, so it is gone as a duplicate.
   static const std::vector<Backend> table = {
       {"custom", "rbx engine: Moore & Wilhelms face/vertex/edge tests, single-point impulse",
        custom_contact, custom_dynamics},
       {"exact", "rbx oracle: separating-axis test over faces and edge pairs, clipped manifold",
        exact_contact, nullptr},
-      {"fcl", "FCL 0.7 Convex, GST_LIBCCD (libccd MPR)", fcl_contact, nullptr, fcl_mass},
+      {"fcl", "FCL 0.7: Box (boxBoxIntersect) or Convex (libccd MPR)", fcl_contact, nullptr,
+       fcl_mass},
+      {"fcl-hull", "FCL 0.7 Convex, GST_LIBCCD (libccd MPR)", fcl_hull_contact, nullptr,
+       fcl_hull_mass},
       {"fcl-epa", "FCL 0.7 signed distance (GJK + EPA)", fcl_epa_contact, nullptr},
       {"fcl-indep", "FCL 0.7 Convex, GST_INDEP (known defects shown)", fcl_indep_contact, nullptr},
-      {"fcl-box", "FCL 0.7 Box-Box (boxBoxIntersect, from ODE)", fcl_box_contact, nullptr},
       {"libccd", "libccd 2.1 on our support function: MPR and GJK + EPA", libccd_contact, nullptr},
-      {"bullet", "Bullet 3.24 double: zero-margin hull GJK + EPA; btDiscreteDynamicsWorld",
+      {"bullet", "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
        bullet_contact, bullet_dynamics, bullet_mass},
-      {"bullet-sat", "Bullet 3.24 double: polyhedral SAT + clipping", bullet_sat_contact, nullptr},
-      {"mujoco", "MuJoCo 2.2.2 mesh geoms (MPR); mj_step, restitution via negative solref",
+      {"bullet-hull", "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",
+       bullet_hull_contact, bullet_hull_dynamics, bullet_hull_mass},
+      {"bullet-sat", "Bullet 3.24 double: polyhedral hull SAT + clipping, boxes too",
+       bullet_sat_contact, nullptr},
+      {"mujoco", "MuJoCo 2.2.2 box geoms (box-box) or mesh + multiccd; mj_step, negative solref",
        mujoco_contact, mujoco_dynamics, mujoco_mass},
-      {"ode", "ODE 0.16.2 dCreateConvex; dWorldStep with bounce = e", ode_contact, ode_dynamics},
+      {"mujoco-hull", "MuJoCo 2.2.2 mesh geoms (MPR, one point); mj_step, negative solref",
+       mujoco_hull_contact, mujoco_hull_dynamics, mujoco_hull_mass},
+      {"ode", "ODE 0.16.2 dCreateBox (dBoxBox) or dCreateConvex; dWorldStep, bounce = e",
+       ode_contact, ode_dynamics},
+      {"ode-hull", "ODE 0.16.2 dCreateConvex (libccd MPR); dWorldStep, bounce = e",
+       ode_hull_contact, ode_hull_dynamics},
   };
   return table;
 }

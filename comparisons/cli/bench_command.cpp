@@ -135,7 +135,7 @@ std::vector<NarrowBackend> narrow_backends() {
       {"bullet-sat", "default", registry("bullet-sat"), 512, 128},
       {"mujoco", "default", registry("mujoco"), 8192, 512},
       {"ode", "default", registry("ode"), 8192, 512},
-      {"fcl-box", "default", registry("fcl-box"), 8, 8, true},
+      {"fcl-box", "default", registry("fcl"), 8, 8, true},
   };
 }
 

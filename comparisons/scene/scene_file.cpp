@@ -77,9 +77,9 @@ const KeyInfo kKeys[] = {
 };
 
 const std::vector<std::string> kChecks = {"contact", "impulse", "trajectory", "stability", "mass"};
-const std::vector<std::string> kBackends = {"custom", "exact",      "fcl",    "fcl-epa",
-                                            "fcl-indep", "fcl-box", "libccd", "bullet",
-                                            "bullet-sat", "mujoco", "ode"};
+const std::vector<std::string> kBackends = {
+    "custom", "exact",       "fcl",        "fcl-hull", "fcl-epa",     "fcl-indep", "libccd",
+    "bullet", "bullet-hull", "bullet-sat", "mujoco",   "mujoco-hull", "ode",       "ode-hull"};
 const std::vector<std::string> kShapes = {"box", "icosphere", "prism", "convex", "mesh"};
 
 // Shape-specific body keys and the shape that owns them.

@@ -52,7 +52,7 @@ struct Backend {
   const char* name;
   ContactQuery query;
 };
-const Backend kBoth[] = {{"bullet", bullet_contact}, {"bullet-sat", bullet_sat_contact}};
+const Backend kBoth[] = {{"bullet-hull", bullet_hull_contact}, {"bullet-sat", bullet_sat_contact}};
 
 // ---------------------------------------------------------------------------------------------
 // Contact conventions
@@ -81,7 +81,7 @@ TEST(BulletContact, FaceOverlapNormalDepthAndPoint) {
     }
   }
   // GJK + EPA: one point. Clipping: the four corners of the overlap rectangle.
-  EXPECT_EQ(bullet_contact(a, b).contacts.size(), 1u);
+  EXPECT_EQ(bullet_hull_contact(a, b).contacts.size(), 1u);
   const ContactResult sat = bullet_sat_contact(a, b);
   ASSERT_EQ(sat.contacts.size(), 4u);
   for (double y : {-0.4, 0.5})
@@ -111,7 +111,7 @@ TEST(BulletContact, SatAlignedCubes) {
 // If Bullet gets fixed this test fails: update REFERENCES.md and the report.
 TEST(BulletContact, KnownDefectEpaCoplanarSides) {
   const ContactResult r =
-      bullet_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(0.9, 0, 0)));
+      bullet_hull_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(0.9, 0, 0)));
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   const ContactPoint& c = r.contacts[0];
@@ -156,12 +156,12 @@ TEST(BulletContact, KnownDefectZeroDepthNormal) {
   const Quat q = Quat(rotation_from_euler_deg(Vec3(30, 30, 0)));
   const double corner = 0.8415063509461096;  // lowest corner's depth below the centre
   const RigidBody slab = make_body(box_spec("B", Vec3(4, 4, 1), Vec3(0, 0, -0.5)));
-  const ContactResult touching = bullet_contact(unit_cube("A", Vec3(0, 0, corner), q), slab);
+  const ContactResult touching = bullet_hull_contact(unit_cube("A", Vec3(0, 0, corner), q), slab);
   ASSERT_EQ(touching.status, Status::Ok) << touching.message;
   ASSERT_EQ(touching.contacts.size(), 1u);
   EXPECT_LT(touching.contacts[0].normal.z(), std::cos(5 * kPi / 180))
       << "zero-depth normal now right: defect fixed?";
-  const ContactResult deeper = bullet_contact(unit_cube("A", Vec3(0, 0, corner - 1e-9), q), slab);
+  const ContactResult deeper = bullet_hull_contact(unit_cube("A", Vec3(0, 0, corner - 1e-9), q), slab);
   ASSERT_EQ(deeper.status, Status::Ok) << deeper.message;
   ASSERT_EQ(deeper.contacts.size(), 1u);
   EXPECT_LT((deeper.contacts[0].normal - Vec3(0, 0, 1)).norm(), 1e-6);
@@ -228,7 +228,7 @@ TEST(BulletContact, TouchingCounts) {
       EXPECT_NEAR(c.point.x(), 0.5, kRoundOff);
     }
   }
-  EXPECT_FALSE(bullet_contact(a, unit_cube("B", Vec3(1.0 + 1e-12, 0, 0))).contacts.empty());
+  EXPECT_FALSE(bullet_hull_contact(a, unit_cube("B", Vec3(1.0 + 1e-12, 0, 0))).contacts.empty());
 }
 
 // Separated: no contacts. 1.01 leaves a gap of 0.01 m, inside Bullet's contact breaking
@@ -288,7 +288,7 @@ Scene head_on(double m1, double v1, double m2, double v2, double e) {
 //   x1 = -1 + t* v1 + (T - t*) v1' = -1.125,  x2 = 0.5 + t* v2 + (T - t*) v2' = 0.375.
 TEST(BulletDynamics, HeadOnUnequalMasses) {
   const Scene s = head_on(1, 1, 3, -0.5, 0.5);
-  const DynamicsResult r = bullet_dynamics(s, {});
+  const DynamicsResult r = bullet_hull_dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.finals.size(), 2u);
   EXPECT_EQ(r.finals[0].name, "A");
@@ -314,7 +314,7 @@ TEST(BulletDynamics, HeadOnUnequalMasses) {
   EXPECT_NEAR(r.finals[0].position.x(), -1.125, 2.82e-3);
   EXPECT_NEAR(r.finals[1].position.x(), 0.375, 0.94e-3);
   // Determinism: the same scene gives bit-identical finals.
-  const DynamicsResult again = bullet_dynamics(s, {});
+  const DynamicsResult again = bullet_hull_dynamics(s, {});
   ASSERT_EQ(again.status, Status::Ok);
   for (size_t i = 0; i < 2; ++i) {
     EXPECT_EQ(again.finals[i].position, r.finals[i].position);
@@ -362,7 +362,7 @@ TEST(BulletDynamics, CubeCornerOnStaticSlab) {
     const Vec3 v1 = v0 + j * n;
     const Vec3 w1 = 6.0 * r.cross(j * n);
 
-    const DynamicsResult res = bullet_dynamics(s, {});
+    const DynamicsResult res = bullet_hull_dynamics(s, {});
     ASSERT_EQ(res.status, Status::Ok) << res.message;
     ASSERT_EQ(res.events.size(), 1u);
     EXPECT_EQ(res.events[0].body_a, "cube");
@@ -395,7 +395,7 @@ TEST(BulletDynamics, DefaultWorldDefectAndFairFix) {
   EXPECT_NEAR(def.finals[1].velocity.x(), 0.5, kRoundOff);
   EXPECT_NEAR(kinetic_energy(s, def), 0.25, kRoundOff);
 
-  const DynamicsResult fair = bullet_dynamics(s, {});
+  const DynamicsResult fair = bullet_hull_dynamics(s, {});
   ASSERT_EQ(fair.status, Status::Ok) << fair.message;
   EXPECT_NEAR((fair.finals[0].velocity - Vec3(0, 0, 0)).norm(), 0.0, kRoundOff);
   EXPECT_NEAR((fair.finals[1].velocity - Vec3(1, 0, 0)).norm(), 0.0, kRoundOff);
@@ -412,7 +412,7 @@ TEST(BulletDynamics, DefaultWorldDefectAndFairFix) {
 TEST(BulletDynamics, KnownDefectAlignedFaceFaceSpins) {
   Scene s = head_on(1, 1, 1, 0, 1.0);
   s.bodies[1].orientation = Quat::Identity();
-  const DynamicsResult r = bullet_dynamics(s, {});
+  const DynamicsResult r = bullet_hull_dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   EXPECT_GT(r.finals[0].angular_velocity.norm(), 0.1) << "aligned face-face now spin-free: fixed?";
 }
@@ -450,7 +450,7 @@ TEST(BulletDynamics, NonDiagonalInertiaPrincipalFrame) {
   const RigidBody b0 = make_body(spec);
   ASSERT_GT(std::abs(b0.inertia_body(0, 1)), 0.01);  // really non-diagonal
 
-  const DynamicsResult r = bullet_dynamics(s, {});
+  const DynamicsResult r = bullet_hull_dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   const BodyFinal& f = r.finals[0];
   const Quat expected = Quat(Eigen::AngleAxisd(2.0 * s.sim.duration, axis)) * b0.orientation;
@@ -480,7 +480,7 @@ TEST(BulletDynamics, GyroscopicImplicitBodyConservesAngularMomentum) {
   auto drift = [&](double dt, double* energy) {
     DynamicsOptions opt;
     opt.dt = dt;
-    const DynamicsResult r = bullet_dynamics(s, opt);
+    const DynamicsResult r = bullet_hull_dynamics(s, opt);
     EXPECT_EQ(r.status, Status::Ok) << r.message;
     RigidBody b = b0;
     b.orientation = r.finals[0].orientation;
@@ -517,7 +517,7 @@ TEST(BulletDynamics, SamplesAndErrors) {
   DynamicsOptions opt;
   opt.dt = 1e-3;  // 1000 steps
   opt.sample_every = 100;
-  const DynamicsResult r = bullet_dynamics(s, opt);
+  const DynamicsResult r = bullet_hull_dynamics(s, opt);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.samples.size(), 11u);
   for (size_t k = 0; k < r.samples.size(); ++k) {
@@ -529,7 +529,7 @@ TEST(BulletDynamics, SamplesAndErrors) {
 
   Scene bad = s;
   bad.sim.dt = 0;
-  const DynamicsResult err = bullet_dynamics(bad, {});
+  const DynamicsResult err = bullet_hull_dynamics(bad, {});
   EXPECT_EQ(err.status, Status::Error);
   EXPECT_FALSE(err.message.empty());
 }

@@ -1,5 +1,6 @@
-// Tests of the FCL 0.7 adapters: fcl (Convex, MPR), fcl-epa (signed distance, GJK + EPA),
-// fcl-indep (Convex, GST_INDEP, defects passed on) and fcl-box (boxBoxIntersect).
+// Tests of the FCL 0.7 adapters: fcl-hull (Convex, MPR), fcl-epa (signed distance, GJK + EPA),
+// fcl-indep (Convex, GST_INDEP, defects passed on) and fcl on boxes (fcl::Box, boxBoxIntersect;
+// formerly the separate backend fcl-box).
 //
 // Every expected value is derived by hand from the geometry in the comment next to it. Known
 // wrong answers of the library are pinned as they are, so that an upgrade that changes them is
@@ -179,7 +180,7 @@ std::vector<Quat> cube_symmetries() {
 
 TEST(FclMpr, FacePairConventionBothOrdersAndRotated) {
   // MPR's portal lands on the exact hull face here: only round-off remains.
-  check_face_pair(fcl_contact, kRoundOff);
+  check_face_pair(fcl_hull_contact, kRoundOff);
 }
 
 TEST(FclMpr, ExactTouchingOffCentreHasNoNormalAndIsAnError) {
@@ -188,13 +189,13 @@ TEST(FclMpr, ExactTouchingOffCentreHasNoNormalAndIsAnError) {
   // direction zeroed (mpr.c findPenetr, below CCD_EPS), which FCL copies as the normal.
   // Pinned: the adapter labels that as no normal (status Error), not a 180 deg miss.
   const ContactResult r =
-      fcl_contact(unit_cube("A", Vec3(0.3, 0.2, 1)), unit_cube("B", Vec3::Zero()));
+      fcl_hull_contact(unit_cube("A", Vec3(0.3, 0.2, 1)), unit_cube("B", Vec3::Zero()));
   EXPECT_EQ(r.status, Status::Error);
   EXPECT_NE(r.message.find("zero or undefined normal"), std::string::npos) << r.message;
 }
 
 TEST(FclMpr, OneContactLabelledMpr) {
-  const ContactResult r = fcl_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
+  const ContactResult r = fcl_hull_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
   ASSERT_EQ(r.contacts.size(), 1u);  // Convex-Convex through MPR yields a single point
   EXPECT_EQ(r.contacts[0].feature, "mpr");
 }
@@ -203,10 +204,10 @@ TEST(FclMpr, TouchingIsNoContactAndSeparatedIsNoContact) {
   // Pinned: at gap 0 libccd's MPR classifies the origin on the Minkowski boundary as outside
   // (ccdMPRPenetration returns -1), so FCL reports no collision. Truth is "touching, depth 0";
   // the difference is a boundary convention, not a depth error.
-  const ContactResult touching = fcl_contact(unit_cube("A", Vec3::Zero()), touching_b());
+  const ContactResult touching = fcl_hull_contact(unit_cube("A", Vec3::Zero()), touching_b());
   EXPECT_EQ(touching.status, Status::Ok);
   EXPECT_TRUE(touching.contacts.empty());
-  const ContactResult separated = fcl_contact(unit_cube("A", Vec3::Zero()), separated_b());
+  const ContactResult separated = fcl_hull_contact(unit_cube("A", Vec3::Zero()), separated_b());
   EXPECT_EQ(separated.status, Status::Ok);
   EXPECT_TRUE(separated.contacts.empty());
 }
@@ -215,7 +216,7 @@ TEST(FclMpr, DiagonalCubeKnownWrongAnswerPinned) {
   // Known wrong answer (FCL issue 545), derived above: MPR gives n = -(1,1,1)/sqrt(3) and depth
   // 0.15 sqrt(3) where the truth is an axis and 0.15. MPR stops exactly at the corner of the
   // Minkowski difference, so the pin holds to round-off.
-  const ContactResult r = fcl_contact(diagonal_big(), diagonal_small());
+  const ContactResult r = fcl_hull_contact(diagonal_big(), diagonal_small());
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   const ContactPoint& c = r.contacts[0];
@@ -226,7 +227,7 @@ TEST(FclMpr, DiagonalCubeKnownWrongAnswerPinned) {
               1e-9);  // degrees; round-off of acos near 0.577 is ~1e-14 rad
   EXPECT_FALSE(is_negative_axis(c.normal, 0.1));
   // Swapping the order flips the (wrong) normal and keeps the depth.
-  const ContactResult swapped = fcl_contact(diagonal_small(), diagonal_big());
+  const ContactResult swapped = fcl_hull_contact(diagonal_small(), diagonal_big());
   ASSERT_EQ(swapped.contacts.size(), 1u);
   EXPECT_NEAR((swapped.contacts[0].normal - Vec3::Ones().normalized()).norm(), 0.0, kRoundOff);
   EXPECT_NEAR(swapped.contacts[0].depth, kDiagonalDepth * std::sqrt(3.0), kRoundOff);
@@ -441,17 +442,17 @@ TEST(FclIndep, SeparatedIsNoContact) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// fcl-box: boxBoxIntersect.
+// fcl on two boxes: fcl::Box, boxBoxIntersect (the former fcl-box).
 
 TEST(FclBox, FacePairConventionBothOrdersAndRotated) {
-  check_face_pair(fcl_box_contact, kRoundOff);
+  check_face_pair(fcl_contact, kRoundOff);
 }
 
 TEST(FclBox, FacePairGivesTheFourCornersOfTheOverlapFace) {
   // B's -x face clipped by A's +x face is the whole unit square: 4 corners (0.45, +-0.5, +-0.5)
   // on the mid-plane, each at depth 0.1.
   const ContactResult r =
-      fcl_box_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
+      fcl_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
   ASSERT_EQ(r.contacts.size(), 4u);
   for (const ContactPoint& c : r.contacts) {
     EXPECT_NEAR(std::abs(c.point.y()), 0.5, kRoundOff);
@@ -463,9 +464,9 @@ TEST(FclBox, FacePairGivesTheFourCornersOfTheOverlapFace) {
 TEST(FclBox, TouchingGivesDepthZeroAndSeparatedNone) {
   // At gap 0 the face test passes with zero overlap: 4 contacts at x = 0.5, depth 0, n = -x
   // (the truth: touching).
-  const ContactResult touching = fcl_box_contact(unit_cube("A", Vec3::Zero()), touching_b());
+  const ContactResult touching = fcl_contact(unit_cube("A", Vec3::Zero()), touching_b());
   expect_all_contacts(touching, kFaceNormal, 0.0, kRoundOff);
-  const ContactResult separated = fcl_box_contact(unit_cube("A", Vec3::Zero()), separated_b());
+  const ContactResult separated = fcl_contact(unit_cube("A", Vec3::Zero()), separated_b());
   EXPECT_EQ(separated.status, Status::Ok);
   EXPECT_TRUE(separated.contacts.empty());
 }
@@ -477,22 +478,24 @@ TEST(FclBox, VertexMassModelGivesTheSameBoxFrame) {
       box_body("A", Vec3::Ones(), Vec3::Zero(), Quat::Identity(), MassModel::Vertices);
   const RigidBody b =
       box_body("B", Vec3::Ones(), kFaceOffset, Quat::Identity(), MassModel::Vertices);
-  expect_all_contacts(fcl_box_contact(a, b), kFaceNormal, kFaceDepth, kRoundOff);
+  expect_all_contacts(fcl_contact(a, b), kFaceNormal, kFaceDepth, kRoundOff);
 }
 
-TEST(FclBox, UnsupportedUnlessBothAreBoxes) {
+TEST(FclBox, ABoxAgainstAGeneralConvexRunsMpr) {
+  // The same unit cube declared as a general convex shape is an fcl::Convex, so the pair runs
+  // libccd MPR (one point), not boxBoxIntersect; the face overlap still gives n = -x, depth 0.1.
   RigidBody hull = unit_cube("B", kFaceOffset);
-  hull.shape_kind = ShapeKind::Convex;  // same hull, declared as a general convex shape
-  const ContactResult r = fcl_box_contact(unit_cube("A", Vec3::Zero()), hull);
-  EXPECT_EQ(r.status, Status::Unsupported);
-  EXPECT_FALSE(r.message.empty());
-  EXPECT_TRUE(r.contacts.empty());
-  EXPECT_EQ(fcl_box_contact(hull, unit_cube("A", Vec3::Zero())).status, Status::Unsupported);
+  hull.shape_kind = ShapeKind::Convex;
+  const ContactResult r = fcl_contact(unit_cube("A", Vec3::Zero()), hull);
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.contacts.size(), 1u);
+  EXPECT_EQ(r.contacts[0].feature, "mpr");
+  expect_all_contacts(r, kFaceNormal, kFaceDepth, kRoundOff);
 }
 
 TEST(FclBox, DiagonalCubeGetsTheMinimumPenetration) {
   // Truth derived above: an axis among -x, -y, -z, depth 0.15 (SAT picks one of the tie).
-  const ContactResult r = fcl_box_contact(diagonal_big(), diagonal_small());
+  const ContactResult r = fcl_contact(diagonal_big(), diagonal_small());
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_FALSE(r.contacts.empty());
   for (const ContactPoint& c : r.contacts) {
@@ -513,7 +516,7 @@ TEST(FclBox, PublicCaseUnitCubeOnEdgeIntoBigCube) {
   for (const Quat& sym : cube_symmetries()) {
     const RigidBody b = box_body("B", Vec3::Constant(3), Vec3(0, 0, -1.5), sym);
     for (bool swapped : {false, true}) {
-      const ContactResult r = swapped ? fcl_box_contact(b, a) : fcl_box_contact(a, b);
+      const ContactResult r = swapped ? fcl_contact(b, a) : fcl_contact(a, b);
       ASSERT_EQ(r.status, Status::Ok) << r.message;
       ASSERT_FALSE(r.contacts.empty());
       const Vec3 n = swapped ? Vec3(0, 0, -1) : Vec3(0, 0, 1);
@@ -547,7 +550,7 @@ TEST(FclBox, PublicCaseTiltedCubeOnRotatedCubeCullsToFour) {
   const RigidBody b =
       unit_cube("B", Vec3(0, 0, -0.75), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ())));
   for (bool swapped : {false, true}) {
-    const ContactResult r = swapped ? fcl_box_contact(b, a) : fcl_box_contact(a, b);
+    const ContactResult r = swapped ? fcl_contact(b, a) : fcl_contact(a, b);
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_EQ(r.contacts.size(), 4u);
     double deepest = 0.0;
@@ -572,8 +575,8 @@ TEST(FclConvexBackends, PublicCasesThroughMprAndEpa) {
       unit_cube("B", Vec3(0, 0, -0.75), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ())));
   const double depth1 = std::sqrt(2.0) / 2;
   const double depth2 = std::sqrt(2.0) / 2 * std::cos(M_PI / 4 - theta) - 0.25;
-  expect_all_contacts(fcl_contact(a1, b1), Vec3::UnitZ(), depth1, kRoundOff);
-  expect_all_contacts(fcl_contact(a2, b2), Vec3::UnitZ(), depth2, kRoundOff);
+  expect_all_contacts(fcl_hull_contact(a1, b1), Vec3::UnitZ(), depth1, kRoundOff);
+  expect_all_contacts(fcl_hull_contact(a2, b2), Vec3::UnitZ(), depth2, kRoundOff);
   expect_all_contacts(fcl_epa_contact(a1, b1), Vec3::UnitZ(), depth1, kEpaTolerance);
   expect_all_contacts(fcl_epa_contact(a2, b2), Vec3::UnitZ(), depth2, kEpaTolerance);
 }
@@ -588,7 +591,7 @@ TEST(FclRandomBoxes, AgainstSeparatingAxes) {
   //  - separated by SAT: no contact from any backend;
   //  - fcl-epa: depth = the SAT minimum and = the overlap along its own normal;
   //  - fcl (MPR): depth >= the SAT minimum (no direction needs less than the minimum);
-  //  - fcl-box: deepest point between the SAT minimum and 1.05 times it: boxBox2 prefers a face
+  //  - fcl on boxes (Box-Box): deepest point between the SAT minimum and 1.05 times it: boxBox2 prefers a face
   //    axis over an edge axis unless the edge is 5% shallower (fudge_factor = 1.05 in
   //    box_box-inl.h, inherited from ODE), so up to 5% too deep by design.
   std::mt19937 rng(12345);
@@ -616,9 +619,9 @@ TEST(FclRandomBoxes, AgainstSeparatingAxes) {
     const RigidBody b = box_body("B", size_b, centre_b, q_b);
     const double truth = sat_depth(a, b);
     if (std::abs(truth) < 1e-6) continue;
-    const ContactResult mpr = fcl_contact(a, b);
+    const ContactResult mpr = fcl_hull_contact(a, b);
     const ContactResult epa = fcl_epa_contact(a, b);
-    const ContactResult box = fcl_box_contact(a, b);
+    const ContactResult box = fcl_contact(a, b);
     ASSERT_EQ(mpr.status, Status::Ok) << "sample " << k << ": " << mpr.message;
     ASSERT_EQ(epa.status, Status::Ok) << "sample " << k << ": " << epa.message;
     ASSERT_EQ(box.status, Status::Ok) << "sample " << k << ": " << box.message;
