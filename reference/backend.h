@@ -179,6 +179,20 @@ const std::vector<Backend>& backends();
 /// The backend called `name`, or nullptr.
 const Backend* find_backend(const std::string& name);
 
+/// A contact query that is the same library path as a registry backend with a different set-up,
+/// kept for timing (`rbx bench`) rather than reported as a backend of its own.
+struct QueryVariant {
+  std::string backend;      // the registry backend it varies, e.g. "fcl"
+  std::string variant;      // e.g. "prebuilt"
+  std::string description;  // one line: what differs
+  ContactFn contact;
+};
+
+/// Every query variant, one line each (reference/registry.cpp).
+const std::vector<QueryVariant>& query_variants();
+/// The variant `variant` of `backend`, or nullptr.
+const QueryVariant* find_query_variant(const std::string& backend, const std::string& variant);
+
 /// Builds the engine bodies of a scene (shared by adapters so all use the same inputs).
 std::vector<RigidBody> make_bodies(const Scene& scene);
 

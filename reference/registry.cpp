@@ -60,6 +60,23 @@ const Backend* find_backend(const std::string& name) {
   return nullptr;
 }
 
+const std::vector<QueryVariant>& query_variants() {
+  // backend, variant, what differs, contact query.
+  static const std::vector<QueryVariant> table = {
+      {"custom", "seed", "the seed's faithful loops (the fast detector's oracle)",
+       custom_seed_contact},
+      {"fcl", "prebuilt", "each fcl::Convex built once and kept, as a user holding FCL objects",
+       fcl_contact_prebuilt},
+  };
+  return table;
+}
+
+const QueryVariant* find_query_variant(const std::string& backend, const std::string& variant) {
+  for (const QueryVariant& v : query_variants())
+    if (v.backend == backend && v.variant == variant) return &v;
+  return nullptr;
+}
+
 std::vector<RigidBody> make_bodies(const Scene& scene) {
   std::vector<RigidBody> bodies;
   bodies.reserve(scene.bodies.size());

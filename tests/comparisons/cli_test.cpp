@@ -19,7 +19,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/common/bad_input.h"
+
 namespace fs = std::filesystem;
+using rbx::test::bad_input_catalogue;
 
 namespace {
 
@@ -68,15 +71,6 @@ TEST(Cli, BadSceneExitsTwoWithOneLineAndNoOutputFile) {
   EXPECT_NE(r.err.find("mass"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(json));
   fs::remove_all(dir);
-}
-
-// Every scene of the bad-input catalogue (stems of tests/bad_input/*.toml, sorted).
-std::vector<std::string> bad_input_catalogue() {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(fs::path(RBX_SOURCE_DIR) / "tests/bad_input"))
-    if (entry.path().extension() == ".toml") names.push_back(entry.path().stem().string());
-  std::sort(names.begin(), names.end());
-  return names;
 }
 
 class CliBadInput : public ::testing::TestWithParam<std::string> {};

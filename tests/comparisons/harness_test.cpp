@@ -113,7 +113,10 @@ TEST(HarnessExpect, AnEngineRunThatStopsFailsItsExpectationAndReferencesDoNotBin
   // An engine whose run stops early: failed, not passed and not "not checked".
   std::vector<Backend> table = {*find_backend("custom")};
   table[0].dynamics = [](const Scene&, const DynamicsOptions&) {
-    return DynamicsResult{Status::Error, "energy grew past the guard", {}, {}, {}};
+    DynamicsResult r;
+    r.status = Status::Error;
+    r.message = "energy grew past the guard";
+    return r;
   };
   opt.registry = &table;
   ev = evaluate_scene(scene, opt);

@@ -18,9 +18,12 @@
 #include <sstream>
 
 #include "comparisons/scene/mesh_io.h"
+#include "tests/common/bad_input.h"
 
 namespace rbx {
 namespace {
+
+using test::bad_input_catalogue;
 
 namespace fs = std::filesystem;
 
@@ -54,15 +57,6 @@ std::string read_text(const fs::path& p) {
 
 // ---- the bad-input catalogue -------------------------------------------------------------------
 
-std::vector<std::string> catalogue() {
-  std::vector<std::string> names;
-  (void)kInSourceDir;
-  for (const auto& entry : fs::directory_iterator("tests/bad_input"))
-    if (entry.path().extension() == ".toml") names.push_back(entry.path().stem().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
 class BadInput : public ::testing::TestWithParam<std::string> {};
 
 // Each case's message is the exact line in NAME.expected (written by hand: file, line, key,
@@ -80,11 +74,11 @@ TEST_P(BadInput, GivesTheExpectedOneLineMessage) {
   EXPECT_EQ(message.rfind(path, 0), 0u) << "a message starts with the path as given";
 }
 
-INSTANTIATE_TEST_SUITE_P(Catalogue, BadInput, ::testing::ValuesIn(catalogue()),
+INSTANTIATE_TEST_SUITE_P(Catalogue, BadInput, ::testing::ValuesIn(bad_input_catalogue()),
                          [](const auto& info) { return info.param; });
 
 TEST(BadInputCatalogue, CoversEveryCaseOfTheBrief) {
-  const std::vector<std::string> names = catalogue();
+  const std::vector<std::string> names = bad_input_catalogue();
   EXPECT_GE(names.size(), 35u);
   for (const char* required :
        {"malformed_toml", "empty", "no_body", "unknown_key", "unknown_section", "wrong_type",

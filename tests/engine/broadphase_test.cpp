@@ -11,7 +11,7 @@
 
 #include "engine/bounding.h"
 #include "engine/world.h"
-#include "tests/engine/test_bodies.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "test_bodies.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <random>
 
-#include "test_bodies.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {

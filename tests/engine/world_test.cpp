@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "test_bodies.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {

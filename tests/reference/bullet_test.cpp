@@ -11,8 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "tests/common/fixtures.h"
+
 namespace rbx {
 namespace {
+
+using test::box_spec;
+using test::unit_cube;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -20,25 +25,6 @@ constexpr double kPi = 3.14159265358979323846;
 // (GJK/EPA witness reconstruction, clipping, one impulse): ~1e-15 in practice; 1e-9 leaves
 // ample margin and is still far below every geometric or physical scale tested (>= 1e-3).
 constexpr double kRoundOff = 1e-9;
-
-/// Scene body: a box of full extents `size`, local origin at `position`.
-BodySpec box_spec(const std::string& name, const Vec3& size, const Vec3& position,
-                  double mass = 1.0, const Quat& orientation = Quat::Identity()) {
-  BodySpec s;
-  s.name = name;
-  s.shape_kind = ShapeKind::Box;
-  s.box_size = size;
-  s.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
-  s.mass = mass;
-  s.position = position;
-  s.orientation = orientation;
-  return s;
-}
-
-RigidBody unit_cube(const std::string& name, const Vec3& position,
-                    const Quat& orientation = Quat::Identity()) {
-  return make_body(box_spec(name, Vec3::Ones(), position, 1.0, orientation));
-}
 
 /// True when some contact point is within tol of p.
 bool has_point(const std::vector<ContactPoint>& cs, const Vec3& p, double tol) {

@@ -18,8 +18,12 @@
 #include <string>
 #include <vector>
 
+#include "tests/common/fixtures.h"
+
 namespace rbx {
 namespace {
+
+using test::cube_symmetries;
 
 // Round-off bound for closed-form cases at unit scale: rotations from quaternions and
 // projections carry a few 1e-16; 1e-12 leaves a margin of ~1000 and still catches any
@@ -122,17 +126,6 @@ std::vector<Vec3> face_corners(const Vec3& c, const Quat& q, const Vec3& h, int 
       out.push_back(c + q * local + shift);
     }
   return out;
-}
-
-// FCL's six orientations of a cube that leave it the same set in space (test_fcl_box_box.cpp):
-// identity, pi about x, pi/2 and 3pi/2 about x, pi/2 and 3pi/2 about y.
-std::vector<Quat> cube_symmetries() {
-  return {Quat::Identity(),
-          about(M_PI, Vec3::UnitX()),
-          about(M_PI / 2, Vec3::UnitX()),
-          about(3 * M_PI / 2, Vec3::UnitX()),
-          about(M_PI / 2, Vec3::UnitY()),
-          about(3 * M_PI / 2, Vec3::UnitY())};
 }
 
 TEST(ExactSat, AxisAlignedBoxesEveryAxisAndSide) {

@@ -18,8 +18,17 @@
 #include <string>
 #include <vector>
 
+#include "tests/common/fixtures.h"
+
 namespace rbx {
 namespace {
+
+using test::box_at;
+using test::cube_symmetries;
+using test::depth_along;
+using test::generic_rotation;
+using test::sat_depth;
+using test::unit_cube;
 
 // Round-off bound for results that FCL computes exactly up to floating point: unit-scale
 // coordinates and a few dozen operations give errors ~1e-15; 1e-12 leaves a wide margin.
@@ -29,71 +38,10 @@ constexpr double kRoundOff = 1e-12;
 // FCL's default 1e-6 m by the adapter: the documented bound on the EPA depth.
 constexpr double kEpaTolerance = 1e-6;
 
-/// A box body of full extents `size` whose centre (its centre of mass) is at `position`.
-RigidBody box_body(const std::string& name, const Vec3& size, const Vec3& position,
-                   const Quat& orientation = Quat::Identity(),
-                   MassModel mass_model = MassModel::Solid) {
-  BodySpec spec;
-  spec.name = name;
-  spec.shape_kind = ShapeKind::Box;
-  spec.box_size = size;
-  spec.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
-  spec.mass_model = mass_model;
-  spec.position = position;
-  spec.orientation = orientation;
-  return make_body(spec);
-}
-
-/// Unit cube centred at `position`.
-RigidBody unit_cube(const std::string& name, const Vec3& position,
-                    const Quat& orientation = Quat::Identity()) {
-  return box_body(name, Vec3::Ones(), position, orientation);
-}
-
-/// A generic rotation (0.7 rad about (1, 2, 3)/|.|): no axis aligned, no symmetry of the cube.
-Quat generic_rotation() { return Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())); }
-
 /// Angle between two directions, degrees.
 double angle_deg(const Vec3& a, const Vec3& b) {
   const double c = a.normalized().dot(b.normalized());
   return std::acos(std::max(-1.0, std::min(1.0, c))) * 180.0 / M_PI;
-}
-
-/// Extent of a body's world vertices along u: {min, max}.
-std::pair<double, double> extent(const RigidBody& body, const Vec3& u) {
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (int i = 0; i < static_cast<int>(body.shape->vertices().size()); ++i) {
-    const double s = body.world_vertex(i).dot(u);
-    lo = std::min(lo, s);
-    hi = std::max(hi, s);
-  }
-  return {lo, hi};
-}
-
-/// How far A must move along the unit direction n (ours: from B toward A) to separate from B:
-/// until its lowest point along n reaches B's highest, max_B(n) - min_A(n).
-double depth_along(const RigidBody& a, const RigidBody& b, const Vec3& n) {
-  return extent(b, n).second - extent(a, n).first;
-}
-
-/// Exact minimum penetration depth of two box bodies by the separating-axis theorem: the least
-/// of the two-sided overlaps over A's 3 and B's 3 face normals and the 9 edge cross products
-/// (the minimum translation of two convex polytopes is attained on one of them). Negative when
-/// separated.
-double sat_depth(const RigidBody& a, const RigidBody& b) {
-  const Mat3 ra = a.pose().rotation(), rb = b.pose().rotation();
-  std::vector<Vec3> axes;
-  for (int i = 0; i < 3; ++i) {
-    axes.push_back(ra.col(i));
-    axes.push_back(rb.col(i));
-    for (int j = 0; j < 3; ++j) {
-      const Vec3 c = ra.col(i).cross(rb.col(j));
-      if (c.norm() > 1e-9) axes.push_back(c.normalized());  // parallel edges add no axis
-    }
-  }
-  double best = std::numeric_limits<double>::infinity();
-  for (const Vec3& u : axes) best = std::min({best, depth_along(a, b, u), depth_along(a, b, -u)});
-  return best;
 }
 
 /// Expects one Ok result whose every contact has the given normal and depth.
@@ -156,23 +104,13 @@ RigidBody separated_b() { return unit_cube("B", Vec3(1.1, 0, 0)); }
 constexpr double kDiagonalDepth = 0.15;
 const Vec3 kDiagonalCentre(0.4, 0.4, 0.4);
 RigidBody diagonal_big() { return unit_cube("A", Vec3::Zero()); }
-RigidBody diagonal_small() { return box_body("B", Vec3::Constant(0.1), kDiagonalCentre); }
+RigidBody diagonal_small() { return box_at("B", Vec3::Constant(0.1), kDiagonalCentre); }
 
 /// True when n is one of -x, -y, -z (within tol): a correct answer on the diagonal pair.
 bool is_negative_axis(const Vec3& n, double tol) {
   for (int i = 0; i < 3; ++i)
     if ((n + Vec3::Unit(i)).norm() <= tol) return true;
   return false;
-}
-
-/// The six orientations of a cube that map it onto itself used by FCL's box-box tests.
-std::vector<Quat> cube_symmetries() {
-  return {Quat::Identity(),
-          Quat(Eigen::AngleAxisd(M_PI, Vec3::UnitX())),
-          Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX())),
-          Quat(Eigen::AngleAxisd(3 * M_PI / 2, Vec3::UnitX())),
-          Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY())),
-          Quat(Eigen::AngleAxisd(3 * M_PI / 2, Vec3::UnitY()))};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -309,7 +247,7 @@ TEST(FclIndep, PublicBoxCaseNormalIsRotatedBackIntoALocalFrame) {
   // (-sin 45, 0, cos 45); the depth is negated.
   const Quat q(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY()));
   const ContactResult r = fcl_indep_contact(unit_cube("A", Vec3::Zero(), q),
-                                            box_body("B", Vec3::Constant(3), Vec3(0, 0, -1.5)));
+                                            box_at("B", Vec3::Constant(3), Vec3(0, 0, -1.5)));
   ASSERT_EQ(r.contacts.size(), 1u);
   const double s = std::sqrt(0.5);
   EXPECT_NEAR((r.contacts[0].normal - Vec3(-s, 0, s)).norm(), 0.0, kRoundOff);
@@ -368,7 +306,7 @@ TEST(FclIndep, PublicBoxCaseBothOrdersAndSymmetriesPinned) {
       unit_cube("A", Vec3::Zero(), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY())));
   const std::vector<Quat> syms = cube_symmetries();
   for (size_t k = 0; k < syms.size(); ++k) {
-    const RigidBody b = box_body("B", Vec3::Constant(3), Vec3(0, 0, -1.5), syms[k]);
+    const RigidBody b = box_at("B", Vec3::Constant(3), Vec3(0, 0, -1.5), syms[k]);
     const ContactResult ba = fcl_indep_contact(b, a);
     ASSERT_EQ(ba.contacts.size(), 1u) << "symmetry " << k;
     EXPECT_NEAR((ba.contacts[0].normal + syms[k].conjugate() * Vec3::UnitZ()).norm(), 0.0,
@@ -475,9 +413,9 @@ TEST(FclBox, VertexMassModelGivesTheSameBoxFrame) {
   // With mass_model = vertices the centre of mass is the corner average = the box centre, so
   // the answer is the solid model's: n = -x, depth 0.1.
   const RigidBody a =
-      box_body("A", Vec3::Ones(), Vec3::Zero(), Quat::Identity(), MassModel::Vertices);
+      box_at("A", Vec3::Ones(), Vec3::Zero(), Quat::Identity(), MassModel::Vertices);
   const RigidBody b =
-      box_body("B", Vec3::Ones(), kFaceOffset, Quat::Identity(), MassModel::Vertices);
+      box_at("B", Vec3::Ones(), kFaceOffset, Quat::Identity(), MassModel::Vertices);
   expect_all_contacts(fcl_contact(a, b), kFaceNormal, kFaceDepth, kRoundOff);
 }
 
@@ -514,7 +452,7 @@ TEST(FclBox, PublicCaseUnitCubeOnEdgeIntoBigCube) {
   const RigidBody a =
       unit_cube("A", Vec3::Zero(), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY())));
   for (const Quat& sym : cube_symmetries()) {
-    const RigidBody b = box_body("B", Vec3::Constant(3), Vec3(0, 0, -1.5), sym);
+    const RigidBody b = box_at("B", Vec3::Constant(3), Vec3(0, 0, -1.5), sym);
     for (bool swapped : {false, true}) {
       const ContactResult r = swapped ? fcl_contact(b, a) : fcl_contact(a, b);
       ASSERT_EQ(r.status, Status::Ok) << r.message;
@@ -568,7 +506,7 @@ TEST(FclConvexBackends, PublicCasesThroughMprAndEpa) {
   // depths derived above (both are face-vertex/edge cases where MPR's ray meets the right face).
   const Quat tilt_y(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY()));
   const RigidBody a1 = unit_cube("A", Vec3::Zero(), tilt_y);
-  const RigidBody b1 = box_body("B", Vec3::Constant(3), Vec3(0, 0, -1.5));
+  const RigidBody b1 = box_at("B", Vec3::Constant(3), Vec3(0, 0, -1.5));
   const double theta = M_PI / 8;
   const RigidBody a2 = unit_cube("A", Vec3::Zero(), Quat(Eigen::AngleAxisd(theta, Vec3::UnitX())));
   const RigidBody b2 =
@@ -615,8 +553,8 @@ TEST(FclRandomBoxes, AgainstSeparatingAxes) {
     const Vec3 size_b = random_vec(size);
     const Vec3 centre_b = random_vec(offset);
     const Quat q_b = random_quat();
-    const RigidBody a = box_body("A", size_a, Vec3::Zero(), q_a);
-    const RigidBody b = box_body("B", size_b, centre_b, q_b);
+    const RigidBody a = box_at("A", size_a, Vec3::Zero(), q_a);
+    const RigidBody b = box_at("B", size_b, centre_b, q_b);
     const double truth = sat_depth(a, b);
     if (std::abs(truth) < 1e-6) continue;
     const ContactResult mpr = fcl_hull_contact(a, b);
@@ -654,11 +592,11 @@ TEST(FclRandomBoxes, AgainstSeparatingAxes) {
 TEST(FclEpa, PairWhereLibccdEpaUnderestimatesIsRight) {
   // The pair pinned in libccd_test.cpp (EpaUnderestimatesPinned), where libccd 2.1's own EPA
   // returns 0.7279 m: FCL's patched EPA returns the SAT minimum (~0.8124 m).
-  const RigidBody a = box_body(
+  const RigidBody a = box_at(
       "A", Vec3(1.1619617394816926, 1.1743795334951157, 1.1237059231902502), Vec3::Zero(),
       Quat(0.057171239174407154, 0.85098897643779126, -0.51827575490333189, 0.062765064104200047)
           .normalized());
-  const RigidBody b = box_body(
+  const RigidBody b = box_at(
       "B", Vec3(1.2277854676293352, 0.73704683757464129, 0.88691392538948266),
       Vec3(0.55841869342978101, 0.040565343341065541, -0.45090973054194416),
       Quat(0.31812010099052296, -0.8985848754636705, 0.28341090204507841, 0.10499087358296565)

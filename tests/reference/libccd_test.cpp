@@ -16,69 +16,20 @@
 #include <random>
 #include <string>
 
+#include "tests/common/fixtures.h"
+
 namespace rbx {
 namespace {
+
+using test::box_at;
+using test::depth_along;
+using test::generic_rotation;
+using test::sat_depth;
+using test::unit_cube;
 
 // Round-off bound for answers libccd computes exactly up to floating point (the portal or the
 // EPA face is an exact hull face): unit-scale coordinates give ~1e-15; 1e-12 leaves margin.
 constexpr double kRoundOff = 1e-12;
-
-/// A box body of full extents `size` centred (centre of mass) at `position`.
-RigidBody box_body(const std::string& name, const Vec3& size, const Vec3& position,
-                   const Quat& orientation = Quat::Identity()) {
-  BodySpec spec;
-  spec.name = name;
-  spec.shape_kind = ShapeKind::Box;
-  spec.box_size = size;
-  spec.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
-  spec.position = position;
-  spec.orientation = orientation;
-  return make_body(spec);
-}
-
-RigidBody unit_cube(const std::string& name, const Vec3& position,
-                    const Quat& orientation = Quat::Identity()) {
-  return box_body(name, Vec3::Ones(), position, orientation);
-}
-
-/// A generic rotation (0.7 rad about (1, 2, 3)/|.|).
-Quat generic_rotation() { return Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())); }
-
-/// Extent of a body's world vertices along u: {min, max}.
-std::pair<double, double> extent(const RigidBody& body, const Vec3& u) {
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (int i = 0; i < static_cast<int>(body.shape->vertices().size()); ++i) {
-    const double s = body.world_vertex(i).dot(u);
-    lo = std::min(lo, s);
-    hi = std::max(hi, s);
-  }
-  return {lo, hi};
-}
-
-/// How far A must move along the unit direction n (ours: from B toward A) to separate from B:
-/// until its lowest point along n reaches B's highest, max_B(n) - min_A(n).
-double depth_along(const RigidBody& a, const RigidBody& b, const Vec3& n) {
-  return extent(b, n).second - extent(a, n).first;
-}
-
-/// Exact minimum penetration depth of two box bodies by the separating-axis theorem: the least
-/// of the two-sided overlaps over A's 3 and B's 3 face normals and the 9 edge cross products.
-/// Negative when separated (the largest gap).
-double sat_depth(const RigidBody& a, const RigidBody& b) {
-  const Mat3 ra = a.pose().rotation(), rb = b.pose().rotation();
-  std::vector<Vec3> axes;
-  for (int i = 0; i < 3; ++i) {
-    axes.push_back(ra.col(i));
-    axes.push_back(rb.col(i));
-    for (int j = 0; j < 3; ++j) {
-      const Vec3 c = ra.col(i).cross(rb.col(j));
-      if (c.norm() > 1e-9) axes.push_back(c.normalized());  // parallel edges add no axis
-    }
-  }
-  double best = std::numeric_limits<double>::infinity();
-  for (const Vec3& u : axes) best = std::min({best, depth_along(a, b, u), depth_along(a, b, -u)});
-  return best;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Face pair: unit cubes, A at the origin, B at (0.9, 0, 0). Overlap 0.1 along x (1 along y, z),
@@ -138,7 +89,7 @@ TEST(Libccd, DiagonalCubeMprWrongEpaRight) {
   // ray leaves at its corner (0.15, 0.15, 0.15): MPR reports ours n = -(1, 1, 1)/sqrt(3), depth
   // 0.15 sqrt(3) ~ 0.2598 (pinned: a known wrong answer). EPA finds a face: an axis, 0.15.
   const RigidBody big = unit_cube("A", Vec3::Zero());
-  const RigidBody small = box_body("B", Vec3::Constant(0.1), Vec3::Constant(0.4));
+  const RigidBody small = box_at("B", Vec3::Constant(0.1), Vec3::Constant(0.4));
   const ContactResult r = libccd_contact(big, small);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 2u);
@@ -180,8 +131,8 @@ TEST(Libccd, RandomBoxPairsAgainstSeparatingAxes) {
     const Vec3 size_b = random_vec(size);
     const Vec3 centre_b = random_vec(offset);
     const Quat q_b = random_quat();
-    const RigidBody a = box_body("A", size_a, Vec3::Zero(), q_a);
-    const RigidBody b = box_body("B", size_b, centre_b, q_b);
+    const RigidBody a = box_at("A", size_a, Vec3::Zero(), q_a);
+    const RigidBody b = box_at("B", size_b, centre_b, q_b);
     const double truth = sat_depth(a, b);
     if (std::abs(truth) < 1e-6) continue;
     const ContactResult r = libccd_contact(a, b);
@@ -224,11 +175,11 @@ TEST(Libccd, EpaUnderestimatesPinned) {
   // The same result for every epa_tolerance from 1e-4 to 1e-12 and without an iteration cap,
   // so it is the library's, not the adapter's settings. FCL's own patched EPA (fcl-epa) gets
   // this pair right (tests/reference/fcl_test.cpp).
-  const RigidBody a = box_body(
+  const RigidBody a = box_at(
       "A", Vec3(1.1619617394816926, 1.1743795334951157, 1.1237059231902502), Vec3::Zero(),
       Quat(0.057171239174407154, 0.85098897643779126, -0.51827575490333189, 0.062765064104200047)
           .normalized());
-  const RigidBody b = box_body(
+  const RigidBody b = box_at(
       "B", Vec3(1.2277854676293352, 0.73704683757464129, 0.88691392538948266),
       Vec3(0.55841869342978101, 0.040565343341065541, -0.45090973054194416),
       Quat(0.31812010099052296, -0.8985848754636705, 0.28341090204507841, 0.10499087358296565)

@@ -13,6 +13,8 @@
 #include <set>
 #include <utility>
 
+#include "tests/common/fixtures.h"
+
 // LeakSanitizer in the sanitizer build (GCC defines __SANITIZE_ADDRESS__, clang has the feature).
 #if defined(__SANITIZE_ADDRESS__)
 #define RBX_HAS_LSAN 1
@@ -28,37 +30,9 @@
 namespace rbx {
 namespace {
 
-// A box specification (solid mass model unless changed).
-BodySpec box_spec(const std::string& name, const Vec3& size, const Vec3& position,
-                  double mass = 1.0, const Quat& orientation = Quat::Identity()) {
-  BodySpec s;
-  s.name = name;
-  s.shape_kind = ShapeKind::Box;
-  s.box_size = size;
-  s.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
-  s.mass = mass;
-  s.position = position;
-  s.orientation = orientation;
-  return s;
-}
-
-// Square pyramid: base (+-0.5, +-0.5, 0), apex (0, 0, 1), in the scene's local frame.
-BodySpec pyramid_spec(const std::string& name, const Vec3& position, const Quat& orientation) {
-  BodySpec s;
-  s.name = name;
-  s.shape_kind = ShapeKind::Convex;
-  s.shape = std::make_shared<const ConvexPolyhedron>(ConvexPolyhedron::from_triangles(
-      {Vec3(-0.5, -0.5, 0), Vec3(0.5, -0.5, 0), Vec3(0.5, 0.5, 0), Vec3(-0.5, 0.5, 0),
-       Vec3(0, 0, 1)},
-      {{0, 2, 1}, {0, 3, 2}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}));
-  s.position = position;
-  s.orientation = orientation;
-  return s;
-}
-
-// Unit cube whose body diagonal (1,1,1) points along +x: its vertex (0.5,0.5,0.5) leads at
-// sqrt(3)/2 ahead of the centre, on the line of centres (a 1-D impact with no lever arm).
-Quat diagonal_along_x() { return Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitX()); }
+using test::box_spec;
+using test::diagonal_along_x;
+using test::pyramid_spec;
 
 // MuJoCo stores mesh vertices as float: coordinates of size 0.5..1 carry ~6e-8 round-off, and
 // the compiler's recentring adds a few more float operations; 1e-6 m covers them.

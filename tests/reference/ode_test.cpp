@@ -8,39 +8,14 @@
 #include <memory>
 #include <utility>
 
+#include "tests/common/fixtures.h"
+
 namespace rbx {
 namespace {
 
-// A box specification (solid mass model).
-BodySpec box_spec(const std::string& name, const Vec3& size, const Vec3& position,
-                  double mass = 1.0, const Quat& orientation = Quat::Identity()) {
-  BodySpec s;
-  s.name = name;
-  s.shape_kind = ShapeKind::Box;
-  s.box_size = size;
-  s.shape = std::make_shared<const ConvexPolyhedron>(make_box(size));
-  s.mass = mass;
-  s.position = position;
-  s.orientation = orientation;
-  return s;
-}
-
-// Square pyramid: base (+-0.5, +-0.5, 0) (two coplanar triangles), apex (0, 0, 1).
-BodySpec pyramid_spec(const std::string& name, const Vec3& position, const Quat& orientation) {
-  BodySpec s;
-  s.name = name;
-  s.shape_kind = ShapeKind::Convex;
-  s.shape = std::make_shared<const ConvexPolyhedron>(ConvexPolyhedron::from_triangles(
-      {Vec3(-0.5, -0.5, 0), Vec3(0.5, -0.5, 0), Vec3(0.5, 0.5, 0), Vec3(-0.5, 0.5, 0),
-       Vec3(0, 0, 1)},
-      {{0, 2, 1}, {0, 3, 2}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}));
-  s.position = position;
-  s.orientation = orientation;
-  return s;
-}
-
-// Unit cube with its body diagonal along +x: vertex (0.5,0.5,0.5) leads sqrt(3)/2 ahead.
-Quat diagonal_along_x() { return Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitX()); }
+using test::box_spec;
+using test::diagonal_along_x;
+using test::pyramid_spec;
 
 // ODE computes in double (dDOUBLE): contact geometry of unit-size boxes is exact to round-off.
 constexpr double kRoundOff = 1e-12;

@@ -1,0 +1,145 @@
+// `rbx bench`'s cases, as a table: Box2D lists its benchmarks as { name, create, step, count };
+// here each family (narrow phase, broad phase, whole step) builds its cases from the plan, and
+// each case is a name, an untimed warm-up and set-up, and a timed body. Backends are reached
+// through the registry (reference/backend.h), timing-only variants through query_variants().
+// The shape and pose builders are shared with tests/comparisons/bench_cases_test.cpp.
+#pragma once
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "engine/body.h"
+#include "engine/broadphase.h"
+#include "engine/polyhedron.h"
+#include "reference/backend.h"
+
+namespace rbx {
+
+/// A pose kind and its offset from the touching distance along the placement direction, as a
+/// fraction of the shape size (1 m): touching = 0.5% of the size deep (within 1%), deep = 20%
+/// deep, separated = a 5% gap.
+struct PoseKind {
+  const char* name;
+  double offset;  // fraction of the size; negative: penetrating
+};
+inline constexpr PoseKind kPoseKinds[] = {{"touching", -0.005}, {"deep", -0.2}, {"separated", 0.05}};
+
+/// Repetitions of the cheap cases and of those behind the goals (the fastest is kept).
+constexpr int kBenchRepetitions = 3;
+/// Size (m) of every benchmark shape: the unit box and hulls of points on a sphere of radius 0.5.
+constexpr double kBenchShapeSize = 1.0;
+
+/// The broad-phase methods timed, in table order.
+inline constexpr BroadPhaseMethod kBenchBroadPhaseMethods[] = {
+    BroadPhaseMethod::AllPairs, BroadPhaseMethod::SweepAndPrune, BroadPhaseMethod::Tree};
+
+/// What a run measures: sizes, caps and times for the full and the quick run.
+struct BenchPlan {
+  bool quick = false;
+  std::vector<int> hull_sizes;              // vertices of the hulls (the box is always included)
+  int poses = 3;                            // poses per kind
+  double min_time = 0.2;                    // s, minimum timed time per case
+  std::vector<int> crowd_sizes;             // bodies in the broad-phase crowds
+  double crowd_min_time = 0.2;              // s
+  std::vector<long> steps_100, steps_1000;  // step counts of the two runs per scene
+  double step_min_time = 0.1;               // s
+};
+
+/// The full plan, or the quick one (--quick).
+BenchPlan bench_plan(bool quick);
+
+/// One contact backend as benchmarked: a row of the narrow-phase table.
+struct NarrowBackend {
+  std::string backend;  // registry name
+  std::string variant;  // "fast" | "seed" for custom; "prebuilt" for fcl; "default" otherwise
+  ContactFn contact;
+  int max_vertices_full;   // largest hull size timed in the full run
+  int max_vertices_quick;  // in the quick run
+  bool boxes_only = false;
+};
+
+/// Every contact backend with the sizes it is timed at.
+std::vector<NarrowBackend> narrow_backends();
+
+// ---- Scene builders ------------------------------------------------------------------------
+
+/// The hull of n random points on the sphere of radius 0.5 (all of them are hull vertices).
+ConvexPolyhedron sphere_hull(int n, std::mt19937_64& rng);
+
+/// One pair of bodies at several poses of one kind.
+struct PosedPair {
+  RigidBody a, b;
+  std::vector<Pose> poses_a, poses_b;
+};
+
+/// Poses of one kind for a pair of copies of `shape`: random orientations and a random
+/// direction d; the touching distance t* along d is found by bisection with libccd (MPR,
+/// tolerance 1e-10 m), and B is placed at t* + offset * size along d from A.
+PosedPair make_poses(const ConvexPolyhedron& shape, bool box, const PoseKind& kind, int count,
+                     std::mt19937_64& rng);
+
+/// A crowd of n cubes of 0.2 m at uniformly random points and orientations, one per 0.125 m^3
+/// (the grid spacing of scenes/many/many_100), so each cube has about the same number of
+/// neighbours at any n.
+std::vector<RigidBody> cube_crowd(int n, std::mt19937_64& rng);
+
+// ---- Cases and results ---------------------------------------------------------------------
+
+/// One timed case. Google Benchmark calls it several times (to size the iteration count, and
+/// per repetition); each call runs warm_up once, then timed iterations of body, with set_up
+/// before each (not timed).
+struct BenchCase {
+  std::string name;                // family/backend/variant/size/kind
+  std::function<void()> warm_up;   // untimed, once per call: caches, hierarchies, page faults
+  std::function<void()> set_up;    // untimed, before every iteration; empty: none
+  std::function<void()> body;      // the timed work of one iteration
+  double min_time_s = 0.1;         // minimum timed time
+  int repetitions = 1;             // the fastest repetition is kept
+};
+
+/// A narrow-phase result row.
+struct NarrowRow {
+  std::string backend, variant, pose, status;
+  int vertices = 0;       // nominal: 8 for the box, else the hull's point count
+  int hull_vertices = 0;  // as built
+  double ns_per_query = NAN;
+  long iterations = 0;
+};
+
+/// A broad-phase result row.
+struct BroadRow {
+  std::string method;
+  int bodies = 0;
+  double ns_per_step = NAN;
+  double pairs_per_step = 0.0;
+};
+
+/// A whole-step result row.
+struct StepRow {
+  std::string backend, variant, scene;
+  int bodies = 0;        // moving bodies
+  int total_bodies = 0;  // including static walls
+  double us_per_body_step = NAN;
+  std::string status;
+};
+
+/// Everything a run measured.
+struct BenchResults {
+  int cpus = 0;        // as Google Benchmark saw the machine
+  double mhz = 0.0;
+  std::size_t cases = 0;
+  std::vector<NarrowRow> narrow;
+  std::vector<BroadRow> broad;
+  std::vector<StepRow> step;
+};
+
+/// Builds every family's cases, times them with Google Benchmark and returns the rows.
+BenchResults run_bench(const BenchPlan& plan);
+
+/// Least-squares slope of log(time) against log(size): the exponent of time against size.
+double fit_exponent(const std::vector<std::pair<double, double>>& points);
+
+}  // namespace rbx

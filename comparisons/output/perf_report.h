@@ -1,0 +1,30 @@
+// `rbx bench`'s pages: the goals of issue 6 judged on the measured rows, and perf.md, perf.json,
+// perf.csv and figures/perf_*.{png,svg} (comparisons/output/bench_plots.py, matplotlib).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "comparisons/eval/bench_cases.h"
+
+namespace rbx {
+
+/// One performance goal and what was measured against it.
+struct PerfGoal {
+  std::string goal, measured;
+  bool met = false;
+};
+
+/// The goals of issue 6, judged on the rows of a run.
+std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& results);
+
+/// Writes perf.md, perf.json, perf.csv and the figures into `out`, each file built in a
+/// temporary folder and moved in (other files there, such as `rbx report`'s, are kept). With
+/// `contract_copy`, reports/perf.md (the path CONTRACT.md names, beside `out`) gets a copy of
+/// perf.md whose figure links point into `out`'s folder name "latest/". `timing_s` is the wall
+/// time of the timing, written into perf.md.
+void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
+                      const std::vector<PerfGoal>& goals, double timing_s, const std::string& out,
+                      bool contract_copy);
+
+}  // namespace rbx
