@@ -96,9 +96,17 @@ int facing_face(const AcceleratedView& y, const AcceleratedView& x) {
   const Vec3 dl = y.rt * d.normalized();
   const auto& pl = y.shape->planes();
   if (!y.accel) {
+    // A face sharing the previous face's normal has its dot product and cannot beat it.
     int best = 0;
-    for (int f = 1; f < y.num_triangles(); ++f)
-      if (pl[f].normal.dot(dl) > pl[best].normal.dot(dl)) best = f;
+    double best_dot = pl[0].normal.dot(dl);
+    for (int f = 1; f < y.num_triangles(); ++f) {
+      if (!y.distinct[f]) continue;
+      const double dot = pl[f].normal.dot(dl);
+      if (dot > best_dot) {
+        best_dot = dot;
+        best = f;
+      }
+    }
     return best;
   }
   const ShapeHierarchy& acc = *y.accel;
@@ -162,12 +170,27 @@ void fill_plane_table(AcceleratedView& x, const AcceleratedView& y, const Limits
                       std::vector<double>& table) {
   const int nv = static_cast<int>(x.shape->vertices().size());
   const auto& tris = y.shape->triangles();
+  const double limit = lim.tol + lim.margin;
+  // Most pairs passing the bounding check are apart: x wholly beyond y's facing face plane
+  // settles it (the rule of may_enter()) without the table.
+  if (y.facing >= 0) {
+    const Vec3& q = y.world_vertices[tris[y.facing][0]];
+    const Vec3& n = y.world_normals[y.facing];
+    bool separated = true;
+    for (int i = 0; i < nv && separated; ++i)
+      separated = plane_dist(x.world_vertices[i], q, n) > limit;
+    if (separated) {
+      x.plane_table = nullptr;
+      x.table_planes = 0;
+      x.enters = false;
+      return;
+    }
+  }
   int planes[kSmallTriangles];
   int count = 0;
   for (int f = 0; f < y.num_triangles(); ++f)
     if (y.distinct[f]) planes[count++] = f;
   table.resize(static_cast<std::size_t>(nv) * count);
-  const double limit = lim.tol + lim.margin;
   bool separated[kSmallTriangles];
   for (int k = 0; k < count; ++k) separated[k] = true;
   for (int i = 0; i < nv; ++i)

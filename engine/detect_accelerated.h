@@ -60,7 +60,8 @@ struct AcceleratedView {
   int facing = -1;  // the face most along the direction toward the other shape (facing_face)
   bool enters = true;  // false: no point of this shape can be inside the other (prepare)
   // Two small shapes: the seed's plane distance of each of this shape's vertices from each
-  // distinct face plane of the other, vertex-major (prepare); null otherwise.
+  // distinct face plane of the other, vertex-major (prepare); null otherwise, and when this
+  // shape cannot enter the other (no test reads it then).
   const double* plane_table = nullptr;
   int table_planes = 0;  // columns of plane_table
   double tol = 0.0;      // m, the pair's Limits
