@@ -54,7 +54,7 @@ struct AcceleratedView {
   Mat3 rt = Mat3::Identity();             // world to body
   Vec3 position = Vec3::Zero();           // m, world
   const Vec3* world_vertices = nullptr;   // small shapes only
-  const Vec3* world_normals = nullptr;    // small shapes only
+  const Vec3* world_normals = nullptr;    // small shapes only (unset when neither can enter)
   const unsigned char* distinct = nullptr;  // small shapes: 1 where a face's normal differs
                                             // from the previous face's (a new plane)
   int facing = -1;  // the face most along the direction toward the other shape (facing_face)
