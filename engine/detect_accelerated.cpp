@@ -39,8 +39,8 @@ __attribute__((always_inline)) inline double plane_distance(const AcceleratedVie
 // Size (m) of a shape: the diagonal of its local bounding box.
 double shape_size(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
 
-// Places a shape: small shapes get world vertices (and which faces start a new plane) in
-// workspace slot `slot`; their world normals follow in place_normals.
+// Places a shape: small shapes get world vertices in workspace slot `slot`; their world normals
+// follow in place_normals.
 AcceleratedView place(const ConvexPolyhedron& shape, const Pose& pose, const Limits& lim,
                       AcceleratedWorkspace& ws, int slot) {
   AcceleratedView p;
@@ -56,13 +56,8 @@ AcceleratedView place(const ConvexPolyhedron& shape, const Pose& pose, const Lim
   // The seed's world copies, into reused buffers.
   wv.resize(shape.vertices().size());
   for (std::size_t i = 0; i < wv.size(); ++i) wv[i] = p.r * shape.vertices()[i] + pose.position;
-  const auto& planes = shape.planes();
-  std::vector<unsigned char>& distinct = ws.distinct[slot];
-  distinct.resize(planes.size());
-  for (std::size_t f = 0; f < planes.size(); ++f)
-    distinct[f] = f == 0 || planes[f].normal != planes[f - 1].normal;
   p.world_vertices = wv.data();
-  p.distinct = distinct.data();
+  p.distinct = shape.new_plane().data();
   return p;
 }
 

@@ -55,8 +55,7 @@ struct AcceleratedView {
   Vec3 position = Vec3::Zero();           // m, world
   const Vec3* world_vertices = nullptr;   // small shapes only
   const Vec3* world_normals = nullptr;    // small shapes only (unset when neither can enter)
-  const unsigned char* distinct = nullptr;  // small shapes: 1 where a face's normal differs
-                                            // from the previous face's (a new plane)
+  const unsigned char* distinct = nullptr;  // small shapes: shape->new_plane()
   int facing = -1;  // the face most along the direction toward the other shape (facing_face)
   bool enters = true;  // false: no point of this shape can be inside the other (prepare)
   // Two small shapes: the seed's plane distance of each of this shape's vertices from each
@@ -95,7 +94,6 @@ struct AcceleratedView {
 /// small shapes and their plane tables.
 struct AcceleratedWorkspace {
   std::vector<Vec3> vertices[2], normals[2];
-  std::vector<unsigned char> distinct[2];
   std::vector<double> tables[2];
 };
 
