@@ -39,7 +39,8 @@ __attribute__((always_inline)) inline double plane_distance(const AcceleratedVie
 // Size (m) of a shape: the diagonal of its local bounding box.
 double shape_size(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
 
-// Places a shape: small shapes get world copies in workspace slot `slot`.
+// Places a shape: small shapes get world vertices in workspace slot `slot`; their world normals
+// follow in place_normals.
 AcceleratedView place(const ConvexPolyhedron& shape, const Pose& pose, const Limits& lim,
                       AcceleratedWorkspace& ws, int slot) {
   AcceleratedView p;
@@ -52,24 +53,37 @@ AcceleratedView place(const ConvexPolyhedron& shape, const Pose& pose, const Lim
   p.margin = lim.margin;
   if (p.accel) return p;
   std::vector<Vec3>& wv = ws.vertices[slot];
-  std::vector<Vec3>& wn = ws.normals[slot];
   // The seed's world copies, into reused buffers.
   wv.resize(shape.vertices().size());
   for (std::size_t i = 0; i < wv.size(); ++i) wv[i] = p.r * shape.vertices()[i] + pose.position;
-  wn.resize(shape.planes().size());
-  // Coplanar triangles (a box face is two) share their normal bit for bit; the same input
-  // gives the same product, so it is computed once.
-  const auto& planes = shape.planes();
-  std::vector<unsigned char>& distinct = ws.distinct[slot];
-  distinct.resize(wn.size());
-  for (std::size_t f = 0; f < wn.size(); ++f) {
-    distinct[f] = f == 0 || planes[f].normal != planes[f - 1].normal;
-    wn[f] = distinct[f] ? Vec3(p.r * planes[f].normal) : wn[f - 1];
-  }
   p.world_vertices = wv.data();
-  p.world_normals = wn.data();
-  p.distinct = distinct.data();
+  p.distinct = shape.new_plane().data();
   return p;
+}
+
+// The world normals of a small placed shape, r n per triangle. Coplanar triangles (a box face
+// is two) share their normal bit for bit; the same input gives the same product, so it is
+// computed once.
+void place_normals(AcceleratedView& p, AcceleratedWorkspace& ws, int slot) {
+  const auto& planes = p.shape->planes();
+  std::vector<Vec3>& wn = ws.normals[slot];
+  wn.resize(planes.size());
+  for (std::size_t f = 0; f < wn.size(); ++f)
+    wn[f] = p.distinct[f] ? Vec3(p.r * planes[f].normal) : wn[f - 1];
+  p.world_normals = wn.data();
+}
+
+// Two small shapes: true when every vertex of x lies beyond y's facing face plane by more than
+// tol + margin (the rule of may_enter(); the normal r n is the one place_normals computes).
+bool beyond_facing(const AcceleratedView& x, const AcceleratedView& y, const Limits& lim) {
+  if (y.facing < 0) return false;
+  const Vec3& q = y.world_vertices[y.shape->triangles()[y.facing][0]];
+  const Vec3 n = y.r * y.shape->planes()[y.facing].normal;
+  const double limit = lim.tol + lim.margin;
+  const int nv = static_cast<int>(x.shape->vertices().size());
+  for (int i = 0; i < nv; ++i)
+    if (plane_dist(x.world_vertices[i], q, n) <= limit) return false;
+  return true;
 }
 
 // A face plane of y used to cull x's primitives: every point p of a hit must have
@@ -96,9 +110,17 @@ int facing_face(const AcceleratedView& y, const AcceleratedView& x) {
   const Vec3 dl = y.rt * d.normalized();
   const auto& pl = y.shape->planes();
   if (!y.accel) {
+    // A face sharing the previous face's normal has its dot product and cannot beat it.
     int best = 0;
-    for (int f = 1; f < y.num_triangles(); ++f)
-      if (pl[f].normal.dot(dl) > pl[best].normal.dot(dl)) best = f;
+    double best_dot = pl[0].normal.dot(dl);
+    for (int f = 1; f < y.num_triangles(); ++f) {
+      if (!y.distinct[f]) continue;
+      const double dot = pl[f].normal.dot(dl);
+      if (dot > best_dot) {
+        best_dot = dot;
+        best = f;
+      }
+    }
     return best;
   }
   const ShapeHierarchy& acc = *y.accel;
@@ -162,12 +184,27 @@ void fill_plane_table(AcceleratedView& x, const AcceleratedView& y, const Limits
                       std::vector<double>& table) {
   const int nv = static_cast<int>(x.shape->vertices().size());
   const auto& tris = y.shape->triangles();
+  const double limit = lim.tol + lim.margin;
+  // Most pairs passing the bounding check are apart: x wholly beyond y's facing face plane
+  // settles it (the rule of may_enter()) without the table.
+  if (y.facing >= 0) {
+    const Vec3& q = y.world_vertices[tris[y.facing][0]];
+    const Vec3& n = y.world_normals[y.facing];
+    bool separated = true;
+    for (int i = 0; i < nv && separated; ++i)
+      separated = plane_dist(x.world_vertices[i], q, n) > limit;
+    if (separated) {
+      x.plane_table = nullptr;
+      x.table_planes = 0;
+      x.enters = false;
+      return;
+    }
+  }
   int planes[kSmallTriangles];
   int count = 0;
   for (int f = 0; f < y.num_triangles(); ++f)
     if (y.distinct[f]) planes[count++] = f;
   table.resize(static_cast<std::size_t>(nv) * count);
-  const double limit = lim.tol + lim.margin;
   bool separated[kSmallTriangles];
   for (int k = 0; k < count; ++k) separated[k] = true;
   for (int i = 0; i < nv; ++i)
@@ -527,6 +564,15 @@ void AcceleratedPair::prepare(const ConvexPolyhedron& sa, const Pose& pa,
   // Each shape's facing face, and whether its points can enter the other.
   a.facing = facing_face(a, b);
   b.facing = facing_face(b, a);
+  // Two small shapes apart across a facing face plane each way: every test returns at
+  // may_enter(), so neither the world normals nor the plane tables are needed.
+  if (!a.accel && !b.accel && beyond_facing(a, b, lim) && beyond_facing(b, a, lim)) {
+    a.enters = false;
+    b.enters = false;
+    return;
+  }
+  if (!a.accel) place_normals(a, ws, 0);
+  if (!b.accel) place_normals(b, ws, 1);
   if (!a.accel && !b.accel) {
     fill_plane_table(a, b, lim, ws.tables[0]);
     fill_plane_table(b, a, lim, ws.tables[1]);

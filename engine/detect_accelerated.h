@@ -54,13 +54,13 @@ struct AcceleratedView {
   Mat3 rt = Mat3::Identity();             // world to body
   Vec3 position = Vec3::Zero();           // m, world
   const Vec3* world_vertices = nullptr;   // small shapes only
-  const Vec3* world_normals = nullptr;    // small shapes only
-  const unsigned char* distinct = nullptr;  // small shapes: 1 where a face's normal differs
-                                            // from the previous face's (a new plane)
+  const Vec3* world_normals = nullptr;    // small shapes only (unset when neither can enter)
+  const unsigned char* distinct = nullptr;  // small shapes: shape->new_plane()
   int facing = -1;  // the face most along the direction toward the other shape (facing_face)
   bool enters = true;  // false: no point of this shape can be inside the other (prepare)
   // Two small shapes: the seed's plane distance of each of this shape's vertices from each
-  // distinct face plane of the other, vertex-major (prepare); null otherwise.
+  // distinct face plane of the other, vertex-major (prepare); null otherwise, and when this
+  // shape cannot enter the other (no test reads it then).
   const double* plane_table = nullptr;
   int table_planes = 0;  // columns of plane_table
   double tol = 0.0;      // m, the pair's Limits
@@ -94,7 +94,6 @@ struct AcceleratedView {
 /// small shapes and their plane tables.
 struct AcceleratedWorkspace {
   std::vector<Vec3> vertices[2], normals[2];
-  std::vector<unsigned char> distinct[2];
   std::vector<double> tables[2];
 };
 

@@ -126,6 +126,8 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
                           " (use hull = true for its convex hull)");
     }
   }
+  for (size_t f = 0; f < p.planes_.size(); ++f)
+    p.new_plane_.push_back(f == 0 || p.planes_[f].normal != p.planes_[f - 1].normal);
   p.build_hierarchy();
   return p;
 }

@@ -70,6 +70,9 @@ class ConvexPolyhedron {
   const std::vector<Edge>& edges() const { return edges_; }
   /// Outward plane of triangle i.
   const std::vector<Plane>& planes() const { return planes_; }
+  /// 1 where triangle i's normal differs (bit for bit) from triangle i - 1's, so a new plane
+  /// starts (always 1 for triangle 0); 0 for the second triangle of a box face and the like.
+  const std::vector<unsigned char>& new_plane() const { return new_plane_; }
   /// Axis-aligned bounds of the vertices, in the shape's frame.
   const Aabb& bounds() const { return bounds_; }
   /// The accelerated detector's trees over this shape (engine/shape_hierarchy.h), built with it;
@@ -88,6 +91,7 @@ class ConvexPolyhedron {
   std::vector<std::array<int, 3>> triangles_;
   std::vector<Edge> edges_;
   std::vector<Plane> planes_;
+  std::vector<unsigned char> new_plane_;
   Aabb bounds_;
   std::shared_ptr<const ShapeHierarchy> hierarchy_;  // shared by copies: the shape is immutable
 
