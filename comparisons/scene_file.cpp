@@ -76,7 +76,7 @@ const KeyInfo kKeys[] = {
 };
 
 const std::vector<std::string> kChecks = {"contact", "impulse", "trajectory", "stability", "mass"};
-const std::vector<std::string> kBackends = {"custom", "exact",      "fcl",    "fcl-epa",
+const std::vector<std::string> kBackends = {"custom", "custom-seed", "exact",      "fcl",    "fcl-epa",
                                             "fcl-indep", "fcl-box", "libccd", "bullet",
                                             "bullet-sat", "mujoco", "ode"};
 const std::vector<std::string> kShapes = {"box", "icosphere", "prism", "convex", "mesh"};
