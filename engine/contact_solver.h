@@ -55,8 +55,8 @@ struct SolvedPoint {
 /// are then corrected by impulses at every point, to convergence: normal impulses j_n >= 0
 /// with complementarity, friction impulses inside the cone |j_t| <= mu j_n (the disc, not a
 /// pyramid), sticking when the impulse that stops the slip fits in the cone, else sliding at
-/// its edge. A friction update never raises the kinetic energy (it is line-searched along its
-/// own direction). Returns every point's impulses.
+/// its edge exactly against the slip, which never adds kinetic energy. Returns every point's
+/// impulses.
 std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies,
                                                   const std::vector<PairManifold>& manifolds,
                                                   const std::vector<std::vector<double>>& approach,
