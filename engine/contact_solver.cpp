@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace rbx {
 
@@ -31,6 +32,7 @@ struct Row {
   Mat2 kt = Mat2::Identity();    // tangent block of K
   double kt_max = 1.0;           // largest eigenvalue of kt
   double target = 0.0;           // m/s, the normal velocity the solve aims at
+  double newton_target = 0.0;    // m/s, Newton's -e v_n0 (target = a fraction of it, see below)
   double jn = 0.0;               // N s, accumulated
   Vec2 jt = Vec2::Zero();        // N s, accumulated, in (t1, t2)
 };
@@ -112,7 +114,8 @@ std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies
       // Newton's law on the normal velocity: a collision (approach faster than rest_speed)
       // leaves at -e times its approach; a resting contact is only stopped.
       const double vn0 = approach[m][k];
-      r.target = vn0 < -settings.rest_speed ? -settings.restitution * vn0 : 0.0;
+      r.newton_target = vn0 < -settings.rest_speed ? -settings.restitution * vn0 : 0.0;
+      r.target = r.newton_target;
       speed_scale = std::max(speed_scale, std::abs(vn0));
       speed_scale = std::max(speed_scale, rel_velocity(bodies[r.a], bodies[r.b], r).norm());
       rows.push_back(r);
@@ -182,12 +185,57 @@ std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies
     }
     return moving;
   };
-  for (int round = 0; round < 100 && !rows.empty(); ++round) {
-    const int normal_moved = stage(normal_sweep);
-    if (!(mu > 0.0)) break;
-    const int friction_moved = stage(friction_sweep);
-    if (round > 0 && normal_moved == 0 && friction_moved == 0) break;
-    if (round == 0 && friction_moved == 0) break;
+  auto solve = [&]() {
+    for (int round = 0; round < 100 && !rows.empty(); ++round) {
+      const int normal_moved = stage(normal_sweep);
+      if (!(mu > 0.0)) break;
+      const int friction_moved = stage(friction_sweep);
+      if (round > 0 && normal_moved == 0 && friction_moved == 0) break;
+      if (round == 0 && friction_moved == 0) break;
+    }
+  };
+  // Kinetic energy of the bodies in the problem (J).
+  std::vector<int> involved;
+  for (const Row& r : rows)
+    for (int i : {r.a, r.b})
+      if (std::find(involved.begin(), involved.end(), i) == involved.end()) involved.push_back(i);
+  auto kinetic = [&]() {
+    double k = 0.0;
+    for (int i : involved) k += bodies[i].kinetic_energy();
+    return k;
+  };
+  std::vector<std::pair<Vec3, Vec3>> start;
+  for (int i : involved) start.emplace_back(bodies[i].velocity, bodies[i].angular_velocity);
+  const double kinetic_before = kinetic();
+  solve();
+  // Departure from a plain Newton law: with friction, Newton's restitution on the normal
+  // velocity can create energy (Kane & Levinson's paradox: the friction impulse turns the body
+  // so the normal velocity it must reverse grows). Where the solve ended with more kinetic
+  // energy than it started with (beyond 1e-12 relative: round-off of an elastic frictionless
+  // solve), the restitution targets are scaled down, by bisection, to the largest fraction that
+  // adds none; at e = 0 the solve only dissipates (j_n v_n' = 0, j_t . v_t' <= 0), so a fraction
+  // always exists. Frictionless one-point impacts never get here (they keep the energy e^2).
+  const double allowed = kinetic_before * (1.0 + 1e-12) + 1e-300;
+  if (kinetic() > allowed && settings.restitution > 0.0) {
+    auto restart = [&](double fraction) {
+      for (size_t k = 0; k < involved.size(); ++k) {
+        bodies[involved[k]].velocity = start[k].first;
+        bodies[involved[k]].angular_velocity = start[k].second;
+      }
+      for (Row& r : rows) {
+        r.jn = 0.0;
+        r.jt.setZero();
+        r.target = fraction * r.newton_target;
+      }
+      solve();
+    };
+    double lo = 0.0, hi = 1.0;  // fractions: lo adds no energy, hi does
+    for (int it = 0; it < 30; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      restart(mid);
+      (kinetic() > allowed ? hi : lo) = mid;
+    }
+    restart(lo);
   }
 
   std::vector<SolvedPoint> out;

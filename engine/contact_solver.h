@@ -55,8 +55,10 @@ struct SolvedPoint {
 /// are then corrected by impulses at every point, to convergence: normal impulses j_n >= 0
 /// with complementarity, friction impulses inside the cone |j_t| <= mu j_n (the disc, not a
 /// pyramid), sticking when the impulse that stops the slip fits in the cone, else sliding at
-/// its edge exactly against the slip, which never adds kinetic energy. Returns every point's
-/// impulses.
+/// its edge exactly against the slip, which never adds kinetic energy. Where Newton's law with
+/// friction would end with more kinetic energy than the solve started with (Kane & Levinson's
+/// paradox), the restitution targets are scaled down to the largest fraction that adds none.
+/// Returns every point's impulses.
 std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies,
                                                   const std::vector<PairManifold>& manifolds,
                                                   const std::vector<std::vector<double>>& approach,

@@ -74,6 +74,10 @@ class World {
   // The extended engine's detection, response and integration for one step
   // (engine/world_extended.cpp).
   void step_extended();
+  // Time of impact within the step for pairs separated at its start: moves, resolves and
+  // finishes the step for each such pair; returns which bodies it carried through the step.
+  std::vector<bool> time_of_impact_step(const std::vector<PairManifold>& manifolds,
+                                        const ContactSolverSettings& settings);
 
   SimSettings sim_;
   std::vector<RigidBody> bodies_;
