@@ -113,7 +113,9 @@ bool World::step() {
   // velocities only, never poses, so the pairs passing the bounding check are fixed for the
   // whole step and the broad phase can find them all first; it returns them in the seed's
   // (i, j) order, so the contacts are resolved in the same order as by the double loop.
-  if (broad_phase_.method() == BroadPhaseMethod::AllPairs) {
+  if (contact_model_ == ContactModel::Extended) {
+    step_extended();  // manifolds, friction, resting contact, time of impact
+  } else if (broad_phase_.method() == BroadPhaseMethod::AllPairs) {
     // The seed's double loop, kept as it was (the oracle of the broad phase).
     const int n = static_cast<int>(bodies_.size());
     for (int i = 0; i < n; ++i)
@@ -122,7 +124,8 @@ bool World::step() {
     for (const BodyPair& pair : broad_phase_.find_pairs(bodies_))
       collide_pair(pair.first, pair.second, true);
   }
-  for (RigidBody& b : bodies_) integrate(b, sim_, sim_.dt);
+  if (contact_model_ == ContactModel::Seed)
+    for (RigidBody& b : bodies_) integrate(b, sim_, sim_.dt);
   ++step_;
   time_ = step_ * sim_.dt;
   return check_state();

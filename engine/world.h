@@ -7,6 +7,7 @@
 #include "engine/body.h"
 #include "engine/broadphase.h"
 #include "engine/contact.h"
+#include "engine/contact_solver.h"
 #include "engine/detect.h"
 #include "engine/scene.h"
 
@@ -52,6 +53,9 @@ class World {
   const std::string& failure() const { return failure_; }
   /// Steps taken so far.
   long steps_taken() const { return step_; }
+  /// Chooses the response (default Seed: the seed's single-point impulse). Extended: manifolds,
+  /// friction, resting contact, time of impact (engine/contact_solver.h, world_extended.cpp).
+  void set_contact_model(ContactModel model) { contact_model_ = model; }
 
   /// The bodies in their current state, in scene order.
   const std::vector<RigidBody>& bodies() const { return bodies_; }
@@ -67,11 +71,19 @@ class World {
   // bounding check.
   void collide_pair(int i, int j, bool bounded);
   bool check_state();
+  // The extended engine's detection, response and integration for one step
+  // (engine/world_extended.cpp).
+  void step_extended();
+  // Time of impact within the step for pairs separated at its start: moves, resolves and
+  // finishes the step for each such pair; returns which bodies it carried through the step.
+  std::vector<bool> time_of_impact_step(const std::vector<PairManifold>& manifolds,
+                                        const ContactSolverSettings& settings);
 
   SimSettings sim_;
   std::vector<RigidBody> bodies_;
   DetectorVariant variant_;
   DetectionCache detection_;  // the pair being resolved: placed once per pair per step
+  ContactModel contact_model_ = ContactModel::Seed;
   BroadPhase broad_phase_;
   std::vector<CollisionEvent> events_;
   double time_ = 0.0;

@@ -29,12 +29,15 @@ ContactResult custom_seed_contact(const RigidBody& a, const RigidBody& b) {
   return contact_with(a, b, DetectorVariant::Faithful);
 }
 
-DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+namespace {
+
+DynamicsResult run_dynamics(const Scene& scene, const DynamicsOptions& opt, ContactModel model) {
   DynamicsResult r;
   try {
     SimSettings sim = scene.sim;
     if (opt.dt > 0) sim.dt = opt.dt;
     World world(sim, make_bodies(scene));
+    world.set_contact_model(model);
     const long steps = sim.steps();
     auto sample = [&] {
       StateSample s{world.time(), {}};
@@ -68,6 +71,16 @@ DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt) {
     r.message = e.what();
   }
   return r;
+}
+
+}  // namespace
+
+DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return run_dynamics(scene, opt, ContactModel::Extended);
+}
+
+DynamicsResult custom_seed_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return run_dynamics(scene, opt, ContactModel::Seed);
 }
 
 }  // namespace rbx

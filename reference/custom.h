@@ -9,7 +9,11 @@ namespace rbx {
 ContactResult custom_contact(const RigidBody& a, const RigidBody& b);
 /// Contact by the faithful seed loops (the oracle of the fast detector).
 ContactResult custom_seed_contact(const RigidBody& a, const RigidBody& b);
-/// Whole-scene run with the engine.
+/// Whole-scene run with the extended engine: manifolds, Coulomb friction, resting contact, time
+/// of impact (the `custom` backend).
 DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt);
+/// Whole-scene run with the seed's algorithm and its corrections only: first hit, single-point
+/// frictionless impulse, no time of impact (the `custom-seed` backend).
+DynamicsResult custom_seed_dynamics(const Scene& scene, const DynamicsOptions& opt);
 
 }  // namespace rbx

@@ -40,7 +40,9 @@ std::string scene_table_markdown(const std::vector<std::string>& inputs) {
     const size_t at = file.find("scenes/");
     if (at != std::string::npos) file = file.substr(at + 7);
     t.add({scene_family(f), "[" + s.name + "](" + file + ")", s.description, checks, list,
-           !s.expect ? "" : s.expect->known_failure.empty() ? "yes" : "yes (custom: known failure)"});
+           !s.expect ? "" : s.expect->known_failure.empty() ? "yes"
+           : "yes (" + s.expect->known_failure.substr(0, s.expect->known_failure.find(':')) +
+                 ": known failure)"});
   }
   std::ostringstream md;
   md << "# Scene library\n\n"

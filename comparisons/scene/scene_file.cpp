@@ -78,7 +78,7 @@ const KeyInfo kKeys[] = {
 
 const std::vector<std::string> kChecks = {"contact", "impulse", "trajectory", "stability", "mass"};
 const std::vector<std::string> kBackends = {
-    "custom", "exact",       "fcl",        "fcl-hull", "fcl-epa",     "fcl-indep", "libccd",
+    "custom", "custom-seed", "exact",       "fcl",        "fcl-hull", "fcl-epa",     "fcl-indep", "libccd",
     "bullet", "bullet-hull", "bullet-sat", "mujoco",   "mujoco-hull", "ode",       "ode-hull"};
 const std::vector<std::string> kShapes = {"box", "icosphere", "prism", "convex", "mesh"};
 

@@ -397,7 +397,7 @@ TEST(CompareMetrics, EnergyErrorIsAgainstTheClosedFormWhereThereIsOne) {
   }
 }
 
-TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSinksOnTheStack) {
+TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSeedSinksOnTheStack) {
   const fs::path dir = temp_dir("report_stab");
   const CmdResult r = rbx("report scenes/stress/resting_stack.toml scenes/stress/tunnel_thin_wall.toml --out '" +
                           (dir / "out").string() + "'");
@@ -405,14 +405,16 @@ TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSinksOnTheStack) {
   std::stringstream csv, md;
   csv << std::ifstream(dir / "out/stability.csv").rdbuf();
   md << std::ifstream(dir / "out/report.md").rdbuf();
-  // stability.csv: dt and restitution columns; custom on the stack (dt 1e-3, e 0) sinks.
+  // stability.csv: dt and restitution columns; the seed's algorithm on the stack (dt 1e-3, e 0)
+  // sinks, the extended engine rests.
   std::string header;
   std::getline(csv, header);
   EXPECT_NE(header.find(",dt,restitution,"), std::string::npos) << header;
-  EXPECT_NE(csv.str().find("resting_stack,stress,custom,0.001,0,sinks,"), std::string::npos) << csv.str();
+  EXPECT_NE(csv.str().find("resting_stack,stress,custom-seed,0.001,0,sinks,"), std::string::npos) << csv.str();
+  EXPECT_EQ(csv.str().find("resting_stack,stress,custom,0.001,0,sinks,"), std::string::npos) << csv.str();
   // report.md: the stability table shows them too.
   EXPECT_NE(md.str().find("| scene | backend | dt (s) | e | verdict |"), std::string::npos);
-  // Summary: custom's cells are marked like everyone else's; the known failure says so.
+  // Summary: custom-seed's cells are marked like everyone else's; the known failure says so.
   std::string line;
   std::istringstream lines(md.str());
   std::vector<std::string> cols;
@@ -426,7 +428,7 @@ TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSinksOnTheStack) {
     std::vector<std::string> cells;
     std::stringstream s(line);
     for (std::string c; std::getline(s, c, '|');) cells.push_back(c);
-    const auto it = std::find(cols.begin(), cols.end(), " custom ");
+    const auto it = std::find(cols.begin(), cols.end(), " custom-seed ");
     ASSERT_NE(it, cols.end());
     const std::string cell = cells.at(it - cols.begin());
     EXPECT_NE(cell.find("✗"), std::string::npos) << line;

@@ -1,0 +1,80 @@
+// Simultaneous contact response over manifolds: Newton restitution, Coulomb friction (exact
+// cone), resting contact, and position projection. The extended engine's answer to what the
+// seed admits it lacks (SEED_NOTES 12: resting contact and friction).
+//
+// Design note. Of the two resting-contact schemes the issue names, sequential impulses to
+// convergence (projected Gauss-Seidel on accumulated impulses, Catto 2005; the velocity-level
+// LCP it solves is that of Anitescu & Potra 1997) is chosen over a direct LCP solver: it handles
+// the exact friction cone (a pivoting LCP needs a pyramid), costs nothing for the many pairs
+// with one or two points, and is run to convergence, so the answer does not depend on an
+// iteration count. Gravity is added to the velocities before the solve (the order of
+// Guendelman, Bridson & Fedkiw 2003: velocity update, then contact, then positions), so a body
+// at rest ends its step at rest instead of carrying -g dt into the next one.
+#pragma once
+
+#include <vector>
+
+#include "engine/body.h"
+#include "engine/manifold.h"
+
+namespace rbx {
+
+/// Which response a world runs. `Seed`: the seed's algorithm with its corrections (first hit,
+/// single-point impulse, frictionless). `Extended`: manifolds, simultaneous impulses with
+/// Coulomb friction, resting contact, position projection and time of impact.
+enum class ContactModel { Seed, Extended };
+
+/// The manifold of bodies a and b (indices into the world's bodies).
+struct PairManifold {
+  int a = 0, b = 0;
+  ContactManifold manifold;
+  Pose pose_a, pose_b;  // the bodies' poses at detection (anchors for the position projection)
+};
+
+/// Tunables of the solver. Every value is justified where it is used.
+struct ContactSolverSettings {
+  double restitution = 1.0;  // Newton's e on the normal velocity, [0, 1]
+  double friction = 0.0;     // Coulomb mu >= 0
+  double rest_speed = 0.0;   // m/s: approaches slower than this get e = 0 (resting contact)
+};
+
+/// One solved point: the accumulated impulses (N s) in the manifold's frame.
+struct SolvedPoint {
+  int manifold = 0;
+  Vec3 point = Vec3::Zero();          // m, world, at detection
+  double normal_impulse = 0.0;        // N s, >= 0, along the manifold normal (on A)
+  Vec3 friction_impulse = Vec3::Zero();  // N s, world, tangent to the normal (on A)
+  double approach_speed = 0.0;        // m/s, -(v_rel . n) before the solve (> 0 approaching)
+};
+
+/// Solves the velocity-level contact problem of `manifolds` on `bodies` in place.
+///
+/// `approach` holds, per manifold and point, the normal relative velocity v_rel . n measured
+/// before this step's forces (the restitution law uses it: Newton, v_n' >= -e v_n0 where
+/// v_n0 < -rest_speed, else v_n' >= 0). The bodies' current velocities (forces already added)
+/// are then corrected by impulses at every point, to convergence: normal impulses j_n >= 0
+/// with complementarity, friction impulses inside the cone |j_t| <= mu j_n (the disc, not a
+/// pyramid), sticking when the impulse that stops the slip fits in the cone, else sliding at
+/// its edge exactly against the slip, which never adds kinetic energy. Where Newton's law with
+/// friction would end with more kinetic energy than the solve started with (Kane & Levinson's
+/// paradox), the restitution targets are scaled down to the largest fraction that adds none.
+/// Returns every point's impulses.
+std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies,
+                                                  const std::vector<PairManifold>& manifolds,
+                                                  const std::vector<std::vector<double>>& approach,
+                                                  const ContactSolverSettings& settings);
+
+/// Normal relative velocity v_rel . n at every point of every manifold (m/s), for
+/// solve_contact_velocities' restitution law.
+std::vector<std::vector<double>> normal_velocities(const std::vector<RigidBody>& bodies,
+                                                   const std::vector<PairManifold>& manifolds);
+
+/// Position projection (nonlinear Gauss-Seidel, as Box2D's position solver): after the poses
+/// moved, each point's penetration is re-evaluated from its anchors on both bodies and a
+/// fraction of what exceeds a slop is removed by moving the bodies apart along the normal.
+/// Velocities are not touched, so no kinetic energy is added; the potential energy can rise
+/// only by the penetration it removes.
+void project_contact_positions(std::vector<RigidBody>& bodies,
+                               const std::vector<PairManifold>& manifolds);
+
+}  // namespace rbx

@@ -1,0 +1,122 @@
+#include "engine/manifold.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <utility>
+
+namespace rbx {
+
+namespace {
+
+// Size of a shape (m): the diagonal of its bounds.
+double size_of(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
+
+// The edges of the solid: an edge whose two triangles are not coplanar. Triangulation diagonals
+// of a flat face are skipped (their crossings lie inside a face contact and add nothing).
+std::vector<Edge> feature_edges(const ConvexPolyhedron& s) {
+  std::map<std::pair<int, int>, std::vector<int>> faces_of;
+  const auto& tris = s.triangles();
+  for (int f = 0; f < static_cast<int>(tris.size()); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int u = tris[f][k], v = tris[f][(k + 1) % 3];
+      faces_of[{std::min(u, v), std::max(u, v)}].push_back(f);
+    }
+  std::vector<Edge> out;
+  for (const Edge& e : s.edges()) {
+    const auto& fs = faces_of[{e.a, e.b}];
+    // 1 - cos(angle) below 1e-12: the same plane to the validation's convexity tolerance.
+    if (fs.size() == 2 && s.planes()[fs[0]].normal.dot(s.planes()[fs[1]].normal) > 1.0 - 1e-12)
+      continue;
+    out.push_back(e);
+  }
+  return out;
+}
+
+// Closest points of segments p0 + s d0 and q0 + t d1 (s, t in [0, 1]); false when the segments
+// are parallel to 1e-9 rad or the closest points are not interior to both (a crossing at an
+// end is a vertex, found by the vertex tests).
+bool crossing(const Vec3& p0, const Vec3& d0, const Vec3& q0, const Vec3& d1, Vec3& c0,
+              Vec3& c1) {
+  const double a = d0.dot(d0), c = d1.dot(d1), b = d0.dot(d1);
+  const double denom = a * c - b * b;  // |d0 x d1|^2
+  if (!(denom > 1e-18 * a * c)) return false;
+  const Vec3 r = p0 - q0;
+  const double d = d0.dot(r), e = d1.dot(r);
+  const double s = (b * e - c * d) / denom, t = (a * e - b * d) / denom;
+  // 1e-9 of the segment: the end of a segment is the vertex's business.
+  if (!(s > 1e-9 && s < 1.0 - 1e-9 && t > 1e-9 && t < 1.0 - 1e-9)) return false;
+  c0 = p0 + s * d0;
+  c1 = q0 + t * d1;
+  return true;
+}
+
+}  // namespace
+
+std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
+                                              const ConvexPolyhedron& b, const Pose& pb,
+                                              DetectorVariant variant) {
+  const auto hit = detect(a, pa, b, pb, variant);
+  if (!hit) return std::nullopt;
+  ContactManifold m;
+  m.detector_contact = *hit;
+  m.normal = hit->normal;
+  m.depth = overlap_along(a, pa, b, pb, m.normal);
+  const Vec3& n = m.normal;
+  const double tol = point_in_mesh_tolerance(a, b);
+
+  // World vertices, and the overlap slab along n: A's lowest and B's highest projection.
+  std::vector<Vec3> va, vb;
+  va.reserve(a.vertices().size());
+  vb.reserve(b.vertices().size());
+  double lo_a = std::numeric_limits<double>::infinity();
+  double hi_b = -std::numeric_limits<double>::infinity();
+  for (const Vec3& v : a.vertices()) {
+    va.push_back(pa.apply(v));
+    lo_a = std::min(lo_a, va.back().dot(n));
+  }
+  for (const Vec3& v : b.vertices()) {
+    vb.push_back(pb.apply(v));
+    hi_b = std::max(hi_b, vb.back().dot(n));
+  }
+
+  std::vector<ManifoldPoint> pts;
+  // Vertices of A inside B: depth below B's extreme along n (exact for a flat contact face).
+  for (const Vec3& p : va)
+    if (point_in_mesh(b, pb, p, tol)) pts.push_back({p, std::max(hi_b - p.dot(n), 0.0)});
+  // Vertices of B inside A.
+  for (const Vec3& p : vb)
+    if (point_in_mesh(a, pa, p, tol)) pts.push_back({p, std::max(p.dot(n) - lo_a, 0.0)});
+  // Edge-edge crossings: only edges that reach into the overlap slab [lo_a, hi_b] can cross.
+  const std::vector<Edge> ea = feature_edges(a), eb = feature_edges(b);
+  std::vector<Edge> ea_in, eb_in;
+  for (const Edge& e : ea)
+    if (std::min(va[e.a].dot(n), va[e.b].dot(n)) <= hi_b + tol) ea_in.push_back(e);
+  for (const Edge& e : eb)
+    if (std::max(vb[e.a].dot(n), vb[e.b].dot(n)) >= lo_a - tol) eb_in.push_back(e);
+  for (const Edge& e : ea_in)
+    for (const Edge& f : eb_in) {
+      Vec3 ca, cb;
+      if (!crossing(va[e.a], va[e.b] - va[e.a], vb[f.a], vb[f.b] - vb[f.a], ca, cb)) continue;
+      const Vec3 mid = 0.5 * (ca + cb);
+      if (!point_in_mesh(a, pa, mid, tol) || !point_in_mesh(b, pb, mid, tol)) continue;
+      // A lies on the +n side: penetrating edges have B's point above A's along n.
+      pts.push_back({mid, std::max((cb - ca).dot(n), 0.0)});
+    }
+
+  // Merge coincident points (a stacked cube's corners sit on the corners below it).
+  const double merge = 1e-7 * std::max(size_of(a), size_of(b));
+  for (const ManifoldPoint& p : pts) {
+    const bool dup = std::any_of(m.points.begin(), m.points.end(), [&](const ManifoldPoint& q) {
+      return (q.point - p.point).norm() <= merge;
+    });
+    if (!dup) m.points.push_back(p);
+  }
+  if (m.points.empty()) m.points.push_back({hit->point, m.depth});
+  // No point is deeper than the shapes overlap.
+  for (ManifoldPoint& p : m.points) p.depth = std::min(p.depth, m.depth);
+  return m;
+}
+
+}  // namespace rbx

@@ -1,0 +1,47 @@
+// Contact manifold: every contact point of a pair in one pass, with one normal.
+//
+// Departure from the seed, which resolves the first face / vertex / edge hit (or an average of
+// one kind) as a single point (SEED_NOTES 12 names a contact plane from the detector as future
+// work): the manifold keeps the detector's normal (Moore & Wilhelms, engine/detect.h) and
+// collects, against it, every vertex of A inside B, every vertex of B inside A and every
+// crossing of a real edge of A with a real edge of B (the closest points of two crossing
+// segments). A face-face landing then has its four corners, not one averaged point.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/contact.h"
+#include "engine/detect.h"
+#include "engine/polyhedron.h"
+
+namespace rbx {
+
+/// One point of a manifold.
+struct ManifoldPoint {
+  Vec3 point = Vec3::Zero();  // m, world
+  double depth = 0.0;         // m, >= 0, penetration along the manifold normal at this point
+};
+
+/// Every contact point of one pair, sharing one normal (engine/contact.h convention: from B
+/// toward A).
+struct ContactManifold {
+  Vec3 normal = Vec3::UnitZ();        // unit, world, from B toward A
+  double depth = 0.0;                 // m, overlap of the two shapes along the normal
+  ContactPoint detector_contact;      // the detector's first hit (its point, normal, feature)
+  std::vector<ManifoldPoint> points;  // at least one
+};
+
+/// The manifold of A and B at their poses, or nothing when the detector finds no contact.
+/// The normal is the detector's; the points are the vertices of each shape inside the other
+/// (point_in_mesh with point_in_mesh_tolerance) and the edge-edge crossings whose midpoint lies
+/// in both shapes. Edges between two coplanar triangles (a face's triangulation diagonal) are
+/// not edges of the solid and are skipped. Points closer than 1e-7 of the larger shape's size
+/// are merged. When no point qualifies (a face centroid inside, no vertex), the detector's point
+/// is the manifold.
+std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
+                                              const ConvexPolyhedron& b, const Pose& pb,
+                                              DetectorVariant variant);
+
+}  // namespace rbx

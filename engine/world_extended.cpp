@@ -1,0 +1,165 @@
+// The extended engine's step (World::step_extended): the seed's bounding check and Moore &
+// Wilhelms detector, then contact manifolds, simultaneous impulses with Coulomb friction,
+// resting contact and position projection (engine/contact_solver.h). Kept out of world.cpp so
+// the seed's step stays as it was.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <tuple>
+#include <utility>
+
+#include "engine/contact_solver.h"
+#include "engine/integrate.h"
+#include "engine/manifold.h"
+#include "engine/time_of_impact.h"
+#include "engine/world.h"
+
+namespace rbx {
+
+void World::step_extended() {
+  const double dt = sim_.dt;
+  // Detection: one manifold per pair passing the bounding check, at the step's start poses.
+  std::vector<PairManifold> manifolds;
+  for (const BodyPair& pair : broad_phase_.find_pairs(bodies_)) {
+    const RigidBody &a = bodies_[pair.first], &b = bodies_[pair.second];
+    if (a.is_static && b.is_static) continue;
+    auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant_);
+    if (m) manifolds.push_back({pair.first, pair.second, std::move(*m), a.pose(), b.pose()});
+  }
+
+  // Approach velocities before this step's forces: the restitution law's v_n0.
+  const std::vector<std::vector<double>> approach = normal_velocities(bodies_, manifolds);
+  // Symplectic: forces first (Guendelman et al. 2003), so the contacts see this step's gravity
+  // and a resting body ends the step at rest. The seed's Euler adds gravity after the move;
+  // there the solve runs before it, as the seed's impulses do.
+  const bool symplectic = sim_.integrator == Integrator::Symplectic;
+  if (symplectic)
+    for (RigidBody& b : bodies_)
+      if (!b.is_static) b.velocity += sim_.gravity * dt;
+
+  // Resting threshold: an approach no faster than two steps of gravity is a body settling, not
+  // a collision, and gets e = 0 (else a resting body with e > 0 bounces by e g dt for ever).
+  // Zero without gravity: every approach is then a collision, as in the seed.
+  ContactSolverSettings settings;
+  settings.restitution = sim_.restitution;
+  settings.friction = sim_.friction;
+  settings.rest_speed = 2.0 * sim_.gravity.norm() * dt;
+  const std::vector<SolvedPoint> solved =
+      solve_contact_velocities(bodies_, manifolds, approach, settings);
+
+  // One event per manifold that was a collision: its total normal impulse at the centre of
+  // the normal impulses (the centre of pressure).
+  std::vector<double> impulse(manifolds.size(), 0.0);
+  std::vector<Vec3> moment(manifolds.size(), Vec3::Zero());
+  std::vector<bool> collision(manifolds.size(), false);
+  for (const SolvedPoint& p : solved) {
+    impulse[p.manifold] += p.normal_impulse;
+    moment[p.manifold] += p.normal_impulse * p.point;
+    if (p.approach_speed > settings.rest_speed) collision[p.manifold] = true;
+  }
+  for (size_t m = 0; m < manifolds.size(); ++m) {
+    if (!collision[m] || !(impulse[m] > 0.0)) continue;
+    ContactPoint c = manifolds[m].manifold.detector_contact;
+    c.point = moment[m] / impulse[m];
+    c.depth = manifolds[m].manifold.depth;
+    events_.push_back({time_, step_, bodies_[manifolds[m].a].name, bodies_[manifolds[m].b].name,
+                       c, impulse[m]});
+  }
+
+  // Time of impact: pairs separated at the step's start that the step's motion brings into
+  // contact (engine/time_of_impact.h) are moved to their first contact, resolved there, and
+  // moved on for the rest of the step: an adaptive step for those two bodies only.
+  std::vector<bool> moved = time_of_impact_step(manifolds, settings);
+
+  // Integration (gravity already in the velocities for the symplectic scheme), then the
+  // position projection on the moved poses.
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    RigidBody& b = bodies_[i];
+    if (moved[i]) continue;  // already carried through the step by its time of impact
+    if (symplectic)
+      integrate_symplectic(b, Vec3::Zero(), dt);
+    else
+      integrate(b, sim_, dt);
+  }
+  // Only pairs that pressed together (a normal impulse) are projected apart: a penetration
+  // that no approach caused, such as two overlapping bodies moving together
+  // (stress/zero_relative_velocity), is left as it is, as the seed leaves it.
+  std::vector<PairManifold> pressed;
+  for (size_t m = 0; m < manifolds.size(); ++m)
+    if (impulse[m] > 0.0) pressed.push_back(std::move(manifolds[m]));
+  project_contact_positions(bodies_, pressed);
+}
+
+std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& manifolds,
+                                             const ContactSolverSettings& settings) {
+  const double dt = sim_.dt;
+  const size_t n = bodies_.size();
+  std::vector<bool> moved(n, false);
+  if (sim_.integrator != Integrator::Symplectic) return moved;  // the seed's Euler: no TOI
+  // Per body: thickness, sweep over the step, bounding radius about the centre of mass.
+  std::vector<double> thick(n), sweep(n), radius(n, 0.0);
+  double thinnest = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < n; ++i) {
+    thick[i] = shape_thickness(*bodies_[i].shape);
+    sweep[i] = sweep_length(bodies_[i], dt);
+    for (const Vec3& v : bodies_[i].shape->vertices()) radius[i] = std::max(radius[i], v.norm());
+    thinnest = std::min(thinnest, thick[i]);
+  }
+  std::set<std::pair<int, int>> touching;
+  for (const PairManifold& pm : manifolds) touching.insert({pm.a, pm.b});
+  // Candidates: a pair whose relative sweep exceeds a quarter of the thinner thickness (below
+  // that, the next step's detection after penetration finds the contact: nothing can pass
+  // through) and whose swept spheres meet. The faster body of such a pair sweeps more than an
+  // eighth of the thinnest body, which keeps the search to the fast bodies.
+  std::vector<std::tuple<double, int, int>> hits;  // (time of impact, i, j), i < j
+  for (size_t i = 0; i < n; ++i) {
+    if (!(sweep[i] > 0.125 * thinnest)) continue;
+    for (size_t j = 0; j < n; ++j) {
+      if (j == i) continue;
+      if (sweep[j] > sweep[i] || (sweep[j] == sweep[i] && j < i)) continue;  // the faster one asks
+      const int lo = static_cast<int>(std::min(i, j)), hi = static_cast<int>(std::max(i, j));
+      if (touching.count({lo, hi})) continue;
+      if (!(sweep[i] + sweep[j] > 0.25 * std::min(thick[i], thick[j]))) continue;
+      const RigidBody &a = bodies_[lo], &b = bodies_[hi];
+      // Swept spheres (the bounding check along the step): the centres' closest approach over
+      // the step within the radii sum; the radius about the centre of mass bounds every
+      // orientation, so rotation needs no margin.
+      const Vec3 p = a.position - b.position, q = (a.velocity - b.velocity) * dt;
+      const double s = q.squaredNorm() > 0.0 ? std::clamp(-p.dot(q) / q.squaredNorm(), 0.0, 1.0) : 0.0;
+      if ((p + s * q).norm() > radius[lo] + radius[hi]) continue;
+      if (const auto t = time_of_impact(a, b, dt, variant_)) hits.emplace_back(*t, lo, hi);
+    }
+  }
+  std::sort(hits.begin(), hits.end());
+  for (const auto& [t, i, j] : hits) {
+    // One time of impact per body and step (the earliest): the rest waits for the next step.
+    if (moved[i] || moved[j]) continue;
+    RigidBody &a = bodies_[i], &b = bodies_[j];
+    a = advanced(a, t);
+    b = advanced(b, t);
+    if (auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant_)) {
+      const std::vector<PairManifold> one = {{i, j, std::move(*m), a.pose(), b.pose()}};
+      const auto approach = normal_velocities(bodies_, one);
+      double impulse = 0.0;
+      Vec3 moment = Vec3::Zero();
+      for (const SolvedPoint& p : solve_contact_velocities(bodies_, one, approach, settings)) {
+        impulse += p.normal_impulse;
+        moment += p.normal_impulse * p.point;
+      }
+      if (impulse > 0.0) {
+        ContactPoint c = one[0].manifold.detector_contact;
+        c.point = moment / impulse;
+        c.depth = one[0].manifold.depth;
+        events_.push_back({time_ + t, step_, a.name, b.name, c, impulse});
+      }
+    }
+    a = advanced(a, dt - t);
+    b = advanced(b, dt - t);
+    moved[i] = !a.is_static;
+    moved[j] = !b.is_static;
+  }
+  return moved;
+}
+
+}  // namespace rbx

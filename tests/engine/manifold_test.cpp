@@ -1,0 +1,66 @@
+// Contact manifolds: every contact point of a pair, one normal.
+#include "engine/manifold.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "engine/detect.h"
+
+namespace rbx {
+namespace {
+
+Pose at(const Vec3& p, const Quat& q = Quat::Identity()) { return {p, q}; }
+
+TEST(Manifold, FaceLandingHasTheFourCorners) {
+  // A unit cube 1 mm into a 4 x 4 x 1 slab: the four base corners, each 1 mm deep, normal +z.
+  const ConvexPolyhedron cube = make_box(Vec3::Ones()), slab = make_box(Vec3(4, 4, 1));
+  const auto m = build_manifold(cube, at(Vec3(0, 0, 0.499)), slab, at(Vec3(0, 0, -0.5)),
+                                DetectorVariant::Faithful);
+  ASSERT_TRUE(m);
+  EXPECT_NEAR((m->normal - Vec3::UnitZ()).norm(), 0.0, 1e-12);
+  ASSERT_EQ(m->points.size(), 4u);
+  for (const ManifoldPoint& p : m->points) {
+    EXPECT_NEAR(std::abs(p.point.x()), 0.5, 1e-12);
+    EXPECT_NEAR(std::abs(p.point.y()), 0.5, 1e-12);
+    EXPECT_NEAR(p.point.z(), -0.001, 1e-12);
+    EXPECT_NEAR(p.depth, 0.001, 1e-12);
+  }
+}
+
+TEST(Manifold, CornerLandingIsOnePointAtTheVertex) {
+  // Cube turned so that one corner points down, 1 mm into the slab: the detector's vertex.
+  const Quat q = Quat(Eigen::AngleAxisd(std::atan(std::sqrt(2.0)), Vec3(1, -1, 0).normalized()));
+  const ConvexPolyhedron cube = make_box(Vec3::Ones()), slab = make_box(Vec3(4, 4, 1));
+  const double half_diagonal = std::sqrt(3.0) / 2;
+  const Pose pa = at(Vec3(0, 0, half_diagonal - 0.001), q), pb = at(Vec3(0, 0, -0.5));
+  const auto m = build_manifold(cube, pa, slab, pb, DetectorVariant::Faithful);
+  ASSERT_TRUE(m);
+  ASSERT_EQ(m->points.size(), 1u);
+  EXPECT_NEAR(m->points[0].point.norm(), 0.001, 1e-9);
+  EXPECT_NEAR(m->points[0].depth, 0.001, 1e-9);
+}
+
+TEST(Manifold, CrossedEdgesGiveTheirCrossing) {
+  // Two bars turned 45 deg about their long axes, crossed (x over y), edges 0.05 m into each
+  // other: no vertex inside, one point where the edges cross, the origin.
+  const ConvexPolyhedron bar_x = make_box(Vec3(4, 0.2, 0.2)), bar_y = make_box(Vec3(0.2, 4, 0.2));
+  const double h = 0.1 * std::sqrt(2.0);
+  const Pose pa = at(Vec3(0, 0, h - 0.025), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX())));
+  const Pose pb = at(Vec3(0, 0, -h + 0.025), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY())));
+  const auto m = build_manifold(bar_x, pa, bar_y, pb, DetectorVariant::Faithful);
+  ASSERT_TRUE(m);
+  ASSERT_EQ(m->points.size(), 1u);
+  EXPECT_NEAR(m->points[0].point.norm(), 0.0, 1e-12);
+  EXPECT_NEAR(m->points[0].depth, 0.05, 1e-12);
+  EXPECT_NEAR(std::abs(m->normal.z()), 1.0, 1e-12);
+}
+
+TEST(Manifold, NothingWhenApart) {
+  const ConvexPolyhedron cube = make_box(Vec3::Ones());
+  EXPECT_FALSE(build_manifold(cube, at(Vec3(0, 0, 1.01)), cube, at(Vec3::Zero()),
+                              DetectorVariant::Faithful));
+}
+
+}  // namespace
+}  // namespace rbx
