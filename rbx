@@ -13,7 +13,7 @@ cd "$here"
 
 packages=(cmake g++ pkg-config libeigen3-dev libbullet-dev libfcl-dev libccd-dev libgtest-dev
           libbenchmark-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libmujoco-dev
-          libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib)
+          libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib zlib1g-dev)
 # Fuzzing needs clang and libFuzzer, which Debian ships in libclang-rt-14-dev (only recommended
 # by clang-14, so not always there).
 if [ "${1:-}" = "fuzz" ]; then
