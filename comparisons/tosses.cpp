@@ -190,6 +190,8 @@ TossErrors toss_errors(const Toss& real, const PoseTrack& sim, double cube_width
   for (size_t i = 1; i < n; ++i) {
     const double d = (sim.position[i] - real.samples[i].position).norm() / cube_width;
     e.position_by_sample.push_back(d);
+    e.horizontal_by_sample.push_back(
+        (sim.position[i] - real.samples[i].position).head<2>().norm() / cube_width);
     e.position += d;
     e.orientation_deg += rotation_angle_deg(sim.orientation[i], real.samples[i].orientation);
   }

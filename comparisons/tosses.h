@@ -80,7 +80,8 @@ struct TossErrors {
   double orientation_deg = 0.0;   // mean rotation angle between sim and real, same samples
   double final_position = 0.0;    // |p_sim - p_real| / cube width at the last sample
   double final_orientation_deg = 0.0;  // rotation angle between sim and real at the last sample
-  std::vector<double> position_by_sample;  // |p_sim - p_real| / width at samples 1..n-1
+  std::vector<double> position_by_sample;    // |p_sim - p_real| / width at samples 1..n-1
+  std::vector<double> horizontal_by_sample;  // the same, x and y only (sliding, rolling away)
 };
 
 /// Position (centre) and orientation of a simulated trajectory at each measured sample.
