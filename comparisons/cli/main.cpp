@@ -7,6 +7,7 @@
 
 #include "comparisons/cli/commands.h"
 #include "comparisons/scene/scene_file.h"
+#include "comparisons/eval/tosses.h"
 #include "engine/polyhedron.h"
 
 namespace {
@@ -61,6 +62,13 @@ int main(int argc, char** argv) {
   CLI::App* bench = app.add_subcommand("bench", "performance comparison (default: reports/latest, and reports/perf.md)");
   bench->add_option("--out", bench_opt.out, "output folder");
   bench->add_flag("--quick", bench_opt.quick, "fewer sizes and shorter runs (under a minute)");
+  rbx::TossesOptions tosses_opt;
+  CLI::App* tosses = app.add_subcommand("tosses", "every dynamics backend against measured cube tosses");
+  tosses->add_option("data", tosses_opt.data, "tosses CSV (.csv or .csv.gz)")->required();
+  tosses->add_option("--params", tosses_opt.params, "parameter file (default: params.json beside DATA)");
+  tosses->add_flag("--fit", tosses_opt.fit, "fit restitution and friction per backend on DATA, write the parameter file");
+  tosses->add_option("--backends", tosses_opt.backends, "comma-separated backend names");
+  tosses->add_option("--json", tosses_opt.json, "write JSON results to FILE, or - for standard output");
 
   try {
     app.parse(argc, argv);
@@ -81,6 +89,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("check")) return rbx::check_command(check_opt);
     if (app.got_subcommand("scenes")) return rbx::scenes_command(scenes_inputs);
     if (app.got_subcommand("bench")) return rbx::bench_command(bench_opt);
+    if (app.got_subcommand("tosses")) return rbx::tosses_command(tosses_opt);
   } catch (const rbx::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;

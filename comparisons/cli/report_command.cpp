@@ -17,6 +17,7 @@
 #include "comparisons/scene/scene_file.h"
 #include "comparisons/output/table.h"
 #include "comparisons/scene/repo_path.h"
+#include "comparisons/eval/tosses.h"
 
 namespace fs = std::filesystem;
 
@@ -387,8 +388,11 @@ int report_command(const ReportOptions& opt) {
       if (!figures_ok) figures_msg = "plots.py failed (see figures.log)";
       else fs::remove(tmp / "figures.log");
     }
-    write_text((tmp / "report.md").string(),
-               write_markdown(scenes, evs, clock.seconds(), figures_ok, figures_msg));
+    std::string md = write_markdown(scenes, evs, clock.seconds(), figures_ok, figures_msg);
+    // Real impacts: every tosses data set under the inputs (comparisons/tosses_command.cpp).
+    for (const std::string& dir : find_toss_datasets(opt.inputs))
+      md += tosses_report_section(dir, tmp.string(), opt.backends);
+    write_text((tmp / "report.md").string(), md);
     // `rbx bench` output in the old folder is kept (its own command, not this report's).
     std::error_code ec;
     for (const char* f : {"perf.md", "perf.json", "perf.csv"})

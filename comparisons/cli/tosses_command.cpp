@@ -1,0 +1,410 @@
+// `rbx tosses DATA.csv`: every dynamics backend against measured cube tosses, and the report's
+// "Real impacts" section built from the same evaluation.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "comparisons/scene/scene_file.h"
+#include "comparisons/output/table.h"
+#include "comparisons/eval/tosses.h"
+
+namespace fs = std::filesystem;
+
+namespace rbx {
+
+namespace {
+
+// Backends to run: --backends (unknown names are an InputError; names without dynamics are
+// kept and reported unsupported), else every backend with dynamics, in registry order.
+std::vector<const Backend*> select_toss_backends(const std::string& list) {
+  std::vector<const Backend*> out;
+  if (list.empty()) {
+    for (const Backend& b : backends())
+      if (b.dynamics) out.push_back(&b);
+    return out;
+  }
+  std::vector<std::string> names;
+  std::stringstream ss(list);
+  std::string name;
+  while (std::getline(ss, name, ','))
+    if (!name.empty()) names.push_back(name);
+  for (const std::string& n : names)
+    if (!find_backend(n)) throw InputError("--backends: unknown backend '" + n + "'");
+  for (const Backend& b : backends())
+    if (std::find(names.begin(), names.end(), b.name) != names.end()) out.push_back(&b);
+  if (out.empty()) throw InputError("--backends: no backend named");
+  return out;
+}
+
+// The stored parameters of `name`, or the published ones (params_source says which).
+ContactParams stored_params(const std::vector<std::pair<std::string, ContactParams>>& stored,
+                            const std::string& name, std::string* source) {
+  for (const auto& [n, p] : stored)
+    if (n == name) {
+      *source = "fitted";
+      return p;
+    }
+  *source = "published (none stored)";
+  return kPublishedParams;
+}
+
+// Every selected backend at its stored parameters and at the published ones.
+struct Evaluation {
+  std::vector<BackendTosses> stored, published;
+};
+
+Evaluation evaluate_all(const std::vector<const Backend*>& chosen, const std::vector<Toss>& tosses,
+                        const std::vector<std::pair<std::string, ContactParams>>& stored) {
+  Evaluation ev;
+  for (const Backend* b : chosen) {
+    std::string source;
+    const ContactParams p = stored_params(stored, b->name, &source);
+    ev.stored.push_back(evaluate_backend(*b, tosses, p));
+    ev.stored.back().params_source = source;
+    ev.published.push_back(evaluate_backend(*b, tosses, kPublishedParams));
+    ev.published.back().params_source = "published";
+  }
+  return ev;
+}
+
+Json model_json(const CubeTossModel& m) {
+  return {{"cube_width_m", 2.0 * m.half_width}, {"mass_kg", m.mass}, {"gravity_mps2", m.gravity},
+          {"sample_rate_hz", m.sample_rate}, {"substeps", m.substeps},
+          {"dt_s", 1.0 / (m.sample_rate * m.substeps)},
+          {"floor", "static box " + fmt_num(m.floor_size, 3) + " x " + fmt_num(m.floor_size, 3) +
+                        " x " + fmt_num(m.floor_thickness, 3) + " m, top face z = 0"}};
+}
+
+Json evaluation_json(const std::string& data, const std::vector<Toss>& tosses,
+                     const std::string& params_file, const Evaluation& ev) {
+  Json j;
+  j["data"] = data;
+  j["tosses"] = tosses.size();
+  size_t samples = 0;
+  for (const Toss& t : tosses) samples += t.samples.size();
+  j["samples"] = samples;
+  j["model"] = model_json(CubeTossModel{});
+  j["params_file"] = params_file;
+  j["errors"] =
+      "position: mean |p_sim - p_real| / cube width over the samples after t = 0; orientation: "
+      "mean rotation angle (deg) between simulated and measured orientation; final: the same at "
+      "the last (resting) sample; median, mean, p90 over tosses";
+  j["backends"] = Json::object();
+  for (const BackendTosses& r : ev.stored) j["backends"][r.name] = backend_tosses_json(r);
+  j["published_params"]["params"] = {{"restitution", kPublishedParams.restitution},
+                                     {"friction", kPublishedParams.friction}};
+  j["published_params"]["backends"] = Json::object();
+  for (const BackendTosses& r : ev.published)
+    j["published_params"]["backends"][r.name] = backend_tosses_json(r);
+  return j;
+}
+
+// Backend indices ordered by median position error (failed-everything backends last).
+std::vector<size_t> ranking(const std::vector<BackendTosses>& rs) {
+  std::vector<size_t> order;
+  for (size_t i = 0; i < rs.size(); ++i) order.push_back(i);
+  auto key = [&](size_t i) {
+    std::vector<double> v;
+    for (const TossErrors& e : rs[i].tosses) v.push_back(e.position);
+    const double m = spread_of(v).median;
+    return std::isfinite(m) ? m : std::numeric_limits<double>::infinity();
+  };
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return key(a) < key(b); });
+  return order;
+}
+
+// The results table, best first.
+Table results_table(const std::vector<BackendTosses>& rs, bool markdown) {
+  Table t({"rank", "backend", "e", "mu", "params", "tosses", "position err (widths) med / mean / p90",
+           "angle err (deg) med / mean / p90", "final position err med / mean / p90",
+           "run time (s)", "status"});
+  auto triple = [](const Spread& s, int d) {
+    return fmt_num(s.median, d) + " / " + fmt_num(s.mean, d) + " / " + fmt_num(s.p90, d);
+  };
+  int rank = 0;
+  for (size_t i : ranking(rs)) {
+    const BackendTosses& r = rs[i];
+    std::vector<double> pos, ang, fin;
+    for (const TossErrors& e : r.tosses) {
+      pos.push_back(e.position);
+      ang.push_back(e.orientation_deg);
+      fin.push_back(e.final_position);
+    }
+    std::string status = to_string(r.status);
+    if (!r.message.empty()) status += markdown ? ": " + r.message : "";
+    t.add({std::to_string(++rank), r.name, fmt_num(r.params.restitution, 3),
+           fmt_num(r.params.friction, 3), r.params_source, std::to_string(r.tosses.size()),
+           triple(spread_of(pos), 3), triple(spread_of(ang), 3), triple(spread_of(fin), 3),
+           fmt_num(r.runtime_s, 3), status});
+  }
+  return t;
+}
+
+std::string default_params_path(const std::string& data) {
+  const fs::path dir = fs::path(data).parent_path();
+  return (dir.empty() ? fs::path("params.json") : dir / "params.json").string();
+}
+
+// The stored params file with the fitted backends replaced (others kept), as JSON.
+Json updated_params_json(const std::string& path, const std::string& data,
+                         const std::vector<std::pair<std::string, FitResult>>& fits) {
+  Json j;
+  std::error_code ec;
+  if (fs::exists(path, ec)) {
+    read_params_file(path);  // validates
+    std::ifstream in(path);
+    j = Json::parse(in);
+  }
+  j["about"] =
+      "Restitution e and Coulomb friction mu per dynamics backend, fitted on the training tosses "
+      "by `rbx tosses train.csv.gz --fit` (5 x 6 grid over e in [0, 1], mu in [0, 1.5], then "
+      "Nelder-Mead; objective: mean position error in cube widths). Backends not listed run at "
+      "the published e = 0.125, mu = 0.18.";
+  j["model"] = model_json(CubeTossModel{});
+  Json& b = j["backends"];
+  if (!b.is_object()) b = Json::object();
+  for (const auto& [name, fit] : fits)
+    b[name] = {{"restitution", fit.params.restitution}, {"friction", fit.params.friction},
+               {"fit_data", fs::path(data).filename().string()},
+               {"train_position_error", fit.objective}, {"evaluations", fit.evaluations},
+               {"fit_s", fit.seconds}};
+  // Registry order, so refitting one backend does not reorder the file.
+  Json sorted = Json::object();
+  for (const Backend& r : backends())
+    if (b.contains(r.name)) sorted[r.name] = b[r.name];
+  for (const auto& [name, v] : b.items())
+    if (!sorted.contains(name)) sorted[name] = v;
+  b = sorted;
+  return j;
+}
+
+}  // namespace
+
+int tosses_command(const TossesOptions& opt) {
+  // Everything is read and validated before anything runs or is written.
+  const std::vector<Toss> tosses = read_tosses(opt.data);
+  const std::vector<const Backend*> chosen = select_toss_backends(opt.backends);
+  const std::string params_path = opt.params.empty() ? default_params_path(opt.data) : opt.params;
+  std::error_code ec;
+  if (!opt.params.empty() && !opt.fit && !fs::exists(opt.params, ec))
+    throw InputError(opt.params + ": no such parameter file");
+  auto stored = read_params_file(params_path);
+
+  if (opt.fit) {
+    std::vector<std::pair<std::string, FitResult>> fits;
+    for (const Backend* b : chosen) {
+      if (!b->dynamics) continue;
+      std::cerr << "fitting " << b->name << " on " << tosses.size() << " tosses\n";
+      const FitResult fit = fit_backend(*b, tosses, CubeTossModel{},
+                                        [](const std::string& s) { std::cerr << "  " << s << "\n"; });
+      std::cerr << b->name << ": e = " << fmt_num(fit.params.restitution, 4)
+                << ", mu = " << fmt_num(fit.params.friction, 4) << ", error "
+                << fmt_num(fit.objective, 4) << " widths, " << fit.evaluations << " evaluations, "
+                << fmt_num(fit.seconds, 4) << " s\n";
+      fits.emplace_back(b->name, fit);
+    }
+    write_json(params_path, updated_params_json(params_path, opt.data, fits));
+    stored = read_params_file(params_path);
+  }
+
+  const Evaluation ev = evaluate_all(chosen, tosses, stored);
+  const Json j = evaluation_json(opt.data, tosses, params_path, ev);
+  if (!opt.json.empty()) write_json(opt.json, j);
+  if (opt.json != "-") {
+    std::cout << opt.data << ": " << tosses.size() << " tosses\n\nAt the stored parameters ("
+              << params_path << "):\n";
+    results_table(ev.stored, false).print(std::cout);
+    std::cout << "\nAt the published parameters (e = 0.125, mu = 0.18):\n";
+    results_table(ev.published, false).print(std::cout);
+    for (const BackendTosses& r : ev.stored)
+      if (!r.message.empty()) std::cout << r.name << ": " << r.message << "\n";
+  }
+  return 0;
+}
+
+std::vector<std::string> find_toss_datasets(const std::vector<std::string>& inputs) {
+  std::vector<std::string> roots = inputs;
+  if (roots.empty()) roots.push_back("scenes");
+  std::vector<std::string> found;
+  for (const std::string& root : roots) {
+    std::error_code ec;
+    if (!fs::is_directory(root, ec)) continue;
+    auto consider = [&](const fs::path& d) {
+      if (fs::exists(d / "params.json") &&
+          (fs::exists(d / "test.csv.gz") || fs::exists(d / "test.csv")))
+        found.push_back(d.string());
+    };
+    consider(root);  // the folder itself, then every folder below it
+    for (const auto& e : fs::recursive_directory_iterator(root, ec))
+      if (e.is_directory()) consider(e.path());
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+std::string tosses_report_section(const std::string& dir, const std::string& out_dir,
+                                  const std::string& backend_list) {
+  const fs::path d(dir);
+  const std::string data =
+      (fs::exists(d / "test.csv.gz") ? d / "test.csv.gz" : d / "test.csv").string();
+  const std::vector<Toss> tosses = read_tosses(data);
+  const std::string params_path = (d / "params.json").string();
+  const auto stored = read_params_file(params_path);
+  // Backends without dynamics named in the report's --backends are simply not tossed.
+  std::vector<const Backend*> chosen;
+  for (const Backend* b : select_toss_backends(backend_list))
+    if (b->dynamics) chosen.push_back(b);
+  if (chosen.empty()) return "";
+
+  Stopwatch clock;
+  const Evaluation ev = evaluate_all(chosen, tosses, stored);
+  const double eval_s = clock.seconds();
+  const fs::path out(out_dir);
+  write_json((out / "tosses.json").string(), evaluation_json(data, tosses, params_path, ev));
+
+  // Per-toss errors (the distribution figure).
+  std::ostringstream per;
+  per << "params,backend,toss,position_error,orientation_error_deg,final_position_error\n";
+  for (const auto* set : {&ev.stored, &ev.published})
+    for (const BackendTosses& r : *set)
+      for (const TossErrors& e : r.tosses)
+        per << (set == &ev.stored ? "stored" : "published") << "," << r.name << "," << e.toss_id
+            << "," << fmt_num(e.position, 9) << "," << fmt_num(e.orientation_deg, 9) << ","
+            << fmt_num(e.final_position, 9) << "\n";
+  write_text((out / "tosses_per_toss.csv").string(), per.str());
+
+  // Median position error over tosses at each sample time (what the error is made of).
+  const double rate = CubeTossModel{}.sample_rate;
+  std::ostringstream over;
+  over << "backend,t,median_position_error,tosses\n";
+  for (const BackendTosses& r : ev.stored) {
+    for (size_t i = 0;; ++i) {
+      std::vector<double> v;
+      for (const TossErrors& e : r.tosses)
+        if (i < e.position_by_sample.size()) v.push_back(e.position_by_sample[i]);
+      if (v.size() * 2 < r.tosses.size() || v.empty()) break;  // at least half the tosses
+      over << r.name << "," << fmt_num((i + 1) / rate, 6) << "," << fmt_num(spread_of(v).median, 6)
+           << "," << v.size() << "\n";
+    }
+  }
+  write_text((out / "tosses_error_time.csv").string(), over.str());
+
+  // Best, median and worst toss of the best backend, drawn for every backend.
+  const std::vector<size_t> order = ranking(ev.stored);
+  const BackendTosses& best = ev.stored[order.front()];
+  std::vector<std::pair<std::string, long>> picks;  // label, toss id
+  if (!best.tosses.empty()) {
+    std::vector<TossErrors> sorted = best.tosses;
+    std::stable_sort(sorted.begin(), sorted.end(),
+                     [](const TossErrors& a, const TossErrors& b) { return a.position < b.position; });
+    picks = {{"best", sorted.front().toss_id},
+             {"median", sorted[(sorted.size() - 1) / 2].toss_id},
+             {"worst", sorted.back().toss_id}};
+  }
+  std::ostringstream traj;
+  traj << "pick,toss,source,t,z,angle_deg\n";
+  for (const auto& [label, id] : picks) {
+    const Toss& t = *std::find_if(tosses.begin(), tosses.end(), [&](const Toss& x) { return x.id == id; });
+    const Quat q0 = t.samples.front().orientation;
+    for (const TossSample& s : t.samples)
+      traj << label << "," << id << ",measured," << fmt_num(s.time - t.samples.front().time, 6)
+           << "," << fmt_num(s.position.z(), 7) << ","
+           << fmt_num(rotation_angle_deg(q0, s.orientation), 6) << "\n";
+    for (size_t k = 0; k < chosen.size(); ++k) {
+      const TossRun run = simulate_toss(chosen[k]->dynamics, t, ev.stored[k].params);
+      if (run.status != Status::Ok) continue;
+      for (size_t i = 0; i < run.track.position.size(); ++i)
+        traj << label << "," << id << "," << chosen[k]->name << "," << fmt_num(i / rate, 6) << ","
+             << fmt_num(run.track.position[i].z(), 7) << ","
+             << fmt_num(rotation_angle_deg(q0, run.track.orientation[i]), 6) << "\n";
+    }
+  }
+  write_text((out / "tosses_traj.csv").string(), traj.str());
+
+  // Figures through matplotlib (the report's own figures need the same python3).
+  bool figures_ok = false;
+  const std::string script = std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/tosses_plots.py";
+  if (fs::exists("/usr/bin/python3")) {
+    const std::string cmd = "/usr/bin/python3 '" + script + "' '" + out_dir + "' > '" +
+                            (out / "tosses_figures.log").string() + "' 2>&1";
+    figures_ok = std::system(cmd.c_str()) == 0;
+    if (figures_ok) fs::remove(out / "tosses_figures.log");
+  }
+
+  size_t samples = 0;
+  for (const Toss& t : tosses) samples += t.samples.size();
+  std::ostringstream md;
+  md << "## Real impacts: measured cube tosses\n\n";
+  md << tosses.size() << " test tosses (" << samples << " samples) of a real 10.48 cm, 0.37 kg "
+     << "cube onto a floor, tracked by motion capture at 148 Hz (ContactNets data, "
+     << "`" << data << "`; the split and the source are in the README beside it). "
+     << "Each toss is simulated from its first measured sample (pose, velocity, angular "
+     << "velocity) for its recorded duration, dt = 1/1480 s (10 substeps per sample), and "
+     << "compared at every sample: **position error** = mean |p_sim - p_real| over the toss in "
+     << "cube widths, **angle error** = mean rotation angle between simulated and measured "
+     << "orientation, **final** = the position error at the last (resting) sample. Median / "
+     << "mean / 90th percentile over tosses; ranked by the median position error. All "
+     << chosen.size() << " backends at both parameter sets took " << fmt_num(eval_s, 3)
+     << " s.\n\n";
+  md << "### At each backend's fitted parameters (`" << params_path << "`, fitted on the "
+     << "training tosses)\n\n"
+     << results_table(ev.stored, true).markdown() << "\n";
+  md << "### At the dataset's published parameters (e = 0.125, mu = 0.18)\n\n"
+     << "The same parameters for every backend: the difference to the table above is what "
+        "fitting buys; what remains is the contact model.\n\n"
+     << results_table(ev.published, true).markdown() << "\n";
+  // What the error is made of: the median over tosses at a few times after release.
+  {
+    const std::vector<double> marks = {0.1, 0.2, 0.3, 0.5};  // s
+    Table t({"backend", "t = 0.1 s", "0.2 s", "0.3 s", "0.5 s", "last sample",
+             "horizontal share at the last sample"});
+    for (size_t k : order) {
+      const BackendTosses& r = ev.stored[k];
+      std::vector<std::string> cells = {r.name};
+      auto median_at = [&](const std::vector<double> TossErrors::*series, long i) {
+        std::vector<double> v;
+        for (const TossErrors& e : r.tosses) {
+          const auto& s = e.*series;
+          if (s.empty()) continue;
+          v.push_back(i < 0 ? s.back() : s[std::min<size_t>(static_cast<size_t>(i), s.size() - 1)]);
+        }
+        return spread_of(v).median;
+      };
+      for (double m : marks)
+        cells.push_back(fmt_num(median_at(&TossErrors::position_by_sample,
+                                          std::lround(m * rate) - 1), 3));
+      const double last = median_at(&TossErrors::position_by_sample, -1);
+      cells.push_back(fmt_num(last, 3));
+      cells.push_back(fmt_num(median_at(&TossErrors::horizontal_by_sample, -1) / last, 3));
+      t.add(cells);
+    }
+    md << "Median position error (cube widths) over the tosses at times after release (a toss "
+          "already at rest counts with its last sample; the first measured impact comes at 0.115 s "
+          "(median; 0.07 to 0.18 s)) and the horizontal (x, y) part of the final error, at the fitted parameters:\n\n"
+       << t.markdown() << "\n";
+  }
+  if (figures_ok) {
+    md << "![toss error distribution](figures/tosses_errors.png)\n\n"
+       << "Left: position error per toss, every backend (fitted and published parameters). "
+          "Right: the median position error over tosses at each time after release: the first "
+          "impact, the tumbling after it and the slide to rest show as the steps of each "
+          "curve.\n\n";
+    if (!picks.empty())
+      md << "![toss trajectories](figures/tosses_trajectories.png)\n\n"
+         << "Height of the centre and rotation angle from the release orientation, measured "
+            "(black) and simulated, for the best (toss "
+         << picks[0].second << "), median (toss " << picks[1].second << ") and worst (toss "
+         << picks[2].second << ") toss of the best backend, `" << best.name << "`.\n\n";
+  } else {
+    md << "(figures not drawn: python3 with matplotlib missing or tosses_plots.py failed, see "
+          "tosses_figures.log)\n\n";
+  }
+  return md.str();
+}
+
+}  // namespace rbx

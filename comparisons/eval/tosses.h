@@ -1,0 +1,179 @@
+// Real cube tosses (ContactNets data, scenes/real/cube_toss/): reading the measured
+// trajectories, simulating each toss with a dynamics backend from its first sample, the errors
+// against the measurement, and the per-backend fit of restitution and friction.
+//
+// Design note: every toss is one two-body scene (the cube and a static floor box) run through
+// the backend's ordinary DynamicsFn, so a backend added to the registry is ranked here without
+// any code of its own; the scene is the only model of the experiment.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "comparisons/eval/json_io.h"
+#include "engine/scene.h"
+#include "reference/backend.h"
+
+namespace rbx {
+
+/// The tossed cube and its world (ContactNets README; Acosta, Yang & Posa 2022).
+struct CubeTossModel {
+  double half_width = 0.0524;   // m: vertices at +-half_width on each body axis
+  double mass = 0.37;           // kg, uniform density
+  double gravity = 9.81;        // m/s^2, along -z
+  double sample_rate = 148.0;   // Hz, motion capture
+  // Time step = 1 / (sample_rate * substeps). 10 substeps (0.68 ms): a cube falling at 2 m/s
+  // moves 1.4 mm (1.3 % of its width) per step, and MuJoCo's soft contact, which lasts a fixed
+  // number of steps, resolves an impact in ~17 ms; every simulated sample falls exactly on a
+  // measured one. Measured on 10 test tosses at the published parameters: 20 and 40 substeps
+  // move each backend's median position error by at most 0.025 widths (mujoco 0.272 -> 0.262
+  // -> 0.248; bullet 0.147 -> 0.147 -> 0.162, ode 0.190 -> 0.191 -> 0.192), well below the
+  // gaps between backends, at 2 and 4 times the cost (which the fit pays ~60 times).
+  int substeps = 10;
+  double floor_size = 4.0;      // m, width of the static floor box (tosses span < 1.1 m)
+  double floor_thickness = 0.2; // m; its top face is the plane z = 0
+};
+
+/// One measured sample: the cube's state at time t.
+struct TossSample {
+  double time = 0.0;                     // s since the toss's first sample
+  Vec3 position = Vec3::Zero();          // m, centre of the cube, world
+  Quat orientation = Quat::Identity();   // body to world, unit
+  Vec3 velocity = Vec3::Zero();          // m/s, world
+  Vec3 angular_velocity = Vec3::Zero();  // rad/s, world frame
+};
+
+/// One toss: release (in the air) to rest.
+struct Toss {
+  long id = 0;                       // the data's toss id
+  long first_row = 0;                // 1-based line of its first sample in the file
+  std::vector<TossSample> samples;   // time increasing, >= 2 samples
+};
+
+/// Reads tosses from a CSV file (plain or gzip, told apart by content) with the header
+/// toss,t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz. Throws InputError naming the file and row for
+/// a missing file, a bad header, a non-numeric or non-finite value, a quaternion whose norm is
+/// off 1 by more than 1e-5, time not increasing within a toss, a toss of one sample, or a toss
+/// id seen again after another toss.
+std::vector<Toss> read_tosses(const std::string& path);
+/// The same from text in memory (`path` is used in messages).
+std::vector<Toss> parse_tosses(const std::string& text, const std::string& path);
+
+/// Contact parameters of one backend.
+struct ContactParams {
+  double restitution = 0.125;  // e in [0, 1]
+  double friction = 0.18;      // Coulomb mu >= 0
+};
+
+/// The parameters fitted to these tosses by the data's authors (ContactNets experiment.json).
+constexpr ContactParams kPublishedParams{0.125, 0.18};
+
+/// The scene of one toss: body "cube" at the toss's first sample, static body "floor" whose top
+/// face is z = 0, gravity -z, the given contact parameters, duration = the toss's last time.
+Scene toss_scene(const Toss& toss, const ContactParams& params, const CubeTossModel& model = {});
+
+/// Errors of one simulated toss against its measurement.
+struct TossErrors {
+  long toss_id = 0;
+  double position = 0.0;          // mean |p_sim - p_real| / cube width over samples after t = 0
+  double orientation_deg = 0.0;   // mean rotation angle between sim and real, same samples
+  double final_position = 0.0;    // |p_sim - p_real| / cube width at the last sample
+  double final_orientation_deg = 0.0;  // rotation angle between sim and real at the last sample
+  std::vector<double> position_by_sample;    // |p_sim - p_real| / width at samples 1..n-1
+  std::vector<double> horizontal_by_sample;  // the same, x and y only (sliding, rolling away)
+};
+
+/// Position (centre) and orientation of a simulated trajectory at each measured sample.
+struct PoseTrack {
+  std::vector<Vec3> position;     // m
+  std::vector<Quat> orientation;  // unit
+};
+
+/// Angle (degrees) of the rotation taking a to b: 2 acos |<a, b>| (q and -q are one rotation).
+double rotation_angle_deg(const Quat& a, const Quat& b);
+/// Errors of `sim` (one pose per measured sample, same count) against the measured toss.
+TossErrors toss_errors(const Toss& real, const PoseTrack& sim, double cube_width);
+
+/// Simulated toss: status, and the poses at the measured sample times when ok.
+struct TossRun {
+  Status status = Status::Ok;
+  std::string message;
+  PoseTrack track;
+};
+/// Runs one toss with a dynamics function (dt = 1 / (rate * substeps), a sample every substeps).
+TossRun simulate_toss(const DynamicsFn& dynamics, const Toss& toss, const ContactParams& params,
+                      const CubeTossModel& model = {});
+
+/// Median, mean and 90th percentile of a set (linear interpolation between order statistics,
+/// numpy's default: p90 of n values is at rank 0.9 (n - 1)). NaN for an empty set.
+struct Spread {
+  double median = 0.0, mean = 0.0, p90 = 0.0;
+};
+Spread spread_of(std::vector<double> values);
+
+/// One backend over a set of tosses.
+struct BackendTosses {
+  std::string name;
+  Status status = Status::Ok;
+  std::string message;
+  ContactParams params;
+  std::string params_source;       // "fitted" | "published" | "published (none stored)"
+  std::vector<TossErrors> tosses;  // the tosses that ran, in data order
+  double runtime_s = 0.0;          // wall time of all its simulations
+};
+/// Simulates every toss with `backend` at `params`. A failed toss makes the status Error (the
+/// message names the first failing toss) and is left out of `tosses`.
+BackendTosses evaluate_backend(const Backend& backend, const std::vector<Toss>& tosses,
+                               const ContactParams& params, const CubeTossModel& model = {});
+
+/// Mean position error over the tosses (the fit's objective); +inf when any toss fails.
+double fit_objective(const Backend& backend, const std::vector<Toss>& tosses,
+                     const ContactParams& params, const CubeTossModel& model = {});
+
+/// Outcome of fitting one backend.
+struct FitResult {
+  ContactParams params;
+  double objective = 0.0;  // mean position error (cube widths) on the fit tosses
+  int evaluations = 0;     // objective evaluations
+  double seconds = 0.0;    // wall time
+};
+/// Fits restitution in [0, 1] and friction in [0, 1.5]: a 5 x 6 grid, then Nelder-Mead from
+/// the best grid point (simplex of one grid spacing, parameters clamped into the box, at most
+/// 30 evaluations). Deterministic: no random numbers.
+FitResult fit_backend(const Backend& backend, const std::vector<Toss>& tosses,
+                      const CubeTossModel& model = {},
+                      const std::function<void(const std::string&)>& progress = nullptr);
+
+/// Stored per-backend parameters (params.json): backends.<name>.{restitution, friction}.
+/// Returns an empty map when the file does not exist; InputError when it is malformed.
+std::vector<std::pair<std::string, ContactParams>> read_params_file(const std::string& path);
+
+/// The JSON of one backend: status, message, params, tosses, position_error,
+/// orientation_error_deg, final_position_error (median, mean, p90), runtime_s, per_toss.
+Json backend_tosses_json(const BackendTosses& r);
+
+/// Runs the tosses data set in folder `dir` (test.csv[.gz] with params.json) through every
+/// dynamics backend (or those named in `backend_list`), at the stored and at the published
+/// parameters; writes tosses.json, tosses_per_toss.csv and tosses_traj.csv into `out_dir`,
+/// the figures into out_dir/figures (through comparisons/output/tosses_plots.py when python3 is there)
+/// and returns the report's "Real impacts" markdown section.
+std::string tosses_report_section(const std::string& dir, const std::string& out_dir,
+                                  const std::string& backend_list);
+
+/// Folders under `inputs` (recursively; "" : scenes/) holding a tosses data set: a
+/// params.json beside test.csv or test.csv.gz. Sorted.
+std::vector<std::string> find_toss_datasets(const std::vector<std::string>& inputs);
+
+/// Options of `rbx tosses`.
+struct TossesOptions {
+  std::string data;      // DATA.csv or .csv.gz
+  std::string params;    // --params FILE ("" : params.json beside DATA)
+  bool fit = false;      // --fit: fit every selected backend on DATA and write the params file
+  std::string backends;  // --backends LIST
+  std::string json;      // --json FILE|-
+};
+/// `rbx tosses`.
+int tosses_command(const TossesOptions& opt);
+
+}  // namespace rbx

@@ -1,0 +1,123 @@
+#!/usr/bin/python3
+"""Figures of the report's "Real impacts" section (measured cube tosses).
+
+Usage: tosses_plots.py REPORT_DIR
+Reads tosses_per_toss.csv, tosses_error_time.csv and tosses_traj.csv (written by rbx report),
+writes figures/tosses_errors.{png,svg} and figures/tosses_trajectories.{png,svg}.
+"""
+import csv
+import os
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def rows(path):
+    """The rows of a CSV file as dicts."""
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def colour_of(names):
+    """One stable colour per backend name (sorted, so the same name gets the same colour)."""
+    return {n: plt.cm.tab10.colors[i % 10] for i, n in enumerate(sorted(names))}
+
+
+def save(fig, out, name):
+    fig.tight_layout()
+    for ext in ("png", "svg"):
+        fig.savefig(os.path.join(out, f"{name}.{ext}"), dpi=110)
+    plt.close(fig)
+
+
+def error_figure(report, out):
+    """Per-toss position error distribution (box plots) and the median error over time."""
+    per = rows(os.path.join(report, "tosses_per_toss.csv"))
+    by = defaultdict(list)  # (params, backend) -> errors
+    for r in per:
+        by[(r["params"], r["backend"])].append(float(r["position_error"]))
+    names = sorted({b for _, b in by}, key=lambda b: sorted(by.get(("stored", b), [1e9]))[
+        len(by.get(("stored", b), [1e9])) // 2])
+    colours = colour_of(names)
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.5))
+    data, labels, cols = [], [], []
+    for b in names:
+        for p in ("stored", "published"):
+            if (p, b) in by:
+                data.append(by[(p, b)])
+                labels.append(f"{b}\n{'fitted' if p == 'stored' else 'published'}")
+                cols.append(colours[b])
+    parts = ax.boxplot(data, whis=(10, 90), showfliers=True, patch_artist=True)
+    for patch, c, lab in zip(parts["boxes"], cols, labels):
+        patch.set_facecolor(c)
+        patch.set_alpha(0.35 if "published" in lab else 0.8)
+    ax.set_xticks(range(1, len(labels) + 1))
+    ax.set_xticklabels(labels, fontsize=8)
+    ax.set_yscale("log")
+    ax.set_ylabel("mean position error per toss (cube widths)")
+    ax.set_title("position error per toss (box: quartiles, whiskers: 10-90 %)")
+    ax.grid(True, axis="y", alpha=0.3)
+
+    series = defaultdict(lambda: ([], []))
+    for r in rows(os.path.join(report, "tosses_error_time.csv")):
+        t, e = series[r["backend"]]
+        t.append(float(r["t"]))
+        e.append(float(r["median_position_error"]))
+    for b in names:
+        if b in series:
+            bx.plot(*series[b], color=colours[b], label=b)
+    bx.set_xlabel("time after release (s)")
+    bx.set_ylabel("median position error over tosses (cube widths)")
+    bx.set_title("error over time, fitted parameters")
+    bx.grid(True, alpha=0.3)
+    bx.legend(fontsize=8)
+    save(fig, out, "tosses_errors")
+
+
+def trajectory_figure(report, out):
+    """Measured and simulated height and rotation angle of the three chosen tosses."""
+    traj = rows(os.path.join(report, "tosses_traj.csv"))
+    if not traj:
+        return
+    picks = []
+    for r in traj:
+        if (r["pick"], r["toss"]) not in picks:
+            picks.append((r["pick"], r["toss"]))
+    sources = sorted({r["source"] for r in traj if r["source"] != "measured"})
+    colours = colour_of(sources)
+    fig, axes = plt.subplots(len(picks), 2, figsize=(12, 3.2 * len(picks)), squeeze=False)
+    for k, (pick, toss) in enumerate(picks):
+        for src in ["measured"] + sources:
+            pts = [r for r in traj if r["pick"] == pick and r["toss"] == toss and r["source"] == src]
+            if not pts:
+                continue
+            t = [float(r["t"]) for r in pts]
+            style = dict(color="black", lw=2.2, label="measured") if src == "measured" else dict(
+                color=colours[src], lw=1.1, label=src)
+            axes[k][0].plot(t, [float(r["z"]) * 100 for r in pts], **style)
+            axes[k][1].plot(t, [float(r["angle_deg"]) for r in pts], **style)
+        axes[k][0].set_ylabel("height of centre (cm)")
+        axes[k][1].set_ylabel("rotation from release (deg)")
+        axes[k][0].set_title(f"{pick} toss ({toss}): height")
+        axes[k][1].set_title(f"{pick} toss ({toss}): angle")
+        for a in axes[k]:
+            a.grid(True, alpha=0.3)
+            a.set_xlabel("time after release (s)")
+    axes[0][0].legend(fontsize=8)
+    save(fig, out, "tosses_trajectories")
+
+
+def main():
+    report = sys.argv[1]
+    out = os.path.join(report, "figures")
+    os.makedirs(out, exist_ok=True)
+    error_figure(report, out)
+    trajectory_figure(report, out)
+
+
+if __name__ == "__main__":
+    main()
