@@ -14,7 +14,8 @@ cd "$here"
 
 packages=(cmake g++ pkg-config libeigen3-dev libbullet-dev libfcl-dev libccd-dev libgtest-dev
           libbenchmark-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libmujoco-dev
-          libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib)
+          libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib
+          libjs-three chromium python3-pil)
 # `./rbx format [--check]` needs clang-format (Debian's `clang-format`, version 14 here).
 if [ "${1:-}" = "format" ]; then
   packages+=(clang-format)

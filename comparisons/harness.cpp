@@ -11,6 +11,7 @@
 #include "comparisons/contact_eval.h"
 #include "comparisons/metrics.h"
 #include "comparisons/table.h"
+#include "comparisons/trajectory.h"
 #include "engine/bounding.h"
 #include "engine/detect.h"
 #include "reference/exact.h"
@@ -372,6 +373,10 @@ class Evaluator {
       const Backend& be = backend(name);
       Json& bj = backend_json(name);
       bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
+      // The sampled trajectory, for results.json and the 3-D replay (rbx view).
+      const size_t moving = static_cast<size_t>(std::count_if(
+          inputs_.begin(), inputs_.end(), [](const RigidBody& b) { return !b.is_static; }));
+      bj["trajectory"] = trajectory_json(main.result.samples, inputs_, frame_budget(moving));
       if (main.result.status != Status::Ok) {
         if (scene_.has_check("stability")) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
         continue;

@@ -7,6 +7,7 @@
 
 #include "comparisons/commands.h"
 #include "comparisons/scene_file.h"
+#include "comparisons/view.h"
 #include "engine/polyhedron.h"
 
 namespace {
@@ -51,6 +52,11 @@ int main(int argc, char** argv) {
   CLI::App* bench = app.add_subcommand("bench", "performance comparison (default: reports/latest, and reports/perf.md)");
   bench->add_option("--out", bench_opt.out, "output folder");
   bench->add_flag("--quick", bench_opt.quick, "fewer sizes and shorter runs (under a minute)");
+  rbx::ViewOptions view_opt;
+  CLI::App* view = app.add_subcommand("view", "one offline HTML page: 3-D replay of every backend");
+  view->add_option("scene", view_opt.scene, "scene file (TOML)")->required();
+  view->add_option("--backends", view_opt.backends, "comma-separated backend names");
+  view->add_option("--out", view_opt.out, "output HTML file (default: FAMILY_STEM.html)");
 
   try {
     app.parse(argc, argv);
@@ -71,6 +77,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("check")) return rbx::check_command(check_opt);
     if (app.got_subcommand("scenes")) return rbx::scenes_command(scenes_inputs);
     if (app.got_subcommand("bench")) return rbx::bench_command(bench_opt);
+    if (app.got_subcommand("view")) return rbx::view_command(view_opt);
   } catch (const rbx::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;
