@@ -44,4 +44,20 @@ Json trajectory_json(const std::vector<StateSample>& samples, const std::vector<
   return {{"time", time}, {"bodies", bodies}};
 }
 
+Json results_scene_json(const Json& scene_result) {
+  Json j = scene_result;
+  if (!j.contains("backends")) return j;
+  for (auto& [name, b] : j["backends"].items()) {
+    if (!b.contains("contacts") || !b["contacts"].is_array()) continue;
+    const size_t total = b["contacts"].size();
+    b["contacts_total"] = total;
+    if (total > kResultsMaxEvents) {
+      Json kept(b["contacts"].begin(), b["contacts"].begin() + kResultsMaxEvents);
+      b["contacts"] = kept;
+      b["contacts_truncated"] = true;
+    }
+  }
+  return j;
+}
+
 }  // namespace rbx

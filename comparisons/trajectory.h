@@ -29,4 +29,12 @@ double round_sig5(double x);
 Json trajectory_json(const std::vector<StateSample>& samples, const std::vector<RigidBody>& inputs,
                      size_t max_frames);
 
+/// Events kept per backend in results.json: a resting stack reports a contact every step
+/// (16 000 for Bullet), which made results.json 27.8 MB; the count is kept as `contacts_total`.
+constexpr size_t kResultsMaxEvents = 100;
+
+/// A scene's result object for results.json: each backend's `contacts` cut to the first
+/// kResultsMaxEvents (with `contacts_total`, and `contacts_truncated` when cut).
+Json results_scene_json(const Json& scene_result);
+
 }  // namespace rbx

@@ -10,6 +10,7 @@
 #include "comparisons/commands.h"
 #include "comparisons/harness.h"
 #include "comparisons/scene_file.h"
+#include "comparisons/scorecard.h"
 #include "comparisons/trajectory.h"
 
 namespace fs = std::filesystem;
@@ -233,6 +234,7 @@ constexpr const char* kScript = R"JS(
       p.label.style.left = (x + 6) + "px"; p.label.style.top = (y + 4) + "px";
     });
     camera.aspect = pw / ph; camera.updateProjectionMatrix();
+    state.canvas_top = Math.round(canvas.getBoundingClientRect().top);
   }
   function render() {
     renderer.setClearColor(0xffffff); renderer.setScissor(0, 0, canvas.width, canvas.height); renderer.clear();
@@ -411,6 +413,29 @@ std::string view_page(const Json& data, const std::string& three_js, const std::
        "<pre id=\"rbx-state\">{}</pre>\n<script id=\"rbx-data\" type=\"application/json\">"
     << script_safe_json(data) << "</script>\n<script>" << kScript << "</script>\n</body></html>\n";
   return h.str();
+}
+
+void write_report_views(const std::string& dir, const std::vector<Scene>& scenes,
+                        const std::vector<SceneEvaluation>& evs) {
+  const fs::path views = fs::path(dir) / "views";
+  fs::create_directories(views);
+  fs::copy_file(three_js_path(), views / "three.min.js", fs::copy_options::overwrite_existing);
+  std::ostringstream index;
+  index << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rbx report: 3-D "
+           "replays</title></head><body>\n<h1>rbx report: 3-D replay of every scene</h1>\n"
+           "<p>Each page plays every backend's run of the scene side by side. See also "
+           "<a href=\"report.md\">report.md</a>.</p>\n<ul>\n";
+  for (size_t i = 0; i < scenes.size() && i < evs.size(); ++i) {
+    const std::string slug = scene_slug(evs[i].family, scenes[i].file);
+    write_text((views / (slug + ".html")).string(),
+               view_page(view_data(scenes[i], evs[i].json), "", "three.min.js"));
+    index << "<li><a href=\"views/" << html_escape(slug) << ".html\">"
+          << html_escape(evs[i].family + "/" + scenes[i].name) << "</a>";
+    if (!scenes[i].description.empty()) index << ": " << html_escape(scenes[i].description);
+    index << "</li>\n";
+  }
+  index << "</ul>\n</body></html>\n";
+  write_text((fs::path(dir) / "index.html").string(), index.str());
 }
 
 int view_command(const ViewOptions& opt) {

@@ -6,6 +6,9 @@
 
 #include <string>
 
+#include <vector>
+
+#include "comparisons/harness.h"
 #include "comparisons/json_io.h"
 #include "engine/scene.h"
 
@@ -35,6 +38,12 @@ std::string view_page(const Json& data, const std::string& three_js, const std::
 
 /// Text safe inside HTML element content and attribute values (& < > " ').
 std::string html_escape(const std::string& s);
+
+/// The report's replay pages: DIR/views/SLUG.html for every scene (sharing one copy of three.js,
+/// DIR/views/three.min.js, so that 59 pages do not carry 59 copies of it; they still open
+/// offline from disk) and DIR/index.html listing them. Throws when three.js is absent.
+void write_report_views(const std::string& dir, const std::vector<Scene>& scenes,
+                        const std::vector<SceneEvaluation>& evs);
 
 /// Options of `rbx view`.
 struct ViewOptions {
