@@ -297,7 +297,7 @@ def contact_picture(scene, out):
         p, n = c["point"], c["normal"]
         pts.append(p)
         colour, marker = ("black", "o") if b == "exact" else style(b)
-        label = "exact (truth)" if b == "exact" else f"{b}: depth {c['depth']:.3g}"
+        label = f"{'exact (truth)' if b == 'exact' else b}: depth {c['depth']:.3g}"
         ax.scatter(*p, color=colour, marker=marker, s=30, label=label)
         ax.quiver(*p, *[arrow * x for x in n], color=colour, linewidth=2 if b == "exact" else 1.4)
         tip = [p[i] + 1.08 * arrow * n[i] for i in range(3)]

@@ -253,11 +253,17 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
   // Error against run time.
   md << "## Error against run time\n\n";
   md << "Dynamics: each backend is run at every time step of the scene's `sweep_dt` (default 4, "
-        "2, 1, 1/2 and 1/4 times `dt`); error is the velocity error in the kinetic-energy norm "
-        "(the figures use the scenes with a closed form, geometric mean over scenes; the "
-        "self-consistency errors of the others are in the CSV), run time is wall-clock per run, "
-        "summed over the family's scenes. Contacts: median time per query against the normal angle "
-        "error. Numbers: `sweep.csv`.\n\n";
+        "2, 1, 1/2 and 1/4 times `dt`). One point per (backend, time step): the **median over the "
+        "family's closed-form scenes** of the velocity error in the kinetic-energy norm, with the "
+        "25-75 % band as a bar, against the median run time of one scene run; the large open "
+        "marker is the coarsest step; the same scenes stand behind every point of a curve "
+        "(self-consistency errors are in `sweep.csv` only). Contacts: one point per backend, "
+        "normal angle error and depth error in two panels, median over the scenes with the 25-75 "
+        "% band on both axes and the worst scene as a small hollow marker; query times include "
+        "building the library's shape on each call, while the custom engine reuses its hulls "
+        "(prebuilt timings: `rbx bench`). Errors under 1e-13 are round-off and are drawn at 1e-15 "
+        "in the grey band. The dashed line is the Pareto front over backends. Numbers: "
+        "`sweep.csv`, `metrics.csv`.\n\n";
   std::set<std::string> families;
   for (const SceneEvaluation& ev : evs)
     for (const SweepPoint& p : ev.sweep) families.insert(ev.family + (p.kind == "contact" ? "-contact" : ""));

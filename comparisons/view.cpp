@@ -80,8 +80,17 @@ constexpr const char* kScript = R"JS(
   if (!isFinite(lo[0])) { lo = [-1, -1, -1]; hi = [1, 1, 1]; }
   var centre = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
   var size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-6);
-  // Clip the view for huge static floors: the moving bodies decide the size when there are any.
-  var arrow = 0.2 * Math.min(size, Math.max.apply(null, radius.concat([1e-6])) * 2);
+  // Arrows scale with the smallest body (a 1000:1 size ratio must still show its normal).
+  var rmin = Math.min.apply(null, radius.length ? radius : [size / 2]);
+  var arrow = 1.2 * Math.min(size / 2, rmin);
+  // A contact query (no timeline): frame the contact region, at the smaller body's scale.
+  var cps = (data.reference.contacts || []).slice();
+  names.forEach(function (n) { (data.backends[n].events || []).forEach(function (e) { cps.push(e); }); });
+  if (data.duration === 0 && cps.length) {
+    centre.set(0, 0, 0);
+    cps.forEach(function (e) { centre.x += e.point[0] / cps.length; centre.y += e.point[1] / cps.length; centre.z += e.point[2] / cps.length; });
+    size = Math.min(size, 3 * rmin);
+  }
 
   var canvas = document.getElementById("view");
   var renderer;
@@ -133,7 +142,14 @@ constexpr const char* kScript = R"JS(
                                new THREE.MeshBasicMaterial({color: colour}));
       g.add(dot);
       var n = new THREE.Vector3(e.normal[0], e.normal[1], e.normal[2]);
-      if (n.length() > 0.5) g.add(new THREE.ArrowHelper(n.normalize(), new THREE.Vector3(), arrow, colour, 0.25 * arrow, 0.12 * arrow));
+      if (n.length() > 0.5) {
+        // Drawn over the bodies (no depth test): a normal inside a body must still show.
+        var a = new THREE.ArrowHelper(n.normalize(), new THREE.Vector3(), arrow, colour, 0.3 * arrow, 0.15 * arrow);
+        // In the transparent pass after the bodies, the backend over the reference: a wrong
+        // normal shows on top of the right one.
+        [a.line, a.cone].forEach(function (o) { o.material.depthTest = false; o.material.transparent = true; o.renderOrder = colour === 0 ? 10 : 11; });
+        g.add(a);
+      }
       g.position.set(e.point[0], e.point[1], e.point[2]);
       sc.add(g); return g;
     }
