@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -207,6 +208,7 @@ TEST_F(ViewBrowser, FailsOnABrokenPage) {
   missing["backends"].erase(dropped);
   std::ofstream(dir / "missing.html") << view_page(missing, three_js());
   const std::vector<std::string> bad1 = check_page(dir / "missing.html", d);
+  for (const std::string& b : bad1) std::cout << "missing-backend page: " << b << "\n";
   ASSERT_FALSE(bad1.empty());
   EXPECT_NE(bad1.front().find("backend " + dropped + " not loaded"), std::string::npos) << bad1.front();
   // An empty scene: no bodies, so nothing drawn and nothing moves.
@@ -215,6 +217,7 @@ TEST_F(ViewBrowser, FailsOnABrokenPage) {
   empty["shapes"] = nlohmann::json::array();
   std::ofstream(dir / "empty.html") << view_page(empty, three_js());
   const std::vector<std::string> bad2 = check_page(dir / "empty.html", d);
+  for (const std::string& b : bad2) std::cout << "empty-scene page: " << b << "\n";
   bool saw_bodies = false, saw_pixels = false;
   for (const std::string& b : bad2) {
     saw_bodies = saw_bodies || b.rfind("bodies drawn", 0) == 0;
