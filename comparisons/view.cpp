@@ -73,11 +73,16 @@ constexpr const char* kScript = R"JS(
     grow([b.position[0] - r, b.position[1] - r, b.position[2] - r]);
     grow([b.position[0] + r, b.position[1] + r, b.position[2] + r]);
   });
+  if (!isFinite(lo[0])) { lo = [-1, -1, -1]; hi = [1, 1, 1]; }
+  // Trajectory points widen the view, except those of a run that flew off (an unstable backend
+  // 1e6 m away would shrink every panel to a dot): only points within 3 scene sizes count.
+  var c0 = [0, 1, 2].map(function (i) { return (lo[i] + hi[i]) / 2; });
+  var s0 = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-6);
   names.forEach(function (n) {
     var fr = data.backends[n].frames || {};
-    Object.keys(fr).forEach(function (b) { fr[b].forEach(function (f) { grow(f); }); });
+    Object.keys(fr).forEach(function (b) { fr[b].forEach(function (f) {
+      if (Math.hypot(f[0] - c0[0], f[1] - c0[1], f[2] - c0[2]) < 3 * s0) grow(f); }); });
   });
-  if (!isFinite(lo[0])) { lo = [-1, -1, -1]; hi = [1, 1, 1]; }
   var centre = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
   var size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-6);
   // Arrows scale with the smallest body (a 1000:1 size ratio must still show its normal).
