@@ -120,7 +120,7 @@ def error_vs_runtime(report, out):
         for k, (_, runtime, error) in enumerate(sorted(pts, reverse=True)):
             dyn[family][backend][k].append((runtime, error))
     for family, per_backend in dyn.items():
-        fig, ax = plt.subplots(figsize=(7.2, 5.2))
+        fig, ax = plt.subplots(figsize=(7.2, 6.0))
         roundoff_band(ax)
         allpts = []
         for backend in order(per_backend):
@@ -154,7 +154,8 @@ def error_vs_runtime(report, out):
         ax.set_title(f"{family}: error against run time, closed-form scenes\n"
                      "one point per time step; large open marker: the coarsest step", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right")
+        # Below the axes: the legend hides no point.
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3)
         save(fig, out, f"error_vs_runtime_{family}")
     # Contacts: normal angle and depth error, each against the query time.
     con = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))  # family, backend, metric
@@ -195,7 +196,8 @@ def error_vs_runtime(report, out):
                           "(libraries build their shape in each query; custom reuses its hulls)")
             ax.set_ylabel(f"{label}: median over scenes,\nbar 25-75 %; small hollow: worst scene")
             ax.grid(True, which="both", alpha=0.3)
-            ax.legend(fontsize=6.5, loc="upper left")
+            # Between the round-off band and the worst scenes, where no point lies.
+            ax.legend(fontsize=6.5, loc="center left")
         fig.suptitle(f"{family}: contact error against query time (one point per backend; "
                      "truth: closed form, else the exact oracle)", fontsize=10)
         save(fig, out, f"error_vs_runtime_{family}-contact")
