@@ -289,21 +289,33 @@ def contact_picture(scene, out):
     arrow = 0.15 * size
     wrong = disagreeing(scene)
     shown = (["exact"] if "exact" in scene["backends"] else []) + [b for b in wrong if b != "exact"]
-    pts = []
+    # Backends with the same answer (point and normal to 1e-6) share one arrow and one label.
+    groups = []
     for b in shown:
         r = scene["backends"][b]
         cs = [c for c in r.get("contacts", []) if c["bodies"][:2] == names]
         if not cs or r.get("status") != "ok":
             continue
         c = max(cs, key=lambda c: c["depth"])
+        key = tuple(round(x, 6) for x in c["point"] + c["normal"] + [c["depth"]])
+        for g in groups:
+            if g[0] == key and b != "exact" and "exact" not in g[1]:
+                g[1].append(b)
+                break
+        else:
+            groups.append((key, [b], c))
+    pts = []
+    for _, members, c in groups:
+        b = members[0]
         p, n = c["point"], c["normal"]
         pts.append(p)
         colour, marker = ("black", "o") if b == "exact" else style(b)
-        label = f"{'exact (truth)' if b == 'exact' else b}: depth {c['depth']:.3g}"
+        who = ", ".join(members)
+        label = f"{'exact (truth)' if b == 'exact' else who}: depth {c['depth']:.3g}"
         ax.scatter(*p, color=colour, marker=marker, s=30, label=label)
         ax.quiver(*p, *[arrow * x for x in n], color=colour, linewidth=2 if b == "exact" else 1.4)
         tip = [p[i] + 1.08 * arrow * n[i] for i in range(3)]
-        ax.text(*tip, b, color=colour, fontsize=8)
+        ax.text(*tip, who, color=colour, fontsize=8)
     if pts:
         centre = [sum(p[i] for p in pts) / len(pts) for i in range(3)]
         small = min(max(h - l for h, l in zip(
