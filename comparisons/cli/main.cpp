@@ -8,6 +8,7 @@
 #include "comparisons/cli/commands.h"
 #include "comparisons/scene/scene_file.h"
 #include "comparisons/eval/tosses.h"
+#include "comparisons/cli/view.h"
 #include "engine/polyhedron.h"
 
 namespace {
@@ -69,6 +70,11 @@ int main(int argc, char** argv) {
   tosses->add_flag("--fit", tosses_opt.fit, "fit restitution and friction per backend on DATA, write the parameter file");
   tosses->add_option("--backends", tosses_opt.backends, "comma-separated backend names");
   tosses->add_option("--json", tosses_opt.json, "write JSON results to FILE, or - for standard output");
+  rbx::ViewOptions view_opt;
+  CLI::App* view = app.add_subcommand("view", "one offline HTML page: 3-D replay of every backend");
+  view->add_option("scene", view_opt.scene, "scene file (TOML)")->required();
+  view->add_option("--backends", view_opt.backends, "comma-separated backend names");
+  view->add_option("--out", view_opt.out, "output HTML file (default: FAMILY_STEM.html)");
 
   try {
     app.parse(argc, argv);
@@ -90,6 +96,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("scenes")) return rbx::scenes_command(scenes_inputs);
     if (app.got_subcommand("bench")) return rbx::bench_command(bench_opt);
     if (app.got_subcommand("tosses")) return rbx::tosses_command(tosses_opt);
+    if (app.got_subcommand("view")) return rbx::view_command(view_opt);
   } catch (const rbx::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;

@@ -16,6 +16,7 @@
 #include "comparisons/eval/select_backends.h"
 #include "comparisons/scene/scene_collection.h"
 #include "comparisons/eval/result_cache.h"
+#include "comparisons/eval/trajectory.h"
 #include "engine/bounding.h"
 #include "engine/detect.h"
 #include "engine/format.h"
@@ -476,6 +477,10 @@ class Evaluator {
       Json& bj = backend_json(name);
       bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
       if (main.cached) bj["cached"] = true;
+      // The sampled trajectory, for results.json and the 3-D replay (rbx view).
+      const size_t moving = static_cast<size_t>(std::count_if(
+          inputs_.begin(), inputs_.end(), [](const RigidBody& b) { return !b.is_static; }));
+      bj["trajectory"] = trajectory_json(main.result.samples, inputs_, frame_budget(moving));
       if (main.result.status != Status::Ok) {
         if (scene_.has_check(CheckKind::Stability)) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
         // The engine under test stopped before t = duration: it fails [expect.body] (no final

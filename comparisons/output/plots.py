@@ -18,12 +18,34 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-# One colour and marker per backend, stable across figures.
-BACKENDS = ["custom", "exact", "fcl", "fcl-epa", "fcl-indep", "fcl-box", "libccd", "bullet",
-            "bullet-sat", "mujoco", "ode"]
-COLOURS = dict(zip(BACKENDS, plt.cm.tab20.colors[::2] + plt.cm.tab20.colors[1::2]))
-MARKERS = dict(zip(BACKENDS, "os^vD<>pPX*"))
-FLOOR = 1e-17  # errors at round-off are drawn at this floor on log axes
+# Colour-blind-safe colours (Okabe & Ito 2008) crossed with distinct markers: backends are data
+# (names come from results.json), so each name met gets the next (colour, marker) pair, in the
+# order below first, so that a backend keeps its look across figures of one report.
+OKABE_ITO = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#56B4E9", "#D55E00", "#F0E442",
+             "#000000"]
+MARKER_CYCLE = "os^DvP<X>*ph"
+PREFERRED = ["custom", "custom-seed", "exact", "fcl", "fcl-hull", "fcl-epa", "fcl-indep",
+             "fcl-box", "libccd", "bullet", "bullet-hull", "bullet-sat", "mujoco", "mujoco-hull",
+             "ode", "ode-hull"]
+_STYLE = {}
+
+
+def style(backend):
+    """(colour, marker) of a backend: every name gets a pair no other name in the report has."""
+    if backend not in _STYLE:
+        k = len(_STYLE)
+        _STYLE[backend] = (OKABE_ITO[k % len(OKABE_ITO)], MARKER_CYCLE[k % len(MARKER_CYCLE)])
+    return _STYLE[backend]
+
+
+def order(names):
+    return sorted(names, key=lambda b: (PREFERRED.index(b) if b in PREFERRED else 99, b))
+
+
+# Errors below ROUNDOFF are round-off (a few ulps of double precision on unit-sized numbers) and
+# are drawn at FLOOR, inside a grey band, so that exact answers stay on a log axis.
+ROUNDOFF = 1e-13
+FLOOR = 1e-15
 
 
 def median(values):
@@ -33,6 +55,22 @@ def median(values):
     return v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2])
 
 
+def quartiles(values):
+    """(25 %, 50 %, 75 %) of a non-empty list, linear interpolation between ranks."""
+    v = sorted(values)
+
+    def q(f):
+        x = f * (len(v) - 1)
+        i = int(math.floor(x))
+        j = min(i + 1, len(v) - 1)
+        return v[i] + (x - i) * (v[j] - v[i])
+    return q(0.25), q(0.5), q(0.75)
+
+
+def floored(x):
+    return max(x, FLOOR) if x >= ROUNDOFF else FLOOR
+
+
 def save(fig, out, name):
     fig.tight_layout()
     for ext in ("png", "svg"):
@@ -40,11 +78,28 @@ def save(fig, out, name):
     plt.close(fig)
 
 
+def pareto(points):
+    """The points no other point beats in both run time and error (lower is better)."""
+    front = []
+    for x, y in sorted(points):
+        if not front or y < front[-1][1]:
+            front.append((x, y))
+    return front
+
+
+def roundoff_band(ax, xlabel_side=False):
+    ax.axhspan(FLOOR * 0.5, ROUNDOFF, color="#dddddd", zorder=0)
+    ax.text(0.01, 0.02, f"grey: error < {ROUNDOFF:g} (round-off), drawn at {FLOOR:g}",
+            transform=ax.transAxes, fontsize=7, color="#444444")
+
+
 def error_vs_runtime(report, out):
-    """Dynamics: per backend, each scene's sweep and the median scene; contacts: a point per scene."""
+    """One point per (backend, time step): the median over the family's closed-form scenes with
+    the 25-75 % band; contacts: one point per backend for the normal and for the depth."""
     rows = list(csv.DictReader(open(os.path.join(report, "sweep.csv"))))
+    metrics = list(csv.DictReader(open(os.path.join(report, "metrics.csv"))))
     sweeps = defaultdict(list)  # (family, scene, backend) -> [(dt, runtime, error)]
-    con = defaultdict(lambda: defaultdict(list))  # family, backend
+    qtime = defaultdict(lambda: defaultdict(list))  # family, backend -> query times (s)
     for r in rows:
         if r["kind"] == "dynamics":
             # Only closed-form references are comparable across time steps and scenes (a
@@ -54,59 +109,97 @@ def error_vs_runtime(report, out):
             sweeps[(r["family"], r["scene"], r["backend"])].append(
                 (float(r["dt"]), float(r["runtime_s"]), float(r["error"])))
         else:
-            con[r["family"]][r["backend"]].append((float(r["runtime_s"]), float(r["error"])))
+            qtime[r["family"]][r["backend"]].append(float(r["runtime_s"]))
     # Scenes differ in dt (and some set their own sweep_dt), so the points of a curve are the
-    # k-th step of each scene's sweep, coarse to fine, not one absolute dt: grouping by dt would
-    # put a different set of scenes behind every point.
+    # k-th step of each scene's sweep, coarse to fine; only steps every scene of the family has
+    # are drawn, so the same scenes stand behind every point of a curve.
     dyn = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))  # family, backend, k
+    nscenes = defaultdict(lambda: defaultdict(int))
     for (family, _, backend), pts in sweeps.items():
+        nscenes[family][backend] += 1
         for k, (_, runtime, error) in enumerate(sorted(pts, reverse=True)):
             dyn[family][backend][k].append((runtime, error))
     for family, per_backend in dyn.items():
-        fig, ax = plt.subplots(figsize=(6.4, 4.6))
-        for backend in sorted(per_backend, key=lambda b: BACKENDS.index(b) if b in BACKENDS else 99):
-            colour = COLOURS.get(backend)
-            # Thin: each scene's own sweep (its run time, its error).
-            for (fam, _, b), pts in sorted(sweeps.items()):
-                if fam == family and b == backend:
-                    pts = sorted(pts, reverse=True)
-                    ax.plot([p[1] for p in pts], [max(p[2], FLOOR) for p in pts], color=colour,
-                            lw=0.7, alpha=0.3)
-            # Bold: the median scene at each step of the sweeps (median run time, median error),
-            # so neither one exact scene nor one failed scene decides where the curve lies.
-            pts = []
+        fig, ax = plt.subplots(figsize=(7.2, 6.0))
+        roundoff_band(ax)
+        allpts = []
+        for backend in order(per_backend):
+            colour, marker = style(backend)
+            n = nscenes[family][backend]
+            xs, ys, lo, hi = [], [], [], []
             for k, vals in sorted(per_backend[backend].items()):
-                pts.append((median([v[0] for v in vals]), max(median([v[1] for v in vals]), FLOOR)))
-            ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=MARKERS.get(backend, "o"),
-                    color=colour, lw=2, label=backend)
+                if len(vals) < n:
+                    continue
+                _, tx, _ = quartiles([v[0] for v in vals])
+                q1, q2, q3 = quartiles([v[1] for v in vals])
+                xs.append(tx)
+                ys.append(floored(q2))
+                lo.append(floored(q2) - floored(q1))
+                hi.append(floored(q3) - floored(q2))
+            if not xs:
+                continue
+            ax.errorbar(xs, ys, yerr=[lo, hi], color=colour, marker=marker, ms=5, lw=1.4,
+                        capsize=2, label=f"{backend} ({n} scenes)")
+            # The coarsest step: a large open marker.
+            ax.scatter([xs[0]], [ys[0]], s=150, facecolors="none", edgecolors=colour, lw=1.5)
+            allpts += [(x, y, backend) for x, y in zip(xs, ys)]
+        front = pareto([(x, y) for x, y, _ in allpts])
+        if len(front) > 1:
+            ax.step([p[0] for p in front], [p[1] for p in front], where="post", color="black",
+                    ls="--", lw=0.9, label="Pareto front over backends")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("run time per scene (s)\npoints: each scene's time steps, coarse to fine")
-        ax.set_ylabel("velocity error, kinetic-energy norm\n(bold: median scene; thin: each scene)")
-        ax.set_title(f"{family}: error against run time (closed-form scenes; exact = {FLOOR:g})",
-                     fontsize=10)
+        ax.set_xlabel("run time of one scene run (s), median over the scenes")
+        ax.set_ylabel("velocity error, kinetic-energy norm:\nmedian over scenes, bar 25-75 %")
+        ax.set_title(f"{family}: error against run time, closed-form scenes\n"
+                     "one point per time step; large open marker: the coarsest step", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
+        # Below the axes: the legend hides no point.
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3)
         save(fig, out, f"error_vs_runtime_{family}")
+    # Contacts: normal angle and depth error, each against the query time.
+    con = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))  # family, backend, metric
+    for m in metrics:
+        if m["check"] == "contact" and m["metric"] in ("normal_err_deg", "depth_err") and \
+                m["against"] in ("analytic", "exact"):
+            con[m["family"]][m["backend"]][m["metric"]].append(float(m["value"]))
     for family, per_backend in con.items():
-        fig, ax = plt.subplots(figsize=(6.4, 4.6))
-        for backend in sorted(per_backend, key=lambda b: BACKENDS.index(b) if b in BACKENDS else 99):
-            vals = per_backend[backend]
-            xs = [v[0] * 1e6 for v in vals]
-            ys = [max(v[1], FLOOR) for v in vals]
-            ax.scatter(xs, ys, marker=MARKERS.get(backend, "o"), color=COLOURS.get(backend),
-                       alpha=0.35, s=18)
-            mean_x = math.exp(sum(math.log(max(x, 1e-3)) for x in xs) / len(xs))
-            mean_y = sum(v[1] for v in vals) / len(vals)
-            ax.scatter([mean_x], [max(mean_y, FLOOR)], marker=MARKERS.get(backend, "o"),
-                       color=COLOURS.get(backend), s=90, edgecolors="black", label=backend)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("time per contact query (µs, median)")
-        ax.set_ylabel("normal angle error (deg)")
-        ax.set_title(f"{family}: contact error against query time\n(small: one scene; large: mean)")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
+        for ax, metric, label in ((axes[0], "normal_err_deg", "normal angle error (deg)"),
+                                  (axes[1], "depth_err", "depth error (m)")):
+            roundoff_band(ax)
+            pts = []
+            for backend in order(per_backend):
+                vals = per_backend[backend][metric]
+                times = qtime[family].get(backend)
+                if not vals or not times:
+                    continue
+                colour, marker = style(backend)
+                t1, t2, t3 = quartiles([t * 1e6 for t in times])
+                q1, q2, q3 = quartiles(vals)
+                worst = max(vals)
+                ax.errorbar([t2], [floored(q2)], xerr=[[t2 - t1], [t3 - t2]],
+                            yerr=[[floored(q2) - floored(q1)], [floored(q3) - floored(q2)]],
+                            color=colour, marker=marker, ms=7, capsize=2,
+                            label=f"{backend} (worst {worst:.2g})")
+                # The worst scene as a small hollow marker above: a known failure shows.
+                ax.scatter([t2], [floored(worst)], marker=marker, s=18, facecolors="none",
+                           edgecolors=colour)
+                pts.append((t2, floored(q2)))
+            front = pareto(pts)
+            if len(front) > 1:
+                ax.step([p[0] for p in front], [p[1] for p in front], where="post",
+                        color="black", ls="--", lw=0.9, label="Pareto front (medians)")
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_xlabel("time per contact query (µs), median over scenes, bar 25-75 %\n"
+                          "(libraries build their shape in each query; custom reuses its hulls)")
+            ax.set_ylabel(f"{label}: median over scenes,\nbar 25-75 %; small hollow: worst scene")
+            ax.grid(True, which="both", alpha=0.3)
+            # Between the round-off band and the worst scenes, where no point lies.
+            ax.legend(fontsize=6.5, loc="center left")
+        fig.suptitle(f"{family}: contact error against query time (one point per backend; "
+                     "truth: closed form, else the exact oracle)", fontsize=10)
         save(fig, out, f"error_vs_runtime_{family}-contact")
 
 
@@ -145,7 +238,7 @@ def velocity_bars(scene, out):
         for k, b in enumerate(backends):
             f = scene["backends"][b]["bodies"][body]["final"]
             ax.bar([i + k * width for i in range(6)], f["velocity"] + f["angular_velocity"], width,
-                   label=b, color=COLOURS.get(b))
+                   label=b, color=style(b)[0])
         e = expect.get(body, {})
         truth = (e.get("velocity") or [None] * 3) + (e.get("angular_velocity") or [None] * 3)
         xs = [i + (len(backends) - 1) * width / 2 for i in range(6)]  # centre of each group
@@ -163,8 +256,19 @@ def velocity_bars(scene, out):
     save(fig, out, f"velocity_{slug(scene)}")
 
 
+def disagreeing(scene):
+    """Backends the scene marks as clearly wrong (its ✗ list), in report order."""
+    names = set()
+    for d in scene.get("disagreements", []):
+        for b in scene["backends"]:
+            if d.startswith(b + " ") or d.startswith(b + ":"):
+                names.add(b)
+    return order(names)
+
+
 def contact_picture(scene, out):
-    """The bodies at t = 0 with each backend's deepest contact point and its normal."""
+    """The bodies at t = 0, the exact contact (black) and only the backends that disagree with
+    the truth, each labelled at the tip of its normal."""
     geom = scene.get("geometry") or []
     if len(geom) < 2:
         return
@@ -173,27 +277,45 @@ def contact_picture(scene, out):
     names = [g["name"] for g in geom[:2]]
     lo = [math.inf] * 3
     hi = [-math.inf] * 3
-    for g, colour in zip(geom[:2], ["#4c72b0", "#dd8452"]):
+    for g, colour in zip(geom[:2], ["#0072B2", "#E69F00"]):
         v = g["vertices"]
         tris = [[v[i] for i in t] for t in g["triangles"]]
-        ax.add_collection3d(Poly3DCollection(tris, alpha=0.18, facecolor=colour, edgecolor="#555555",
+        ax.add_collection3d(Poly3DCollection(tris, alpha=0.15, facecolor=colour, edgecolor="#555555",
                                              linewidths=0.3))
         for p in v:
             lo = [min(a, b) for a, b in zip(lo, p)]
             hi = [max(a, b) for a, b in zip(hi, p)]
-    # Zoom on the overlap of the two bodies' boxes when one is much larger.
     size = max(h - l for h, l in zip(hi, lo))
     arrow = 0.15 * size
-    pts = []
-    for b, r in scene["backends"].items():
+    wrong = disagreeing(scene)
+    shown = (["exact"] if "exact" in scene["backends"] else []) + [b for b in wrong if b != "exact"]
+    # Backends with the same answer (point and normal to 1e-6) share one arrow and one label.
+    groups = []
+    for b in shown:
+        r = scene["backends"][b]
         cs = [c for c in r.get("contacts", []) if c["bodies"][:2] == names]
         if not cs or r.get("status") != "ok":
             continue
         c = max(cs, key=lambda c: c["depth"])
+        key = tuple(round(x, 6) for x in c["point"] + c["normal"] + [c["depth"]])
+        for g in groups:
+            if g[0] == key and b != "exact" and "exact" not in g[1]:
+                g[1].append(b)
+                break
+        else:
+            groups.append((key, [b], c))
+    pts = []
+    for _, members, c in groups:
+        b = members[0]
         p, n = c["point"], c["normal"]
         pts.append(p)
-        ax.scatter(*p, color=COLOURS.get(b), marker=MARKERS.get(b, "o"), s=30, label=b)
-        ax.quiver(*p, *[arrow * x for x in n], color=COLOURS.get(b), linewidth=1.2)
+        colour, marker = ("black", "o") if b == "exact" else style(b)
+        who = ", ".join(members)
+        label = f"{'exact (truth)' if b == 'exact' else who}: depth {c['depth']:.3g}"
+        ax.scatter(*p, color=colour, marker=marker, s=30, label=label)
+        ax.quiver(*p, *[arrow * x for x in n], color=colour, linewidth=2 if b == "exact" else 1.4)
+        tip = [p[i] + 1.08 * arrow * n[i] for i in range(3)]
+        ax.text(*tip, who, color=colour, fontsize=8)
     if pts:
         centre = [sum(p[i] for p in pts) / len(pts) for i in range(3)]
         small = min(max(h - l for h, l in zip(
@@ -208,7 +330,10 @@ def contact_picture(scene, out):
     ax.set_xlabel("x")
     ax.set_ylabel("y")
     ax.set_zlabel("z")
-    ax.set_title(f"{scene['scene']}\ncontact point and normal ({names[1]} toward {names[0]})", fontsize=9)
+    who = (f"{len(wrong)} backend(s) disagree: " + ", ".join(wrong)) if wrong else \
+        "every backend agrees with the truth"
+    ax.set_title(f"{scene['scene']}: contact normal ({names[1]} toward {names[0]})\n{who}",
+                 fontsize=9)
     ax.legend(fontsize=7, loc="upper left")
     save(fig, out, f"contact_{slug(scene)}")
 

@@ -1,0 +1,483 @@
+#include "comparisons/cli/view.h"
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include "comparisons/cli/commands.h"
+#include "comparisons/eval/harness.h"
+#include "comparisons/scene/scene_file.h"
+#include "comparisons/output/scorecard.h"
+#include "comparisons/eval/trajectory.h"
+
+namespace fs = std::filesystem;
+
+namespace rbx {
+
+namespace {
+
+Json rounded(const Json& v) {
+  if (v.is_number_float()) return round_sig5(v.get<double>());
+  if (v.is_array()) {
+    Json out = Json::array();
+    for (const Json& x : v) out.push_back(rounded(x));
+    return out;
+  }
+  return v;
+}
+
+Json vec_json(const Vec3& v) { return {round_sig5(v.x()), round_sig5(v.y()), round_sig5(v.z())}; }
+
+// A backend's events (or t = 0 contacts), at most kViewMaxEvents, rounded for the page.
+Json events_json(const Json& contacts) {
+  Json out = Json::array();
+  for (const Json& c : contacts) {
+    if (out.size() >= kViewMaxEvents) break;
+    out.push_back({{"t", rounded(c.value("time", 0.0))}, {"bodies", c["bodies"]},
+                   {"point", rounded(c["point"])}, {"normal", rounded(c["normal"])},
+                   {"depth", rounded(c["depth"])}});
+  }
+  return out;
+}
+
+// The page's script: data from the JSON block, one viewport per backend on one WebGL canvas,
+// a shared camera, a timeline. The page writes its state into #rbx-state (for the browser test).
+constexpr const char* kScript = R"JS(
+(function () {
+  "use strict";
+  var data = JSON.parse(document.getElementById("rbx-data").textContent);
+  var state = {loaded: false, webgl: false, error: "", time: 0, playing: false, backends: {},
+               bodies_drawn: 0, frames_shown: {}};
+  function publish() { document.getElementById("rbx-state").textContent = JSON.stringify(state); }
+  function text(el, s) { el.textContent = s; return el; }
+  // Okabe-Ito: colour-blind-safe body colours.
+  var bodyColours = [0x0072B2, 0xE69F00, 0x009E73, 0xCC79A7, 0x56B4E9, 0xD55E00, 0xF0E442];
+  var names = Object.keys(data.backends);
+  var duration = 0;
+  names.forEach(function (n) {
+    var t = data.backends[n].time || [];
+    if (t.length) duration = Math.max(duration, t[t.length - 1]);
+    state.backends[n] = {status: data.backends[n].status, frames: t.length,
+                         events: (data.backends[n].events || []).length};
+  });
+  // Scene size from the bodies' vertices at t = 0 and every trajectory point.
+  var lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  function grow(p) { for (var i = 0; i < 3; ++i) { lo[i] = Math.min(lo[i], p[i]); hi[i] = Math.max(hi[i], p[i]); } }
+  var radius = data.shapes.map(function (s) {
+    var r = 0; s.vertices.forEach(function (v) { r = Math.max(r, Math.hypot(v[0], v[1], v[2])); }); return r; });
+  data.bodies.forEach(function (b) {
+    var r = radius[b.shape];
+    grow([b.position[0] - r, b.position[1] - r, b.position[2] - r]);
+    grow([b.position[0] + r, b.position[1] + r, b.position[2] + r]);
+  });
+  if (!isFinite(lo[0])) { lo = [-1, -1, -1]; hi = [1, 1, 1]; }
+  // Trajectory points widen the view, except those of a run that flew off (an unstable backend
+  // 1e6 m away would shrink every panel to a dot): only points within 3 scene sizes count.
+  var c0 = [0, 1, 2].map(function (i) { return (lo[i] + hi[i]) / 2; });
+  var s0 = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-6);
+  names.forEach(function (n) {
+    var fr = data.backends[n].frames || {};
+    Object.keys(fr).forEach(function (b) { fr[b].forEach(function (f) {
+      if (Math.hypot(f[0] - c0[0], f[1] - c0[1], f[2] - c0[2]) < 3 * s0) grow(f); }); });
+  });
+  var centre = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+  var size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-6);
+  // Arrows scale with the smallest body (a 1000:1 size ratio must still show its normal).
+  var rmin = Math.min.apply(null, radius.length ? radius : [size / 2]);
+  var arrow = 1.2 * Math.min(size / 2, rmin);
+  // A contact query (no timeline): frame the contact region, at the smaller body's scale.
+  var cps = (data.reference.contacts || []).slice();
+  names.forEach(function (n) { (data.backends[n].events || []).forEach(function (e) { cps.push(e); }); });
+  if (data.duration === 0 && cps.length) {
+    centre.set(0, 0, 0);
+    cps.forEach(function (e) { centre.x += e.point[0] / cps.length; centre.y += e.point[1] / cps.length; centre.z += e.point[2] / cps.length; });
+    size = Math.min(size, 3 * rmin);
+  }
+
+  var canvas = document.getElementById("view");
+  var renderer;
+  try {
+    renderer = new THREE.WebGLRenderer({canvas: canvas, antialias: true, preserveDrawingBuffer: true});
+    state.webgl = true;
+  } catch (e) {
+    state.error = "WebGL unavailable: " + e.message; publish(); return;
+  }
+  renderer.setPixelRatio(1);
+  renderer.setScissorTest(true);
+  var camera = new THREE.PerspectiveCamera(40, 1, size * 1e-3, size * 100);
+  var yaw = 0.7, pitch = 0.45, dist = 2.2 * size;
+  function placeCamera() {
+    camera.position.set(centre.x + dist * Math.cos(pitch) * Math.cos(yaw),
+                        centre.y + dist * Math.cos(pitch) * Math.sin(yaw),
+                        centre.z + dist * Math.sin(pitch));
+    camera.up.set(0, 0, 1); camera.lookAt(centre);
+  }
+  placeCamera();
+
+  // One three.js scene per backend: bodies, its events, the reference.
+  var geoms = data.shapes.map(function (s) {
+    var g = new THREE.BufferGeometry(), pos = [];
+    s.triangles.forEach(function (t) { t.forEach(function (i) { pos.push(s.vertices[i][0], s.vertices[i][1], s.vertices[i][2]); }); });
+    g.setAttribute("position", new THREE.Float32BufferAttribute(pos, 3));
+    g.computeVertexNormals();
+    return {mesh: g, edges: new THREE.EdgesGeometry(g, 20)};
+  });
+  var panels = names.map(function (n, k) {
+    var sc = new THREE.Scene();
+    sc.background = new THREE.Color(0xf7f7f7);
+    sc.add(new THREE.AmbientLight(0xffffff, 0.55));
+    var light = new THREE.DirectionalLight(0xffffff, 0.6); light.position.set(1, 0.6, 2); sc.add(light);
+    var bodies = data.bodies.map(function (b, i) {
+      var grp = new THREE.Group();
+      var mat = new THREE.MeshLambertMaterial({color: bodyColours[i % bodyColours.length],
+        transparent: true, opacity: 0.45, side: THREE.DoubleSide});
+      grp.add(new THREE.Mesh(geoms[b.shape].mesh, mat));
+      grp.add(new THREE.LineSegments(geoms[b.shape].edges, new THREE.LineBasicMaterial({color: 0x333333})));
+      grp.position.set(b.position[0], b.position[1], b.position[2]);
+      grp.quaternion.set(b.orientation[1], b.orientation[2], b.orientation[3], b.orientation[0]);
+      sc.add(grp); state.bodies_drawn += 1;
+      return grp;
+    });
+    function marker(e, colour) {
+      var g = new THREE.Group();
+      var dot = new THREE.Mesh(new THREE.SphereBufferGeometry(0.04 * arrow + 1e-9, 10, 8),
+                               new THREE.MeshBasicMaterial({color: colour}));
+      g.add(dot);
+      var n = new THREE.Vector3(e.normal[0], e.normal[1], e.normal[2]);
+      if (n.length() > 0.5) {
+        // Drawn over the bodies (no depth test): a normal inside a body must still show.
+        var a = new THREE.ArrowHelper(n.normalize(), new THREE.Vector3(), arrow, colour, 0.3 * arrow, 0.15 * arrow);
+        // In the transparent pass after the bodies, the backend over the reference: a wrong
+        // normal shows on top of the right one.
+        [a.line, a.cone].forEach(function (o) { o.material.depthTest = false; o.material.transparent = true; o.renderOrder = colour === 0 ? 10 : 11; });
+        g.add(a);
+      }
+      g.position.set(e.point[0], e.point[1], e.point[2]);
+      sc.add(g); return g;
+    }
+    var events = (data.backends[n].events || []).map(function (e) { return {t: e.t, obj: marker(e, 0xd62728)}; });
+    var ref = [];
+    (data.reference.contacts || []).forEach(function (e) { ref.push({t: e.t, obj: marker(e, 0x000000)}); });
+    var finals = data.reference.finals || {};
+    var refFinal = [];
+    data.bodies.forEach(function (b, i) {
+      var v = finals[b.name];
+      if (!v || !v.velocity) return;
+      var d = new THREE.Vector3(v.velocity[0], v.velocity[1], v.velocity[2]);
+      var len = d.length();
+      if (len === 0) return;
+      var a = new THREE.ArrowHelper(d.normalize(), new THREE.Vector3(), arrow * 2, 0x000000, 0.3 * arrow, 0.15 * arrow);
+      sc.add(a); refFinal.push({body: i, obj: a});
+    });
+    var label = document.createElement("div");
+    label.className = "label";
+    var st = data.backends[n].status;
+    text(label, n + (st === "ok" ? "" : " (" + st + ")"));
+    label.title = data.backends[n].message || "";
+    document.getElementById("labels").appendChild(label);
+    return {name: n, scene: sc, bodies: bodies, events: events, ref: ref, refFinal: refFinal,
+            label: label, visible: true};
+  });
+
+  // Controls: per-backend toggles, reference toggle, play/pause, slider.
+  var toggles = document.getElementById("toggles");
+  panels.forEach(function (p) {
+    var l = document.createElement("label"), c = document.createElement("input");
+    c.type = "checkbox"; c.checked = true;
+    c.addEventListener("change", function () { p.visible = c.checked; layout(); render(); });
+    l.appendChild(c); l.appendChild(document.createTextNode(" " + p.name)); toggles.appendChild(l);
+  });
+  var showRef = true;
+  var rc = document.getElementById("ref");
+  rc.addEventListener("change", function () { showRef = rc.checked; render(); });
+  var slider = document.getElementById("slider"), play = document.getElementById("play");
+  var clock = document.getElementById("clock");
+  slider.addEventListener("input", function () { setTime(duration * slider.value / 1000); });
+  play.addEventListener("click", function () { setPlaying(!state.playing); });
+  function setPlaying(on) { state.playing = on; text(play, on ? "pause" : "play"); publish(); if (on) tick.last = null, requestAnimationFrame(tick); }
+
+  function frameAt(times, t) {  // last frame at or before t
+    var k = 0; while (k + 1 < times.length && times[k + 1] <= t + 1e-12) ++k; return k;
+  }
+  function setTime(t) {
+    state.time = Math.min(Math.max(t, 0), duration);
+    slider.value = duration > 0 ? Math.round(1000 * state.time / duration) : 0;
+    text(clock, "t = " + state.time.toFixed(4) + " s / " + duration.toFixed(4) + " s");
+    var window = Math.max(duration / 20, 1e-9);
+    panels.forEach(function (p) {
+      var b = data.backends[p.name], times = b.time || [];
+      var k = frameAt(times, state.time);
+      state.frames_shown[p.name] = times.length ? k : -1;
+      data.bodies.forEach(function (body, i) {
+        var f = b.frames && b.frames[body.name];
+        if (!f || !f.length) return;
+        var s = f[Math.min(k, f.length - 1)];
+        p.bodies[i].position.set(s[0], s[1], s[2]);
+        p.bodies[i].quaternion.set(s[4], s[5], s[6], s[3]);
+      });
+      // Events near the current time (all of them when the run has no timeline).
+      p.events.forEach(function (e) { e.obj.visible = duration === 0 || (e.t <= state.time + 1e-12 && e.t > state.time - window); });
+      p.ref.forEach(function (e) { e.obj.visible = showRef; });
+      p.refFinal.forEach(function (r) {
+        r.obj.visible = showRef && state.time >= duration - 1e-12;
+        r.obj.position.copy(p.bodies[r.body].position);
+      });
+    });
+    render();
+  }
+  function tick(now) {
+    if (!state.playing) return;
+    if (tick.last != null) {
+      var t = state.time + (duration / 4) * (now - tick.last) / 1000;  // the whole run in 4 s
+      if (t >= duration) { setTime(duration); setPlaying(false); return; }
+      setTime(t);
+    }
+    tick.last = now;
+    requestAnimationFrame(tick);
+  }
+
+  var rects = [];
+  function layout() {
+    var w = canvas.clientWidth, h = canvas.clientHeight;
+    renderer.setSize(w, h, false);
+    var shown = panels.filter(function (p) { return p.visible; });
+    var cols = Math.ceil(Math.sqrt(shown.length || 1)), rows = Math.ceil((shown.length || 1) / cols);
+    var pw = Math.floor(w / cols), ph = Math.floor(h / rows);
+    rects = [];
+    panels.forEach(function (p) { p.label.style.display = "none"; });
+    shown.forEach(function (p, k) {
+      var x = (k % cols) * pw, y = Math.floor(k / cols) * ph;
+      rects.push({p: p, x: x, y: h - y - ph, w: pw - 2, h: ph - 2});
+      p.label.style.display = "block";
+      p.label.style.left = (x + 6) + "px"; p.label.style.top = (y + 4) + "px";
+    });
+    camera.aspect = pw / ph; camera.updateProjectionMatrix();
+    state.canvas_top = Math.round(canvas.getBoundingClientRect().top);
+  }
+  function render() {
+    renderer.setClearColor(0xffffff); renderer.setScissor(0, 0, canvas.width, canvas.height); renderer.clear();
+    rects.forEach(function (r) {
+      renderer.setViewport(r.x, r.y, r.w, r.h); renderer.setScissor(r.x, r.y, r.w, r.h);
+      renderer.render(r.p.scene, camera);
+    });
+    publish();
+  }
+  // Orbit with the mouse, zoom with the wheel.
+  var drag = null;
+  canvas.addEventListener("mousedown", function (e) { drag = [e.clientX, e.clientY]; });
+  window.addEventListener("mouseup", function () { drag = null; });
+  window.addEventListener("mousemove", function (e) {
+    if (!drag) return;
+    yaw -= (e.clientX - drag[0]) * 0.01; pitch = Math.max(-1.5, Math.min(1.5, pitch + (e.clientY - drag[1]) * 0.01));
+    drag = [e.clientX, e.clientY]; placeCamera(); render();
+  });
+  canvas.addEventListener("wheel", function (e) { e.preventDefault(); dist *= e.deltaY > 0 ? 1.1 : 0.9; placeCamera(); render(); });
+  window.addEventListener("resize", function () { layout(); render(); });
+
+  layout();
+  // #t=FRACTION opens at that fraction of the run; #play starts playing.
+  var hash = window.location.hash, m = /t=([0-9.]+)/.exec(hash);
+  setTime(m ? duration * parseFloat(m[1]) : 0);
+  state.loaded = true;
+  publish();
+  if (/play/.test(hash)) setPlaying(true);
+})();
+)JS";
+
+constexpr const char* kStyle = R"CSS(
+body { font: 14px sans-serif; margin: 0; display: flex; flex-direction: column; height: 100vh; }
+header { padding: 6px 10px; border-bottom: 1px solid #ccc; }
+header h1 { font-size: 16px; margin: 0 0 2px 0; }
+header p { margin: 2px 0; color: #444; }
+#controls label { margin-right: 10px; white-space: nowrap; }
+#slider { width: 40%; vertical-align: middle; }
+#stage { position: relative; flex: 1; }
+#view { width: 100%; height: 100%; display: block; }
+.label { position: absolute; background: rgba(255,255,255,0.8); padding: 1px 4px; font-weight: bold; }
+#rbx-state { display: none; }
+)CSS";
+
+// JSON inside a <script> element: no "<", ">" or "&" (their \u escapes mean the same in JSON
+// strings, and they occur nowhere else), so no scene text can close the element.
+std::string script_safe_json(const Json& j) {
+  const std::string s = j.dump(-1, ' ', false, Json::error_handler_t::replace);
+  std::string out;
+  out.reserve(s.size());
+  for (char c : s) {
+    if (c == '<') out += "\\u003c";
+    else if (c == '>') out += "\\u003e";
+    else if (c == '&') out += "\\u0026";
+    else out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string html_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+Json view_data(const Scene& scene, const Json& result) {
+  Json d;
+  d["scene"] = scene.name;
+  d["family"] = scene_family(scene.file);
+  d["description"] = scene.description;
+  d["file"] = scene.file;
+  d["duration"] = scene.sim.duration;
+  // Shapes in the body frame (centre of mass at the origin), shared between identical bodies.
+  d["shapes"] = Json::array();
+  d["bodies"] = Json::array();
+  std::map<std::string, size_t> shape_index;
+  for (const RigidBody& b : make_bodies(scene)) {
+    Json verts = Json::array();
+    for (const Vec3& v : b.shape->vertices()) verts.push_back(vec_json(v));
+    Json tris = Json::array();
+    for (const auto& t : b.shape->triangles()) tris.push_back({t[0], t[1], t[2]});
+    Json shape = {{"vertices", verts}, {"triangles", tris}};
+    const std::string key = shape.dump();
+    auto it = shape_index.find(key);
+    if (it == shape_index.end()) {
+      it = shape_index.emplace(key, d["shapes"].size()).first;
+      d["shapes"].push_back(shape);
+    }
+    const Quat q = b.orientation.normalized();
+    d["bodies"].push_back({{"name", b.name}, {"shape", it->second}, {"static", b.is_static},
+                           {"position", vec_json(b.position)},
+                           {"orientation", {round_sig5(q.w()), round_sig5(q.x()), round_sig5(q.y()),
+                                            round_sig5(q.z())}}});
+  }
+  // Each backend: status, sampled trajectory, events.
+  d["backends"] = Json::object();
+  const Json& bj = result.contains("backends") ? result["backends"] : Json::object();
+  for (const auto& [name, b] : bj.items()) {
+    Json v = {{"status", b.value("status", "")}, {"message", b.value("message", "")}};
+    const Json traj = b.value("trajectory", Json::object());
+    v["time"] = traj.value("time", Json::array());
+    v["frames"] = traj.value("bodies", Json::object());
+    const Json contacts = b.value("contacts", Json::array());
+    v["events"] = events_json(contacts);
+    v["events_total"] = contacts.size();
+    d["backends"][name] = v;
+  }
+  // The reference: the closed form where the scene gives one, else the exact oracle's contacts.
+  Json ref = {{"source", ""}, {"contacts", Json::array()}, {"finals", Json::object()}};
+  if (bj.contains("exact") && scene.has_check(CheckKind::Contact)) {
+    ref["source"] = "exact";
+    ref["contacts"] = events_json(bj["exact"].value("contacts", Json::array()));
+  }
+  if (scene.expect) {
+    if (scene.expect->contact && scene.expect->contact->normal) {
+      ref["source"] = "closed form";
+      ref["normal"] = vec_json(scene.expect->contact->normal->normalized());
+      if (scene.expect->contact->depth) ref["depth"] = round_sig5(*scene.expect->contact->depth);
+      // Drawn at the exact oracle's deepest point when there is one (the closed form gives no
+      // point in most scenes).
+      for (Json& c : ref["contacts"]) c["normal"] = ref["normal"];
+    }
+    for (const ExpectBody& e : scene.expect->bodies) {
+      if (!e.velocity && !e.angular_velocity) continue;
+      ref["source"] = "closed form";
+      Json f = Json::object();
+      if (e.velocity) f["velocity"] = vec_json(*e.velocity);
+      if (e.angular_velocity) f["angular_velocity"] = vec_json(*e.angular_velocity);
+      ref["finals"][e.name] = f;
+    }
+  }
+  d["reference"] = ref;
+  return d;
+}
+
+std::string three_js_path() {
+  for (const char* p : {"/usr/share/javascript/three/three.min.js",
+                        "/usr/share/javascript/three/build/three.min.js"})
+    if (fs::exists(p)) return p;
+  throw std::runtime_error("three.js not found under /usr/share/javascript/three/ (install Debian's libjs-three)");
+}
+
+std::string view_page(const Json& data, const std::string& three_js, const std::string& three_src) {
+  const std::string title = data.value("family", "") + "/" + data.value("scene", "");
+  const Json& ref = data["reference"];
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rbx view: "
+    << html_escape(title) << "</title>\n<style>" << kStyle << "</style>\n";
+  if (!three_src.empty()) h << "<script src=\"" << html_escape(three_src) << "\"></script>\n";
+  else h << "<script>" << three_js << "</script>\n";
+  h << "</head><body>\n<header><h1>" << html_escape(title) << "</h1>\n";
+  if (!data.value("description", "").empty())
+    h << "<p>" << html_escape(data.value("description", "")) << "</p>\n";
+  h << "<p>One panel per backend, same camera (drag to orbit, wheel to zoom). Red: the backend's "
+       "contact points and normals (from B toward A) of the events near the current time"
+    << (data["duration"].get<double>() > 0 ? "" : " (contact query at t = 0)") << ". Black: the reference ("
+    << html_escape(ref.value("source", "").empty() ? "none for this scene" : ref.value("source", ""))
+    << ")";
+  if (!ref["finals"].empty()) h << "; at the end of the run, arrows give the closed-form final velocity direction";
+  h << ". Trajectories are sampled (at most " << kMaxFrames << " frames); at most " << kViewMaxEvents
+    << " events per backend are drawn.</p>\n<div id=\"controls\"><button id=\"play\">play</button> "
+       "<input id=\"slider\" type=\"range\" min=\"0\" max=\"1000\" value=\"0\"> <span id=\"clock\"></span> "
+       "<label><input id=\"ref\" type=\"checkbox\" checked> reference</label> <span id=\"toggles\"></span></div>\n"
+       "</header>\n<div id=\"stage\"><canvas id=\"view\"></canvas><div id=\"labels\"></div></div>\n"
+       "<pre id=\"rbx-state\">{}</pre>\n<script id=\"rbx-data\" type=\"application/json\">"
+    << script_safe_json(data) << "</script>\n<script>" << kScript << "</script>\n</body></html>\n";
+  return h.str();
+}
+
+void write_report_views(const std::string& dir, const std::vector<Scene>& scenes,
+                        const std::vector<SceneEvaluation>& evs) {
+  const fs::path views = fs::path(dir) / "views";
+  fs::create_directories(views);
+  fs::copy_file(three_js_path(), views / "three.min.js", fs::copy_options::overwrite_existing);
+  std::ostringstream index;
+  index << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rbx report: 3-D "
+           "replays</title></head><body>\n<h1>rbx report: 3-D replay of every scene</h1>\n"
+           "<p>Each page plays every backend's run of the scene side by side. See also "
+           "<a href=\"report.md\">report.md</a>.</p>\n<ul>\n";
+  for (size_t i = 0; i < scenes.size() && i < evs.size(); ++i) {
+    const std::string slug = scene_slug(evs[i].family, scenes[i].file);
+    write_text((views / (slug + ".html")).string(),
+               view_page(view_data(scenes[i], evs[i].json), "", "three.min.js"));
+    index << "<li><a href=\"views/" << html_escape(slug) << ".html\">"
+          << html_escape(evs[i].family + "/" + scenes[i].name) << "</a>";
+    if (!scenes[i].description.empty()) index << ": " << html_escape(scenes[i].description);
+    index << "</li>\n";
+  }
+  index << "</ul>\n</body></html>\n";
+  write_text((fs::path(dir) / "index.html").string(), index.str());
+}
+
+int view_command(const ViewOptions& opt) {
+  SceneCommandOptions so;
+  so.scenes = {opt.scene};
+  const Scene scene = load_scene_for_command(opt.scene, so);
+  HarnessOptions hopt;
+  hopt.backends = opt.backends;
+  hopt.sweep = false;
+  const SceneEvaluation ev = evaluate_scene(scene, hopt);
+  std::ifstream in(three_js_path(), std::ios::binary);
+  std::ostringstream js;
+  js << in.rdbuf();
+  const std::string out = opt.out.empty()
+                              ? ev.family + "_" + fs::path(scene.file).stem().string() + ".html"
+                              : opt.out;
+  const std::string page = view_page(view_data(scene, ev.json), js.str());
+  write_text(out, page);
+  std::cout << "view: " << out << " (" << page.size() / 1024 << " kB, "
+            << ev.json["backends"].size() << " backends)\n";
+  return 0;
+}
+
+}  // namespace rbx

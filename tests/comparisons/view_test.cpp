@@ -1,0 +1,232 @@
+// The 3-D replay page (`rbx view`): scene text is escaped, and in headless Chromium the page
+// loads every backend with its frames, draws the bodies and moves them; a deliberately broken
+// page (no bodies, a backend missing) fails the same check.
+#include "comparisons/cli/view.h"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "comparisons/eval/harness.h"
+#include "comparisons/scene/scene_file.h"
+#include "comparisons/output/scorecard.h"
+
+namespace fs = std::filesystem;
+
+namespace rbx {
+namespace {
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("rbx_view_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+// Runs a shell command, returns its exit code.
+int shell(const std::string& cmd) {
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool have_chromium() { return shell("command -v chromium > /dev/null 2>&1") == 0; }
+
+// Headless Chromium with software WebGL (no GPU on a build machine). Running as root needs
+// --no-sandbox. The virtual time budget lets the page's timers and animation frames run.
+std::string chromium(const std::string& extra, int budget_ms) {
+  return "chromium --headless --no-sandbox --disable-gpu --enable-unsafe-swiftshader "
+         "--use-angle=swiftshader --hide-scrollbars --window-size=900,800 --virtual-time-budget=" +
+         std::to_string(budget_ms) + " " + extra;
+}
+
+// The page's own state (#rbx-state) after it loaded and, with `#play`, played for a while.
+nlohmann::json page_state(const fs::path& page, const std::string& hash, int budget_ms) {
+  const fs::path dom = page.string() + ".dom";
+  shell(chromium("--dump-dom 'file://" + page.string() + hash + "'", budget_ms) + " > '" +
+        dom.string() + "' 2>/dev/null");
+  const std::string html = read_file(dom);
+  const std::string open = "<pre id=\"rbx-state\">";
+  const size_t a = html.find(open);
+  if (a == std::string::npos) return nlohmann::json();
+  const size_t b = html.find("</pre>", a);
+  std::string text = html.substr(a + open.size(), b - a - open.size());
+  // --dump-dom serialises the text with &quot; etc. only for attributes; & < > are escaped.
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"&quot;", "\""}, {"&lt;", "<"}, {"&gt;", ">"}, {"&amp;", "&"}}) {
+    for (size_t k = text.find(from); k != std::string::npos; k = text.find(from, k + 1))
+      text.replace(k, from.size(), to);
+  }
+  return nlohmann::json::parse(text, nullptr, false);
+}
+
+// Coloured pixels (bodies: saturated Okabe-Ito colours, against grey/white panels and black
+// text) below `top` in one screenshot, and pixels that differ between two screenshots there.
+// Debian's Python with PIL reads the PNGs (python3-pil, installed by ./rbx).
+std::pair<long, long> screenshot_pixels(const fs::path& a, const fs::path& b, int top) {
+  const fs::path out = a.string() + ".px";
+  const std::string py =
+      "import sys\nfrom PIL import Image\n"
+      "a=Image.open(sys.argv[1]).convert('RGB'); b=Image.open(sys.argv[2]).convert('RGB')\n"
+      "top=int(sys.argv[3]); w,h=a.size\n"
+      "pa=a.load(); pb=b.load(); col=0; diff=0\n"
+      "for y in range(top,h):\n"
+      "  for x in range(w):\n"
+      "    p=pa[x,y]; q=pb[x,y]\n"
+      "    if max(p)-min(p)>40: col+=1\n"
+      "    if max(abs(p[i]-q[i]) for i in range(3))>30: diff+=1\n"
+      "print(col, diff)\n";
+  const fs::path script = a.string() + ".py";
+  std::ofstream(script) << py;
+  if (shell("/usr/bin/python3 '" + script.string() + "' '" + a.string() + "' '" + b.string() + "' " +
+            std::to_string(top) + " > '" + out.string() + "' 2>&1") != 0)
+    return {-1, -1};
+  std::istringstream in(read_file(out));
+  long col = -1, diff = -1;
+  in >> col >> diff;
+  return {col, diff};
+}
+
+// Everything wrong with a page, judged against `expected` (the view data it should show).
+std::vector<std::string> check_page(const fs::path& page, const nlohmann::json& expected) {
+  std::vector<std::string> bad;
+  // Played from the start for 2 s of virtual time (the page plays a run in 4 s).
+  const nlohmann::json st = page_state(page, "#play", 2000);
+  if (st.is_discarded() || !st.is_object()) return {"no page state (the script did not run)"};
+  if (!st.value("loaded", false)) bad.push_back("page did not finish loading: " + st.value("error", ""));
+  if (!st.value("webgl", false)) bad.push_back("no WebGL renderer");
+  for (const auto& [name, b] : expected["backends"].items()) {
+    const size_t frames = b["time"].size();
+    if (!st["backends"].contains(name)) bad.push_back("backend " + name + " not loaded");
+    else if (st["backends"][name].value("frames", 0ul) != frames)
+      bad.push_back("backend " + name + ": " + st["backends"][name]["frames"].dump() +
+                    " frames loaded, " + std::to_string(frames) + " expected");
+  }
+  const size_t bodies = expected["bodies"].size() * expected["backends"].size();
+  if (st.value("bodies_drawn", 0ul) != bodies || bodies == 0)
+    bad.push_back("bodies drawn: " + st["bodies_drawn"].dump() + ", expected " +
+                  std::to_string(bodies) + " (one per body and backend, at least one)");
+  if (expected["duration"].get<double>() > 0 && !(st.value("time", 0.0) > 0))
+    bad.push_back("playing did not advance the time");
+  // Screenshots at the start and at the end of the run: bodies drawn, and moved.
+  const fs::path s0 = page.string() + ".0.png", s1 = page.string() + ".1.png";
+  for (const auto& [shot, hash] : {std::pair{s0, "#t=0"}, std::pair{s1, "#t=1"}})
+    shell(chromium("--screenshot='" + shot.string() + "' 'file://" + page.string() + hash + "'", 2000) +
+          " > /dev/null 2>&1");
+  const auto [coloured, moved] = screenshot_pixels(s0, s1, st.value("canvas_top", 0));
+  // A body covers thousands of pixels of a 900x800 window; an empty scene none.
+  if (coloured < 500) bad.push_back("bodies not visible in the screenshot (" + std::to_string(coloured) + " coloured pixels)");
+  // A 1 m cube moving 1.25 m in a panel changes thousands of pixels.
+  if (moved < 200) bad.push_back("bodies did not move between t = 0 and the end (" + std::to_string(moved) + " pixels differ)");
+  return bad;
+}
+
+// Evaluates a scene (no sweep) and returns its view data.
+nlohmann::json data_of(const std::string& file) {
+  const Scene scene = load_scene(std::string(RBX_SOURCE_DIR) + "/" + file);
+  HarnessOptions opt;
+  opt.sweep = false;
+  return view_data(scene, evaluate_scene(scene, opt).json);
+}
+
+std::string three_js() { return read_file(three_js_path()); }
+
+TEST(ViewPage, SceneTextIsEscapedInHtmlAndJsonAndMarkdown) {
+  const fs::path dir = temp_dir("escape");
+  const std::string evil = "</script><img src=x onerror=alert(1)> & \"'";
+  std::ofstream(dir / "evil.toml") << "name = \"" << "</script><img src=x onerror=alert(1)> & \\\"'"
+                                   << "\"\ndescription = \"<b>bold</b>\"\nchecks = [\"contact\"]\n"
+                                      "backends = [\"exact\"]\n[[body]]\nname = \"A\"\nshape = \"box\"\n"
+                                      "[[body]]\nname = \"B</script>\"\nshape = \"box\"\nposition = [0.9, 0, 0]\n";
+  const Scene scene = load_scene((dir / "evil.toml").string());
+  ASSERT_EQ(scene.name, evil);
+  HarnessOptions opt;
+  opt.sweep = false;
+  const std::string page = view_page(view_data(scene, evaluate_scene(scene, opt).json), "/*three*/");
+  // The only </script> closings are the page's own script elements.
+  size_t closings = 0;
+  for (size_t k = page.find("</script>"); k != std::string::npos; k = page.find("</script>", k + 1)) ++closings;
+  EXPECT_EQ(closings, 3u);  // three.js, the data, the page script
+  EXPECT_EQ(page.find("<img"), std::string::npos);
+  EXPECT_EQ(page.find("<b>bold"), std::string::npos);
+  EXPECT_NE(page.find("&lt;/script&gt;&lt;img"), std::string::npos);
+  EXPECT_EQ(html_escape("<a href=\"x\">&'"), "&lt;a href=&quot;x&quot;&gt;&amp;&#39;");
+  EXPECT_EQ(md_escape("a|b[c](d)*_`<x>#"), "a\\|b\\[c\\](d)\\*\\_\\`\\<x\\>\\#");
+  fs::remove_all(dir);
+}
+
+TEST(ViewPage, TrajectoriesAreSampledSoAPageStaysSmall) {
+  // 100 bodies: the frame budget keeps the page under 2 MB with three.js inlined (the
+  // report's pages of every scene, many_1000 included, are measured in the report).
+  const nlohmann::json d = data_of("scenes/many/many_100.toml");
+  const std::string page = view_page(d, three_js());
+  EXPECT_LT(page.size(), 2u << 20);
+  for (const auto& [name, b] : d["backends"].items()) {
+    EXPECT_GE(b["time"].size(), 2u) << name;
+    EXPECT_LE(b["time"].size(), 100u) << name;
+  }
+}
+
+class ViewBrowser : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!have_chromium()) GTEST_SKIP() << "chromium not installed (./rbx installs it): browser test skipped";
+  }
+};
+
+TEST_F(ViewBrowser, PlaysEveryBackendAndTheBodiesAreDrawnAndMove) {
+  const fs::path dir = temp_dir("browser");
+  const nlohmann::json d = data_of("scenes/analytic/headon_e05.toml");
+  ASSERT_GE(d["backends"].size(), 2u);
+  const fs::path page = dir / "headon_e05.html";
+  std::ofstream(page) << view_page(d, three_js());
+  const std::vector<std::string> bad = check_page(page, d);
+  for (const std::string& b : bad) ADD_FAILURE() << b;
+  fs::remove_all(dir);
+}
+
+TEST_F(ViewBrowser, FailsOnABrokenPage) {
+  const fs::path dir = temp_dir("broken");
+  const nlohmann::json d = data_of("scenes/analytic/headon_e05.toml");
+  // A page that lost a backend: judged against the data it should show.
+  nlohmann::json missing = d;
+  const std::string dropped = missing["backends"].begin().key();
+  missing["backends"].erase(dropped);
+  std::ofstream(dir / "missing.html") << view_page(missing, three_js());
+  const std::vector<std::string> bad1 = check_page(dir / "missing.html", d);
+  for (const std::string& b : bad1) std::cout << "missing-backend page: " << b << "\n";
+  ASSERT_FALSE(bad1.empty());
+  EXPECT_NE(bad1.front().find("backend " + dropped + " not loaded"), std::string::npos) << bad1.front();
+  // An empty scene: no bodies, so nothing drawn and nothing moves.
+  nlohmann::json empty = d;
+  empty["bodies"] = nlohmann::json::array();
+  empty["shapes"] = nlohmann::json::array();
+  std::ofstream(dir / "empty.html") << view_page(empty, three_js());
+  const std::vector<std::string> bad2 = check_page(dir / "empty.html", d);
+  for (const std::string& b : bad2) std::cout << "empty-scene page: " << b << "\n";
+  bool saw_bodies = false, saw_pixels = false;
+  for (const std::string& b : bad2) {
+    saw_bodies = saw_bodies || b.rfind("bodies drawn", 0) == 0;
+    saw_pixels = saw_pixels || b.rfind("bodies not visible", 0) == 0;
+  }
+  EXPECT_TRUE(saw_bodies);
+  EXPECT_TRUE(saw_pixels);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rbx
