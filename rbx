@@ -14,7 +14,7 @@ cd "$here"
 
 packages=(cmake g++ pkg-config libeigen3-dev libbullet-dev libfcl-dev libccd-dev libgtest-dev
           libbenchmark-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libmujoco-dev
-          libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib)
+          libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib libopenmpi-dev openmpi-bin)
 # `./rbx format [--check]` needs clang-format (Debian's `clang-format`, version 14 here).
 if [ "${1:-}" = "format" ]; then
   packages+=(clang-format)
