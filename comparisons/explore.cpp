@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csetjmp>
+#include <csignal>
 #include <cstdio>
 #include <sstream>
 
@@ -286,6 +288,35 @@ std::string sample_scene_text(const ContactSample& s, const std::string& header,
 
 namespace {
 
+// An abort inside a library call (a failed assertion: FCL 0.7's EPA asserts in
+// ComputeVisiblePatch on some random pairs) must not end a run of 20,000 samples. While a
+// query runs, SIGABRT jumps back to it and the query becomes that backend's error. The
+// library's state of that call is abandoned (leaked); glibc's abort() releases its own lock
+// before raising, so later aborts on any thread are caught the same way. Design note: a fork
+// per query (reference/isolate.h) would also do, at a fork per call.
+thread_local sigjmp_buf* t_abort_jump = nullptr;
+
+extern "C" void explore_on_abort(int) {
+  if (t_abort_jump) siglongjmp(*t_abort_jump, 1);
+  std::signal(SIGABRT, SIG_DFL);  // not inside a guarded query: abort as usual
+  std::raise(SIGABRT);
+}
+
+ContactRun guarded_contact(const Backend& be, const RigidBody& a, const RigidBody& b) {
+  sigjmp_buf here;
+  sigjmp_buf* outer = t_abort_jump;
+  ContactRun run;
+  if (sigsetjmp(here, 1) == 0) {
+    t_abort_jump = &here;
+    run = run_contact(be, a, b);
+  } else {
+    run = ContactRun{};
+    run.result = {Status::Error, be.name + " aborted inside the library (SIGABRT, a failed assertion)", {}};
+  }
+  t_abort_jump = outer;
+  return run;
+}
+
 // Below this many body sizes of depth or gap, touching or not is round-off: a stated tolerance
 // of the iterative references (FCL's 1e-6 m distance tolerance is far larger; the exact oracle's
 // depth carries about 1e-15 relative error), so a touching mismatch inside it is not counted.
@@ -305,7 +336,7 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
   for (const std::string& name : names) {
     const Backend* be = find_backend(name);
     if (!be || !be->contact) continue;
-    const ContactRun run = run_contact(*be, a, b);
+    const ContactRun run = guarded_contact(*be, a, b);
     if (run.result.status == Status::Unsupported) continue;
     BackendOutcome o;
     o.backend = name;
@@ -352,6 +383,26 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
 }
 
 }  // namespace
+
+AbortGuard::AbortGuard() { previous_ = reinterpret_cast<void*>(std::signal(SIGABRT, explore_on_abort)); }
+
+AbortGuard::~AbortGuard() {
+  std::signal(SIGABRT, reinterpret_cast<void (*)(int)>(previous_));
+}
+
+bool AbortGuard::run(const std::function<void()>& f) {
+  sigjmp_buf here;
+  sigjmp_buf* outer = t_abort_jump;
+  bool ok = true;
+  if (sigsetjmp(here, 1) == 0) {
+    t_abort_jump = &here;
+    f();
+  } else {
+    ok = false;
+  }
+  t_abort_jump = outer;
+  return ok;
+}
 
 SampleOutcome evaluate_contact_sample(const ContactSample& s,
                                       const std::vector<std::string>& names) {
