@@ -229,7 +229,7 @@ std::string markdown(const Json& j, bool have_figure) {
   for (const auto& [name, b] : j["backends"].items())
     for (const Json& x : b["groups"])
       g.add({name, x["signature"], std::to_string(x["count"].get<long>()), fmt_num(x["rate"], 3),
-             x.value("scene", std::string("-")),
+             x["scene"].is_string() ? x["scene"].get<std::string>() : std::string("-"),
              std::to_string(x.value("points_before", 0)) + " -> " + std::to_string(x.value("points_after", 0)),
              x.value("reproduced", false) ? "yes" : "no"});
   o << g.markdown();
