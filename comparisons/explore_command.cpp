@@ -94,7 +94,13 @@ std::string expect_block(const std::string& text) {
 
 std::string describe(const BackendOutcome& b) {
   std::ostringstream o;
-  if (b.error == "error") return "status error: " + b.message;
+  if (b.error == "error") {
+    // One line: the message goes into a scene file's comment.
+    std::string m = b.message;
+    std::replace(m.begin(), m.end(), '\n', ' ');
+    std::replace(m.begin(), m.end(), '\r', ' ');
+    return "status error: " + m;
+  }
   if (b.error == "misses") return "misses a contact";
   if (b.error == "false_contact") return "reports a contact where there is none";
   o << "normal off by " << fmt_num(b.normal_err_deg, 3) << " deg, depth off by "
