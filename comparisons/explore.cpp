@@ -5,6 +5,7 @@
 #include <csetjmp>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "comparisons/contact_eval.h"
@@ -237,8 +238,12 @@ ContactSample make_contact_sample(uint64_t seed, uint64_t index) {
 namespace {
 
 std::string num(double x) {
+  // The shortest text that reads back as the same double (at most 17 significant digits).
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
   std::string s = buf;
   // TOML floats need a '.' or an exponent to read back as floats everywhere; integers are fine
   // as vector components, but keep the text uniform.
@@ -460,9 +465,15 @@ Vec3 euler_deg(const Quat& q) {
   return Vec3(zyx[2], zyx[1], zyx[0]) * (180.0 / M_PI);
 }
 
+// Each coordinate to the nearest multiple of grid, as the decimal number a reader would write
+// (3 * 0.1 is 0.30000000000000004; its 12-digit text reads back as 0.3).
 Vec3 round_to(const Vec3& v, double grid) {
-  return Vec3(std::round(v.x() / grid) * grid, std::round(v.y() / grid) * grid,
-              std::round(v.z() / grid) * grid);
+  auto one = [grid](double x) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.12g", std::round(x / grid) * grid);
+    return std::strtod(buf, nullptr);
+  };
+  return Vec3(one(v.x()), one(v.y()), one(v.z()));
 }
 
 int point_count(const ContactSample& s) {
