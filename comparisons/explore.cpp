@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <sstream>
 
 #include "comparisons/contact_eval.h"
@@ -242,7 +243,9 @@ std::string num(double x) {
   char buf[40];
   for (int digits = 1; digits <= 17; ++digits) {
     std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-    if (std::strtod(buf, nullptr) == x) break;
+    // Plain decimals for ordinary magnitudes ("90.0", not "9e+01").
+    const bool plain = std::abs(x) < 1e-5 || std::abs(x) >= 1e15 || !std::strchr(buf, 'e');
+    if (plain && std::strtod(buf, nullptr) == x) break;
   }
   std::string s = buf;
   // TOML floats need a '.' or an exponent to read back as floats everywhere; integers are fine
