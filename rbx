@@ -15,7 +15,7 @@ cd "$here"
 packages=(cmake g++ pkg-config libeigen3-dev libbullet-dev libfcl-dev libccd-dev libgtest-dev
           libbenchmark-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libmujoco-dev
           libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib zlib1g-dev
-          libjs-three chromium python3-pil)
+          libjs-three chromium python3-pil libopenmpi-dev openmpi-bin)
 # libjs-three: three.js for the replay pages (`rbx view`, report views/); chromium and python3-pil:
 # the browser test of those pages (headless screenshots read with PIL).
 # `./rbx format [--check]` needs clang-format (Debian's `clang-format`, version 14 here).

@@ -76,3 +76,26 @@ struct BenchOptions {
 int bench_command(const BenchOptions& opt);
 
 }  // namespace rbx
+
+namespace rbx {
+
+/// Options of `rbx explore`.
+struct ExploreOptions {
+  long count = 20000;         // samples
+  unsigned long long seed = 1;  // sample k of seed s depends on (s, k) only
+  std::string kind = "contact";  // contact | impact
+  std::string backends;       // --backends LIST ("" : every contact backend but exact)
+  std::string out;            // output folder ("" : reports/explore)
+  std::string baseline;       // --baseline FILE: exit 1 when a backend got worse
+  int threads = 0;            // per rank (0: the cores of the node, divided among its ranks)
+  int shrink_budget = 400;    // predicate evaluations per group
+  bool bench = false;         // --bench: throughput of the sampling only, hulls under 100 points
+  bool no_figure = false;     // --no-figure: skip matplotlib (tests)
+};
+
+/// `rbx explore`: random contact pairs against the exact oracle on every core or MPI rank;
+/// disagreements grouped by signature, each group shrunk to a scene; writes explore.json,
+/// explore.md and scenes/*.toml. Exit 1 when --baseline finds a backend worse.
+int explore_command(const ExploreOptions& opt);
+
+}  // namespace rbx

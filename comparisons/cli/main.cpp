@@ -76,6 +76,19 @@ int main(int argc, char** argv) {
   view->add_option("--backends", view_opt.backends, "comma-separated backend names");
   view->add_option("--out", view_opt.out, "output HTML file (default: FAMILY_STEM.html)");
 
+  rbx::ExploreOptions explore_opt;
+  CLI::App* explore = app.add_subcommand("explore", "random contact pairs against the exact oracle; disagreements shrunk to scenes");
+  explore->add_option("--count", explore_opt.count, "number of samples (default 20000)");
+  explore->add_option("--seed", explore_opt.seed, "seed (default 1)");
+  explore->add_option("--kind", explore_opt.kind, "contact | impact");
+  explore->add_option("--backends", explore_opt.backends, "comma-separated backend names");
+  explore->add_option("--out", explore_opt.out, "output folder (default reports/explore)");
+  explore->add_option("--baseline", explore_opt.baseline, "stored explore.json: exit 1 when a backend got worse");
+  explore->add_option("--threads", explore_opt.threads, "threads per rank (default: every core)");
+  explore->add_option("--shrink-budget", explore_opt.shrink_budget, "evaluations per group while shrinking");
+  explore->add_flag("--bench", explore_opt.bench, "time the sampling only (hulls under 100 points)");
+  explore->add_flag("--no-figure", explore_opt.no_figure, "skip the matplotlib figure");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -97,6 +110,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("bench")) return rbx::bench_command(bench_opt);
     if (app.got_subcommand("tosses")) return rbx::tosses_command(tosses_opt);
     if (app.got_subcommand("view")) return rbx::view_command(view_opt);
+    if (app.got_subcommand("explore")) return rbx::explore_command(explore_opt);
   } catch (const rbx::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;

@@ -1,0 +1,647 @@
+#include "comparisons/eval/explore.h"
+
+#include <algorithm>
+#include <cmath>
+#include <csetjmp>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+
+#include "comparisons/eval/contact_eval.h"
+#include "comparisons/eval/harness.h"
+#include "comparisons/scene/mesh_io.h"
+#include "comparisons/eval/metrics.h"
+#include "comparisons/scene/scene_file.h"
+#include "engine/body.h"
+#include "engine/bounding.h"
+#include "engine/detect.h"
+#include "reference/exact.h"
+
+namespace rbx {
+
+// ---------------------------------------------------------------------------------------------
+// Random numbers
+
+namespace {
+
+uint64_t splitmix64(uint64_t& x) {
+  uint64_t z = (x += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+SampleRng::SampleRng(uint64_t seed, uint64_t index) {
+  // Hash of (seed, index): two rounds of splitmix64 mix the pair into one well-spread state.
+  uint64_t s = seed;
+  const uint64_t h = splitmix64(s);
+  uint64_t t = h ^ (index * 0xD1B54A32D192ED03ull);
+  state_ = splitmix64(t);
+}
+
+uint64_t SampleRng::next() { return splitmix64(state_); }
+
+double SampleRng::uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+
+int SampleRng::integer(int lo, int hi) {
+  return lo + static_cast<int>(next() % static_cast<uint64_t>(hi - lo + 1));
+}
+
+Vec3 SampleRng::direction() {
+  const double z = uniform(-1.0, 1.0), phi = uniform(0.0, 2.0 * M_PI);
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+Quat SampleRng::rotation() {
+  const double u1 = uniform(), u2 = uniform(0.0, 2.0 * M_PI), u3 = uniform(0.0, 2.0 * M_PI);
+  const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
+  return Quat(a * std::sin(u2), a * std::cos(u2), b * std::sin(u3), b * std::cos(u3)).normalized();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Samples
+
+namespace {
+
+// The body's shape exactly as the scene loader builds it (box or convex hull of the points).
+std::shared_ptr<const ConvexPolyhedron> build_shape(const ExploreBody& e) {
+  if (e.shape_class == "box") return std::make_shared<const ConvexPolyhedron>(make_box(e.box_size));
+  return std::make_shared<const ConvexPolyhedron>(convex_hull(e.points));
+}
+
+// Orientation exactly as the scene loader builds it from what sample_scene_text writes.
+Quat build_orientation(const ExploreBody& e) {
+  if (e.use_degrees) return Quat(rotation_from_euler_deg(e.rotation_deg)).normalized();
+  return e.orientation.normalized();
+}
+
+RigidBody build_body(const ExploreBody& e, const std::string& name) {
+  BodySpec spec;
+  spec.name = name;
+  spec.shape_kind = e.shape_class == "box" ? ShapeKind::Box : ShapeKind::Convex;
+  spec.box_size = e.box_size;
+  spec.shape = build_shape(e);
+  spec.position = e.position;
+  spec.orientation = build_orientation(e);
+  return make_body(spec);
+}
+
+// Furthest extent of a placed shape along the unit direction n, from its local origin (m).
+double support(const ConvexPolyhedron& shape, const Quat& q, const Vec3& n) {
+  const Vec3 local = q.conjugate() * n;
+  double best = -1e300;
+  for (const Vec3& v : shape.vertices()) best = std::max(best, v.dot(local));
+  return best;
+}
+
+// Random points of a hull: on a sphere, on an ellipsoid, or in a cube.
+std::vector<Vec3> hull_points(SampleRng& r, int n, double scale) {
+  const int style = r.integer(0, 2);
+  Vec3 axes = Vec3::Ones();
+  if (style == 1) axes = Vec3(r.uniform(0.3, 1.0), r.uniform(0.3, 1.0), r.uniform(0.3, 1.0));
+  std::vector<Vec3> p;
+  for (int i = 0; i < n; ++i) {
+    if (style == 2)
+      p.push_back(0.5 * scale * Vec3(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1)));
+    else
+      p.push_back(0.5 * scale * r.direction().cwiseProduct(axes));
+  }
+  return p;
+}
+
+// A random body of roughly `scale` metres: a box, a hull of 4 to 2000 points, or a sliver.
+ExploreBody random_body(SampleRng& r, double scale) {
+  ExploreBody e;
+  const double u = r.uniform();
+  if (u < 0.4) {
+    e.shape_class = "box";
+    for (int k = 0; k < 3; ++k) e.box_size[k] = scale * std::pow(10.0, r.uniform(-0.5, 0.5));
+  } else if (u < 0.85) {
+    e.shape_class = "hull";
+    // Mostly small hulls (the speed goal is set on under 100 vertices), a few up to 2000.
+    const double v = r.uniform();
+    const int n = v < 0.7 ? r.integer(4, 32)
+                  : v < 0.97 ? r.integer(33, 99)
+                             : static_cast<int>(std::round(std::pow(10.0, r.uniform(2.0, 3.30103))));
+    e.points = hull_points(r, n, scale);
+  } else {
+    e.shape_class = "sliver";
+    e.points = hull_points(r, r.integer(4, 10), scale);
+    // Flat (one thin axis) or a needle (two), thickness 1e-3 to 3e-2 of the length.
+    const double thin = std::pow(10.0, r.uniform(-3.0, -1.5));
+    const int first = r.integer(0, 2);
+    const bool needle = r.uniform() < 0.3;
+    for (Vec3& p : e.points) {
+      p[first] *= thin;
+      if (needle) p[(first + 1) % 3] *= thin;
+    }
+  }
+  return e;
+}
+
+double extent(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
+
+}  // namespace
+
+ContactSample make_contact_sample(uint64_t seed, uint64_t index) {
+  SampleRng r(seed, index);
+  ContactSample s;
+  s.seed = seed;
+  s.index = index;
+  // Sizes: mostly comparable, else a ratio up to 1e3 either way.
+  const double scale_a = std::pow(10.0, r.uniform(-0.3, 0.3));
+  double scale_b = std::pow(10.0, r.uniform(-0.3, 0.3));
+  if (r.uniform() < 0.4) scale_b = scale_a * std::pow(10.0, r.uniform(-3.0, -0.5));
+  const bool small_first = r.uniform() < 0.5;
+  s.a = random_body(r, small_first ? scale_b : scale_a);
+  s.b = random_body(r, small_first ? scale_a : scale_b);
+  s.a.orientation = r.rotation();
+  s.b.orientation = r.rotation();
+  s.a.position = Vec3(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1));
+
+  const auto shape_a = build_shape(s.a), shape_b = build_shape(s.b);
+  const double small = std::min(extent(*shape_a), extent(*shape_b));
+  // B is placed so that the projections of A and B on n overlap by `overlap` (negative: a gap),
+  // plus a sideways offset; n points from A toward B.
+  Vec3 n = r.direction();
+  double overlap = 0.0, sideways = r.uniform(0.0, 0.3) * small;
+  const double u = r.uniform();
+  if (u < 0.2) {
+    s.pose_class = "touching";
+    if (r.uniform() < 0.5) {
+      const auto& planes = shape_a->planes();
+      n = s.a.orientation * planes[r.integer(0, static_cast<int>(planes.size()) - 1)].normal;
+    }
+  } else if (u < 0.33) {
+    s.pose_class = "separated";
+    overlap = -std::pow(10.0, r.uniform(-6.0, -2.0)) * small;
+  } else if (u < 0.46) {
+    s.pose_class = "deep";
+    overlap = r.uniform(0.1, 1.0) * small;
+  } else if (u < 0.64) {
+    // Near a face diagonal: the smaller body pushed in around a corner of the larger one,
+    // along the direction from the larger one's origin through that corner (FCL issue 545).
+    s.pose_class = "diagonal";
+    const bool a_big = extent(*shape_a) >= extent(*shape_b);
+    const ConvexPolyhedron& big = a_big ? *shape_a : *shape_b;
+    const Quat& q = a_big ? s.a.orientation : s.b.orientation;
+    const Vec3 corner = big.vertices()[r.integer(0, static_cast<int>(big.vertices().size()) - 1)];
+    n = (q * corner.normalized() + 0.02 * r.direction()).normalized();
+    if (!a_big) n = -n;
+    overlap = r.uniform(0.3, 1.5) * small;
+    sideways = r.uniform(0.0, 0.05) * small;
+  } else if (u < 0.80) {
+    // Nearly parallel faces: a face of B turned to face one of A's, then tilted slightly.
+    s.pose_class = "parallel";
+    const auto& pa = shape_a->planes();
+    const auto& pb = shape_b->planes();
+    n = s.a.orientation * pa[r.integer(0, static_cast<int>(pa.size()) - 1)].normal;
+    const Vec3 mb = pb[r.integer(0, static_cast<int>(pb.size()) - 1)].normal;
+    const Quat align = Quat::FromTwoVectors(mb, -n);
+    const Quat spin(Eigen::AngleAxisd(r.uniform(0.0, 2.0 * M_PI), n));
+    Vec3 axis = n.cross(r.direction());
+    if (axis.norm() < 1e-6) axis = n.unitOrthogonal();
+    const Quat tilt(Eigen::AngleAxisd(std::pow(10.0, r.uniform(-5.0, -1.5)), axis.normalized()));
+    s.b.orientation = (tilt * spin * align).normalized();
+    overlap = std::pow(10.0, r.uniform(-4.0, -1.0)) * small;
+  } else if (u < 0.90) {
+    // Edge on edge: n across one edge of A and one of B.
+    s.pose_class = "edge_edge";
+    const auto& ea = shape_a->edges()[r.integer(0, static_cast<int>(shape_a->edges().size()) - 1)];
+    const auto& eb = shape_b->edges()[r.integer(0, static_cast<int>(shape_b->edges().size()) - 1)];
+    const Vec3 da = s.a.orientation * (shape_a->vertices()[ea.b] - shape_a->vertices()[ea.a]);
+    const Vec3 db = s.b.orientation * (shape_b->vertices()[eb.b] - shape_b->vertices()[eb.a]);
+    const Vec3 c = da.cross(db);
+    if (c.norm() > 1e-9 * da.norm() * db.norm()) n = c.normalized() * (r.uniform() < 0.5 ? 1 : -1);
+    overlap = std::pow(10.0, r.uniform(-4.0, -1.5)) * small;
+    sideways = r.uniform(0.0, 0.1) * small;
+  } else {
+    s.pose_class = "random";
+    overlap = r.uniform(-0.1, 0.5) * small;
+  }
+  // Where A's and B's shapes are placed: shape frames are the scene's local frames (their
+  // origins are what `position` places), so supports are measured from those origins.
+  const double reach = support(*shape_a, s.a.orientation, n) + support(*shape_b, s.b.orientation, -n);
+  Vec3 side = n.cross(r.direction());
+  side = side.norm() > 1e-9 ? side.normalized() : Vec3::Zero();
+  s.b.position = s.a.position + (reach - overlap) * n + sideways * side;
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene text
+
+namespace {
+
+std::string num(double x) {
+  // The shortest text that reads back as the same double (at most 17 significant digits).
+  char buf[40];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+    // Plain decimals for ordinary magnitudes ("90.0", not "9e+01").
+    const bool plain = std::abs(x) < 1e-5 || std::abs(x) >= 1e15 || !std::strchr(buf, 'e');
+    if (plain && std::strtod(buf, nullptr) == x) break;
+  }
+  std::string s = buf;
+  // TOML floats need a '.' or an exponent to read back as floats everywhere; integers are fine
+  // as vector components, but keep the text uniform.
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string vec(const Vec3& v) { return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]"; }
+
+std::string body_text(const ExploreBody& e, const std::string& name) {
+  std::ostringstream o;
+  o << "[[body]]\nname = \"" << name << "\"\n";
+  if (e.shape_class == "box") {
+    o << "shape = \"box\"\nsize = " << vec(e.box_size) << "\n";
+  } else {
+    o << "shape = \"convex\"  # " << e.shape_class << ", " << e.points.size() << " points\n";
+    o << "vertices = [";
+    for (size_t i = 0; i < e.points.size(); ++i)
+      o << (i ? ",\n            " : "") << vec(e.points[i]);
+    o << "]\n";
+  }
+  o << "position = " << vec(e.position) << "\n";
+  if (e.use_degrees)
+    o << "rotation = " << vec(e.rotation_deg) << "\n";
+  else
+    o << "orientation = [" << num(e.orientation.w()) << ", " << num(e.orientation.x()) << ", "
+      << num(e.orientation.y()) << ", " << num(e.orientation.z()) << "]\n";
+  return o.str();
+}
+
+}  // namespace
+
+std::string sample_scene_text(const ContactSample& s, const std::string& header,
+                              const std::string& expect) {
+  std::ostringstream o;
+  o << header;
+  o << "description = \"rbx explore seed " << s.seed << " sample " << s.index << " ("
+    << s.pose_class << "), shrunk\"\n";
+  o << "checks = [\"contact\"]\n\n[sim]\nduration = 0\n\n";
+  o << body_text(s.a, "A") << "\n" << body_text(s.b, "B");
+  if (!expect.empty()) o << "\n" << expect;
+  return o.str();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Evaluation
+
+namespace {
+
+// An abort inside a library call (a failed assertion: FCL 0.7's EPA asserts in
+// ComputeVisiblePatch on some random pairs) must not end a run of 20,000 samples. While a
+// query runs, SIGABRT jumps back to it and the query becomes that backend's error. The
+// library's state of that call is abandoned (leaked); glibc's abort() releases its own lock
+// before raising, so later aborts on any thread are caught the same way. Design note: a fork
+// per query (reference/isolate.h) would also do, at a fork per call.
+thread_local sigjmp_buf* t_abort_jump = nullptr;
+
+extern "C" void explore_on_abort(int) {
+  if (t_abort_jump) siglongjmp(*t_abort_jump, 1);
+  std::signal(SIGABRT, SIG_DFL);  // not inside a guarded query: abort as usual
+  std::raise(SIGABRT);
+}
+
+ContactRun guarded_contact(const Backend& be, const RigidBody& a, const RigidBody& b) {
+  sigjmp_buf here;
+  sigjmp_buf* outer = t_abort_jump;
+  ContactRun run;
+  if (sigsetjmp(here, 1) == 0) {
+    t_abort_jump = &here;
+    run = run_contact(be, a, b);
+  } else {
+    run = ContactRun{};
+    run.result = {Status::Error, be.name + " aborted inside the library (SIGABRT, a failed assertion)", {}};
+  }
+  t_abort_jump = outer;
+  return run;
+}
+
+// Below this many body sizes of depth or gap, touching or not is round-off: a stated tolerance
+// of the iterative references (FCL's 1e-6 m distance tolerance is far larger; the exact oracle's
+// depth carries about 1e-15 relative error), so a touching mismatch inside it is not counted.
+constexpr double kTouchBand = 1e-9;
+
+SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
+                              const std::vector<std::string>& names, const std::string& shapes) {
+  SampleOutcome out;
+  out.shapes = shapes;
+  const SatResult sat = sat_query(*a.shape, a.pose(), *b.shape, b.pose());
+  const double size =
+      std::min(2.0 * bounding_sphere(a).radius, 2.0 * bounding_sphere(b).radius);
+  out.touching = sat.touching;
+  out.depth_rel = sat.depth / size;
+  out.feature = sat.touching ? sat.axis_kind : "separated";
+  const double band = kTouchBand * size, true_depth = std::max(sat.depth, 0.0);
+  for (const std::string& name : names) {
+    const Backend* be = find_backend(name);
+    if (!be || !be->contact) continue;
+    const ContactRun run = guarded_contact(*be, a, b);
+    if (run.result.status == Status::Unsupported) continue;
+    BackendOutcome o;
+    o.backend = name;
+    if (run.result.status == Status::Error) {
+      o.error = "error";
+      o.message = run.result.message;
+      out.backends.push_back(o);
+      continue;
+    }
+    const ContactPoint* c = deepest(run.result);
+    const bool touch = c != nullptr;
+    if (touch != sat.touching) {
+      if (sat.touching && sat.depth > band) o.error = "misses";
+      if (!sat.touching && sat.depth < -band) o.error = "false_contact";
+      out.backends.push_back(o);
+      continue;
+    }
+    if (!touch) {
+      out.backends.push_back(o);
+      continue;
+    }
+    // The harness's rule for ties: a normal along which the overlap equals the true depth
+    // (within round-off, 1e-12 of the body size) is as right as the oracle's.
+    double angle = angle_deg(c->normal, sat.normal);
+    if (angle > 0 && c->normal.allFinite() && c->normal.norm() > 0.5 &&
+        std::abs(overlap_along(*a.shape, a.pose(), *b.shape, b.pose(), c->normal.normalized()) -
+                 true_depth) <= 1e-12 * size)
+      angle = 0.0;
+    o.measured = true;
+    o.normal_err_deg = angle;
+    o.depth_err_rel = std::abs(c->depth - true_depth) / size;
+    o.point_err_rel =
+        sat.manifold.empty() ? 0.0 : contact_point_error(c->point, a, b, sat.manifold) / size;
+    // Clear disagreements, by the harness's marks (harness.h): 1 degree, 1 % of the size.
+    if (!(angle <= kMarkAngleDeg))
+      o.error = "normal";
+    else if (!(o.depth_err_rel <= kMarkDepthRel))
+      o.error = "depth";
+    else if (!(o.point_err_rel <= kMarkDepthRel))
+      o.error = "point";
+    out.backends.push_back(o);
+  }
+  return out;
+}
+
+}  // namespace
+
+AbortGuard::AbortGuard() { previous_ = reinterpret_cast<void*>(std::signal(SIGABRT, explore_on_abort)); }
+
+AbortGuard::~AbortGuard() {
+  std::signal(SIGABRT, reinterpret_cast<void (*)(int)>(previous_));
+}
+
+bool AbortGuard::run(const std::function<void()>& f) {
+  sigjmp_buf here;
+  sigjmp_buf* outer = t_abort_jump;
+  bool ok = true;
+  if (sigsetjmp(here, 1) == 0) {
+    t_abort_jump = &here;
+    f();
+  } else {
+    ok = false;
+  }
+  t_abort_jump = outer;
+  return ok;
+}
+
+SampleOutcome evaluate_contact_sample(const ContactSample& s,
+                                      const std::vector<std::string>& names) {
+  const RigidBody a = build_body(s.a, "A"), b = build_body(s.b, "B");
+  SampleOutcome out = evaluate_bodies(a, b, names, s.a.shape_class + "-" + s.b.shape_class);
+  out.index = s.index;
+  out.pose_class = s.pose_class;
+  return out;
+}
+
+SampleOutcome evaluate_scene_text(const std::string& text, const std::vector<std::string>& names,
+                                  const std::string& pose_class, const std::string& shapes) {
+  const Scene scene = parse_scene(text, "explore.toml");
+  const std::vector<RigidBody> bodies = make_bodies(scene);
+  SampleOutcome out = evaluate_bodies(bodies[0], bodies[1], names, shapes);
+  out.pose_class = pose_class;
+  return out;
+}
+
+std::string signature(const SampleOutcome& s, const BackendOutcome& b) {
+  return b.backend + " " + s.shapes + " " + s.feature + " " + b.error;
+}
+
+std::string encode(const SampleOutcome& s) {
+  Json j = {{"i", s.index}, {"p", s.pose_class}, {"s", s.shapes}, {"f", s.feature},
+            {"t", s.touching}, {"d", s.depth_rel}, {"b", Json::array()}};
+  for (const BackendOutcome& b : s.backends)
+    j["b"].push_back({b.backend, b.error, b.measured, b.normal_err_deg, b.depth_err_rel,
+                      b.point_err_rel, b.message});
+  return j.dump();
+}
+
+SampleOutcome decode(const std::string& text) {
+  const Json j = Json::parse(text);
+  SampleOutcome s;
+  s.index = j["i"].get<uint64_t>();
+  s.pose_class = j["p"];
+  s.shapes = j["s"];
+  s.feature = j["f"];
+  s.touching = j["t"];
+  s.depth_rel = j["d"];
+  for (const Json& b : j["b"])
+    s.backends.push_back({b[0], b[1], b[2], b[3], b[4], b[5], b[6]});
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shrinking
+
+namespace {
+
+// Euler angles (degrees, R = Rz Ry Rx as the scene format) of a rotation.
+Vec3 euler_deg(const Quat& q) {
+  const Vec3 zyx = q.toRotationMatrix().eulerAngles(2, 1, 0);
+  return Vec3(zyx[2], zyx[1], zyx[0]) * (180.0 / M_PI);
+}
+
+// Each coordinate to the nearest multiple of grid, as the decimal number a reader would write
+// (3 * 0.1 is 0.30000000000000004; its 12-digit text reads back as 0.3).
+Vec3 round_to(const Vec3& v, double grid) {
+  auto one = [grid](double x) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.12g", std::round(x / grid) * grid);
+    return std::strtod(buf, nullptr);
+  };
+  return Vec3(one(v.x()), one(v.y()), one(v.z()));
+}
+
+int point_count(const ContactSample& s) {
+  auto n = [](const ExploreBody& e) {
+    return e.shape_class == "box" ? 8 : static_cast<int>(e.points.size());
+  };
+  return n(s.a) + n(s.b);
+}
+
+}  // namespace
+
+ShrinkResult shrink(const ContactSample& start, const std::string& backend, const std::string& sig,
+                    int max_evaluations) {
+  ShrinkResult r;
+  r.sample = start;
+  r.vertices_before = point_count(start);
+  const std::vector<std::string> names = {backend};
+  // Keeps candidate c when its scene text still shows the same signature.
+  auto keeps = [&](const ContactSample& c, SampleOutcome* out = nullptr) {
+    if (r.evaluations >= max_evaluations) return false;
+    ++r.evaluations;
+    try {
+      const SampleOutcome o = evaluate_scene_text(sample_scene_text(c), names, c.pose_class,
+                                                    c.a.shape_class + "-" + c.b.shape_class);
+      for (const BackendOutcome& b : o.backends)
+        if (!b.error.empty() && signature(o, b) == sig) {
+          if (out) *out = o;
+          return true;
+        }
+    } catch (const std::exception&) {
+      // A candidate the loader rejects (a flat hull, say) is simply not simpler.
+    }
+    return false;
+  };
+  auto accept = [&](const ContactSample& c) {
+    if (!keeps(c)) return false;
+    r.sample = c;
+    ++r.steps_accepted;
+    return true;
+  };
+
+  // 1. Fewer points: only the hull's own vertices, then drop chunks of points (halves first).
+  for (ExploreBody ContactSample::*body : {&ContactSample::a, &ContactSample::b}) {
+    if ((r.sample.*body).shape_class == "box") continue;
+    ContactSample c = r.sample;
+    try {
+      (c.*body).points = convex_hull((c.*body).points).vertices();
+      if ((c.*body).points.size() < (r.sample.*body).points.size()) accept(c);
+    } catch (const std::exception&) {
+    }
+    for (size_t chunk = (r.sample.*body).points.size() / 2; chunk >= 1; chunk /= 2) {
+      for (size_t at = 0; at < (r.sample.*body).points.size() && (r.sample.*body).points.size() > 4;) {
+        ContactSample d = r.sample;
+        auto& p = (d.*body).points;
+        const size_t end = std::min(at + chunk, p.size());
+        if (p.size() - (end - at) < 4) break;
+        p.erase(p.begin() + at, p.begin() + end);
+        if (!accept(d)) at += chunk;
+      }
+      if (r.evaluations >= max_evaluations) break;
+    }
+  }
+  // 2. A at the origin.
+  {
+    ContactSample c = r.sample;
+    c.b.position -= c.a.position;
+    c.a.position = Vec3::Zero();
+    accept(c);
+  }
+  // 3. Rotations toward axis-aligned: none, then Euler angles rounded, coarsest grid first.
+  const double grids_deg[] = {90, 45, 15, 5, 1, 0.1, 0.01, 0.001};
+  for (ExploreBody ContactSample::*body : {&ContactSample::a, &ContactSample::b}) {
+    ContactSample c = r.sample;
+    (c.*body).use_degrees = true;
+    (c.*body).rotation_deg = Vec3::Zero();
+    if (accept(c)) continue;
+    const Vec3 deg = euler_deg(build_orientation(r.sample.*body));
+    for (double g : grids_deg) {
+      ContactSample d = r.sample;
+      (d.*body).use_degrees = true;
+      (d.*body).rotation_deg = round_to(deg, g);
+      if (accept(d)) break;
+    }
+  }
+  // 4. Rounder positions, sizes and points, on grids relative to the smaller body's extent.
+  const double small = std::min(extent(*build_shape(r.sample.a)), extent(*build_shape(r.sample.b)));
+  const double unit = std::pow(10.0, std::floor(std::log10(small)));
+  const double grids[] = {1, 0.5, 0.1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6};
+  for (ExploreBody ContactSample::*body : {&ContactSample::a, &ContactSample::b}) {
+    for (double g : grids) {
+      ContactSample d = r.sample;
+      (d.*body).position = round_to((d.*body).position, g * unit);
+      if ((d.*body).position == (r.sample.*body).position || accept(d)) break;
+    }
+    for (double g : grids) {
+      ContactSample d = r.sample;
+      ExploreBody& e = d.*body;
+      if (e.shape_class == "box") {
+        e.box_size = round_to(e.box_size, g * unit);
+        if (e.box_size.minCoeff() <= 0) continue;
+      } else {
+        for (Vec3& p : e.points) p = round_to(p, g * unit);
+      }
+      if (accept(d)) break;
+    }
+  }
+  r.vertices_after = point_count(r.sample);
+  if (!keeps(r.sample, &r.outcome)) {
+    // The budget ran out before the final check: evaluate once more regardless of the budget.
+    ++max_evaluations;
+    keeps(r.sample, &r.outcome);
+  }
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reproduction through the harness
+
+bool harness_reproduces(const std::string& scene_text, const std::string& path,
+                        const BackendOutcome& b, std::string* detail) {
+  const Scene scene = parse_scene(scene_text, path);
+  HarnessOptions hopt;
+  hopt.backends = b.backend;
+  hopt.sweep = false;
+  hopt.timing_budget_s = 0.0;  // one query each: no timing repeats
+  const SceneEvaluation ev = evaluate_scene(scene, hopt);
+  const std::vector<RigidBody> bodies = make_bodies(scene);
+  const double size = std::min(2.0 * bounding_sphere(bodies[0]).radius,
+                               2.0 * bounding_sphere(bodies[1]).radius);
+  auto metric = [&](const std::string& name) -> double {
+    for (const Metric& m : ev.metrics)
+      if (m.backend == b.backend && m.name == name) return m.value;
+    return -1.0;
+  };
+  auto said = [&](const std::string& what) {
+    for (const std::string& s : ev.disagreements)
+      if (s.rfind(b.backend + " on ", 0) == 0 && s.find(what) != std::string::npos) return true;
+    return false;
+  };
+  const std::string status = ev.json["backends"].contains(b.backend)
+                                 ? ev.json["backends"][b.backend]["status"].get<std::string>()
+                                 : "missing";
+  bool ok = false;
+  std::ostringstream d;
+  if (b.error == "error") {
+    ok = status == "error";
+    d << "status " << status;
+  } else if (b.error == "misses") {
+    ok = said("misses a contact");
+    d << (ok ? "misses a contact" : "no missed contact");
+  } else if (b.error == "false_contact") {
+    ok = said("reports a contact where there is none");
+    d << (ok ? "reports a contact where there is none" : "no false contact");
+  } else if (b.error == "normal") {
+    ok = metric("normal_err_deg") > kMarkAngleDeg;
+    d << "normal_err_deg " << metric("normal_err_deg");
+  } else if (b.error == "depth") {
+    ok = metric("depth_err") > kMarkDepthRel * size;
+    d << "depth_err " << metric("depth_err") << " m (size " << size << " m)";
+  } else if (b.error == "point") {
+    ok = metric("point_err_rel") > kMarkDepthRel;
+    d << "point_err_rel " << metric("point_err_rel");
+  }
+  if (detail) *detail = d.str();
+  return ok;
+}
+
+}  // namespace rbx

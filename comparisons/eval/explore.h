@@ -1,0 +1,150 @@
+// `rbx explore`: random contact pairs checked against the exact oracle, disagreements grouped by
+// signature and each group shrunk to a simple scene.
+//
+// Sample k of seed s is a pure function of (s, k): its generator is seeded from a hash of the
+// two (a counter-based stream, as in Salmon et al. 2011), so any sample can be regenerated
+// alone, on any rank or thread. A sample is written as scene text (TOML, every number with 17
+// significant digits) and is built from that text exactly as `rbx compare` builds it, so what
+// explore measured is what the harness measures on the written scene.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "comparisons/eval/json_io.h"
+#include "engine/math.h"
+#include "reference/backend.h"
+
+namespace rbx {
+
+/// While alive, an abort (SIGABRT) inside a library query run by explore becomes that query's
+/// error instead of ending the process; `run` does the same for any block (false: it aborted;
+/// what it left half done is abandoned). Create one per command, on the main thread.
+class AbortGuard {
+ public:
+  AbortGuard();
+  ~AbortGuard();
+  AbortGuard(const AbortGuard&) = delete;
+  AbortGuard& operator=(const AbortGuard&) = delete;
+  /// Runs f; false when it aborted.
+  static bool run(const std::function<void()>& f);
+
+ private:
+  void* previous_ = nullptr;
+};
+
+/// Counter-based random numbers: splitmix64 seeded from a hash of (seed, index).
+class SampleRng {
+ public:
+  SampleRng(uint64_t seed, uint64_t index);
+  /// 64 uniform random bits.
+  uint64_t next();
+  /// Uniform in [0, 1).
+  double uniform();
+  /// Uniform in [lo, hi).
+  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
+  /// Uniform integer in [lo, hi].
+  int integer(int lo, int hi);
+  /// Uniform direction on the unit sphere.
+  Vec3 direction();
+  /// Uniform random rotation (Shoemake's method).
+  Quat rotation();
+
+ private:
+  uint64_t state_;
+};
+
+/// A body of a sample, as it is written to a scene.
+struct ExploreBody {
+  std::string shape_class;      // "box" | "hull" | "sliver"
+  Vec3 box_size = Vec3::Ones();  // m, full extents (box)
+  std::vector<Vec3> points;     // m, local points whose convex hull is the shape (hull, sliver)
+  Vec3 position = Vec3::Zero();  // m, world position of the local origin
+  Quat orientation = Quat::Identity();
+  Vec3 rotation_deg = Vec3::Zero();  // used instead of `orientation` when `use_degrees`
+  bool use_degrees = false;
+};
+
+/// One random contact pair: body A, body B, and how the pose was chosen.
+struct ContactSample {
+  uint64_t seed = 0;
+  uint64_t index = 0;
+  std::string pose_class;  // touching | separated | deep | diagonal | parallel | edge_edge | random
+  ExploreBody a, b;
+};
+
+/// Sample `index` of `seed`: shapes and a pose biased toward hard cases.
+ContactSample make_contact_sample(uint64_t seed, uint64_t index);
+
+/// The sample as a scene file (checks = ["contact"], duration 0); `expect` is inserted verbatim
+/// (an [expect] block or ""), `header` as leading comment lines.
+std::string sample_scene_text(const ContactSample& s, const std::string& header = "",
+                              const std::string& expect = "");
+
+/// What went wrong for one backend on one sample ("" : agrees with the truth).
+/// error | misses | false_contact | normal | depth | point
+struct BackendOutcome {
+  std::string backend;
+  std::string error;            // "" when it agrees, else the kind above
+  bool measured = false;        // both touch: the three errors below are set
+  double normal_err_deg = 0.0;  // against exact, ties counted as right (as the harness does)
+  double depth_err_rel = 0.0;   // |depth - exact depth| / smaller body size
+  double point_err_rel = 0.0;   // distance of the point from the intersection / size
+  std::string message;          // the backend's message when status is error
+};
+
+/// Everything measured on one sample.
+struct SampleOutcome {
+  uint64_t index = 0;
+  std::string pose_class;
+  std::string shapes;   // "box-hull": the classes of A and B
+  std::string feature;  // exact's axis: face_a | face_b | edge_edge, or "separated"
+  bool touching = false;
+  double depth_rel = 0.0;  // exact depth / smaller body size (negative: separated)
+  std::vector<BackendOutcome> backends;  // in the order asked for; unsupported ones left out
+};
+
+/// Runs the sample through `exact` and each named backend and classifies each answer.
+/// Thresholds: the harness's marks of a clear disagreement (kMarkAngleDeg, kMarkDepthRel).
+SampleOutcome evaluate_contact_sample(const ContactSample& s, const std::vector<std::string>& names);
+
+/// The same on a scene's text (as `rbx compare` would read it); `shapes` names the classes of
+/// A and B ("box-hull"), which the text does not record.
+SampleOutcome evaluate_scene_text(const std::string& text, const std::vector<std::string>& names,
+                                  const std::string& pose_class, const std::string& shapes);
+
+/// Group key of a disagreement: "backend shapes feature error".
+std::string signature(const SampleOutcome& s, const BackendOutcome& b);
+
+/// Compact text form of an outcome (for the ranks' exchange) and back.
+std::string encode(const SampleOutcome& s);
+SampleOutcome decode(const std::string& text);
+
+/// The simplest member found of a disagreement group.
+struct ShrinkResult {
+  ContactSample sample;           // shrunk
+  SampleOutcome outcome;          // of the shrunk sample, for its backend
+  int vertices_before = 0;        // total points of both bodies
+  int vertices_after = 0;
+  int steps_accepted = 0;         // simplifications kept
+  int evaluations = 0;            // predicate calls
+};
+
+/// Shrinks sample `s` while `backend` keeps the same signature `sig`: fewer hull points, A at
+/// the origin, rotations rounded toward axis-aligned (whole degrees, then coarser), rounder
+/// positions, sizes and points. Every candidate is judged on its scene text. At most
+/// `max_evaluations` predicate calls.
+ShrinkResult shrink(const ContactSample& s, const std::string& backend, const std::string& sig,
+                    int max_evaluations = 400);
+
+/// True when the harness (evaluate_scene, as `rbx compare` runs it) shows on the scene text
+/// the disagreement of `b`'s kind: status error, a touching mismatch, a normal off by more
+/// than kMarkAngleDeg, a depth off by more than kMarkDepthRel of the smaller body, a point
+/// off by more than the same fraction. `detail` says what it saw.
+bool harness_reproduces(const std::string& scene_text, const std::string& path,
+                        const BackendOutcome& b, std::string* detail = nullptr);
+
+}  // namespace rbx
