@@ -114,7 +114,7 @@ int check_command(const ReportOptions& opt) {
   std::map<std::string, double> now;
   std::set<std::string> scene_in_run;
   // Known failures that no longer fail: scene name -> file.
-  std::vector<std::pair<std::string, std::string>> now_passing;
+  std::vector<std::pair<std::string, std::pair<std::string, std::string>>> now_passing;  // scene, (file, engine)
   int cached = 0, cacheable = 0;
   for (const Scene& s : scenes) {
     const std::string scene = scene_family(s.file) + "/" + s.name;
@@ -127,15 +127,22 @@ int check_command(const ReportOptions& opt) {
         ++cacheable;
         cached += bj.value("cached", false) ? 1 : 0;
       }
-    // A known failure of the engine that passes now: custom ran and bound the [expect], and
-    // none of its violations is left.
-    const bool custom_ran = ev.json["backends"].contains("custom") &&
-                            ev.json["backends"]["custom"]["status"] == "ok";
-    if (s.expect && !s.expect->known_failure.empty() && custom_ran &&
+    // A known failure of the engine it names ("custom: ..." or "custom-seed: ..."; no prefix:
+    // custom) that passes now: that engine ran and bound the [expect], and none of its
+    // violations is left.
+    std::string subject = "custom";
+    if (s.expect) {
+      const std::string& known = s.expect->known_failure;
+      const std::string prefix = known.substr(0, known.find(':'));
+      if (prefix == "custom" || prefix == "custom-seed") subject = prefix;
+    }
+    const bool subject_ran = ev.json["backends"].contains(subject) &&
+                             ev.json["backends"][subject]["status"] == "ok";
+    if (s.expect && !s.expect->known_failure.empty() && subject_ran &&
         ev.json["expect"].value("checked", false) &&
         std::none_of(ev.expect_failures.begin(), ev.expect_failures.end(),
-                     [](const std::string& f) { return f.rfind("custom:", 0) == 0; }))
-      now_passing.emplace_back(scene, s.file);
+                     [&](const std::string& f) { return f.rfind(subject + ":", 0) == 0; }))
+      now_passing.emplace_back(scene, std::make_pair(s.file, subject));
   }
   const double runtime = clock.seconds();
 
@@ -190,9 +197,9 @@ int check_command(const ReportOptions& opt) {
       for (const std::string& line : lines) std::cout << "    " << line << "\n";
     }
   }
-  for (const auto& [scene, file] : now_passing)
-    std::cout << scene << ": custom now meets [expect], a known failure: remove known_failure from "
-              << file << "\n";
+  for (const auto& [scene, passing] : now_passing)
+    std::cout << scene << ": " << passing.second << " now meets [expect], a known failure: remove known_failure from "
+              << passing.first << "\n";
   const double base_rt = base.value("runtime_s", 0.0);
   std::cout << "check: " << now.size() << " metrics over " << scenes.size() << " scenes: " << worse + missing
             << " worse, " << better << " better, " << added << " new; run time " << fmt_num(runtime, 3)
