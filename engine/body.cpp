@@ -37,7 +37,8 @@ RigidBody make_body(const BodySpec& spec) {
   b.mass = mp.mass;
   b.inertia_body = mp.inertia;
   if (spec.is_static) {
-    // SEED_NOTES 5: static bodies have zero inverse mass and inverse inertia.
+    // seed correction 5 (world-frame inverse inertia, static bodies zero): static bodies have zero
+    // inverse mass and inverse inertia.
     b.inverse_mass = 0.0;
     b.inverse_inertia_body.setZero();
   } else {

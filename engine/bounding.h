@@ -14,8 +14,8 @@ struct BoundingSphere {
 /// The bounding sphere of a body at its current pose.
 BoundingSphere bounding_sphere(const RigidBody& body);
 
-/// SEED_NOTES 7: two bodies may touch only if |c_a - c_b| <= r_a + r_b. (The seed compares
-/// with each radius alone, "less than both", which misses pairs.)
+/// seed correction 7 (bounding check on the sum of radii): two bodies may touch only if |c_a - c_b|
+/// <= r_a + r_b. (The seed compares with each radius alone, "less than both", which misses pairs.)
 bool bounding_check(const RigidBody& a, const RigidBody& b);
 
 }  // namespace rbx

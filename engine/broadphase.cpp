@@ -21,9 +21,12 @@ constexpr int kLeafSize = 4;
 
 const char* to_string(BroadPhaseMethod method) {
   switch (method) {
-    case BroadPhaseMethod::AllPairs: return "all-pairs";
-    case BroadPhaseMethod::SweepAndPrune: return "sweep-and-prune";
-    case BroadPhaseMethod::Tree: return "tree";
+    case BroadPhaseMethod::AllPairs:
+      return "all-pairs";
+    case BroadPhaseMethod::SweepAndPrune:
+      return "sweep-and-prune";
+    case BroadPhaseMethod::Tree:
+      return "tree";
   }
   return "tree";
 }
@@ -56,9 +59,15 @@ const std::vector<BodyPair>& BroadPhase::find_pairs(const std::vector<RigidBody>
   }
   pairs_.clear();
   switch (method_) {
-    case BroadPhaseMethod::AllPairs: all_pairs(); break;
-    case BroadPhaseMethod::SweepAndPrune: sweep_and_prune(); break;
-    case BroadPhaseMethod::Tree: tree(); break;
+    case BroadPhaseMethod::AllPairs:
+      all_pairs();
+      break;
+    case BroadPhaseMethod::SweepAndPrune:
+      sweep_and_prune();
+      break;
+    case BroadPhaseMethod::Tree:
+      tree();
+      break;
   }
   // The seed's loop order: by i, then j.
   if (method_ != BroadPhaseMethod::AllPairs) std::sort(pairs_.begin(), pairs_.end());

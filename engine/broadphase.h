@@ -1,5 +1,5 @@
-// Broad phase: the pairs of bodies that pass the seed's bounding check (SEED_NOTES 7), found
-// without testing every pair.
+// Broad phase: the pairs of bodies that pass the seed's bounding check (seed correction 7 (bounding
+// check on the sum of radii)), found without testing every pair.
 //
 // Design note. Every method returns exactly the pairs i < j for which bounding_check(bodies[i],
 // bodies[j]) is true, sorted by (i, j): the same set, in the order of the seed's double loop, so
@@ -55,11 +55,11 @@ class BroadPhase {
   void test_pair(int i, int j);
 
   BroadPhaseMethod method_;
-  std::vector<BoundingSphere> spheres_;  // this call's bounding spheres (bounding_sphere())
-  std::vector<Vec3> box_min_, box_max_;  // m, padded boxes around them
-  std::vector<int> order_;               // sweep and prune: sorted along sap_axis_
-  int sap_axis_ = -1;                    // axis of the last sweep (-1: none yet)
-  Bvh tree_;                             // tree: over the padded boxes
+  std::vector<BoundingSphere> spheres_;          // this call's bounding spheres (bounding_sphere())
+  std::vector<Vec3> box_min_, box_max_;          // m, padded boxes around them
+  std::vector<int> order_;                       // sweep and prune: sorted along sap_axis_
+  int sap_axis_ = -1;                            // axis of the last sweep (-1: none yet)
+  Bvh tree_;                                     // tree: over the padded boxes
   std::vector<std::pair<int, int>> node_pairs_;  // tree: traversal stack
   std::vector<Vec3> leaf_min_, leaf_max_;        // tree: boxes in tree order
   std::vector<BoundingSphere> leaf_spheres_;     // tree: spheres in tree order

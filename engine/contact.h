@@ -22,9 +22,12 @@ enum class Feature {
 /// "face" | "vertex" | "edge": the label the custom detector writes into ContactPoint::feature.
 inline const char* to_string(Feature feature) {
   switch (feature) {
-    case Feature::Face: return "face";
-    case Feature::Vertex: return "vertex";
-    case Feature::Edge: return "edge";
+    case Feature::Face:
+      return "face";
+    case Feature::Vertex:
+      return "vertex";
+    case Feature::Edge:
+      return "edge";
   }
   return "face";
 }

@@ -13,7 +13,7 @@ using Mat2 = Eigen::Matrix2d;
 
 // Per-body data the solver reads: inverse mass and world inverse inertia (zero when static).
 struct BodyInverse {
-  double inv_mass = 0.0;  // 1/kg
+  double inv_mass = 0.0;            // 1/kg
   Mat3 inv_inertia = Mat3::Zero();  // world frame
 };
 
@@ -44,7 +44,8 @@ Vec3 response(const BodyInverse& A, const BodyInverse& B, const Row& r, const Ve
 }
 
 Vec3 rel_velocity(const RigidBody& a, const RigidBody& b, const Row& r) {
-  return (a.velocity + a.angular_velocity.cross(r.ra)) - (b.velocity + b.angular_velocity.cross(r.rb));
+  return (a.velocity + a.angular_velocity.cross(r.ra)) -
+         (b.velocity + b.angular_velocity.cross(r.rb));
 }
 
 void apply(RigidBody& a, RigidBody& b, const BodyInverse& A, const BodyInverse& B, const Row& r,
@@ -72,8 +73,8 @@ std::vector<std::vector<double>> normal_velocities(const std::vector<RigidBody>&
     std::vector<double> v;
     for (const ManifoldPoint& p : pm.manifold.points) {
       const Vec3 ra = p.point - a.position, rb = p.point - b.position;
-      const Vec3 vrel = (a.velocity + a.angular_velocity.cross(ra)) -
-                        (b.velocity + b.angular_velocity.cross(rb));
+      const Vec3 vrel =
+          (a.velocity + a.angular_velocity.cross(ra)) - (b.velocity + b.angular_velocity.cross(rb));
       v.push_back(vrel.dot(pm.manifold.normal));
     }
     out.push_back(std::move(v));
@@ -274,14 +275,15 @@ void project_contact_positions(std::vector<RigidBody>& bodies,
         if (!(c > 0.0)) continue;
         const Vec3 ra = pa - a.position, rb = pb - b.position;
         const Vec3 ran = ra.cross(n), rbn = rb.cross(n);
-        const double k = A.inv_mass + B.inv_mass + ran.dot(A.inv_inertia * ran) +
-                         rbn.dot(B.inv_inertia * rbn);
+        const double k =
+            A.inv_mass + B.inv_mass + ran.dot(A.inv_inertia * ran) + rbn.dot(B.inv_inertia * rbn);
         if (!(k > 0.0)) continue;
         const Vec3 P = (c / k) * n;
         auto turn = [](RigidBody& body, const Vec3& angle) {
           const double t = angle.norm();
           if (t > 0.0)
-            body.orientation = (Quat(Eigen::AngleAxisd(t, angle / t)) * body.orientation).normalized();
+            body.orientation =
+                (Quat(Eigen::AngleAxisd(t, angle / t)) * body.orientation).normalized();
         };
         if (!a.is_static) {
           a.position += A.inv_mass * P;

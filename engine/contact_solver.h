@@ -1,6 +1,7 @@
 // Simultaneous contact response over manifolds: Newton restitution, Coulomb friction (exact
 // cone), resting contact, and position projection. The extended engine's answer to what the
-// seed admits it lacks (SEED_NOTES 12: resting contact and friction).
+// seed admits it lacks (seed correction 12 (contact point and plane in one pass): resting contact
+// and friction).
 //
 // Design note. Of the two resting-contact schemes the issue names, sequential impulses to
 // convergence (projected Gauss-Seidel on accumulated impulses, Catto 2005; the velocity-level
@@ -41,10 +42,10 @@ struct ContactSolverSettings {
 /// One solved point: the accumulated impulses (N s) in the manifold's frame.
 struct SolvedPoint {
   int manifold = 0;
-  Vec3 point = Vec3::Zero();          // m, world, at detection
-  double normal_impulse = 0.0;        // N s, >= 0, along the manifold normal (on A)
+  Vec3 point = Vec3::Zero();             // m, world, at detection
+  double normal_impulse = 0.0;           // N s, >= 0, along the manifold normal (on A)
   Vec3 friction_impulse = Vec3::Zero();  // N s, world, tangent to the normal (on A)
-  double approach_speed = 0.0;        // m/s, -(v_rel . n) before the solve (> 0 approaching)
+  double approach_speed = 0.0;           // m/s, -(v_rel . n) before the solve (> 0 approaching)
 };
 
 /// Solves the velocity-level contact problem of `manifolds` on `bodies` in place.

@@ -49,18 +49,24 @@ void DetectionCache::prepare(const ConvexPolyhedron& a, const Pose& pa, const Co
 
 std::optional<ContactPoint> DetectionCache::test(Feature feature) {
   switch (state_->live) {
-    case State::Live::Accelerated: return state_->accelerated.test(feature, state_->scratch);
-    case State::Live::Faithful: return state_->faithful.test(feature, state_->scratch);
-    case State::Live::None: break;
+    case State::Live::Accelerated:
+      return state_->accelerated.test(feature, state_->scratch);
+    case State::Live::Faithful:
+      return state_->faithful.test(feature, state_->scratch);
+    case State::Live::None:
+      break;
   }
   throw std::logic_error("DetectionCache::test before prepare");
 }
 
 std::optional<ContactPoint> DetectionCache::detect() {
   switch (state_->live) {
-    case State::Live::Accelerated: return state_->accelerated.detect(state_->scratch);
-    case State::Live::Faithful: return state_->faithful.detect(state_->scratch);
-    case State::Live::None: break;
+    case State::Live::Accelerated:
+      return state_->accelerated.detect(state_->scratch);
+    case State::Live::Faithful:
+      return state_->faithful.detect(state_->scratch);
+    case State::Live::None:
+      break;
   }
   throw std::logic_error("DetectionCache::detect before prepare");
 }
@@ -88,9 +94,8 @@ double overlap_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPoly
 namespace {
 
 // One order of one faithful test.
-std::optional<ContactPoint> faithful_one(Feature feature, const ConvexPolyhedron& a,
-                                         const Pose& pa, const ConvexPolyhedron& b,
-                                         const Pose& pb) {
+std::optional<ContactPoint> faithful_one(Feature feature, const ConvexPolyhedron& a, const Pose& pa,
+                                         const ConvexPolyhedron& b, const Pose& pb) {
   detail::FaithfulPair pair;
   pair.prepare(a, pa, b, pb);
   detail::FeatureScratch scratch;

@@ -1,5 +1,6 @@
 // Narrow phase after Moore & Wilhelms, as the seed describes it: the face, vertex and edge
-// tests, each returning a contact point *and* plane in one pass (SEED_NOTES 12).
+// tests, each returning a contact point *and* plane in one pass (seed correction 12 (contact point
+// and plane in one pass)).
 //
 // Every function here is a pure function of two shapes and two poses (no world). Shapes are in
 // their body frames; poses map them to the world. Results follow engine/contact.h: the normal is
@@ -38,10 +39,11 @@ class DetectionCache {
   DetectionCache& operator=(DetectionCache&&) noexcept;
 
   /// Places a and b at pa and pb for the tests that follow, with the given implementation.
-  void prepare(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-               const Pose& pb, DetectorVariant variant);
+  void prepare(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b, const Pose& pb,
+               DetectorVariant variant);
   /// One kind of test in both orders on the prepared pair: (A, B), then (B, A) with the normal
-  /// flipped (SEED_NOTES 8). Throws std::logic_error when nothing was prepared.
+  /// flipped (seed correction 8 (both orders, normal flipped)). Throws std::logic_error when
+  /// nothing was prepared.
   std::optional<ContactPoint> test(Feature feature);
   /// The full detector on the prepared pair: face, vertex, edge, each in both orders; the first
   /// hit. Throws std::logic_error when nothing was prepared.
@@ -56,8 +58,8 @@ class DetectionCache {
 /// outside a face plane count as inside, so exactly touching bodies are seen.
 double point_in_mesh_tolerance(const ConvexPolyhedron& a, const ConvexPolyhedron& b);
 
-/// SEED_NOTES 1: p is inside the convex mesh iff (p - q_f) . n_f <= tol for every face f.
-/// `p_world` is in the world frame; the mesh is placed by `pose`.
+/// seed correction 1 (point in mesh uses p - q_f): p is inside the convex mesh iff (p - q_f) . n_f
+/// <= tol for every face f. `p_world` is in the world frame; the mesh is placed by `pose`.
 bool point_in_mesh(const ConvexPolyhedron& mesh, const Pose& pose, const Vec3& p_world, double tol);
 
 /// Penetration of A into B along the unit normal n (from B toward A): how far A must move along
@@ -68,7 +70,7 @@ double overlap_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPoly
 
 /// Face test, one order (faithful): centroids of A's triangles that lie inside B, averaged (the
 /// seed's "better collision point"); normal = minus the outward normal of the first such
-/// triangle of A (SEED_NOTES 9). feature = "face".
+/// triangle of A (seed correction 9 (face normal negated)). feature = "face".
 std::optional<ContactPoint> face_test(const ConvexPolyhedron& a, const Pose& pa,
                                       const ConvexPolyhedron& b, const Pose& pb);
 
@@ -80,12 +82,12 @@ std::optional<ContactPoint> vertex_test(const ConvexPolyhedron& a, const Pose& p
                                         const ConvexPolyhedron& b, const Pose& pb);
 
 /// Edge test, one order (faithful): each edge of A is cut where it crosses the planes of B's
-/// triangles (SEED_NOTES 2), the crossing parameters sorted with 0 and 1, and the midpoint of
-/// each consecutive pair tested in B; the first inside is the point. Normal: e_a x e_b, e_b the
-/// edge of B's crossed triangle nearest the point, oriented from B toward A (SEED_NOTES 10).
-/// Departure: where the crossed triangle's outward normal separates the shapes with a smaller
-/// translation than e_a x e_b (an edge piercing a face, not an edge), that face normal is
-/// taken. feature = "edge".
+/// triangles (seed correction 2 (edge crossing at v_i + t (v_j - v_i))), the crossing parameters
+/// sorted with 0 and 1, and the midpoint of each consecutive pair tested in B; the first inside is
+/// the point. Normal: e_a x e_b, e_b the edge of B's crossed triangle nearest the point, oriented
+/// from B toward A (seed correction 10 (edge normal e_a x e_b)). Departure: where the crossed
+/// triangle's outward normal separates the shapes with a smaller translation than e_a x e_b (an
+/// edge piercing a face, not an edge), that face normal is taken. feature = "edge".
 std::optional<ContactPoint> edge_test(const ConvexPolyhedron& a, const Pose& pa,
                                       const ConvexPolyhedron& b, const Pose& pb);
 

@@ -210,8 +210,8 @@ void fill_plane_table(AcceleratedView& x, const AcceleratedView& y, const Limits
   for (int i = 0; i < nv; ++i)
     for (int k = 0; k < count; ++k) {
       const int f = planes[k];
-      const double d = plane_dist(x.world_vertices[i], y.world_vertices[tris[f][0]],
-                                  y.world_normals[f]);
+      const double d =
+          plane_dist(x.world_vertices[i], y.world_vertices[tris[f][0]], y.world_normals[f]);
       table[static_cast<std::size_t>(i) * count + k] = d;
       if (d <= limit) separated[k] = false;
     }
@@ -372,10 +372,11 @@ void AcceleratedView::candidates(Primitive kind, const AcceleratedView& y,
   std::sort(out.begin(), out.end());
 }
 
-// SEED_NOTES 1 point in mesh, the seed's predicate exactly: (p - q_f) . n_f <= tol for every
-// face. Small shapes: the seed's loop. Others: clusters of faces whose bound is at most
-// tol - margin are certified without evaluating them; the rest are evaluated exactly, and the
-// first face found outside ends the search (the answer is an AND, so order does not matter).
+// seed correction 1 (point in mesh uses p - q_f) point in mesh, the seed's predicate exactly: (p -
+// q_f) . n_f <= tol for every face. Small shapes: the seed's loop. Others: clusters of faces whose
+// bound is at most tol - margin are certified without evaluating them; the rest are evaluated
+// exactly, and the first face found outside ends the search (the answer is an AND, so order does
+// not matter).
 bool AcceleratedView::inside(const Vec3& p) const {
   // The face toward the other shape first: most points of the other shape are outside it.
   if (facing >= 0 && plane_distance(*this, facing, p) > tol) return false;
@@ -556,8 +557,8 @@ void AcceleratedPair::prepare(const ConvexPolyhedron& sa, const Pose& pa,
   // The query's constants: the seed's tolerance, and the margin scaled by the coordinates.
   Limits lim;
   lim.tol = point_in_mesh_tolerance(sa, sb);
-  const double scale = pa.position.norm() + pb.position.norm() + 2.0 * shape_size(sa) +
-                       2.0 * shape_size(sb);
+  const double scale =
+      pa.position.norm() + pb.position.norm() + 2.0 * shape_size(sa) + 2.0 * shape_size(sb);
   lim.margin = kMarginScale * scale;
   a = place(sa, pa, lim, ws, 0);
   b = place(sb, pb, lim, ws, 1);
@@ -582,8 +583,7 @@ void AcceleratedPair::prepare(const ConvexPolyhedron& sa, const Pose& pa,
   b.enters = may_enter(b, a, lim);
 }
 
-std::optional<ContactPoint> AcceleratedPair::test(Feature feature,
-                                                  FeatureScratch& scratch) const {
+std::optional<ContactPoint> AcceleratedPair::test(Feature feature, FeatureScratch& scratch) const {
   return both_orders(feature, a, b, scratch);
 }
 

@@ -49,14 +49,14 @@ struct Limits {
 /// World vertices and normals are the seed's expressions (r v + position, r n), bit-identical.
 struct AcceleratedView {
   const ConvexPolyhedron* shape = nullptr;
-  const ShapeHierarchy* accel = nullptr;  // null: small shape, plain loops over world copies
-  Mat3 r = Mat3::Identity();              // body to world
-  Mat3 rt = Mat3::Identity();             // world to body
-  Vec3 position = Vec3::Zero();           // m, world
-  const Vec3* world_vertices = nullptr;   // small shapes only
-  const Vec3* world_normals = nullptr;    // small shapes only (unset when neither can enter)
+  const ShapeHierarchy* accel = nullptr;    // null: small shape, plain loops over world copies
+  Mat3 r = Mat3::Identity();                // body to world
+  Mat3 rt = Mat3::Identity();               // world to body
+  Vec3 position = Vec3::Zero();             // m, world
+  const Vec3* world_vertices = nullptr;     // small shapes only
+  const Vec3* world_normals = nullptr;      // small shapes only (unset when neither can enter)
   const unsigned char* distinct = nullptr;  // small shapes: shape->new_plane()
-  int facing = -1;  // the face most along the direction toward the other shape (facing_face)
+  int facing = -1;     // the face most along the direction toward the other shape (facing_face)
   bool enters = true;  // false: no point of this shape can be inside the other (prepare)
   // Two small shapes: the seed's plane distance of each of this shape's vertices from each
   // distinct face plane of the other, vertex-major (prepare); null otherwise, and when this
@@ -103,9 +103,9 @@ struct AcceleratedPair {
   AcceleratedView a, b;
 
   /// Places a and b, finds their facing faces and which order can hit.
-  void prepare(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-               const Pose& pb, AcceleratedWorkspace& workspace);
-  /// One test in both orders (SEED_NOTES 8).
+  void prepare(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b, const Pose& pb,
+               AcceleratedWorkspace& workspace);
+  /// One test in both orders (seed correction 8 (both orders, normal flipped)).
   std::optional<ContactPoint> test(Feature feature, FeatureScratch& scratch) const;
   /// Face, vertex, edge in turn, each in both orders: the first hit.
   std::optional<ContactPoint> detect(FeatureScratch& scratch) const;

@@ -20,17 +20,17 @@ FaithfulView FaithfulView::place(const ConvexPolyhedron& s, const Pose& pose, do
 }
 
 void FaithfulView::candidates(Primitive kind, const FaithfulView&, std::vector<int>& out) const {
-  const std::size_t n = kind == Primitive::Triangles ? shape->triangles().size()
+  const std::size_t n = kind == Primitive::Triangles  ? shape->triangles().size()
                         : kind == Primitive::Vertices ? shape->vertices().size()
                                                       : shape->edges().size();
   out.resize(n);
   for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<int>(i);
 }
 
-// SEED_NOTES 1. The seed text says "taking the dot product of the point with every face
-// normal" and then gives two contradictory sign rules; p . n_f depends on where the world origin
-// is and is no inside test. The half-space test is (p - q_f) . n_f <= tol for every face f,
-// q_f a vertex of f (here its first vertex).
+// seed correction 1 (point in mesh uses p - q_f). The seed text says "taking the dot product of the
+// point with every face normal" and then gives two contradictory sign rules; p . n_f depends on
+// where the world origin is and is no inside test. The half-space test is (p - q_f) . n_f <= tol
+// for every face f, q_f a vertex of f (here its first vertex).
 bool FaithfulView::inside(const Vec3& p) const {
   const auto& tris = shape->triangles();
   for (std::size_t f = 0; f < tris.size(); ++f)

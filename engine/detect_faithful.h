@@ -26,7 +26,7 @@ struct FaithfulView {
   bool may_enter() const { return true; }
   /// Every primitive of the kind, in index order.
   void candidates(Primitive kind, const FaithfulView& other, std::vector<int>& out) const;
-  /// SEED_NOTES 1: (p - q_f) . n_f <= tol for every face f.
+  /// seed correction 1 (point in mesh uses p - q_f): (p - q_f) . n_f <= tol for every face f.
   bool inside(const Vec3& p) const;
   /// max over the world vertices of v . n.
   double support_max(const Vec3& n) const;
@@ -49,7 +49,7 @@ struct FaithfulPair {
   /// Places a and b with the pair's tolerance (point_in_mesh_tolerance).
   void prepare(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                const Pose& pb);
-  /// One test in both orders (SEED_NOTES 8).
+  /// One test in both orders (seed correction 8 (both orders, normal flipped)).
   std::optional<ContactPoint> test(Feature feature, FeatureScratch& scratch) const;
   /// Face, vertex, edge in turn, each in both orders: the first hit.
   std::optional<ContactPoint> detect(FeatureScratch& scratch) const;

@@ -1,6 +1,7 @@
 // The seed's Moore & Wilhelms tests (face, vertex, edge; one order and both orders), written once
-// as templates over a "shape view", with the corrections of SEED_NOTES (1, 2, 8, 9, 10) marked
-// where they apply. Internal to the engine: the public entry points are in engine/detect.h.
+// as templates over a "shape view", with the corrections of seed corrections 1, 2, 8, 9, 10
+// (docs/seed_corrections.md) marked where they apply. Internal to the engine: the public entry
+// points are in engine/detect.h.
 //
 // Design note. The faithful and the accelerated detectors differ only in how a shape answers
 // queries, never in the steps of a test, so the steps live here and each detector supplies a
@@ -16,12 +17,13 @@
 //   vertex(i), normal(f)                 world vertex i, world outward normal of triangle f;
 //   may_enter()                          false: no point of X can be inside the other shape;
 //   candidates(kind, other, out)         indices of X's primitives that may hold a hit, increasing;
-//   inside(p)                            SEED_NOTES 1 point-in-mesh of a world point;
-//   support_max(n), support_min(n)       max / min over X's world vertices of v . n;
-//   closest_face(p)                      argmin over faces of |(p - q_f) . n_f| (ties: lowest);
-//   crossings(v_i, v_j, out)             the planes of X the segment crosses (crossing_of), by face;
-//   nearest_triangle(p)                  argmin of triangle_distance (ties: lowest index);
-//   segment_outside(other, v_i, v_j)     true only when no point of the segment is inside X.
+//   inside(p)                            seed correction 1 (point in mesh uses p - q_f)
+//   point-in-mesh of a world point; support_max(n), support_min(n)       max / min over X's world
+//   vertices of v . n; closest_face(p)                      argmin over faces of |(p - q_f) . n_f|
+//   (ties: lowest); crossings(v_i, v_j, out)             the planes of X the segment crosses
+//   (crossing_of), by face; nearest_triangle(p)                  argmin of triangle_distance (ties:
+//   lowest index); segment_outside(other, v_i, v_j)     true only when no point of the segment is
+//   inside X.
 #pragma once
 
 #include <algorithm>
@@ -91,8 +93,9 @@ void crossing_of(const View& y, int f, const Vec3& v_i, const Vec3& v_j,
   const double d_i = (v_i - u).dot(n);
   const double d_j = (v_j - u).dot(n);
   if (!((d_i < 0.0 && d_j > 0.0) || (d_i > 0.0 && d_j < 0.0))) return;
-  // SEED_NOTES 2. The seed prints P = v_i + t (v_i - v_i), which is always v_i; the crossing is
-  // P = v_i + t (v_j - v_i) with t = |d_i| / (|d_i| + |d_j|).
+  // seed correction 2 (edge crossing at v_i + t (v_j - v_i)). The seed prints P = v_i + t (v_i -
+  // v_i), which is always v_i; the crossing is P = v_i + t (v_j - v_i) with t = |d_i| / (|d_i| +
+  // |d_j|).
   out.push_back({std::abs(d_i) / (std::abs(d_i) + std::abs(d_j)), f});
 }
 
@@ -116,9 +119,9 @@ std::optional<ContactPoint> face_one(const View& a, const View& b, FeatureScratc
   if (hits == 0) return std::nullopt;
   ContactPoint cp;
   cp.point = sum / hits;
-  // SEED_NOTES 9. The seed text takes "the normal of any of the collision triangles" and calls
-  // it the normal from B to A; but A's outward triangle normal points from A toward B. The
-  // contact normal (from B toward A) is its negation.
+  // seed correction 9 (face normal negated). The seed text takes "the normal of any of the
+  // collision triangles" and calls it the normal from B to A; but A's outward triangle normal
+  // points from A toward B. The contact normal (from B toward A) is its negation.
   cp.normal = -a.normal(first);
   cp.depth = overlap(a, b, cp.normal);  // the seed defines no depth
   cp.feature = to_string(Feature::Face);
@@ -158,8 +161,8 @@ std::optional<ContactPoint> vertex_one(const View& a, const View& b, FeatureScra
   return cp;
 }
 
-/// SEED_NOTES 10: the contact normal of an edge hit at p on A's edge v_i + t e_a, given the
-/// planes of B the edge crosses.
+/// seed correction 10 (edge normal e_a x e_b): the contact normal of an edge hit at p on A's edge
+/// v_i + t e_a, given the planes of B the edge crosses.
 template <typename View>
 Vec3 edge_normal(const View& a, const View& b, const Vec3& v_i, const Vec3& e_a, const Vec3& p,
                  const std::vector<Crossing>& crossings) {
@@ -191,9 +194,9 @@ Vec3 edge_normal(const View& a, const View& b, const Vec3& v_i, const Vec3& e_a,
       e_b = s1 - s0;
     }
   }
-  // SEED_NOTES 10. The seed text uses "the cross product of the edge with the plane it is
-  // intersecting": e_a x n_plane lies in the plane (and is zero when the edge runs along the
-  // plane normal), so it is no contact normal. The edge-edge normal is e_a x e_b.
+  // seed correction 10 (edge normal e_a x e_b). The seed text uses "the cross product of the edge
+  // with the plane it is intersecting": e_a x n_plane lies in the plane (and is zero when the edge
+  // runs along the plane normal), so it is no contact normal. The edge-edge normal is e_a x e_b.
   const Vec3 n_face = b.normal(face);
   Vec3 n = e_a.cross(e_b);
   // Parallel edges (sin of their angle below 1e-9, far above the ~1e-16 round-off of the
@@ -227,8 +230,9 @@ inline void merged_parameters(const std::vector<Crossing>& crossings, double len
   for (std::size_t k = 1; k < ts.size(); ++k)
     for (std::size_t m = k; m > 0 && ts[m] < ts[m - 1]; --m) std::swap(ts[m], ts[m - 1]);
   const double merge = tol / std::max(length, std::numeric_limits<double>::min());
-  ts.erase(std::unique(ts.begin(), ts.end(), [merge](double x, double y) { return y - x <= merge; }),
-           ts.end());
+  ts.erase(
+      std::unique(ts.begin(), ts.end(), [merge](double x, double y) { return y - x <= merge; }),
+      ts.end());
   if (ts.back() < 1.0) ts.back() = 1.0;  // merging may have swallowed the end
 }
 
@@ -267,17 +271,20 @@ template <typename View>
 std::optional<ContactPoint> one_order(Feature feature, const View& a, const View& b,
                                       FeatureScratch& s) {
   switch (feature) {
-    case Feature::Face: return face_one(a, b, s);
-    case Feature::Vertex: return vertex_one(a, b, s);
-    case Feature::Edge: return edge_one(a, b, s);
+    case Feature::Face:
+      return face_one(a, b, s);
+    case Feature::Vertex:
+      return vertex_one(a, b, s);
+    case Feature::Edge:
+      return edge_one(a, b, s);
   }
   return std::nullopt;
 }
 
-/// SEED_NOTES 8. The seed loops A's features against B only, so a vertex (or face, or edge) of
-/// B striking A goes unseen. Run (A, B), then (B, A) with the normal flipped back to "from B
-/// toward A". The point is unchanged and the depth symmetric:
-/// max_a(a . -n) - min_b(b . -n) = max_b(b . n) - min_a(a . n).
+/// seed correction 8 (both orders, normal flipped). The seed loops A's features against B only, so
+/// a vertex (or face, or edge) of B striking A goes unseen. Run (A, B), then (B, A) with the normal
+/// flipped back to "from B toward A". The point is unchanged and the depth symmetric: max_a(a . -n)
+/// - min_b(b . -n) = max_b(b . n) - min_a(a . n).
 template <typename View>
 std::optional<ContactPoint> both_orders(Feature feature, const View& a, const View& b,
                                         FeatureScratch& s) {

@@ -1,8 +1,8 @@
 #include "engine/format.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <algorithm>
 #include <cstdlib>
 
 namespace rbx {

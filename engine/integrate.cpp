@@ -1,8 +1,7 @@
 #include "engine/integrate.h"
 
-#include <cmath>
-
 #include <Eigen/Eigenvalues>
+#include <cmath>
 
 namespace rbx {
 

@@ -12,8 +12,8 @@ void integrate_euler(RigidBody& body, const Vec3& gravity, double dt);
 
 /// Semi-implicit (symplectic) Euler: v += g dt first, then x += v dt; the rotation is the
 /// torque-free motion with gyroscopic precession (rotate_free_body), carrying the world angular
-/// momentum L exactly; then w = I_w^-1 L. Departs from the seed (SEED_NOTES 11), which holds w
-/// fixed in the world.
+/// momentum L exactly; then w = I_w^-1 L. Departs from the seed (seed correction 11 (the seed's
+/// per-axis Euler kept; symplectic added)), which holds w fixed in the world.
 void integrate_symplectic(RigidBody& body, const Vec3& gravity, double dt);
 
 /// Orientation after dt of a torque-free body with body-frame inertia `inertia_body` (kg m^2)

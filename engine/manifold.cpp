@@ -37,8 +37,7 @@ std::vector<Edge> feature_edges(const ConvexPolyhedron& s) {
 // Closest points of segments p0 + s d0 and q0 + t d1 (s, t in [0, 1]); false when the segments
 // are parallel to 1e-9 rad or the closest points are not interior to both (a crossing at an
 // end is a vertex, found by the vertex tests).
-bool crossing(const Vec3& p0, const Vec3& d0, const Vec3& q0, const Vec3& d1, Vec3& c0,
-              Vec3& c1) {
+bool crossing(const Vec3& p0, const Vec3& d0, const Vec3& q0, const Vec3& d1, Vec3& c0, Vec3& c1) {
   const double a = d0.dot(d0), c = d1.dot(d1), b = d0.dot(d1);
   const double denom = a * c - b * b;  // |d0 x d1|^2
   if (!(denom > 1e-18 * a * c)) return false;

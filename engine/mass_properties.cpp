@@ -40,7 +40,7 @@ MassProperties vertex_mass_properties(const ConvexPolyhedron& shape, double mass
   com /= static_cast<double>(v.size());
   mp.center_of_mass = com;
   // The seed's I11 = sum m_k (y^2 + z^2), I12 = -sum m_k x y, ... with m_k = mass / N, about
-  // the centre of mass (SEED_NOTES 5).
+  // the centre of mass (seed correction 5 (world-frame inverse inertia, static bodies zero)).
   const double mk = mass / static_cast<double>(v.size());
   Mat3 inertia = Mat3::Zero();
   for (const Vec3& p : v) {

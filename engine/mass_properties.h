@@ -13,9 +13,9 @@ enum class MassModel {
 
 /// Mass properties in the shape's local frame. Inertia is about the centre of mass.
 struct MassProperties {
-  double mass = 0.0;                      // kg
-  Vec3 center_of_mass = Vec3::Zero();     // m, shape-local frame
-  Mat3 inertia = Mat3::Identity();        // kg m^2, about the centre of mass, shape-local axes
+  double mass = 0.0;                   // kg
+  Vec3 center_of_mass = Vec3::Zero();  // m, shape-local frame
+  Mat3 inertia = Mat3::Identity();     // kg m^2, about the centre of mass, shape-local axes
 };
 
 /// Exact uniform-density mass properties of a closed polyhedron of total mass `mass`

@@ -26,9 +26,11 @@ std::string fmt_vec(const Vec3& v) {
 ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
                                                   std::vector<std::array<int, 3>> triangles) {
   const int nv = static_cast<int>(vertices.size());
-  if (nv < 4) throw GeometryError("a polyhedron needs at least 4 vertices, got " + std::to_string(nv));
+  if (nv < 4)
+    throw GeometryError("a polyhedron needs at least 4 vertices, got " + std::to_string(nv));
   if (triangles.size() < 4)
-    throw GeometryError("a polyhedron needs at least 4 faces, got " + std::to_string(triangles.size()));
+    throw GeometryError("a polyhedron needs at least 4 faces, got " +
+                        std::to_string(triangles.size()));
   for (int i = 0; i < nv; ++i)
     if (!vertices[i].allFinite())
       throw GeometryError("vertex " + std::to_string(i) + " is not finite");
@@ -60,7 +62,8 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
       throw GeometryError("face " + std::to_string(f) + " is degenerate (zero area)");
   }
   for (int i = 0; i < nv; ++i)
-    if (uses[i] == 0) throw GeometryError("vertex " + std::to_string(i) + " is not used by any face");
+    if (uses[i] == 0)
+      throw GeometryError("vertex " + std::to_string(i) + " is not used by any face");
 
   // Closed and consistently oriented: each directed edge once, and its reverse once.
   std::map<std::pair<int, int>, int> directed;
@@ -103,7 +106,9 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
   // (far above the round-off of the two dot products) cannot hold an outside vertex, so only
   // the boxes the plane cuts are opened, and only their leaves are tested vertex by vertex.
   const Bvh tree = Bvh::build(p.vertices_, p.vertices_, 16);
-  auto vertex_outside = [&](size_t f, int i) { return p.planes_[f].distance(p.vertices_[i]) > tol; };
+  auto vertex_outside = [&](size_t f, int i) {
+    return p.planes_[f].distance(p.vertices_[i]) > tol;
+  };
   for (size_t f = 0; f < p.planes_.size(); ++f) {
     const Plane& plane = p.planes_[f];
     // Height of a node's box corner furthest along the normal: skipped when <= tol / 2.
@@ -191,13 +196,12 @@ ConvexPolyhedron make_icosphere(double radius, int subdivisions) {
   if (subdivisions < 0 || subdivisions > 6)
     throw GeometryError("icosphere subdivisions must be in 0..6");
   const double g = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vec3> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
-                         {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
-                         {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  std::vector<std::array<int, 3>> t = {
-      {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-      {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-      {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  std::vector<Vec3> v = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
+                         {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<std::array<int, 3>> t = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   for (Vec3& p : v) p.normalize();
   // Split every triangle in four; midpoints shared through an edge map.
   for (int s = 0; s < subdivisions; ++s) {
@@ -226,7 +230,8 @@ ConvexPolyhedron make_icosphere(double radius, int subdivisions) {
 }
 
 ConvexPolyhedron make_prism(double radius, double height, int sides) {
-  if (!(radius > 0) || !(height > 0)) throw GeometryError("prism radius and height must be positive");
+  if (!(radius > 0) || !(height > 0))
+    throw GeometryError("prism radius and height must be positive");
   if (sides < 3 || sides > 100000) throw GeometryError("prism sides must be in 3..100000");
   std::vector<Vec3> v;
   for (int k = 0; k < sides; ++k) {

@@ -1,4 +1,5 @@
-// Single-point impulse response with restitution (the seed's, corrected: SEED_NOTES 3-5).
+// Single-point impulse response with restitution (the seed's, corrected: seed corrections 3-5
+// (impulse, velocity updates, world inertia)).
 #pragma once
 
 #include "engine/body.h"
@@ -17,7 +18,8 @@ double impulse_magnitude(const RigidBody& a, const RigidBody& b, const ContactPo
                          double restitution);
 
 /// Computes j and applies it: v_a += j/m_a n, v_b -= j/m_b n, w_a += Ia^-1 (r_a x j n),
-/// w_b -= Ib^-1 (r_b x j n) (SEED_NOTES 4). Returns j (0: nothing applied).
+/// w_b -= Ib^-1 (r_b x j n) (seed correction 4 (velocity update signs)). Returns j (0: nothing
+/// applied).
 double apply_impulse(RigidBody& a, RigidBody& b, const ContactPoint& c, double restitution);
 
 }  // namespace rbx

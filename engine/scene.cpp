@@ -23,29 +23,39 @@ long SimSettings::steps() const { return step_count(duration, dt); }
 
 const char* to_string(ShapeKind kind) {
   switch (kind) {
-    case ShapeKind::Box: return "box";
-    case ShapeKind::Icosphere: return "icosphere";
-    case ShapeKind::Prism: return "prism";
-    case ShapeKind::Convex: return "convex";
-    case ShapeKind::Mesh: return "mesh";
+    case ShapeKind::Box:
+      return "box";
+    case ShapeKind::Icosphere:
+      return "icosphere";
+    case ShapeKind::Prism:
+      return "prism";
+    case ShapeKind::Convex:
+      return "convex";
+    case ShapeKind::Mesh:
+      return "mesh";
   }
   return "box";
 }
 
 std::optional<ShapeKind> shape_kind_from_string(const std::string& name) {
-  for (ShapeKind k : {ShapeKind::Box, ShapeKind::Icosphere, ShapeKind::Prism, ShapeKind::Convex,
-                      ShapeKind::Mesh})
+  for (ShapeKind k :
+       {ShapeKind::Box, ShapeKind::Icosphere, ShapeKind::Prism, ShapeKind::Convex, ShapeKind::Mesh})
     if (name == to_string(k)) return k;
   return std::nullopt;
 }
 
 const char* to_string(CheckKind check) {
   switch (check) {
-    case CheckKind::Contact: return "contact";
-    case CheckKind::Impulse: return "impulse";
-    case CheckKind::Trajectory: return "trajectory";
-    case CheckKind::Stability: return "stability";
-    case CheckKind::Mass: return "mass";
+    case CheckKind::Contact:
+      return "contact";
+    case CheckKind::Impulse:
+      return "impulse";
+    case CheckKind::Trajectory:
+      return "trajectory";
+    case CheckKind::Stability:
+      return "stability";
+    case CheckKind::Mass:
+      return "mass";
   }
   return "contact";
 }

@@ -30,14 +30,14 @@ enum class Integrator {
 
 /// Simulation settings ([sim] in a scene file). Defaults are the contract's.
 struct SimSettings {
-  double dt = 1e-3;                        // s, > 0
-  double duration = 1.0;                   // s, >= 0
-  Vec3 gravity = Vec3::Zero();             // m/s^2
-  double restitution = 1.0;                // e in [0, 1]
-  double friction = 0.0;                   // Coulomb mu >= 0 (the seed omits friction)
+  double dt = 1e-3;             // s, > 0
+  double duration = 1.0;        // s, >= 0
+  Vec3 gravity = Vec3::Zero();  // m/s^2
+  double restitution = 1.0;     // e in [0, 1]
+  double friction = 0.0;        // Coulomb mu >= 0 (the seed omits friction)
   Integrator integrator = Integrator::Symplectic;
-  std::vector<double> sweep_dt;            // s, time steps for error against run time
-  double max_energy_ratio = 1e3;           // guard: stop when E > ratio * max(E0, tiny)
+  std::vector<double> sweep_dt;   // s, time steps for error against run time
+  double max_energy_ratio = 1e3;  // guard: stop when E > ratio * max(E0, tiny)
 
   /// Number of steps to cover `duration`: step_count(duration, dt) (throws std::domain_error when
   /// that is not a countable number).
@@ -76,12 +76,12 @@ std::optional<CheckKind> check_kind_from_string(const std::string& name);
 struct BodySpec {
   std::string name;
   ShapeKind shape_kind = ShapeKind::Box;
-  Vec3 box_size = Vec3::Ones();          // m, full extents (box only)
+  Vec3 box_size = Vec3::Ones();                   // m, full extents (box only)
   std::shared_ptr<const ConvexPolyhedron> shape;  // in the scene's local frame
-  double mass = 1.0;                     // kg
+  double mass = 1.0;                              // kg
   bool is_static = false;
   MassModel mass_model = MassModel::Solid;
-  Vec3 position = Vec3::Zero();          // m, world position of the shape's local origin
+  Vec3 position = Vec3::Zero();  // m, world position of the shape's local origin
   Quat orientation = Quat::Identity();
   Vec3 velocity = Vec3::Zero();          // m/s, of the centre of mass
   Vec3 angular_velocity = Vec3::Zero();  // rad/s, world frame
@@ -115,9 +115,9 @@ struct Expect {
 struct Scene {
   std::string name;
   std::string description;
-  std::string file;                     // path it was read from, as given
-  std::vector<CheckKind> checks;        // in the order the scene lists them
-  std::vector<std::string> backends;    // empty: every backend that serves the checks
+  std::string file;                   // path it was read from, as given
+  std::vector<CheckKind> checks;      // in the order the scene lists them
+  std::vector<std::string> backends;  // empty: every backend that serves the checks
   SimSettings sim;
   std::vector<BodySpec> bodies;
   std::optional<Expect> expect;

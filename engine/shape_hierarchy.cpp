@@ -33,8 +33,8 @@ ShapeHierarchy ShapeHierarchy::build(const ConvexPolyhedron& s) {
     FaceCone& cone = h.cones[k];
     Vec3 sum = Vec3::Zero();
     for (int i = node.begin; i < node.end; ++i) sum += planes[h.triangles.order[i]].normal;
-    cone.axis = sum.norm() > 1e-6 ? Vec3(sum.normalized())
-                                  : planes[h.triangles.order[node.begin]].normal;
+    cone.axis =
+        sum.norm() > 1e-6 ? Vec3(sum.normalized()) : planes[h.triangles.order[node.begin]].normal;
     double c = 1.0;
     cone.e_min = std::numeric_limits<double>::infinity();
     cone.e_max = -cone.e_min;
@@ -48,8 +48,8 @@ ShapeHierarchy ShapeHierarchy::build(const ConvexPolyhedron& s) {
     // Widen the cone by more than the round-off of the dot products (a cosine of exactly 1 would
     // otherwise hide an angle of up to ~1e-8 rad).
     cone.cos_half = std::max(-1.0, c - 1e-15);
-    cone.sin_half = std::min(1.0, std::sqrt(std::max(0.0, 1.0 - cone.cos_half * cone.cos_half)) +
-                                      1e-12);
+    cone.sin_half =
+        std::min(1.0, std::sqrt(std::max(0.0, 1.0 - cone.cos_half * cone.cos_half)) + 1e-12);
   }
   // Vertices.
   h.vertices = Bvh::build(v, v, kLeafSize);

@@ -23,8 +23,8 @@ constexpr int kSmallTriangles = 32;
 /// e_f = n_f . (q_f - c). The normals lie in a cone (axis, half-angle t), so with w = p - c at an
 /// angle phi from the axis, n_f . w <= |w| cos(max(0, phi - t)), and e_f is in [e_min, e_max].
 struct FaceCone {
-  Vec3 axis = Vec3::UnitZ();        // unit, body frame
-  double cos_half = -1.0;           // cosine and sine of the half-angle, widened by round-off
+  Vec3 axis = Vec3::UnitZ();  // unit, body frame
+  double cos_half = -1.0;     // cosine and sine of the half-angle, widened by round-off
   double sin_half = 0.0;
   double e_min = 0.0, e_max = 0.0;  // m, plane offsets from the node centre
 };

@@ -1,8 +1,8 @@
 // Time of impact for the extended engine: the first contact time of two bodies that were
 // separated at the start of a step, found on the Moore & Wilhelms detector itself. The seed
 // names this as missing ("a time-of-impact method ... is obvious when the bounding box check
-// passes", SEED_NOTES 12); without it a body crossing another's thickness within one step
-// passes through (stress/tunnel_thin_wall).
+// passes", seed correction 12 (contact point and plane in one pass)); without it a body crossing
+// another's thickness within one step passes through (stress/tunnel_thin_wall).
 #pragma once
 
 #include <optional>

@@ -14,7 +14,9 @@ namespace rbx {
 
 World::World(SimSettings sim, std::vector<RigidBody> bodies, DetectorVariant variant,
              BroadPhaseMethod broad_phase)
-    : sim_(std::move(sim)), bodies_(std::move(bodies)), variant_(variant),
+    : sim_(std::move(sim)),
+      bodies_(std::move(bodies)),
+      variant_(variant),
       broad_phase_(broad_phase) {
   // Energy guard budget: the initial kinetic energy, or the work gravity could do over the
   // bodies' own sizes, whichever is larger, so a scene starting at rest is not flagged.

@@ -15,7 +15,7 @@ namespace rbx {
 
 /// One resolved collision: a detection that applied a non-zero impulse.
 struct CollisionEvent {
-  double time = 0.0;     // s, start of the step in which it was detected
+  double time = 0.0;  // s, start of the step in which it was detected
   long step = 0;
   std::string body_a, body_b;
   ContactPoint contact;  // normal from body_b toward body_a
@@ -25,10 +25,10 @@ struct CollisionEvent {
 /// Outcome of a whole run.
 struct RunResult {
   bool ok = true;
-  std::string message;                 // why the run stopped early, when !ok
+  std::string message;  // why the run stopped early, when !ok
   long steps_taken = 0;
   std::vector<CollisionEvent> events;
-  std::vector<RigidBody> bodies;       // final states
+  std::vector<RigidBody> bodies;  // final states
 };
 
 /// A set of bodies stepped by the seed's algorithm.

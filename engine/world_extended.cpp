@@ -63,8 +63,8 @@ void World::step_extended() {
     ContactPoint c = manifolds[m].manifold.detector_contact;
     c.point = moment[m] / impulse[m];
     c.depth = manifolds[m].manifold.depth;
-    events_.push_back({time_, step_, bodies_[manifolds[m].a].name, bodies_[manifolds[m].b].name,
-                       c, impulse[m]});
+    events_.push_back(
+        {time_, step_, bodies_[manifolds[m].a].name, bodies_[manifolds[m].b].name, c, impulse[m]});
   }
 
   // Time of impact: pairs separated at the step's start that the step's motion brings into
@@ -126,7 +126,8 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
       // the step within the radii sum; the radius about the centre of mass bounds every
       // orientation, so rotation needs no margin.
       const Vec3 p = a.position - b.position, q = (a.velocity - b.velocity) * dt;
-      const double s = q.squaredNorm() > 0.0 ? std::clamp(-p.dot(q) / q.squaredNorm(), 0.0, 1.0) : 0.0;
+      const double s =
+          q.squaredNorm() > 0.0 ? std::clamp(-p.dot(q) / q.squaredNorm(), 0.0, 1.0) : 0.0;
       if ((p + s * q).norm() > radius[lo] + radius[hi]) continue;
       if (const auto t = time_of_impact(a, b, dt, variant_)) hits.emplace_back(*t, lo, hi);
     }

@@ -58,8 +58,8 @@ inline bool is_native_box(const RigidBody& body) {
   // Round-off of the centre of mass and of the inertia integrals: 1e-12 of the size / trace.
   const double size = body.box_size.norm();
   const Mat3& inertia = body.inertia_body;
-  const double off_diagonal = std::abs(inertia(0, 1)) + std::abs(inertia(0, 2)) +
-                              std::abs(inertia(1, 2));
+  const double off_diagonal =
+      std::abs(inertia(0, 1)) + std::abs(inertia(0, 2)) + std::abs(inertia(1, 2));
   return body.shape->bounds().center().norm() <= 1e-12 * size &&
          off_diagonal <= 1e-12 * std::abs(inertia.trace());
 }
@@ -83,14 +83,14 @@ struct StateSample {
 /// from measurement (one point or a manifold, the normal, how deep the contact was first seen).
 /// Filled by each adapter at the first step that applied an impulse.
 struct FirstImpulse {
-  bool seen = false;                 // false: no impulse in the run
-  std::string body_a, body_b;        // the pair, in scene order
-  long step = -1;                    // the step whose start-of-step poses detected it
-  int contact_points = 0;            // points the library solved for the pair in that step
-  Vec3 normal = Vec3::Zero();        // unit, from B toward A (mean over the points)
-  double depth = 0.0;                // m, deepest point at detection
-  double approach_speed = 0.0;       // m/s, closing normal speed before the step (>= 0)
-  double entry_phase = -1.0;         // depth / (approach_speed * dt); -1: not closing
+  bool seen = false;            // false: no impulse in the run
+  std::string body_a, body_b;   // the pair, in scene order
+  long step = -1;               // the step whose start-of-step poses detected it
+  int contact_points = 0;       // points the library solved for the pair in that step
+  Vec3 normal = Vec3::Zero();   // unit, from B toward A (mean over the points)
+  double depth = 0.0;           // m, deepest point at detection
+  double approach_speed = 0.0;  // m/s, closing normal speed before the step (>= 0)
+  double entry_phase = -1.0;    // depth / (approach_speed * dt); -1: not closing
 };
 
 /// Result of a dynamics run over a whole scene.

@@ -175,9 +175,10 @@ ContactResult pair_query(const RigidBody& a, const RigidBody& b, const BulletSet
     obj_b.setWorldTransform(body_transform(b, identity));
     // With polyhedral features the algorithm takes its axis from SAT when m_enableSatConvex is
     // set, otherwise from GJK/EPA before clipping.
-    ctx.world.getDispatchInfo().m_enableSatConvex = settings.polyhedral_hulls && settings.sat_convex;
-    PairCallback callback(&obj_a, pair_feature(native_box(a, settings), native_box(b, settings),
-                                               settings));
+    ctx.world.getDispatchInfo().m_enableSatConvex =
+        settings.polyhedral_hulls && settings.sat_convex;
+    PairCallback callback(&obj_a,
+                          pair_feature(native_box(a, settings), native_box(b, settings), settings));
     ctx.world.contactPairTest(&obj_a, &obj_b, callback);
     return {Status::Ok, "", std::move(callback.contacts)};
   } catch (const std::exception& e) {
@@ -354,7 +355,8 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
       const size_t events_before = result.events.size();
       if (!result.first_impulse.seen) {
         before.clear();
-        for (size_t i = 0; i < bodies.size(); ++i) before.push_back(final_state(names[i], bodies[i]));
+        for (size_t i = 0; i < bodies.size(); ++i)
+          before.push_back(final_state(names[i], bodies[i]));
       }
       // One internal step of exactly dt (maxSubSteps = 0: no fixed 1/60 s sub-stepping and no
       // interpolated motion states).

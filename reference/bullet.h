@@ -17,8 +17,8 @@ struct BulletSettings {
   double hull_margin = 0.0;      // m, btConvexHullShape's margin (outside the hull: inflates it)
   bool fair_world = true;        // the solver settings below; false: Bullet's defaults throughout
   double split_impulse_threshold = 1e30;  // m; Bullet splits where distance < this (BT_LARGE_FLOAT)
-  double restitution_threshold = 0.0;      // m/s; no bounce below this approach speed
-  double processing_threshold = 0.0;       // m; contacts solved once closer than this
+  double restitution_threshold = 0.0;     // m/s; no bounce below this approach speed
+  double processing_threshold = 0.0;      // m; contacts solved once closer than this
 };
 
 /// `bullet`: native boxes, polyhedral hulls (GJK + EPA axis, clipped manifold), zero hull

@@ -16,7 +16,7 @@ namespace rbx {
 /// Error state of one C library on one thread.
 struct CErrorTrap {
   static constexpr std::size_t kMessageSize = 512;
-  std::jmp_buf* jump = nullptr;  // innermost guarded() on this thread, or none
+  std::jmp_buf* jump = nullptr;     // innermost guarded() on this thread, or none
   char error[kMessageSize] = {};    // the last error
   char warning[kMessageSize] = {};  // the first warning since clear_warning()
   long warning_count = 0;           // warnings counted (ODE counts its messages; resets it)

@@ -40,8 +40,8 @@
 #include <iterator>
 #include <limits>
 #include <map>
-#include <stdexcept>
 #include <memory>
+#include <stdexcept>
 #include <unordered_map>
 #include <utility>
 

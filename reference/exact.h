@@ -1,4 +1,5 @@
-// Exact contact oracle: separating-axis test over all face normals and edge-pair cross products, and the contact manifold by clipping the reference face against the incident face.
+// Exact contact oracle: separating-axis test over all face normals and edge-pair cross products,
+// and the contact manifold by clipping the reference face against the incident face.
 #pragma once
 
 #include <memory>
@@ -9,7 +10,7 @@ namespace rbx {
 
 /// Result of the exact SAT query between two placed convex polyhedra.
 struct SatResult {
-  bool touching = false;       // overlap >= 0 on every axis (touching counts)
+  bool touching = false;        // overlap >= 0 on every axis (touching counts)
   Vec3 normal = Vec3::UnitZ();  // unit, world, from B toward A: minimum-translation direction
   double depth = 0.0;          // m: minimum translation distance (negative: separation lower bound)
   std::string axis_kind;       // "face_a" | "face_b" | "edge_edge"

@@ -147,17 +147,16 @@ ContactResult fcl_contact(const RigidBody& a, const RigidBody& b) {
   // GST_LIBCCD: with two Box shapes both solvers dispatch to boxBoxIntersect (the table in
   // gjk_solver_libccd-inl.h); with a Convex in the pair it runs libccd MPR.
   const bool boxes = is_native_box(a) && is_native_box(b);
-  return reject_undefined_normals(guarded(boxes ? "fcl::collide (Box-Box)"
-                                                : "fcl::collide (GST_LIBCCD)",
-                                          [&] {
-                                            fcl::Transform3d tf_a, tf_b;
-                                            auto geom_a = native_geometry(a, tf_a);
-                                            auto geom_b = native_geometry(b, tf_b);
-                                            return collide(geom_a, tf_a, geom_b, tf_b,
-                                                           fcl::GST_LIBCCD,
-                                                           boxes ? "box-box" : "mpr");
-                                          }),
-                                  "fcl::collide (GST_LIBCCD)");
+  return reject_undefined_normals(
+      guarded(boxes ? "fcl::collide (Box-Box)" : "fcl::collide (GST_LIBCCD)",
+              [&] {
+                fcl::Transform3d tf_a, tf_b;
+                auto geom_a = native_geometry(a, tf_a);
+                auto geom_b = native_geometry(b, tf_b);
+                return collide(geom_a, tf_a, geom_b, tf_b, fcl::GST_LIBCCD,
+                               boxes ? "box-box" : "mpr");
+              }),
+      "fcl::collide (GST_LIBCCD)");
 }
 
 ContactResult fcl_hull_contact(const RigidBody& a, const RigidBody& b) {

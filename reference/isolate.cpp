@@ -109,14 +109,13 @@ ContactResult run_isolated(const std::function<ContactResult()>& query, double t
   // Parent: read until EOF or the deadline.
   close(fds[1]);
   std::string bytes;
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   bool timed_out = false;
   char buf[4096];
   for (;;) {
     // Rounded up: truncating would time out up to 1 ms before the deadline.
-    const auto left = std::chrono::ceil<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::ceil<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) {
       timed_out = true;
       break;

@@ -204,9 +204,8 @@ std::string build_mjcf(const std::vector<RigidBody>& bodies, bool all_free,
     const RigidBody& b = bodies[i];
     const std::string shape = shape_attributes(b, i, opt.box_geoms);
     if (b.is_static && !all_free) {
-      s << "<geom name=\"g" << i << "\"" << shape << " pos=\""
-        << vec_text(b.position) << "\" quat=\"" << quat_text(b.orientation) << "\"" << contact
-        << "/>\n";
+      s << "<geom name=\"g" << i << "\"" << shape << " pos=\"" << vec_text(b.position)
+        << "\" quat=\"" << quat_text(b.orientation) << "\"" << contact << "/>\n";
       continue;
     }
     // Body frame = our centre-of-mass frame; explicit inertia about it, in body axes.
@@ -457,8 +456,8 @@ MassResult mass_of_geom(const RigidBody& body, bool box) {
   std::ostringstream xml;
   xml << "<mujoco model=\"rbx_mass\">\n<compiler inertiafromgeom=\"true\"/>\n<asset>\n"
       << (box ? "" : mesh_element("hull0", *body.shape)) << "</asset>\n<worldbody>\n"
-      << "<body name=\"b\">\n<freejoint/>\n<geom" << shape_attributes(body, 0, box)
-      << " mass=\"" << num(body.mass) << "\"/>\n</body>\n</worldbody>\n</mujoco>\n";
+      << "<body name=\"b\">\n<freejoint/>\n<geom" << shape_attributes(body, 0, box) << " mass=\""
+      << num(body.mass) << "\"/>\n</body>\n</worldbody>\n</mujoco>\n";
   std::string error;
   ModelPtr m = load_model(xml.str(), &error);
   if (!m) return {Status::Error, error, 0.0, -1.0, Vec3::Zero(), Mat3::Zero()};
@@ -467,7 +466,8 @@ MassResult mass_of_geom(const RigidBody& body, bool box) {
   r.center_of_mass = Vec3(m->body_ipos[3 * b], m->body_ipos[3 * b + 1], m->body_ipos[3 * b + 2]);
   const Quat q(m->body_iquat[4 * b], m->body_iquat[4 * b + 1], m->body_iquat[4 * b + 2],
                m->body_iquat[4 * b + 3]);
-  const Vec3 moments(m->body_inertia[3 * b], m->body_inertia[3 * b + 1], m->body_inertia[3 * b + 2]);
+  const Vec3 moments(m->body_inertia[3 * b], m->body_inertia[3 * b + 1],
+                     m->body_inertia[3 * b + 2]);
   const Mat3 rot = q.normalized().toRotationMatrix();
   r.inertia = rot * moments.asDiagonal() * rot.transpose();
   r.message = box ? "box geom, inertiafromgeom" : "mesh geom, inertiafromgeom";
@@ -520,7 +520,8 @@ ContactResult mujoco_contact_with(const RigidBody& a, const RigidBody& b,
   t_trap.clear_warning();
   if (!guarded([&] { mj_forward(mc, dd); }))
     return {Status::Error, std::string("MuJoCo mj_forward: ") + t_trap.error, {}};
-  if (t_trap.has_warning()) return {Status::Error, std::string("MuJoCo warning: ") + t_trap.warning, {}};
+  if (t_trap.has_warning())
+    return {Status::Error, std::string("MuJoCo warning: ") + t_trap.warning, {}};
   const int body_a = m->geom_bodyid[geom_of(mc, 0)];
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& c = d->contact[i];
@@ -609,7 +610,7 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
     }
     // d->contact and efc_force describe the state at the start of this step.
     std::map<std::pair<int, int>, size_t> still_open;
-    std::map<std::pair<int, int>, int> points;     // pushing contacts per pair this step
+    std::map<std::pair<int, int>, int> points;      // pushing contacts per pair this step
     std::map<std::pair<int, int>, double> deepest;  // m, per pair this step
     for (int c = 0; c < dd->ncon; ++c) {
       const mjContact& con = dd->contact[c];
@@ -673,6 +674,5 @@ MassResult mujoco_mass(const RigidBody& body) {
 }
 
 MassResult mujoco_hull_mass(const RigidBody& body) { return mass_of_geom(body, false); }
-
 
 }  // namespace rbx

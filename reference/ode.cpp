@@ -213,7 +213,7 @@ struct WorldOwner {
 
 // One contact joint created in a step, with what we need to report it.
 struct StepContact {
-  int a = 0, b = 0;       // scene indices, a < b
+  int a = 0, b = 0;  // scene indices, a < b
   const char* feature = "convex";
   dContactGeom geom{};    // g1 belongs to a
   double approach = 0.0;  // m/s, relative normal velocity before the step (< 0: closing)
@@ -453,7 +453,8 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
     const size_t events_before = r.events.size();
     if (!r.first_impulse.seen) {
       before.clear();
-      for (size_t i = 0; i < bodies.size(); ++i) before.push_back(read_state(bodies[i], ode_bodies[i]));
+      for (size_t i = 0; i < bodies.size(); ++i)
+        before.push_back(read_state(bodies[i], ode_bodies[i]));
     }
     ctx.contacts.clear();
     ctx.feedback.clear();

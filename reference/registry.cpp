@@ -12,9 +12,12 @@ namespace rbx {
 
 const char* to_string(Status s) {
   switch (s) {
-    case Status::Ok: return "ok";
-    case Status::Error: return "error";
-    case Status::Unsupported: return "unsupported";
+    case Status::Ok:
+      return "ok";
+    case Status::Error:
+      return "error";
+    case Status::Unsupported:
+      return "unsupported";
   }
   return "error";
 }
@@ -27,8 +30,9 @@ const std::vector<Backend>& backends() {
   static const std::vector<Backend> table = {
       {"custom", "rbx engine: Moore & Wilhelms face/vertex/edge tests, single-point impulse",
        custom_contact, custom_dynamics},
-      {"custom-seed", "rbx engine, the seed's algorithm: first hit, single-point frictionless impulse",
-       nullptr, custom_seed_dynamics},
+      {"custom-seed",
+       "rbx engine, the seed's algorithm: first hit, single-point frictionless impulse", nullptr,
+       custom_seed_dynamics},
       {"exact", "rbx oracle: separating-axis test over faces and edge pairs, clipped manifold",
        exact_contact, nullptr},
       {"fcl", "FCL 0.7: Box (boxBoxIntersect) or Convex (libccd MPR)", fcl_contact, nullptr,

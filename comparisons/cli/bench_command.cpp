@@ -1,7 +1,7 @@
 // `rbx bench`: times the bench table (comparisons/eval/bench_cases.h) and writes its pages
 // (comparisons/output/perf_report.h) into --out (default reports/latest, beside `rbx report`'s
 // files, which that command carries over when it replaces the folder). Without --out,
-// reports/perf.md (the path CONTRACT.md names) gets a copy of perf.md whose figure links point
+// reports/perf.md (the path docs/contract.md names) gets a copy of perf.md whose figure links point
 // into latest/.
 #include <filesystem>
 #include <iostream>

@@ -92,7 +92,8 @@ int check_command(const ReportOptions& opt) {
   const std::vector<std::string> only = split_list(opt.backends);
   const std::vector<Backend>& table = opt.registry ? *opt.registry : backends();
   for (const std::string& name : only)
-    if (std::none_of(table.begin(), table.end(), [&](const Backend& b) { return b.name == name; })) {
+    if (std::none_of(table.begin(), table.end(),
+                     [&](const Backend& b) { return b.name == name; })) {
       std::string names;
       for (const Backend& b : table) names += (names.empty() ? "" : ", ") + b.name;
       throw InputError("--backends: unknown backend '" + name + "'; known: " + names);
@@ -114,14 +115,16 @@ int check_command(const ReportOptions& opt) {
   std::map<std::string, double> now;
   std::set<std::string> scene_in_run;
   // Known failures that no longer fail: scene name -> file.
-  std::vector<std::pair<std::string, std::pair<std::string, std::string>>> now_passing;  // scene, (file, engine)
+  std::vector<std::pair<std::string, std::pair<std::string, std::string>>>
+      now_passing;  // scene, (file, engine)
   int cached = 0, cacheable = 0;
   for (const Scene& s : scenes) {
     const std::string scene = scene_family(s.file) + "/" + s.name;
     scene_in_run.insert(scene);
     const SceneEvaluation ev = evaluate_scene(s, hopt);
     for (const Metric& m : ev.metrics)
-      if (m.name.find("err") != std::string::npos && selected(m.backend)) now[key_of(scene, m)] = m.value;
+      if (m.name.find("err") != std::string::npos && selected(m.backend))
+        now[key_of(scene, m)] = m.value;
     for (const auto& [name, bj] : ev.json["backends"].items())
       if (ResultCache::caches(name)) {
         ++cacheable;
@@ -136,8 +139,8 @@ int check_command(const ReportOptions& opt) {
       const std::string prefix = known.substr(0, known.find(':'));
       if (prefix == "custom" || prefix == "custom-seed") subject = prefix;
     }
-    const bool subject_ran = ev.json["backends"].contains(subject) &&
-                             ev.json["backends"][subject]["status"] == "ok";
+    const bool subject_ran =
+        ev.json["backends"].contains(subject) && ev.json["backends"][subject]["status"] == "ok";
     if (s.expect && !s.expect->known_failure.empty() && subject_ran &&
         ev.json["expect"].value("checked", false) &&
         std::none_of(ev.expect_failures.begin(), ev.expect_failures.end(),
@@ -182,7 +185,8 @@ int check_command(const ReportOptions& opt) {
       ++worse;
       changes[p.scene][p.backend].push_back("worse   " + p.label + ": " +
                                             change_text(old, cur, unit_of(p.label)));
-    } else if ((was_nan && !is_nan) || cur < old - kRelativeMargin * std::abs(old) - kAbsoluteMargin) {
+    } else if ((was_nan && !is_nan) ||
+               cur < old - kRelativeMargin * std::abs(old) - kAbsoluteMargin) {
       ++better;
       changes[p.scene][p.backend].push_back("better  " + p.label + ": " +
                                             change_text(old, cur, unit_of(p.label)));
@@ -198,12 +202,14 @@ int check_command(const ReportOptions& opt) {
     }
   }
   for (const auto& [scene, passing] : now_passing)
-    std::cout << scene << ": " << passing.second << " now meets [expect], a known failure: remove known_failure from "
-              << passing.first << "\n";
+    std::cout << scene << ": " << passing.second
+              << " now meets [expect], a known failure: remove known_failure from " << passing.first
+              << "\n";
   const double base_rt = base.value("runtime_s", 0.0);
-  std::cout << "check: " << now.size() << " metrics over " << scenes.size() << " scenes: " << worse + missing
-            << " worse, " << better << " better, " << added << " new; run time " << fmt_num(runtime, 3)
-            << " s (baseline " << fmt_num(base_rt, 3) << " s; timings never fail the check";
+  std::cout << "check: " << now.size() << " metrics over " << scenes.size()
+            << " scenes: " << worse + missing << " worse, " << better << " better, " << added
+            << " new; run time " << fmt_num(runtime, 3) << " s (baseline " << fmt_num(base_rt, 3)
+            << " s; timings never fail the check";
   if (hopt.cache_dir.size() && cacheable > 0)
     std::cout << "; " << cached << " of " << cacheable << " reference runs from the cache, "
               << ResultCache::default_dir();
@@ -216,9 +222,10 @@ int check_command(const ReportOptions& opt) {
   }
   // --update: refused while anything is worse, unless the researcher accepts it explicitly.
   if (worse + missing > 0 && !opt.accept_worse) {
-    std::cout << "check: --update refused: " << worse + missing
-              << " metrics are worse (listed above); the baseline is unchanged. Fix them, or record "
-                 "them as the new truth with --update --accept-worse\n";
+    std::cout
+        << "check: --update refused: " << worse + missing
+        << " metrics are worse (listed above); the baseline is unchanged. Fix them, or record "
+           "them as the new truth with --update --accept-worse\n";
     return 1;
   }
   // Merge: metrics of scenes (and, with --backends, backends) not in this run stay as they were.
@@ -238,8 +245,9 @@ int check_command(const ReportOptions& opt) {
   b["runtime_s"] = whole || !base.contains("runtime_s") ? runtime : base_rt;
   b["metrics"] = metrics;
   write_json(baseline_path, b);
-  std::cout << "check: baseline " << baseline_path << " updated: " << now.size() << " metrics from this run, "
-            << kept << " kept from scenes or backends not run (" << metrics.size() << " in all)\n";
+  std::cout << "check: baseline " << baseline_path << " updated: " << now.size()
+            << " metrics from this run, " << kept << " kept from scenes or backends not run ("
+            << metrics.size() << " in all)\n";
   return 0;
 }
 

@@ -13,12 +13,12 @@ namespace rbx {
 
 /// Options shared by the scene commands.
 struct SceneCommandOptions {
-  std::vector<std::string> scenes;     // scene files (compare takes several)
-  std::string json;                    // --json FILE|- ("" : none)
-  std::vector<std::string> sets;       // --set KEY=VALUE
-  std::string backends;                // --backends LIST ("" : the scene's, or every one)
-  bool force = false;                  // --force: accept absurd step counts
-  std::string at;                      // contacts --at: "" (t = 0) | "first-contact"
+  std::vector<std::string> scenes;  // scene files (compare takes several)
+  std::string json;                 // --json FILE|- ("" : none)
+  std::vector<std::string> sets;    // --set KEY=VALUE
+  std::string backends;             // --backends LIST ("" : the scene's, or every one)
+  bool force = false;               // --force: accept absurd step counts
+  std::string at;                   // contacts --at: "" (t = 0) | "first-contact"
 };
 
 /// Loads a scene applying --set and --force (InputError on bad input).
@@ -47,8 +47,8 @@ struct ReportOptions {
   bool no_cache = false;            // check --no-cache: rerun every reference library
   /// Backends to choose from (nullptr: the registry); tests pass a table with a broken engine.
   const std::vector<Backend>* registry = nullptr;
-  std::string backends;             // --backends LIST
-  bool quiet = false;               // no progress line
+  std::string backends;  // --backends LIST
+  bool quiet = false;    // no progress line
 };
 
 /// `rbx report`: accuracy report over a scene library.
@@ -81,16 +81,16 @@ namespace rbx {
 
 /// Options of `rbx explore`.
 struct ExploreOptions {
-  long count = 20000;         // samples
-  unsigned long long seed = 1;  // sample k of seed s depends on (s, k) only
+  long count = 20000;            // samples
+  unsigned long long seed = 1;   // sample k of seed s depends on (s, k) only
   std::string kind = "contact";  // contact | impact
-  std::string backends;       // --backends LIST ("" : every contact backend but exact)
-  std::string out;            // output folder ("" : reports/explore)
-  std::string baseline;       // --baseline FILE: exit 1 when a backend got worse
-  int threads = 0;            // per rank (0: the cores of the node, divided among its ranks)
-  int shrink_budget = 400;    // predicate evaluations per group
-  bool bench = false;         // --bench: throughput of the sampling only, hulls under 100 points
-  bool no_figure = false;     // --no-figure: skip matplotlib (tests)
+  std::string backends;          // --backends LIST ("" : every contact backend but exact)
+  std::string out;               // output folder ("" : reports/explore)
+  std::string baseline;          // --baseline FILE: exit 1 when a backend got worse
+  int threads = 0;               // per rank (0: the cores of the node, divided among its ranks)
+  int shrink_budget = 400;       // predicate evaluations per group
+  bool bench = false;            // --bench: throughput of the sampling only, hulls under 100 points
+  bool no_figure = false;        // --no-figure: skip matplotlib (tests)
 };
 
 /// `rbx explore`: random contact pairs against the exact oracle on every core or MPI rank;

@@ -68,9 +68,11 @@ int compare_command(const SceneCommandOptions& opt) {
         out << "  [expect]: not checked\n";
       else if (ev.expect_failures.empty())
         out << "  [expect]: passed\n";
-      for (const std::string& s : ev.expect_unchecked) out << "  [expect] not checked: " << s << "\n";
+      for (const std::string& s : ev.expect_unchecked)
+        out << "  [expect] not checked: " << s << "\n";
       for (const std::string& s : ev.expect_failures) out << "  [expect] FAILED: " << s << "\n";
-      if (ev.expect_known) out << "  [expect] known failure: " << scene.expect->known_failure << "\n";
+      if (ev.expect_known)
+        out << "  [expect] known failure: " << scene.expect->known_failure << "\n";
     }
     out << "\n";
     // A documented limitation of the custom engine does not fail the command; anything else does.

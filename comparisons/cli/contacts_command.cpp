@@ -70,16 +70,17 @@ int contacts_command(const SceneCommandOptions& opt) {
   const std::vector<RigidBody> bodies =
       at_first ? first_contact_state(scene, contact_step, stop_reason) : make_bodies(scene);
   if (at_first && contact_step >= 0)
-    out << "first contact: step " << contact_step << ", t = " << fmt_num(contact_step * scene.sim.dt)
+    out << "first contact: step " << contact_step
+        << ", t = " << fmt_num(contact_step * scene.sim.dt)
         << " s (the custom engine's motion up to there; the exact oracle's test)\n";
   const double tol = scene.expect ? scene.expect->tolerance : 1e-6;
   std::vector<std::string> marks;
 
   Json backends_json = Json::object();
   for (const std::string& name : names) {
-    backends_json[name] = {{"status", "ok"}, {"message", ""}, {"runtime_s", 0.0},
-                           {"contacts", Json::array()}, {"pairs", Json::array()},
-                           {"bodies", bodies_json(bodies)}};
+    backends_json[name] = {{"status", "ok"},         {"message", ""},
+                           {"runtime_s", 0.0},       {"contacts", Json::array()},
+                           {"pairs", Json::array()}, {"bodies", bodies_json(bodies)}};
   }
   int pairs_shown = 0;
   for (size_t i = 0; i < bodies.size(); ++i) {
@@ -126,11 +127,12 @@ int contacts_command(const SceneCommandOptions& opt) {
           angle = fmt_num(pair["normal_err_deg"].get<double>(), 3);
           ddepth = fmt_num(pair["depth_err"].get<double>(), 3);
           const double size = 2.0 * std::min(bounding_sphere(a).radius, bounding_sphere(b).radius);
-          mark = mark_of(pair["normal_err_deg"].get<double>(), std::abs(c->depth - t->depth), size, tol);
+          mark = mark_of(pair["normal_err_deg"].get<double>(), std::abs(c->depth - t->depth), size,
+                         tol);
           if (!mark.empty())
-            marks.push_back(mark + ": " + name + " on " + a.name + "-" + b.name + ": normal off by " +
-                            angle + " deg, depth off by " + fmt_num(std::abs(c->depth - t->depth), 3) +
-                            " m (against exact)");
+            marks.push_back(mark + ": " + name + " on " + a.name + "-" + b.name +
+                            ": normal off by " + angle + " deg, depth off by " +
+                            fmt_num(std::abs(c->depth - t->depth), 3) + " m (against exact)");
         } else if (run.result.status == Status::Ok) {
           pair["touching_agrees"] = (c != nullptr) == (t != nullptr);
           if ((c != nullptr) != (t != nullptr)) {
@@ -145,7 +147,9 @@ int contacts_command(const SceneCommandOptions& opt) {
         table.add({name, to_string(run.result.status), std::to_string(run.result.contacts.size()),
                    c ? fmt_vec(c->normal) : "-", c ? fmt_num(c->depth, 5) : "-",
                    c ? fmt_vec(c->point) : "-", angle, ddepth,
-                   mark == "disagrees" ? "✗" : mark == "deviates" ? "~" : "",
+                   mark == "disagrees"  ? "✗"
+                   : mark == "deviates" ? "~"
+                                        : "",
                    fmt_num(run.runtime_s * 1e6, 3)});
       }
       table.print(out);
@@ -156,9 +160,11 @@ int contacts_command(const SceneCommandOptions& opt) {
   for (const std::string& m : marks) out << "  " << m << "\n";
   if (pairs_shown == 0) {
     if (!at_first)
-      out << "no pair of bodies touches at t = 0 (--at first-contact queries where one first does)\n";
+      out << "no pair of bodies touches at t = 0 (--at first-contact queries where one first "
+             "does)\n";
     else
-      out << "no pair of bodies touches within the run (" << scene.sim.steps() << " steps of the custom engine"
+      out << "no pair of bodies touches within the run (" << scene.sim.steps()
+          << " steps of the custom engine"
           << (stop_reason.empty() ? "" : "; it stopped: " + stop_reason) << ")\n";
   }
   Json result;
@@ -173,7 +179,8 @@ int contacts_command(const SceneCommandOptions& opt) {
   result["disagreements"] = Json::array();
   result["deviations"] = Json::array();
   for (const std::string& m : marks)
-    result[m.rfind("disagrees", 0) == 0 ? "disagreements" : "deviations"].push_back(m.substr(m.find(": ") + 2));
+    result[m.rfind("disagrees", 0) == 0 ? "disagreements" : "deviations"].push_back(
+        m.substr(m.find(": ") + 2));
   result["backends"] = backends_json;
   if (!opt.json.empty()) write_json(opt.json, result);
   return 0;

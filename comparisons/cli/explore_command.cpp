@@ -12,8 +12,8 @@
 #include "comparisons/cli/commands.h"
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/parallel.h"
-#include "comparisons/scene/scene_file.h"
 #include "comparisons/output/table.h"
+#include "comparisons/scene/scene_file.h"
 #include "engine/bounding.h"
 #include "reference/exact.h"
 
@@ -54,7 +54,8 @@ std::vector<std::string> contact_backends(const std::string& list) {
   std::string name;
   while (std::getline(ss, name, ',')) {
     if (name.empty()) continue;
-    if (!find_backend(name)) throw InputError("rbx explore: --backends: unknown backend '" + name + "'");
+    if (!find_backend(name))
+      throw InputError("rbx explore: --backends: unknown backend '" + name + "'");
     names.push_back(name);
   }
   if (names.empty()) throw InputError("rbx explore: --backends: no backend named");
@@ -72,10 +73,10 @@ std::string file_stem(const std::string& sig) {
 std::string expect_block(const std::string& text) {
   const Scene scene = parse_scene(text, "explore.toml");
   const std::vector<RigidBody> bodies = make_bodies(scene);
-  const SatResult sat = sat_query(*bodies[0].shape, bodies[0].pose(), *bodies[1].shape,
-                                  bodies[1].pose());
-  const double size = std::min(2.0 * bounding_sphere(bodies[0]).radius,
-                               2.0 * bounding_sphere(bodies[1]).radius);
+  const SatResult sat =
+      sat_query(*bodies[0].shape, bodies[0].pose(), *bodies[1].shape, bodies[1].pose());
+  const double size =
+      std::min(2.0 * bounding_sphere(bodies[0]).radius, 2.0 * bounding_sphere(bodies[1]).radius);
   char buf[512];
   std::ostringstream o;
   o << "# Truth: the exact oracle (separating axes over faces and edge pairs), not a closed form.\n"
@@ -83,7 +84,8 @@ std::string expect_block(const std::string& text) {
        "# the disagreements explore looks for are above 1 degree or 1 % of that size).\n";
   o << "[expect]\n";
   std::snprintf(buf, sizeof buf, "tolerance = %.3g\n", std::max(1e-12, 1e-6 * size));
-  o << buf << "[expect.contact]\n" << "touching = " << (sat.touching ? "true" : "false") << "\n";
+  o << buf << "[expect.contact]\n"
+    << "touching = " << (sat.touching ? "true" : "false") << "\n";
   if (sat.touching) {
     std::snprintf(buf, sizeof buf, "normal = [%.17g, %.17g, %.17g]\ndepth = %.17g\n",
                   sat.normal.x(), sat.normal.y(), sat.normal.z(), std::max(sat.depth, 0.0));
@@ -126,16 +128,18 @@ std::string shrink_group(const Json& g, uint64_t seed, long count, int budget) {
   std::ostringstream h;
   h << "# Found by `rbx explore --seed " << seed << " --count " << count << "`: sample "
     << start.index << " (" << start.pose_class << " pose), group '" << sig << "',\n# "
-    << g["count"].get<long>() << " samples. " << backend << " against the exact oracle: "
-    << describe(found) << ".\n# Shrunk from " << r.vertices_before << " to " << r.vertices_after
-    << " points (" << r.steps_accepted << " simplifications kept, " << r.evaluations
+    << g["count"].get<long>() << " samples. " << backend
+    << " against the exact oracle: " << describe(found) << ".\n# Shrunk from " << r.vertices_before
+    << " to " << r.vertices_after << " points (" << r.steps_accepted << " simplifications kept, "
+    << r.evaluations
     << " tried), while the disagreement stayed.\n# Reproduce: rbx compare THIS_FILE --backends "
     << backend << "\n";
   const std::string body = sample_scene_text(r.sample, h.str());
   const std::string text = body + "\n" + expect_block(body);
   std::string detail;
   bool reproduced = false;
-  if (!AbortGuard::run([&] { reproduced = harness_reproduces(text, "explore.toml", found, &detail); })) {
+  if (!AbortGuard::run(
+          [&] { reproduced = harness_reproduces(text, "explore.toml", found, &detail); })) {
     // The harness does not guard against aborts: `rbx compare` ends the same way on this scene.
     detail = "the harness aborted inside the library (rbx compare aborts on this scene too)";
   }
@@ -179,7 +183,8 @@ int compare_baseline(const Json& now, const std::string& path) {
     }
     const Json& o = old["backends"][name];
     if (up(o["rate"], b["rate"])) {
-      std::cout << "  WORSE " << name << ": disagreement rate " << o["rate"] << " -> " << b["rate"] << "\n";
+      std::cout << "  WORSE " << name << ": disagreement rate " << o["rate"] << " -> " << b["rate"]
+                << "\n";
       ++worse;
     }
     for (const char* m : kMetrics)
@@ -219,11 +224,12 @@ std::string markdown(const Json& j, bool have_figure) {
   for (const auto& [name, b] : j["backends"].items()) {
     const Json& e = b["errors"];
     auto three = [&](const char* m) {
-      return fmt_num(e[m]["p50"], 2) + " / " + fmt_num(e[m]["p90"], 2) + " / " + fmt_num(e[m]["p99"], 2);
+      return fmt_num(e[m]["p50"], 2) + " / " + fmt_num(e[m]["p90"], 2) + " / " +
+             fmt_num(e[m]["p99"], 2);
     };
-    t.add({name, std::to_string(b["samples"].get<long>()), std::to_string(b["disagreements"].get<long>()),
-           fmt_num(b["rate"], 3), three("normal_err_deg"), three("depth_err_rel"),
-           fmt_num(e["point_err_rel"]["p99"], 2)});
+    t.add({name, std::to_string(b["samples"].get<long>()),
+           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
+           three("normal_err_deg"), three("depth_err_rel"), fmt_num(e["point_err_rel"]["p99"], 2)});
   }
   o << t.markdown();
   if (have_figure) o << "\n![error distributions per backend](explore_errors.png)\n";
@@ -236,7 +242,8 @@ std::string markdown(const Json& j, bool have_figure) {
     for (const Json& x : b["groups"])
       g.add({name, x["signature"], std::to_string(x["count"].get<long>()), fmt_num(x["rate"], 3),
              x["scene"].is_string() ? x["scene"].get<std::string>() : std::string("-"),
-             std::to_string(x.value("points_before", 0)) + " -> " + std::to_string(x.value("points_after", 0)),
+             std::to_string(x.value("points_before", 0)) + " -> " +
+                 std::to_string(x.value("points_after", 0)),
              x.value("reproduced", false) ? "yes" : "no"});
   o << g.markdown();
   return o.str();
@@ -247,7 +254,8 @@ std::string markdown(const Json& j, bool have_figure) {
 int explore_command(const ExploreOptions& opt) {
   ParallelRun par(opt.threads);
   const AbortGuard guard;
-  if (opt.count <= 0) throw InputError("rbx explore: --count: must be > 0, got " + std::to_string(opt.count));
+  if (opt.count <= 0)
+    throw InputError("rbx explore: --count: must be > 0, got " + std::to_string(opt.count));
   if (opt.kind == "impact")
     throw InputError("rbx explore: --kind impact: not implemented in this version (use contact)");
   if (opt.kind != "contact")
@@ -329,7 +337,9 @@ int explore_command(const ExploreOptions& opt) {
     }
     for (const std::string& n : names)
       for (const auto& [sig, c] : tally[n].by_signature)
-        groups.push_back({{"backend", n}, {"signature", sig}, {"count", c},
+        groups.push_back({{"backend", n},
+                          {"signature", sig},
+                          {"count", c},
                           {"first_sample", tally[n].first_index[sig]}});
   }
 
@@ -374,9 +384,12 @@ int explore_command(const ExploreOptions& opt) {
       std::sort(v.begin(), v.end());
       Json q = Json::array();
       for (int p = 0; p <= 100; p += 5) q.push_back(percentile(v, p));
-      b["errors"][m] = {{"n", v.size()},          {"p50", percentile(v, 50)},
-                        {"p90", percentile(v, 90)}, {"p99", percentile(v, 99)},
-                        {"max", percentile(v, 100)}, {"quantiles_every_5", q}};
+      b["errors"][m] = {{"n", v.size()},
+                        {"p50", percentile(v, 50)},
+                        {"p90", percentile(v, 90)},
+                        {"p99", percentile(v, 99)},
+                        {"max", percentile(v, 100)},
+                        {"quantiles_every_5", q}};
     }
     b["groups"] = Json::array();
     std::vector<std::pair<long, std::string>> order;
@@ -395,7 +408,8 @@ int explore_command(const ExploreOptions& opt) {
         write_text((out / file).string(), r["text"].get<std::string>());
         ++written;
         g["scene"] = file;
-        for (const char* k : {"points_before", "points_after", "evaluations", "reproduced", "harness"})
+        for (const char* k :
+             {"points_before", "points_after", "evaluations", "reproduced", "harness"})
           g[k] = r[k];
         g["shrunk_error"] = {{"normal_err_deg", r["normal_err_deg"]},
                              {"depth_err_rel", r["depth_err_rel"]},
@@ -420,7 +434,8 @@ int explore_command(const ExploreOptions& opt) {
 
   // The figure (matplotlib from Debian, as `rbx report`), then the page that shows it.
   bool figure = false;
-  const std::string script = std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/explore_plots.py";
+  const std::string script =
+      std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/explore_plots.py";
   if (fs::exists("/usr/bin/python3") && !opt.no_figure) {
     const std::string cmd = "/usr/bin/python3 '" + script + "' '" + out.string() + "' > '" +
                             (out / "figures.log").string() + "' 2>&1";

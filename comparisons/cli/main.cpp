@@ -1,14 +1,13 @@
 // The `rbx` command: parses arguments, dispatches to a subcommand, maps failures to exit codes
 // (0 success, 1 a check failed, 2 bad input or usage, with one line on stderr).
 #include <CLI/CLI.hpp>
-
 #include <exception>
 #include <iostream>
 
 #include "comparisons/cli/commands.h"
-#include "comparisons/scene/scene_file.h"
-#include "comparisons/eval/tosses.h"
 #include "comparisons/cli/view.h"
+#include "comparisons/eval/tosses.h"
+#include "comparisons/scene/scene_file.h"
 #include "engine/polyhedron.h"
 
 namespace {
@@ -34,15 +33,18 @@ int main(int argc, char** argv) {
   rbx::ReportOptions report_opt, check_opt;
   scene_options(app.add_subcommand("run", "custom engine only: collision events and final state"),
                 run_opt, false, true);
-  CLI::App* contacts = app.add_subcommand("contacts", "contact query at the t=0 poses, every backend");
+  CLI::App* contacts =
+      app.add_subcommand("contacts", "contact query at the t=0 poses, every backend");
   scene_options(contacts, contacts_opt, false, true);
-  contacts->add_option("--at", contacts_opt.at,
-                       "first-contact: query at the first step where a pair touches (the custom "
-                       "engine's motion, the exact oracle's test)")
+  contacts
+      ->add_option("--at", contacts_opt.at,
+                   "first-contact: query at the first step where a pair touches (the custom "
+                   "engine's motion, the exact oracle's test)")
       ->check(CLI::IsMember({"first-contact"}));
   scene_options(app.add_subcommand("compare", "the scenes' checks, side by side"), compare_opt,
                 true, true);
-  CLI::App* report = app.add_subcommand("report", "accuracy report (default: scenes/ -> reports/latest)");
+  CLI::App* report =
+      app.add_subcommand("report", "accuracy report (default: scenes/ -> reports/latest)");
   report->add_option("inputs", report_opt.inputs, "scene files or folders");
   report->add_option("--out", report_opt.out, "output folder");
   report->add_option("--backends", report_opt.backends, "comma-separated backend names");
@@ -52,24 +54,33 @@ int main(int argc, char** argv) {
   CLI::App* check = app.add_subcommand("check", "regression check against reports/baseline.json");
   check->add_option("inputs", check_opt.inputs, "scene files or folders (default: scenes/)");
   check->add_option("--baseline", check_opt.baseline, "baseline file");
-  check->add_option("--backends", check_opt.backends, "comma-separated backend names: only their metrics are compared (and updated)");
-  CLI::Option* update = check->add_flag(
-      "--update", check_opt.update,
-      "merge this run into the baseline (scenes and backends not run stay); refused while anything is worse");
-  check->add_flag("--accept-worse", check_opt.accept_worse, "with --update: record worse metrics too")
+  check->add_option("--backends", check_opt.backends,
+                    "comma-separated backend names: only their metrics are compared (and updated)");
+  CLI::Option* update = check->add_flag("--update", check_opt.update,
+                                        "merge this run into the baseline (scenes and backends not "
+                                        "run stay); refused while anything is worse");
+  check
+      ->add_flag("--accept-worse", check_opt.accept_worse,
+                 "with --update: record worse metrics too")
       ->needs(update);
-  check->add_flag("--no-cache", check_opt.no_cache, "rerun every reference library (no build/cache)");
+  check->add_flag("--no-cache", check_opt.no_cache,
+                  "rerun every reference library (no build/cache)");
   rbx::BenchOptions bench_opt;
-  CLI::App* bench = app.add_subcommand("bench", "performance comparison (default: reports/latest, and reports/perf.md)");
+  CLI::App* bench = app.add_subcommand(
+      "bench", "performance comparison (default: reports/latest, and reports/perf.md)");
   bench->add_option("--out", bench_opt.out, "output folder");
   bench->add_flag("--quick", bench_opt.quick, "fewer sizes and shorter runs (under a minute)");
   rbx::TossesOptions tosses_opt;
-  CLI::App* tosses = app.add_subcommand("tosses", "every dynamics backend against measured cube tosses");
+  CLI::App* tosses =
+      app.add_subcommand("tosses", "every dynamics backend against measured cube tosses");
   tosses->add_option("data", tosses_opt.data, "tosses CSV (.csv or .csv.gz)")->required();
-  tosses->add_option("--params", tosses_opt.params, "parameter file (default: params.json beside DATA)");
-  tosses->add_flag("--fit", tosses_opt.fit, "fit restitution and friction per backend on DATA, write the parameter file");
+  tosses->add_option("--params", tosses_opt.params,
+                     "parameter file (default: params.json beside DATA)");
+  tosses->add_flag("--fit", tosses_opt.fit,
+                   "fit restitution and friction per backend on DATA, write the parameter file");
   tosses->add_option("--backends", tosses_opt.backends, "comma-separated backend names");
-  tosses->add_option("--json", tosses_opt.json, "write JSON results to FILE, or - for standard output");
+  tosses->add_option("--json", tosses_opt.json,
+                     "write JSON results to FILE, or - for standard output");
   rbx::ViewOptions view_opt;
   CLI::App* view = app.add_subcommand("view", "one offline HTML page: 3-D replay of every backend");
   view->add_option("scene", view_opt.scene, "scene file (TOML)")->required();
@@ -77,16 +88,20 @@ int main(int argc, char** argv) {
   view->add_option("--out", view_opt.out, "output HTML file (default: FAMILY_STEM.html)");
 
   rbx::ExploreOptions explore_opt;
-  CLI::App* explore = app.add_subcommand("explore", "random contact pairs against the exact oracle; disagreements shrunk to scenes");
+  CLI::App* explore = app.add_subcommand(
+      "explore", "random contact pairs against the exact oracle; disagreements shrunk to scenes");
   explore->add_option("--count", explore_opt.count, "number of samples (default 20000)");
   explore->add_option("--seed", explore_opt.seed, "seed (default 1)");
   explore->add_option("--kind", explore_opt.kind, "contact | impact");
   explore->add_option("--backends", explore_opt.backends, "comma-separated backend names");
   explore->add_option("--out", explore_opt.out, "output folder (default reports/explore)");
-  explore->add_option("--baseline", explore_opt.baseline, "stored explore.json: exit 1 when a backend got worse");
+  explore->add_option("--baseline", explore_opt.baseline,
+                      "stored explore.json: exit 1 when a backend got worse");
   explore->add_option("--threads", explore_opt.threads, "threads per rank (default: every core)");
-  explore->add_option("--shrink-budget", explore_opt.shrink_budget, "evaluations per group while shrinking");
-  explore->add_flag("--bench", explore_opt.bench, "time the sampling only (hulls under 100 points)");
+  explore->add_option("--shrink-budget", explore_opt.shrink_budget,
+                      "evaluations per group while shrinking");
+  explore->add_flag("--bench", explore_opt.bench,
+                    "time the sampling only (hulls under 100 points)");
   explore->add_flag("--no-figure", explore_opt.no_figure, "skip the matplotlib figure");
 
   try {

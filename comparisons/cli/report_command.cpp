@@ -12,15 +12,15 @@
 #include <sstream>
 
 #include "comparisons/cli/commands.h"
-#include "comparisons/eval/harness.h"
-#include "comparisons/scene/scene_collection.h"
-#include "comparisons/scene/scene_file.h"
-#include "comparisons/output/table.h"
-#include "comparisons/scene/repo_path.h"
-#include "comparisons/eval/tosses.h"
 #include "comparisons/cli/view.h"
+#include "comparisons/eval/harness.h"
+#include "comparisons/eval/tosses.h"
 #include "comparisons/eval/trajectory.h"
 #include "comparisons/output/scorecard.h"
+#include "comparisons/output/table.h"
+#include "comparisons/scene/repo_path.h"
+#include "comparisons/scene/scene_collection.h"
+#include "comparisons/scene/scene_file.h"
 
 namespace fs = std::filesystem;
 
@@ -35,8 +35,8 @@ class Progress {
       : on_(!quiet && isatty(STDERR_FILENO) && std::getenv("CI") == nullptr) {}
   void show(size_t i, size_t n, const std::string& what, double elapsed) {
     if (!on_) return;
-    std::cerr << "\r\033[K[" << i << "/" << n << "] " << what << " (" << fmt_num(elapsed, 3) << " s)"
-              << std::flush;
+    std::cerr << "\r\033[K[" << i << "/" << n << "] " << what << " (" << fmt_num(elapsed, 3)
+              << " s)" << std::flush;
   }
   void done() {
     if (on_) std::cerr << "\r\033[K" << std::flush;
@@ -91,8 +91,10 @@ std::string headline(const SceneEvaluation& ev, const std::string& backend, std:
   } else {
     cell = "ok";
   }
-  if (mentions(ev.disagreements, backend)) cell += " ✗";
-  else if (mentions(ev.deviations, backend)) cell += " ~";
+  if (mentions(ev.disagreements, backend))
+    cell += " ✗";
+  else if (mentions(ev.deviations, backend))
+    cell += " ~";
   // The engine under test on a documented limitation: marked by the same rule, and labelled.
   // The engine the known failure names ("custom" or "custom-seed", before its colon).
   const std::string known = ev.json["expect"].value("known_failure", std::string());
@@ -130,12 +132,14 @@ constexpr const char* kWhy =
     "- **fcl-indep**: FCL 0.7's GST_INDEP leaves the EPA normal in A's local frame and returns "
     "the depth negated (`FclIndep.*`); its signed distance on Box-Convex aborts on an assertion "
     "(`FclIndepDistance.*`, run in a forked process).\n"
-    "- **fcl-hull, libccd, ode-hull, mujoco-hull on `small_on_diagonal`**: MPR follows the ray between the "
+    "- **fcl-hull, libccd, ode-hull, mujoco-hull on `small_on_diagonal`**: MPR follows the ray "
+    "between the "
     "centres, not the minimum-translation axis (FCL issue 545): n = (1, 1, 1)/sqrt(3), depth "
     "0.26 for a true 0.15 (`FclMpr.*`, `Libccd.DiagonalCubeMprWrongEpaRight`, "
     "`MujocoKnownWrongAnswer.*`). Debian's ODE runs convex-convex through libccd MPR too, so it "
     "shares FCL's answers bit for bit.\n"
-    "- **fcl-hull, libccd, ode-hull at exact touching**: libccd's MPR zeroes its direction below CCD_EPS "
+    "- **fcl-hull, libccd, ode-hull at exact touching**: libccd's MPR zeroes its direction below "
+    "CCD_EPS "
     "of depth; the adapters report that as `error` (no normal), not as a 180 deg miss.\n"
     "- **bullet-sat**: the SAT + clipping path measures each point's depth to the first body's "
     "reference face, reported along the separating normal: too deep when A touches with an edge "
@@ -146,20 +150,22 @@ constexpr const char* kWhy =
     "`KnownDefectAlignedFaceFaceSpins`); at exactly zero depth its normal is left in A's frame "
     "(`offcentre_vertex`, `KnownDefectZeroDepthNormal`). Led by a corner "
     "(`headon_vertex_e05`) it is exact.\n"
-    "- **mujoco, mujoco-hull (dynamics)**: no coefficient of restitution: a soft contact calibrated through "
+    "- **mujoco, mujoco-hull (dynamics)**: no coefficient of restitution: a soft contact "
+    "calibrated through "
     "a negative `solref` spans several steps, so e comes out within a few % and the impact is "
     "spread in time; `mujoco-hull`'s mesh-mesh contacts are one MPR point per step.\n"
     "- **ode-hull (dynamics)**: one MPR point per step on face-face pairs, and its error reduction "
     "(ERP) turns penetration into separating velocity (`headon_e0`, `zero_relative_velocity`); "
     "corner-led impacts match to 1e-7.\n"
-    "- **mass (`-hull`)**: Bullet's hull inertia is its bounding box's; FCL 0.7's Convex inertia is off on "
-    "every hull here, the box included (relative 0.5 to 5); MuJoCo's mesh inertia is exact to float round-off "
+    "- **mass (`-hull`)**: Bullet's hull inertia is its bounding box's; FCL 0.7's Convex inertia "
+    "is off on "
+    "every hull here, the box included (relative 0.5 to 5); MuJoCo's mesh inertia is exact to "
+    "float round-off "
     "(`LibraryMass.*`, `scenes/mass/`).\n";
 
-
-std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs,
-                           double total_s, bool figures_ok, const std::string& figures_msg,
-                           bool views_ok) {
+std::string write_markdown(const std::vector<Scene>& scenes,
+                           const std::vector<SceneEvaluation>& evs, double total_s, bool figures_ok,
+                           const std::string& figures_msg, bool views_ok) {
   std::ostringstream md;
   // Backends that appear anywhere, in registry order.
   std::vector<std::string> cols;
@@ -196,7 +202,8 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
   for (size_t i = 0; i < evs.size(); ++i) {
     std::string against;
     std::vector<std::string> row = {md_escape(evs[i].family + "/" + scenes[i].name), "", ""};
-    if (views_ok) row[0] = "[" + row[0] + "](views/" + scene_slug(evs[i].family, scenes[i].file) + ".html)";
+    if (views_ok)
+      row[0] = "[" + row[0] + "](views/" + scene_slug(evs[i].family, scenes[i].file) + ".html)";
     std::string checks;
     for (const std::string& c : scenes[i].check_names()) checks += (checks.empty() ? "" : ", ") + c;
     row[1] = checks;
@@ -204,8 +211,10 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
       std::string a;
       row.push_back(headline(evs[i], c, a));
       if (row.back().find("✗") != std::string::npos) ++marks;
-      if (against.empty() || against == a) against = a;
-      else if (!a.empty() && a.rfind("self", 0) == 0 && against.rfind("self", 0) == 0) against = "self (finest dt)";
+      if (against.empty() || against == a)
+        against = a;
+      else if (!a.empty() && a.rfind("self", 0) == 0 && against.rfind("self", 0) == 0)
+        against = "self (finest dt)";
     }
     row[2] = against;
     if (!evs[i].expect_failures.empty())
@@ -249,7 +258,8 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
         "`sweep.csv`, `metrics.csv`.\n\n";
   std::set<std::string> families;
   for (const SceneEvaluation& ev : evs)
-    for (const SweepPoint& p : ev.sweep) families.insert(ev.family + (p.kind == "contact" ? "-contact" : ""));
+    for (const SweepPoint& p : ev.sweep)
+      families.insert(ev.family + (p.kind == "contact" ? "-contact" : ""));
   if (!figures_ok) md << "_Figures were not drawn: " << figures_msg << "_\n\n";
   for (const std::string& f : families)
     md << "![error against run time, " << f << "](figures/error_vs_runtime_" << f << ".png)\n\n";
@@ -259,7 +269,8 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
   md << "Verdicts, worst first: **unstable** (non-finite state, energy gained beyond 1 %, "
         "tunnelling, a stopped run, momentum drift in a closed system, penetration past half a "
         "body), **sinks** (bodies more than 1 % of the smaller body inside each other in every "
-        "sample of the last fifth of the run: \"at rest\"), **dissipative** (e = 1, no friction, more than 1 % of the "
+        "sample of the last fifth of the run: \"at rest\"), **dissipative** (e = 1, no friction, "
+        "more than 1 % of the "
         "energy lost by the end), **stable**. Energy drift: the largest |E/E0 - 1| over the run, "
         "signed (+ gained, - lost); penetration relative to the smaller body's size.\n\n";
   Table st({"scene", "backend", "dt (s)", "e", "verdict", "energy drift", "max penetration",
@@ -277,10 +288,12 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
               fmt_num(100 * s["max_penetration_rel"].get<double>(), 3) + " %",
               fmt_num(100 * s["rest_penetration_rel"].get<double>(), 3) + " %",
               std::to_string(s["tunnelled_pairs"].get<int>()),
-              s.contains("jitter_rms_mps") ? fmt_num(s["jitter_rms_mps"].get<double>(), 3) : "-", why});
+              s.contains("jitter_rms_mps") ? fmt_num(s["jitter_rms_mps"].get<double>(), 3) : "-",
+              why});
     }
   }
-  md << (any_stab ? st.markdown() : std::string("No scene asks for the stability check.\n")) << "\n";
+  md << (any_stab ? st.markdown() : std::string("No scene asks for the stability check.\n"))
+     << "\n";
 
   // Per-scene detail.
   md << "## Scenes\n\n";
@@ -303,11 +316,14 @@ std::string write_markdown(const std::vector<Scene>& scenes, const std::vector<S
       md << mt.markdown() << "\n";
     }
     for (const std::string& d : ev.disagreements) md << "- disagrees: " << d << "\n";
-    for (const std::string& d : ev.deviations) md << "- deviates (within the ✗ bounds): " << d << "\n";
+    for (const std::string& d : ev.deviations)
+      md << "- deviates (within the ✗ bounds): " << d << "\n";
     for (const std::string& s : ev.skipped) md << "- left out: " << s << "\n";
     if (scenes[i].expect)
       md << "- [expect]: "
-         << (!ev.expect_failures.empty() ? "FAILED" : ev.expect_checked ? "passed" : "not checked")
+         << (!ev.expect_failures.empty() ? "FAILED"
+             : ev.expect_checked         ? "passed"
+                                         : "not checked")
          << "\n";
     for (const std::string& f : ev.expect_unchecked) md << "  - not checked: " << f << "\n";
     for (const std::string& f : ev.expect_failures) md << "  - " << f << "\n";
@@ -342,7 +358,8 @@ int report_command(const ReportOptions& opt) {
   for (size_t i = 0; i < scenes.size(); ++i) {
     progress.show(i + 1, scenes.size(), scenes[i].file, clock.seconds());
     evs.push_back(evaluate_scene(scenes[i], hopt));
-    if (scenes[i].has_check(CheckKind::Contact)) evs.back().json["geometry"] = geometry_json(scenes[i]);
+    if (scenes[i].has_check(CheckKind::Contact))
+      evs.back().json["geometry"] = geometry_json(scenes[i]);
   }
   progress.done();
 
@@ -357,7 +374,8 @@ int report_command(const ReportOptions& opt) {
     results["generated_by"] = "rbx report";
     results["backends"] = Json::array();
     for (const Backend& b : backends())
-      results["backends"].push_back({{"name", b.name}, {"description", b.description},
+      results["backends"].push_back({{"name", b.name},
+                                     {"description", b.description},
                                      {"contact", static_cast<bool>(b.contact)},
                                      {"dynamics", static_cast<bool>(b.dynamics)}});
     results["scenes"] = Json::array();
@@ -381,8 +399,9 @@ int report_command(const ReportOptions& opt) {
               << csv_escape(p.against) << "\n";
       for (const auto& [name, s] : evs[i].json["stability"].items())
         stab << sc << "," << fam << "," << name << "," << fmt_num(s["dt"].get<double>(), 17) << ","
-             << fmt_num(s["restitution"].get<double>(), 17) << "," << s["verdict"].get<std::string>()
-             << "," << fmt_num(s["energy_growth_rel"].get<double>(), 17) << ","
+             << fmt_num(s["restitution"].get<double>(), 17) << ","
+             << s["verdict"].get<std::string>() << ","
+             << fmt_num(s["energy_growth_rel"].get<double>(), 17) << ","
              << fmt_num(s["energy_drift_rel"].get<double>(), 17) << ","
              << fmt_num(s["max_penetration_rel"].get<double>(), 17) << ","
              << fmt_num(s["rest_penetration_rel"].get<double>(), 17) << ","
@@ -405,8 +424,10 @@ int report_command(const ReportOptions& opt) {
                               (tmp / "figures.log").string() + "' 2>&1";
       const int rc = std::system(cmd.c_str());
       figures_ok = rc == 0;
-      if (!figures_ok) figures_msg = "plots.py failed (see figures.log)";
-      else fs::remove(tmp / "figures.log");
+      if (!figures_ok)
+        figures_msg = "plots.py failed (see figures.log)";
+      else
+        fs::remove(tmp / "figures.log");
     }
     // --- replay pages (view-report): views/SLUG.html and index.html ---
     bool views_ok = true;
@@ -417,7 +438,8 @@ int report_command(const ReportOptions& opt) {
       std::cerr << "report: no replay pages: " << e.what() << "\n";
     }
     // --- end replay pages ---
-    std::string md = write_markdown(scenes, evs, clock.seconds(), figures_ok, figures_msg, views_ok);
+    std::string md =
+        write_markdown(scenes, evs, clock.seconds(), figures_ok, figures_msg, views_ok);
     // Real impacts: every tosses data set under the inputs (comparisons/cli/tosses_command.cpp).
     for (const std::string& dir : find_toss_datasets(opt.inputs))
       md += tosses_report_section(dir, tmp.string(), opt.backends);

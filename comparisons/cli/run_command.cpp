@@ -22,8 +22,9 @@ void print_dynamics(std::ostream& out, const std::string& name, const Scene& sce
     const size_t shown = std::min<size_t>(r.events.size(), 20);
     for (size_t i = 0; i < shown; ++i) {
       const CollisionEvent& e = r.events[i];
-      t.add({fmt_num(e.time), e.body_a + "-" + e.body_b, e.contact.feature, fmt_vec(e.contact.point),
-             fmt_vec(e.contact.normal), fmt_num(e.contact.depth), fmt_num(e.impulse)});
+      t.add({fmt_num(e.time), e.body_a + "-" + e.body_b, e.contact.feature,
+             fmt_vec(e.contact.point), fmt_vec(e.contact.normal), fmt_num(e.contact.depth),
+             fmt_num(e.impulse)});
     }
     t.print(out);
     if (shown < r.events.size()) out << "  ... " << r.events.size() - shown << " more events\n";

@@ -9,9 +9,9 @@
 #include <iostream>
 #include <sstream>
 
-#include "comparisons/scene/scene_file.h"
-#include "comparisons/output/table.h"
 #include "comparisons/eval/tosses.h"
+#include "comparisons/output/table.h"
+#include "comparisons/scene/scene_file.h"
 
 namespace fs = std::filesystem;
 
@@ -73,8 +73,11 @@ Evaluation evaluate_all(const std::vector<const Backend*>& chosen, const std::ve
 }
 
 Json model_json(const CubeTossModel& m) {
-  return {{"cube_width_m", 2.0 * m.half_width}, {"mass_kg", m.mass}, {"gravity_mps2", m.gravity},
-          {"sample_rate_hz", m.sample_rate}, {"substeps", m.substeps},
+  return {{"cube_width_m", 2.0 * m.half_width},
+          {"mass_kg", m.mass},
+          {"gravity_mps2", m.gravity},
+          {"sample_rate_hz", m.sample_rate},
+          {"substeps", m.substeps},
           {"dt_s", 1.0 / (m.sample_rate * m.substeps)},
           {"floor", "static box " + fmt_num(m.floor_size, 3) + " x " + fmt_num(m.floor_size, 3) +
                         " x " + fmt_num(m.floor_thickness, 3) + " m, top face z = 0"}};
@@ -120,9 +123,9 @@ std::vector<size_t> ranking(const std::vector<BackendTosses>& rs) {
 
 // The results table, best first.
 Table results_table(const std::vector<BackendTosses>& rs, bool markdown) {
-  Table t({"rank", "backend", "e", "mu", "params", "tosses", "position err (widths) med / mean / p90",
-           "angle err (deg) med / mean / p90", "final position err med / mean / p90",
-           "run time (s)", "status"});
+  Table t({"rank", "backend", "e", "mu", "params", "tosses",
+           "position err (widths) med / mean / p90", "angle err (deg) med / mean / p90",
+           "final position err med / mean / p90", "run time (s)", "status"});
   auto triple = [](const Spread& s, int d) {
     return fmt_num(s.median, d) + " / " + fmt_num(s.mean, d) + " / " + fmt_num(s.p90, d);
   };
@@ -169,9 +172,11 @@ Json updated_params_json(const std::string& path, const std::string& data,
   Json& b = j["backends"];
   if (!b.is_object()) b = Json::object();
   for (const auto& [name, fit] : fits)
-    b[name] = {{"restitution", fit.params.restitution}, {"friction", fit.params.friction},
+    b[name] = {{"restitution", fit.params.restitution},
+               {"friction", fit.params.friction},
                {"fit_data", fs::path(data).filename().string()},
-               {"train_position_error", fit.objective}, {"evaluations", fit.evaluations},
+               {"train_position_error", fit.objective},
+               {"evaluations", fit.evaluations},
                {"fit_s", fit.seconds}};
   // Registry order, so refitting one backend does not reorder the file.
   Json sorted = Json::object();
@@ -200,8 +205,9 @@ int tosses_command(const TossesOptions& opt) {
     for (const Backend* b : chosen) {
       if (!b->dynamics) continue;
       std::cerr << "fitting " << b->name << " on " << tosses.size() << " tosses\n";
-      const FitResult fit = fit_backend(*b, tosses, CubeTossModel{},
-                                        [](const std::string& s) { std::cerr << "  " << s << "\n"; });
+      const FitResult fit = fit_backend(*b, tosses, CubeTossModel{}, [](const std::string& s) {
+        std::cerr << "  " << s << "\n";
+      });
       std::cerr << b->name << ": e = " << fmt_num(fit.params.restitution, 4)
                 << ", mu = " << fmt_num(fit.params.friction, 4) << ", error "
                 << fmt_num(fit.objective, 4) << " widths, " << fit.evaluations << " evaluations, "
@@ -300,8 +306,9 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
   std::vector<std::pair<std::string, long>> picks;  // label, toss id
   if (!best.tosses.empty()) {
     std::vector<TossErrors> sorted = best.tosses;
-    std::stable_sort(sorted.begin(), sorted.end(),
-                     [](const TossErrors& a, const TossErrors& b) { return a.position < b.position; });
+    std::stable_sort(sorted.begin(), sorted.end(), [](const TossErrors& a, const TossErrors& b) {
+      return a.position < b.position;
+    });
     picks = {{"best", sorted.front().toss_id},
              {"median", sorted[(sorted.size() - 1) / 2].toss_id},
              {"worst", sorted.back().toss_id}};
@@ -309,7 +316,8 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
   std::ostringstream traj;
   traj << "pick,toss,source,t,z,angle_deg\n";
   for (const auto& [label, id] : picks) {
-    const Toss& t = *std::find_if(tosses.begin(), tosses.end(), [&](const Toss& x) { return x.id == id; });
+    const Toss& t =
+        *std::find_if(tosses.begin(), tosses.end(), [&](const Toss& x) { return x.id == id; });
     const Quat q0 = t.samples.front().orientation;
     for (const TossSample& s : t.samples)
       traj << label << "," << id << ",measured," << fmt_num(s.time - t.samples.front().time, 6)
@@ -328,7 +336,8 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
 
   // Figures through matplotlib (the report's own figures need the same python3).
   bool figures_ok = false;
-  const std::string script = std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/tosses_plots.py";
+  const std::string script =
+      std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/tosses_plots.py";
   if (fs::exists("/usr/bin/python3")) {
     const std::string cmd = "/usr/bin/python3 '" + script + "' '" + out_dir + "' > '" +
                             (out / "tosses_figures.log").string() + "' 2>&1";
@@ -376,8 +385,8 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
         return spread_of(v).median;
       };
       for (double m : marks)
-        cells.push_back(fmt_num(median_at(&TossErrors::position_by_sample,
-                                          std::lround(m * rate) - 1), 3));
+        cells.push_back(
+            fmt_num(median_at(&TossErrors::position_by_sample, std::lround(m * rate) - 1), 3));
       const double last = median_at(&TossErrors::position_by_sample, -1);
       cells.push_back(fmt_num(last, 3));
       cells.push_back(fmt_num(median_at(&TossErrors::horizontal_by_sample, -1) / last, 3));
@@ -385,7 +394,8 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
     }
     md << "Median position error (cube widths) over the tosses at times after release (a toss "
           "already at rest counts with its last sample; the first measured impact comes at 0.115 s "
-          "(median; 0.07 to 0.18 s)) and the horizontal (x, y) part of the final error, at the fitted parameters:\n\n"
+          "(median; 0.07 to 0.18 s)) and the horizontal (x, y) part of the final error, at the "
+          "fitted parameters:\n\n"
        << t.markdown() << "\n";
   }
   if (figures_ok) {

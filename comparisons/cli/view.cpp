@@ -9,9 +9,9 @@
 
 #include "comparisons/cli/commands.h"
 #include "comparisons/eval/harness.h"
-#include "comparisons/scene/scene_file.h"
-#include "comparisons/output/scorecard.h"
 #include "comparisons/eval/trajectory.h"
+#include "comparisons/output/scorecard.h"
+#include "comparisons/scene/scene_file.h"
 
 namespace fs = std::filesystem;
 
@@ -36,8 +36,10 @@ Json events_json(const Json& contacts) {
   Json out = Json::array();
   for (const Json& c : contacts) {
     if (out.size() >= kViewMaxEvents) break;
-    out.push_back({{"t", rounded(c.value("time", 0.0))}, {"bodies", c["bodies"]},
-                   {"point", rounded(c["point"])}, {"normal", rounded(c["normal"])},
+    out.push_back({{"t", rounded(c.value("time", 0.0))},
+                   {"bodies", c["bodies"]},
+                   {"point", rounded(c["point"])},
+                   {"normal", rounded(c["normal"])},
                    {"depth", rounded(c["depth"])}});
   }
   return out;
@@ -307,10 +309,14 @@ std::string script_safe_json(const Json& j) {
   std::string out;
   out.reserve(s.size());
   for (char c : s) {
-    if (c == '<') out += "\\u003c";
-    else if (c == '>') out += "\\u003e";
-    else if (c == '&') out += "\\u0026";
-    else out += c;
+    if (c == '<')
+      out += "\\u003c";
+    else if (c == '>')
+      out += "\\u003e";
+    else if (c == '&')
+      out += "\\u0026";
+    else
+      out += c;
   }
   return out;
 }
@@ -321,12 +327,23 @@ std::string html_escape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -356,10 +373,13 @@ Json view_data(const Scene& scene, const Json& result) {
       d["shapes"].push_back(shape);
     }
     const Quat q = b.orientation.normalized();
-    d["bodies"].push_back({{"name", b.name}, {"shape", it->second}, {"static", b.is_static},
-                           {"position", vec_json(b.position)},
-                           {"orientation", {round_sig5(q.w()), round_sig5(q.x()), round_sig5(q.y()),
-                                            round_sig5(q.z())}}});
+    d["bodies"].push_back(
+        {{"name", b.name},
+         {"shape", it->second},
+         {"static", b.is_static},
+         {"position", vec_json(b.position)},
+         {"orientation",
+          {round_sig5(q.w()), round_sig5(q.x()), round_sig5(q.y()), round_sig5(q.z())}}});
   }
   // Each backend: status, sampled trajectory, events.
   d["backends"] = Json::object();
@@ -406,7 +426,8 @@ std::string three_js_path() {
   for (const char* p : {"/usr/share/javascript/three/three.min.js",
                         "/usr/share/javascript/three/build/three.min.js"})
     if (fs::exists(p)) return p;
-  throw std::runtime_error("three.js not found under /usr/share/javascript/three/ (install Debian's libjs-three)");
+  throw std::runtime_error(
+      "three.js not found under /usr/share/javascript/three/ (install Debian's libjs-three)");
 }
 
 std::string view_page(const Json& data, const std::string& three_js, const std::string& three_src) {
@@ -415,21 +436,29 @@ std::string view_page(const Json& data, const std::string& three_js, const std::
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rbx view: "
     << html_escape(title) << "</title>\n<style>" << kStyle << "</style>\n";
-  if (!three_src.empty()) h << "<script src=\"" << html_escape(three_src) << "\"></script>\n";
-  else h << "<script>" << three_js << "</script>\n";
+  if (!three_src.empty())
+    h << "<script src=\"" << html_escape(three_src) << "\"></script>\n";
+  else
+    h << "<script>" << three_js << "</script>\n";
   h << "</head><body>\n<header><h1>" << html_escape(title) << "</h1>\n";
   if (!data.value("description", "").empty())
     h << "<p>" << html_escape(data.value("description", "")) << "</p>\n";
   h << "<p>One panel per backend, same camera (drag to orbit, wheel to zoom). Red: the backend's "
        "contact points and normals (from B toward A) of the events near the current time"
-    << (data["duration"].get<double>() > 0 ? "" : " (contact query at t = 0)") << ". Black: the reference ("
-    << html_escape(ref.value("source", "").empty() ? "none for this scene" : ref.value("source", ""))
+    << (data["duration"].get<double>() > 0 ? "" : " (contact query at t = 0)")
+    << ". Black: the reference ("
+    << html_escape(ref.value("source", "").empty() ? "none for this scene"
+                                                   : ref.value("source", ""))
     << ")";
-  if (!ref["finals"].empty()) h << "; at the end of the run, arrows give the closed-form final velocity direction";
-  h << ". Trajectories are sampled (at most " << kMaxFrames << " frames); at most " << kViewMaxEvents
+  if (!ref["finals"].empty())
+    h << "; at the end of the run, arrows give the closed-form final velocity direction";
+  h << ". Trajectories are sampled (at most " << kMaxFrames << " frames); at most "
+    << kViewMaxEvents
     << " events per backend are drawn.</p>\n<div id=\"controls\"><button id=\"play\">play</button> "
-       "<input id=\"slider\" type=\"range\" min=\"0\" max=\"1000\" value=\"0\"> <span id=\"clock\"></span> "
-       "<label><input id=\"ref\" type=\"checkbox\" checked> reference</label> <span id=\"toggles\"></span></div>\n"
+       "<input id=\"slider\" type=\"range\" min=\"0\" max=\"1000\" value=\"0\"> <span "
+       "id=\"clock\"></span> "
+       "<label><input id=\"ref\" type=\"checkbox\" checked> reference</label> <span "
+       "id=\"toggles\"></span></div>\n"
        "</header>\n<div id=\"stage\"><canvas id=\"view\"></canvas><div id=\"labels\"></div></div>\n"
        "<pre id=\"rbx-state\">{}</pre>\n<script id=\"rbx-data\" type=\"application/json\">"
     << script_safe_json(data) << "</script>\n<script>" << kScript << "</script>\n</body></html>\n";
@@ -442,10 +471,11 @@ void write_report_views(const std::string& dir, const std::vector<Scene>& scenes
   fs::create_directories(views);
   fs::copy_file(three_js_path(), views / "three.min.js", fs::copy_options::overwrite_existing);
   std::ostringstream index;
-  index << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rbx report: 3-D "
-           "replays</title></head><body>\n<h1>rbx report: 3-D replay of every scene</h1>\n"
-           "<p>Each page plays every backend's run of the scene side by side. See also "
-           "<a href=\"report.md\">report.md</a>.</p>\n<ul>\n";
+  index
+      << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rbx report: 3-D "
+         "replays</title></head><body>\n<h1>rbx report: 3-D replay of every scene</h1>\n"
+         "<p>Each page plays every backend's run of the scene side by side. See also "
+         "<a href=\"report.md\">report.md</a>.</p>\n<ul>\n";
   for (size_t i = 0; i < scenes.size() && i < evs.size(); ++i) {
     const std::string slug = scene_slug(evs[i].family, scenes[i].file);
     write_text((views / (slug + ".html")).string(),
@@ -470,9 +500,8 @@ int view_command(const ViewOptions& opt) {
   std::ifstream in(three_js_path(), std::ios::binary);
   std::ostringstream js;
   js << in.rdbuf();
-  const std::string out = opt.out.empty()
-                              ? ev.family + "_" + fs::path(scene.file).stem().string() + ".html"
-                              : opt.out;
+  const std::string out =
+      opt.out.empty() ? ev.family + "_" + fs::path(scene.file).stem().string() + ".html" : opt.out;
   const std::string page = view_page(view_data(scene, ev.json), js.str());
   write_text(out, page);
   std::cout << "view: " << out << " (" << page.size() / 1024 << " kB, "

@@ -5,7 +5,6 @@
 #pragma once
 
 #include <string>
-
 #include <vector>
 
 #include "comparisons/eval/harness.h"
@@ -19,7 +18,8 @@ namespace rbx {
 ///  bodies: [{name, shape, static, position, orientation}] (t = 0),
 ///  backends: {NAME: {status, message, time: [s], frames: {BODY: [[x,y,z,qw,qx,qy,qz]]},
 ///            events: [{t, bodies, point, normal, depth}], events_total}},
-///  reference: {source, contacts: [...], normal, depth, finals: {BODY: {velocity, angular_velocity}}}}.
+///  reference: {source, contacts: [...], normal, depth, finals: {BODY: {velocity,
+///  angular_velocity}}}}.
 /// Events beyond kViewMaxEvents per backend are counted, not listed.
 Json view_data(const Scene& scene, const Json& scene_result);
 
@@ -34,7 +34,8 @@ std::string three_js_path();
 /// The page. `three_js` is the library's source, inlined; or, when `three_src` is non-empty, the
 /// page loads it from that relative path instead (the report shares one copy among its pages).
 /// Every text from the scene is escaped (HTML and the embedded JSON), never parsed as markup.
-std::string view_page(const Json& data, const std::string& three_js, const std::string& three_src = "");
+std::string view_page(const Json& data, const std::string& three_js,
+                      const std::string& three_src = "");
 
 /// Text safe inside HTML element content and attribute values (& < > " ').
 std::string html_escape(const std::string& s);

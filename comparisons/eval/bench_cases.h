@@ -25,7 +25,8 @@ struct PoseKind {
   const char* name;
   double offset;  // fraction of the size; negative: penetrating
 };
-inline constexpr PoseKind kPoseKinds[] = {{"touching", -0.005}, {"deep", -0.2}, {"separated", 0.05}};
+inline constexpr PoseKind kPoseKinds[] = {
+    {"touching", -0.005}, {"deep", -0.2}, {"separated", 0.05}};
 
 /// Repetitions of the cheap cases and of those behind the goals (the fastest is kept).
 constexpr int kBenchRepetitions = 3;
@@ -92,12 +93,12 @@ std::vector<RigidBody> cube_crowd(int n, std::mt19937_64& rng);
 /// per repetition); each call runs warm_up once, then timed iterations of body, with set_up
 /// before each (not timed).
 struct BenchCase {
-  std::string name;                // family/backend/variant/size/kind
-  std::function<void()> warm_up;   // untimed, once per call: caches, hierarchies, page faults
-  std::function<void()> set_up;    // untimed, before every iteration; empty: none
-  std::function<void()> body;      // the timed work of one iteration
-  double min_time_s = 0.1;         // minimum timed time
-  int repetitions = 1;             // the fastest repetition is kept
+  std::string name;               // family/backend/variant/size/kind
+  std::function<void()> warm_up;  // untimed, once per call: caches, hierarchies, page faults
+  std::function<void()> set_up;   // untimed, before every iteration; empty: none
+  std::function<void()> body;     // the timed work of one iteration
+  double min_time_s = 0.1;        // minimum timed time
+  int repetitions = 1;            // the fastest repetition is kept
 };
 
 /// A narrow-phase result row.
@@ -128,7 +129,7 @@ struct StepRow {
 
 /// Everything a run measured.
 struct BenchResults {
-  int cpus = 0;        // as Google Benchmark saw the machine
+  int cpus = 0;  // as Google Benchmark saw the machine
   double mhz = 0.0;
   std::size_t cases = 0;
   std::vector<NarrowRow> narrow;

@@ -11,8 +11,8 @@
 
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/harness.h"
-#include "comparisons/scene/mesh_io.h"
 #include "comparisons/eval/metrics.h"
+#include "comparisons/scene/mesh_io.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/body.h"
 #include "engine/bounding.h"
@@ -126,8 +126,9 @@ ExploreBody random_body(SampleRng& r, double scale) {
     // Mostly small hulls (the speed goal is set on under 100 vertices), a few up to 2000.
     const double v = r.uniform();
     const int n = v < 0.7 ? r.integer(4, 32)
-                  : v < 0.97 ? r.integer(33, 99)
-                             : static_cast<int>(std::round(std::pow(10.0, r.uniform(2.0, 3.30103))));
+                  : v < 0.97
+                      ? r.integer(33, 99)
+                      : static_cast<int>(std::round(std::pow(10.0, r.uniform(2.0, 3.30103))));
     e.points = hull_points(r, n, scale);
   } else {
     e.shape_class = "sliver";
@@ -226,7 +227,8 @@ ContactSample make_contact_sample(uint64_t seed, uint64_t index) {
   }
   // Where A's and B's shapes are placed: shape frames are the scene's local frames (their
   // origins are what `position` places), so supports are measured from those origins.
-  const double reach = support(*shape_a, s.a.orientation, n) + support(*shape_b, s.b.orientation, -n);
+  const double reach =
+      support(*shape_a, s.a.orientation, n) + support(*shape_b, s.b.orientation, -n);
   Vec3 side = n.cross(r.direction());
   side = side.norm() > 1e-9 ? side.normalized() : Vec3::Zero();
   s.b.position = s.a.position + (reach - overlap) * n + sideways * side;
@@ -254,7 +256,9 @@ std::string num(double x) {
   return s;
 }
 
-std::string vec(const Vec3& v) { return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]"; }
+std::string vec(const Vec3& v) {
+  return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]";
+}
 
 std::string body_text(const ExploreBody& e, const std::string& name) {
   std::ostringstream o;
@@ -319,7 +323,8 @@ ContactRun guarded_contact(const Backend& be, const RigidBody& a, const RigidBod
     run = run_contact(be, a, b);
   } else {
     run = ContactRun{};
-    run.result = {Status::Error, be.name + " aborted inside the library (SIGABRT, a failed assertion)", {}};
+    run.result = {
+        Status::Error, be.name + " aborted inside the library (SIGABRT, a failed assertion)", {}};
   }
   t_abort_jump = outer;
   return run;
@@ -335,8 +340,7 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
   SampleOutcome out;
   out.shapes = shapes;
   const SatResult sat = sat_query(*a.shape, a.pose(), *b.shape, b.pose());
-  const double size =
-      std::min(2.0 * bounding_sphere(a).radius, 2.0 * bounding_sphere(b).radius);
+  const double size = std::min(2.0 * bounding_sphere(a).radius, 2.0 * bounding_sphere(b).radius);
   out.touching = sat.touching;
   out.depth_rel = sat.depth / size;
   out.feature = sat.touching ? sat.axis_kind : "separated";
@@ -392,11 +396,11 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
 
 }  // namespace
 
-AbortGuard::AbortGuard() { previous_ = reinterpret_cast<void*>(std::signal(SIGABRT, explore_on_abort)); }
-
-AbortGuard::~AbortGuard() {
-  std::signal(SIGABRT, reinterpret_cast<void (*)(int)>(previous_));
+AbortGuard::AbortGuard() {
+  previous_ = reinterpret_cast<void*>(std::signal(SIGABRT, explore_on_abort));
 }
+
+AbortGuard::~AbortGuard() { std::signal(SIGABRT, reinterpret_cast<void (*)(int)>(previous_)); }
 
 bool AbortGuard::run(const std::function<void()>& f) {
   sigjmp_buf here;
@@ -435,8 +439,8 @@ std::string signature(const SampleOutcome& s, const BackendOutcome& b) {
 }
 
 std::string encode(const SampleOutcome& s) {
-  Json j = {{"i", s.index}, {"p", s.pose_class}, {"s", s.shapes}, {"f", s.feature},
-            {"t", s.touching}, {"d", s.depth_rel}, {"b", Json::array()}};
+  Json j = {{"i", s.index},    {"p", s.pose_class}, {"s", s.shapes},     {"f", s.feature},
+            {"t", s.touching}, {"d", s.depth_rel},  {"b", Json::array()}};
   for (const BackendOutcome& b : s.backends)
     j["b"].push_back({b.backend, b.error, b.measured, b.normal_err_deg, b.depth_err_rel,
                       b.point_err_rel, b.message});
@@ -452,8 +456,7 @@ SampleOutcome decode(const std::string& text) {
   s.feature = j["f"];
   s.touching = j["t"];
   s.depth_rel = j["d"];
-  for (const Json& b : j["b"])
-    s.backends.push_back({b[0], b[1], b[2], b[3], b[4], b[5], b[6]});
+  for (const Json& b : j["b"]) s.backends.push_back({b[0], b[1], b[2], b[3], b[4], b[5], b[6]});
   return s;
 }
 
@@ -500,7 +503,7 @@ ShrinkResult shrink(const ContactSample& start, const std::string& backend, cons
     ++r.evaluations;
     try {
       const SampleOutcome o = evaluate_scene_text(sample_scene_text(c), names, c.pose_class,
-                                                    c.a.shape_class + "-" + c.b.shape_class);
+                                                  c.a.shape_class + "-" + c.b.shape_class);
       for (const BackendOutcome& b : o.backends)
         if (!b.error.empty() && signature(o, b) == sig) {
           if (out) *out = o;
@@ -528,7 +531,8 @@ ShrinkResult shrink(const ContactSample& start, const std::string& backend, cons
     } catch (const std::exception&) {
     }
     for (size_t chunk = (r.sample.*body).points.size() / 2; chunk >= 1; chunk /= 2) {
-      for (size_t at = 0; at < (r.sample.*body).points.size() && (r.sample.*body).points.size() > 4;) {
+      for (size_t at = 0;
+           at < (r.sample.*body).points.size() && (r.sample.*body).points.size() > 4;) {
         ContactSample d = r.sample;
         auto& p = (d.*body).points;
         const size_t end = std::min(at + chunk, p.size());
@@ -604,8 +608,8 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
   hopt.timing_budget_s = 0.0;  // one query each: no timing repeats
   const SceneEvaluation ev = evaluate_scene(scene, hopt);
   const std::vector<RigidBody> bodies = make_bodies(scene);
-  const double size = std::min(2.0 * bounding_sphere(bodies[0]).radius,
-                               2.0 * bounding_sphere(bodies[1]).radius);
+  const double size =
+      std::min(2.0 * bounding_sphere(bodies[0]).radius, 2.0 * bounding_sphere(bodies[1]).radius);
   auto metric = [&](const std::string& name) -> double {
     for (const Metric& m : ev.metrics)
       if (m.backend == b.backend && m.name == name) return m.value;

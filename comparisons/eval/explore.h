@@ -59,9 +59,9 @@ class SampleRng {
 
 /// A body of a sample, as it is written to a scene.
 struct ExploreBody {
-  std::string shape_class;      // "box" | "hull" | "sliver"
+  std::string shape_class;       // "box" | "hull" | "sliver"
   Vec3 box_size = Vec3::Ones();  // m, full extents (box)
-  std::vector<Vec3> points;     // m, local points whose convex hull is the shape (hull, sliver)
+  std::vector<Vec3> points;      // m, local points whose convex hull is the shape (hull, sliver)
   Vec3 position = Vec3::Zero();  // m, world position of the local origin
   Quat orientation = Quat::Identity();
   Vec3 rotation_deg = Vec3::Zero();  // used instead of `orientation` when `use_degrees`
@@ -103,13 +103,14 @@ struct SampleOutcome {
   std::string shapes;   // "box-hull": the classes of A and B
   std::string feature;  // exact's axis: face_a | face_b | edge_edge, or "separated"
   bool touching = false;
-  double depth_rel = 0.0;  // exact depth / smaller body size (negative: separated)
+  double depth_rel = 0.0;                // exact depth / smaller body size (negative: separated)
   std::vector<BackendOutcome> backends;  // in the order asked for; unsupported ones left out
 };
 
 /// Runs the sample through `exact` and each named backend and classifies each answer.
 /// Thresholds: the harness's marks of a clear disagreement (kMarkAngleDeg, kMarkDepthRel).
-SampleOutcome evaluate_contact_sample(const ContactSample& s, const std::vector<std::string>& names);
+SampleOutcome evaluate_contact_sample(const ContactSample& s,
+                                      const std::vector<std::string>& names);
 
 /// The same on a scene's text (as `rbx compare` would read it); `shapes` names the classes of
 /// A and B ("box-hull"), which the text does not record.
@@ -125,12 +126,12 @@ SampleOutcome decode(const std::string& text);
 
 /// The simplest member found of a disagreement group.
 struct ShrinkResult {
-  ContactSample sample;           // shrunk
-  SampleOutcome outcome;          // of the shrunk sample, for its backend
-  int vertices_before = 0;        // total points of both bodies
+  ContactSample sample;     // shrunk
+  SampleOutcome outcome;    // of the shrunk sample, for its backend
+  int vertices_before = 0;  // total points of both bodies
   int vertices_after = 0;
-  int steps_accepted = 0;         // simplifications kept
-  int evaluations = 0;            // predicate calls
+  int steps_accepted = 0;  // simplifications kept
+  int evaluations = 0;     // predicate calls
 };
 
 /// Shrinks sample `s` while `backend` keeps the same signature `sig`: fewer hull points, A at

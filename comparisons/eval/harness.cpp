@@ -13,10 +13,10 @@
 
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/metrics.h"
-#include "comparisons/eval/select_backends.h"
-#include "comparisons/scene/scene_collection.h"
 #include "comparisons/eval/result_cache.h"
+#include "comparisons/eval/select_backends.h"
 #include "comparisons/eval/trajectory.h"
+#include "comparisons/scene/scene_collection.h"
 #include "engine/bounding.h"
 #include "engine/detect.h"
 #include "engine/format.h"
@@ -36,7 +36,7 @@ struct DynRun {
   DynamicsResult result;
   double runtime_s = 0.0;
   double dt = 0.0;
-  bool cached = false;  // from the reference-result cache
+  bool cached = false;    // from the reference-result cache
   std::string cache_key;  // the run's cache key ("" : not cacheable)
 };
 
@@ -47,9 +47,9 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
   DynRun run;
   run.dt = dt;
   const bool cacheable = cache.enabled() && ResultCache::caches(b.name);
-  const std::string key = cacheable ? cache.dynamics_key(b.name, scene, bodies,
-                                                                DynamicsOptions{dt, sample_every})
-                                    : std::string();
+  const std::string key =
+      cacheable ? cache.dynamics_key(b.name, scene, bodies, DynamicsOptions{dt, sample_every})
+                : std::string();
   run.cache_key = key;
   if (cacheable)
     if (auto hit = cache.load_dynamics(key)) {
@@ -181,29 +181,38 @@ class Evaluator {
     backends_json_ = Json::object();
     if (scene_.checks.empty()) out_.skipped.push_back("scene lists no checks: nothing to run");
     if (scene_.has_check(CheckKind::Contact)) contact_check();
-    const bool dynamics = scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory) ||
+    const bool dynamics = scene_.has_check(CheckKind::Impulse) ||
+                          scene_.has_check(CheckKind::Trajectory) ||
                           scene_.has_check(CheckKind::Stability);
     if (dynamics) dynamics_checks();
     if (scene_.has_check(CheckKind::Mass)) mass_check();
     j["backends"] = backends_json_;
     Json metrics = Json::array();
     for (const Metric& m : out_.metrics)
-      metrics.push_back({{"check", m.check}, {"backend", m.backend}, {"pair", m.pair},
-                         {"name", m.name}, {"value", m.value}, {"against", m.against}});
+      metrics.push_back({{"check", m.check},
+                         {"backend", m.backend},
+                         {"pair", m.pair},
+                         {"name", m.name},
+                         {"value", m.value},
+                         {"against", m.against}});
     j["metrics"] = metrics;
     Json sweep = Json::array();
     for (const SweepPoint& s : out_.sweep)
-      sweep.push_back({{"backend", s.backend}, {"kind", s.kind}, {"dt", s.dt},
-                       {"runtime_s", s.runtime_s}, {"error", s.error}, {"against", s.against}});
+      sweep.push_back({{"backend", s.backend},
+                       {"kind", s.kind},
+                       {"dt", s.dt},
+                       {"runtime_s", s.runtime_s},
+                       {"error", s.error},
+                       {"against", s.against}});
     j["sweep"] = sweep;
     j["stability"] = stability_json_.is_null() ? Json::object() : stability_json_;
     j["skipped"] = out_.skipped;
     // A documented limitation excuses the engine it names only ("custom: ..." or
     // "custom-seed: ...", the text before the colon): any other subject's failure (the oracle's:
     // a wrong derivation; the other custom engine's) still fails the scene.
-    const std::string known_subject =
-        scene_.expect ? scene_.expect->known_failure.substr(0, scene_.expect->known_failure.find(':'))
-                      : "";
+    const std::string known_subject = scene_.expect ? scene_.expect->known_failure.substr(
+                                                          0, scene_.expect->known_failure.find(':'))
+                                                    : "";
     out_.expect_known =
         scene_.expect && !scene_.expect->known_failure.empty() && !out_.expect_failures.empty() &&
         (known_subject == "custom" || known_subject == "custom-seed") &&
@@ -243,8 +252,10 @@ class Evaluator {
                     : "[expect.body]: binds the custom engine, which was not run (backends: " +
                           join_names() + ")");
     }
-    out_.expect_checked = (e.contact && expect_contact_bound_) || (!e.bodies.empty() && expect_bodies_bound_);
-    if (!e.contact && e.bodies.empty()) out_.expect_unchecked.push_back("[expect] gives nothing to check");
+    out_.expect_checked =
+        (e.contact && expect_contact_bound_) || (!e.bodies.empty() && expect_bodies_bound_);
+    if (!e.contact && e.bodies.empty())
+      out_.expect_unchecked.push_back("[expect] gives nothing to check");
   }
 
   std::string join_names() const {
@@ -266,8 +277,11 @@ class Evaluator {
 
   Json& backend_json(const std::string& name) {
     if (!backends_json_.contains(name))
-      backends_json_[name] = {{"status", "ok"}, {"message", ""}, {"runtime_s", 0.0},
-                              {"contacts", Json::array()}, {"bodies", bodies_json(inputs_)}};
+      backends_json_[name] = {{"status", "ok"},
+                              {"message", ""},
+                              {"runtime_s", 0.0},
+                              {"contacts", Json::array()},
+                              {"bodies", bodies_json(inputs_)}};
     return backends_json_[name];
   }
 
@@ -304,8 +318,8 @@ class Evaluator {
     const std::string pair = pair_name(a, b);
     const SatResult sat = sat_query(*a.shape, a.pose(), *b.shape, b.pose());
     // Truth: the [expect.contact] closed form for the first pair, else the exact oracle.
-    const ExpectContact* ex = first_pair && scene_.expect && scene_.expect->contact
-                                  ? &*scene_.expect->contact : nullptr;
+    const ExpectContact* ex =
+        first_pair && scene_.expect && scene_.expect->contact ? &*scene_.expect->contact : nullptr;
     const bool have_normal = ex && ex->normal, have_depth = ex && ex->depth;
     const bool true_touch = ex && ex->touching ? *ex->touching : sat.touching;
     const Vec3 true_normal = have_normal ? ex->normal->normalized() : sat.normal;
@@ -316,7 +330,8 @@ class Evaluator {
     const double tol = scene_.expect ? scene_.expect->tolerance : 1e-6;
     // [expect.contact] binds the oracle, whatever backends run: if the exact answer (computed
     // here anyway) disagrees with the closed form, the derivation or the oracle is wrong.
-    if (ex) check_expect_contact("exact", *ex, sat.touching, sat.normal, std::max(sat.depth, 0.0), tol);
+    if (ex)
+      check_expect_contact("exact", *ex, sat.touching, sat.normal, std::max(sat.depth, 0.0), tol);
     if (ex) expect_contact_bound_ = true;
 
     for (const std::string& name : names) {
@@ -335,9 +350,9 @@ class Evaluator {
       metric("contact", name, pair, "touching_err", touching_error(run.result, true_touch),
              ex && ex->touching ? "analytic" : "exact");
       if (touch != true_touch)
-        out_.disagreements.push_back(name + " on " + pair + ": " +
-                                     (touch ? "reports a contact where there is none"
-                                            : "misses a contact"));
+        out_.disagreements.push_back(
+            name + " on " + pair + ": " +
+            (touch ? "reports a contact where there is none" : "misses a contact"));
       if (!touch || !true_touch) continue;
       double angle = angle_deg(c->normal, true_normal);
       // Ties: where several directions give the same minimum translation (a cube on another's
@@ -359,14 +374,15 @@ class Evaluator {
       const double depth_tol = std::max(tol, 1e-6 * size);
       if (angle > 1e-3 || derr > depth_tol) {
         std::ostringstream s;
-        s << name << " on " << pair << ": normal off by " << fmt_num(angle, 3) << " deg, depth off by "
-          << fmt_num(derr, 3) << " m (against " << normal_src << ")";
+        s << name << " on " << pair << ": normal off by " << fmt_num(angle, 3)
+          << " deg, depth off by " << fmt_num(derr, 3) << " m (against " << normal_src << ")";
         const bool clear = angle > kMarkAngleDeg || derr > kMarkDepthRel * size;
         (clear ? out_.disagreements : out_.deviations).push_back(s.str());
       }
       // [expect.contact] binds the engine under test too, like [expect.body]: a violation
       // fails the scene unless the scene documents it as a known failure.
-      if (name == "custom" && ex) check_expect_contact("custom", *ex, touch, c->normal, c->depth, tol);
+      if (name == "custom" && ex)
+        check_expect_contact("custom", *ex, touch, c->normal, c->depth, tol);
     }
   }
 
@@ -404,8 +420,8 @@ class Evaluator {
       return;
     }
     if (ex.normal && (normal - ex.normal->normalized()).norm() > tol)
-      out_.expect_failures.push_back(who + ": contact normal " + fmt_vec(normal, 8) + ", expected " +
-                                     fmt_vec(ex.normal->normalized(), 8));
+      out_.expect_failures.push_back(who + ": contact normal " + fmt_vec(normal, 8) +
+                                     ", expected " + fmt_vec(ex.normal->normalized(), 8));
     if (ex.depth && std::abs(depth - *ex.depth) > tol)
       out_.expect_failures.push_back(who + ": contact depth " + fmt_num(depth, 10) + ", expected " +
                                      fmt_num(*ex.depth, 10));
@@ -432,7 +448,8 @@ class Evaluator {
     bool angular = false;  // angular metrics only where something rotates
     for (const RigidBody& b : inputs_) angular = angular || b.angular_velocity.norm() > 0;
     // Momentum scale: the largest momentum any body has or could get from the energy.
-    const double p_scale = std::max(p0.norm(), std::sqrt(2.0 * mass_total * std::max(e0_kin, 1e-300)));
+    const double p_scale =
+        std::max(p0.norm(), std::sqrt(2.0 * mass_total * std::max(e0_kin, 1e-300)));
     const double h_scale = std::max(h0.norm(), p_scale * size_max);
 
     // Reference for final velocities: the [expect] block, if it gives any.
@@ -450,7 +467,8 @@ class Evaluator {
 
     const long steps = scene_.sim.steps();
     const long sample_every = std::max<long>(1, steps / 400);
-    const bool wants_sweep = opt_.sweep && (scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory));
+    const bool wants_sweep = opt_.sweep && (scene_.has_check(CheckKind::Impulse) ||
+                                            scene_.has_check(CheckKind::Trajectory));
     const std::vector<double> dts = sweep_steps(scene_);
     const double finest = dts.back();
 
@@ -464,11 +482,13 @@ class Evaluator {
         set_status(name, Status::Unsupported, name + " has no dynamics (contact queries only)");
         continue;
       }
-      mains.emplace_back(name, run_dynamics(be, scene_, scene_.sim.dt, sample_every, cache_, inputs_));
+      mains.emplace_back(name,
+                         run_dynamics(be, scene_, scene_.sim.dt, sample_every, cache_, inputs_));
     }
     for (const auto& [name, run] : mains)
       if (run.result.status == Status::Ok)
-        for (const BodyFinal& f : run.result.finals) angular = angular || f.angular_velocity.norm() > 1e-12;
+        for (const BodyFinal& f : run.result.finals)
+          angular = angular || f.angular_velocity.norm() > 1e-12;
 
     for (const auto& entry : mains) {
       const std::string& name = entry.first;  // (not a structured binding: lambdas below)
@@ -482,13 +502,14 @@ class Evaluator {
           inputs_.begin(), inputs_.end(), [](const RigidBody& b) { return !b.is_static; }));
       bj["trajectory"] = trajectory_json(main.result.samples, inputs_, frame_budget(moving));
       if (main.result.status != Status::Ok) {
-        if (scene_.has_check(CheckKind::Stability)) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
+        if (scene_.has_check(CheckKind::Stability))
+          stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
         // The engine under test stopped before t = duration: it fails [expect.body] (no final
         // state to compare is not a pass).
         if ((name == "custom" || name == "custom-seed") && scene_.expect &&
             !scene_.expect->bodies.empty()) {
-          out_.expect_failures.push_back(name + ": the run stopped before t = duration: " +
-                                         main.result.message);
+          out_.expect_failures.push_back(
+              name + ": the run stopped before t = duration: " + main.result.message);
           expect_bodies_bound_ = true;
         }
         continue;
@@ -499,16 +520,20 @@ class Evaluator {
       std::vector<DynRun> sweep_runs;
       // Velocity errors belong to the impulse and trajectory checks: a stability-only scene
       // does not pay for the self-consistency run.
-      const bool wants_velocity = scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory);
-      if (wants_sweep || (!have_expect && wants_velocity) || scene_.has_check(CheckKind::Trajectory)) {
+      const bool wants_velocity =
+          scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory);
+      if (wants_sweep || (!have_expect && wants_velocity) ||
+          scene_.has_check(CheckKind::Trajectory)) {
         // Without a sweep only the finest step is needed (the self-consistency reference).
         const std::vector<double> to_run = wants_sweep ? dts : std::vector<double>{finest};
         for (double dt : to_run) {
-          if (std::abs(dt - scene_.sim.dt) <= 1e-15 * dt) sweep_runs.push_back(main);
+          if (std::abs(dt - scene_.sim.dt) <= 1e-15 * dt)
+            sweep_runs.push_back(main);
           else {
             // The finest run of a trajectory check is sampled at the same times as the main run.
             const bool sample = scene_.has_check(CheckKind::Trajectory) && dt == finest;
-            const long every = sample ? std::max<long>(1, std::lround(sample_every * scene_.sim.dt / dt)) : 0;
+            const long every =
+                sample ? std::max<long>(1, std::lround(sample_every * scene_.sim.dt / dt)) : 0;
             sweep_runs.push_back(run_dynamics(be, scene_, dt, every, cache_, inputs_));
           }
         }
@@ -517,9 +542,9 @@ class Evaluator {
       auto ref_of = [&](const DynRun& r) {
         std::vector<std::optional<RefState>> ref(inputs_.size());
         for (size_t i = 0; i < inputs_.size(); ++i)
-          ref[i] = RefState{r.result.finals[i].velocity,
-                            angular ? std::optional<Vec3>(r.result.finals[i].angular_velocity)
-                                    : std::nullopt};
+          ref[i] = RefState{
+              r.result.finals[i].velocity,
+              angular ? std::optional<Vec3>(r.result.finals[i].angular_velocity) : std::nullopt};
         return ref;
       };
       std::string against;
@@ -561,10 +586,10 @@ class Evaluator {
           if (std::abs(ref.time - smp.time) > 0.5 * scene_.sim.dt) continue;  // no partner
           for (size_t i = 0; i < inputs_.size() && i < ref.bodies.size(); ++i)
             if (!inputs_[i].is_static)
-              worst = std::max(worst, (smp.bodies[i].position - ref.bodies[i].position).norm() /
-                                              body_size(inputs_[i]) +
-                                          0.5 * smp.bodies[i].orientation.angularDistance(
-                                                    ref.bodies[i].orientation));
+              worst = std::max(
+                  worst,
+                  (smp.bodies[i].position - ref.bodies[i].position).norm() / body_size(inputs_[i]) +
+                      0.5 * smp.bodies[i].orientation.angularDistance(ref.bodies[i].orientation));
         }
         metric("trajectory", name, "", "state_divergence_err", worst, fmt_dt(finest));
       }
@@ -577,8 +602,8 @@ class Evaluator {
       // Conservation: momentum (where it is an invariant), energy against what e allows.
       const std::vector<BodyFinal>& f = main.result.finals;
       if (closed) {
-        metric(primary_check(), name, "", "momentum_drift_err", (linear_momentum(inputs_, f) - p0).norm() / p_scale,
-               "invariant");
+        metric(primary_check(), name, "", "momentum_drift_err",
+               (linear_momentum(inputs_, f) - p0).norm() / p_scale, "invariant");
         if (angular)
           metric(primary_check(), name, "", "angular_momentum_drift_err",
                  (angular_momentum(inputs_, f) - h0).norm() / h_scale, "invariant");
@@ -589,9 +614,9 @@ class Evaluator {
         metric(primary_check(), name, "", "energy_change_rel", (e1 - e0) / e_scale, "initial");
         // Against the closed form's final kinetic energy where [expect] gives every moving
         // body's velocities, else the invariant rule of the restitution.
-        const EnergyError err =
-            energy_error(e0, e1, kinetic_energy(inputs_, f), expected_kinetic_energy(inputs_, f, expected),
-                         scene_.sim.restitution, e_scale);
+        const EnergyError err = energy_error(e0, e1, kinetic_energy(inputs_, f),
+                                             expected_kinetic_energy(inputs_, f, expected),
+                                             scene_.sim.restitution, e_scale);
         metric(primary_check(), name, "", "energy_err", err.value, err.against);
       }
       // [expect.body] binds the custom engine, both the extended one and the seed's algorithm;
@@ -602,9 +627,11 @@ class Evaluator {
         expect_bodies_bound_ = true;
       }
       if (scene_.expect)
-        mark_expect_disagreement(name, main.result.finals,
-                                 have_expect ? ke_norm_error(inputs_, main.result.finals, expected, e0_kin) : 0.0);
-      if (scene_.has_check(CheckKind::Stability)) stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
+        mark_expect_disagreement(
+            name, main.result.finals,
+            have_expect ? ke_norm_error(inputs_, main.result.finals, expected, e0_kin) : 0.0);
+      if (scene_.has_check(CheckKind::Stability))
+        stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
     }
     if (!angular) out_.skipped.push_back("angular metrics: nothing rotates in this scene");
   }
@@ -616,16 +643,18 @@ class Evaluator {
   }
 
   // Compares final states with [expect.body]: violations of the custom engine fail the scene.
-  std::vector<std::string> expect_violations(const std::string& name, const std::vector<BodyFinal>& finals) {
+  std::vector<std::string> expect_violations(const std::string& name,
+                                             const std::vector<BodyFinal>& finals) {
     std::vector<std::string> v;
     const double tol = scene_.expect->tolerance;
     for (const ExpectBody& eb : scene_.expect->bodies) {
-      auto it = std::find_if(finals.begin(), finals.end(), [&](const BodyFinal& f) { return f.name == eb.name; });
+      auto it = std::find_if(finals.begin(), finals.end(),
+                             [&](const BodyFinal& f) { return f.name == eb.name; });
       if (it == finals.end()) continue;
       auto check = [&](const char* what, const std::optional<Vec3>& want, const Vec3& got) {
         if (want && (got - *want).cwiseAbs().maxCoeff() > tol)
-          v.push_back(name + ": body " + eb.name + " " + what + " " + fmt_vec(got, 8) + ", expected " +
-                      fmt_vec(*want, 8) + " (tolerance " + fmt_num(tol, 3) + ")");
+          v.push_back(name + ": body " + eb.name + " " + what + " " + fmt_vec(got, 8) +
+                      ", expected " + fmt_vec(*want, 8) + " (tolerance " + fmt_num(tol, 3) + ")");
       };
       check("velocity", eb.velocity, it->velocity);
       check("angular_velocity", eb.angular_velocity, it->angular_velocity);
@@ -680,7 +709,8 @@ class Evaluator {
       for (size_t k = i + 1; k < inputs_.size(); ++k) {
         if (inputs_[i].is_static && inputs_[k].is_static) continue;
         if (inputs_.size() > 3 && !inputs_[i].is_static && !inputs_[k].is_static) continue;
-        const SatResult sat = sat_query(sat_shapes[i], inputs_[i].pose(), sat_shapes[k], inputs_[k].pose());
+        const SatResult sat =
+            sat_query(sat_shapes[i], inputs_[i].pose(), sat_shapes[k], inputs_[k].pose());
         if (sat.touching) continue;
         // Half-thickness of both bodies along the separating normal, at the t = 0 poses.
         double reach = 0.0;
@@ -709,7 +739,8 @@ class Evaluator {
           if ((pa.position - pb.position).norm() > reach + 1e-9 * reach) continue;
           const SatResult sat = sat_query(sat_shapes[i], pa, sat_shapes[k], pb);
           if (!sat.touching) continue;
-          pen_sample = std::max(pen_sample, sat.depth / std::min(body_size(inputs_[i]), body_size(inputs_[k])));
+          pen_sample = std::max(pen_sample,
+                                sat.depth / std::min(body_size(inputs_[i]), body_size(inputs_[k])));
         }
       }
       return pen_sample;
@@ -818,7 +849,8 @@ class Evaluator {
     metric("stability", name, "", "energy_growth_err", std::max(growth, 0.0), "invariant");
     metric("stability", name, "", "max_penetration_rel_err", pen_max, "exact");
     metric("stability", name, "", "tunnelled_pairs_err", tunnelled, "invariant");
-    if (scene_.sim.gravity.norm() > 0) metric("stability", name, "", "jitter_rms_mps_err", jitter, "invariant");
+    if (scene_.sim.gravity.norm() > 0)
+      metric("stability", name, "", "jitter_rms_mps_err", jitter, "invariant");
   }
 
   // -- mass ------------------------------------------------------------------------------------
@@ -859,8 +891,10 @@ class Evaluator {
             name + " on " + body.name + ": mass properties off by " + fmt_num(worst, 3) +
             " (relative, worst of mass, centre of mass and inertia) against the exact solid" +
             (name == "custom" ? " (the seed's point masses at the vertices)" : "");
-        if (worst > 1e-2) out_.disagreements.push_back(what);
-        else if (worst > 1e-6) out_.deviations.push_back(what);
+        if (worst > 1e-2)
+          out_.disagreements.push_back(what);
+        else if (worst > 1e-6)
+          out_.deviations.push_back(what);
       };
       // The seed's model (point masses at the vertices) on the same hull.
       const MassProperties seed = vertex_mass_properties(*body.shape, body.mass);
@@ -892,8 +926,9 @@ class Evaluator {
     for (const std::string& name : wanted)
       if (named && name != "custom" && !backend(name).mass)
         set_status(name, Status::Unsupported,
-                   name + " computes no mass properties of its own (every backend is given the "
-                          "exact solid values)");
+                   name +
+                       " computes no mass properties of its own (every backend is given the "
+                       "exact solid values)");
     out_.skipped.push_back("mass: custom is the seed's vertex model; ode has no hull mass routine");
   }
 

@@ -16,8 +16,8 @@ namespace rbx {
 
 /// Harness settings.
 struct HarnessOptions {
-  std::string backends;      // --backends LIST ("" : the scene's, or all that serve a check)
-  bool sweep = true;         // run the time-step sweep for error against run time
+  std::string backends;           // --backends LIST ("" : the scene's, or all that serve a check)
+  bool sweep = true;              // run the time-step sweep for error against run time
   double timing_budget_s = 0.01;  // per contact query and backend: repeat until this much time
   /// Backends to choose from; nullptr: the registry (reference/registry.cpp). Tests pass their
   /// own table to add a failing backend without touching the registry.
@@ -30,10 +30,10 @@ struct HarnessOptions {
 
 /// One measured number.
 struct Metric {
-  std::string check;    // contact | impulse | trajectory | stability | mass
+  std::string check;  // contact | impulse | trajectory | stability | mass
   std::string backend;
-  std::string pair;     // "A-B" for contact metrics, "" otherwise
-  std::string name;     // e.g. normal_err_deg; names of errors contain "err"
+  std::string pair;  // "A-B" for contact metrics, "" otherwise
+  std::string name;  // e.g. normal_err_deg; names of errors contain "err"
   double value = 0.0;
   std::string against;  // analytic | exact | self dt=... | backend NAME | invariant
 };
@@ -41,20 +41,20 @@ struct Metric {
 /// One point of error against run time.
 struct SweepPoint {
   std::string backend;
-  std::string kind;     // "dynamics" (a time step) or "contact" (a query)
-  double dt = 0.0;      // s (dynamics)
+  std::string kind;  // "dynamics" (a time step) or "contact" (a query)
+  double dt = 0.0;   // s (dynamics)
   double runtime_s = 0.0;
-  double error = 0.0;   // velocity error in the kinetic-energy norm, or normal angle (deg)
+  double error = 0.0;  // velocity error in the kinetic-energy norm, or normal angle (deg)
   std::string against;
 };
 
 /// Everything the harness learned about one scene.
 struct SceneEvaluation {
-  std::string family;                  // folder under scenes/, or "scenes"
-  Json json;                           // the contract's per-scene object, metrics included
+  std::string family;  // folder under scenes/, or "scenes"
+  Json json;           // the contract's per-scene object, metrics included
   std::vector<Metric> metrics;
   std::vector<SweepPoint> sweep;
-  std::vector<std::string> skipped;    // what was left out, and why
+  std::vector<std::string> skipped;          // what was left out, and why
   std::vector<std::string> expect_failures;  // violated [expect] entries, "SUBJECT: what"
                                              // (custom: the engine; exact: the oracle)
   bool expect_checked = false;  // some part of [expect] was bound by a backend that ran: never
@@ -62,8 +62,8 @@ struct SceneEvaluation {
   std::vector<std::string> expect_unchecked;  // parts of [expect] no backend run could bind, why
   bool expect_known = false;  // failures are all custom's and the scene's known_failure explains
                               // them: compare does not fail on them
-  std::vector<std::string> disagreements;    // clearly different from the truth (see kMark*)
-  std::vector<std::string> deviations;       // beyond the scene's tolerance, yet close
+  std::vector<std::string> disagreements;  // clearly different from the truth (see kMark*)
+  std::vector<std::string> deviations;     // beyond the scene's tolerance, yet close
 };
 
 /// Thresholds between a deviation and a disagreement: a contact normal more than 1 degree off or

@@ -1,10 +1,9 @@
 // JSON vocabulary of results (the contract's shape) and atomic output.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "engine/body.h"
 #include "engine/contact.h"
@@ -30,7 +29,8 @@ Json body_inputs_json(const RigidBody& b);
 /// The contract's `bodies` block: NAME -> body_inputs_json, plus `final` from `finals` (same
 /// order as `inputs`) when given. Every backend gets the same inputs, so contact and mass
 /// results carry the scene's bodies without `final`.
-Json bodies_json(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>* finals = nullptr);
+Json bodies_json(const std::vector<RigidBody>& inputs,
+                 const std::vector<BodyFinal>* finals = nullptr);
 /// {"position", "orientation", "velocity", "angular_velocity"}.
 Json final_json(const BodyFinal& f);
 /// The scene's settings as written into results (every tunable, for reproducibility).

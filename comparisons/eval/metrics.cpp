@@ -49,8 +49,9 @@ double kinetic_energy(const std::vector<RigidBody>& inputs, const std::vector<Bo
   for (size_t i = 0; i < inputs.size() && i < s.size(); ++i) {
     const RigidBody& b = inputs[i];
     if (b.is_static) continue;
-    e += 0.5 * b.mass * s[i].velocity.squaredNorm() +
-         0.5 * s[i].angular_velocity.dot(world_inertia(b, s[i].orientation) * s[i].angular_velocity);
+    e +=
+        0.5 * b.mass * s[i].velocity.squaredNorm() +
+        0.5 * s[i].angular_velocity.dot(world_inertia(b, s[i].orientation) * s[i].angular_velocity);
   }
   return e;
 }
@@ -168,8 +169,10 @@ StabilityVerdict stability_verdict(const StabilityFacts& f) {
   // steps and give it back. 1 % as for growth.
   if (f.restitution >= 1.0 && f.friction == 0.0 && -f.energy_final > kDissipativeEnergyLoss)
     dissipative.push_back("energy lost " + fmt_num(-100 * f.energy_final, 3) + " % with e = 1");
-  v.verdict = !unstable.empty() ? "unstable" : !sinks.empty() ? "sinks"
-              : !dissipative.empty() ? "dissipative" : "stable";
+  v.verdict = !unstable.empty()      ? "unstable"
+              : !sinks.empty()       ? "sinks"
+              : !dissipative.empty() ? "dissipative"
+                                     : "stable";
   for (const auto* list : {&unstable, &sinks, &dissipative})
     v.why.insert(v.why.end(), list->begin(), list->end());
   return v;

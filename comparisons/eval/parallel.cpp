@@ -19,8 +19,7 @@ namespace {
 #ifdef RBX_WITH_MPI
 // True when a launcher (Open MPI's mpirun, or a PMI-based one) started this process.
 bool launched_by_mpirun() {
-  return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_RANK") ||
-         std::getenv("PMIX_RANK");
+  return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_RANK") || std::getenv("PMIX_RANK");
 }
 
 #endif

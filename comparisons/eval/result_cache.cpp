@@ -22,7 +22,10 @@ namespace {
 class Writer {
  public:
   void put(double x) { raw(&x, sizeof x); }
-  void put(long x) { std::int64_t v = x; raw(&v, sizeof v); }
+  void put(long x) {
+    std::int64_t v = x;
+    raw(&v, sizeof v);
+  }
   void put(int x) { put(static_cast<long>(x)); }
   void put(bool x) { put(static_cast<long>(x)); }
   void put(const std::string& s) {
@@ -31,10 +34,21 @@ class Writer {
   }
   void put(const char* s) { put(std::string(s)); }
   template <class E, std::enable_if_t<std::is_enum_v<E>, int> = 0>
-  void put(E e) { put(static_cast<long>(e)); }
-  void put(const Vec3& v) { for (int i = 0; i < 3; ++i) put(v[i]); }
-  void put(const Quat& q) { put(q.w()); put(q.x()); put(q.y()); put(q.z()); }
-  void put(const Mat3& m) { for (int i = 0; i < 9; ++i) put(m.data()[i]); }
+  void put(E e) {
+    put(static_cast<long>(e));
+  }
+  void put(const Vec3& v) {
+    for (int i = 0; i < 3; ++i) put(v[i]);
+  }
+  void put(const Quat& q) {
+    put(q.w());
+    put(q.x());
+    put(q.y());
+    put(q.z());
+  }
+  void put(const Mat3& m) {
+    for (int i = 0; i < 9; ++i) put(m.data()[i]);
+  }
   const std::string& str() const { return out_; }
 
  private:
@@ -47,9 +61,21 @@ class Reader {
  public:
   explicit Reader(const std::string& s) : in_(s) {}
   void get(double& x) { raw(&x, sizeof x); }
-  void get(long& x) { std::int64_t v; raw(&v, sizeof v); x = static_cast<long>(v); }
-  void get(int& x) { long v; get(v); x = static_cast<int>(v); }
-  void get(bool& x) { long v; get(v); x = v != 0; }
+  void get(long& x) {
+    std::int64_t v;
+    raw(&v, sizeof v);
+    x = static_cast<long>(v);
+  }
+  void get(int& x) {
+    long v;
+    get(v);
+    x = static_cast<int>(v);
+  }
+  void get(bool& x) {
+    long v;
+    get(v);
+    x = v != 0;
+  }
   void get(std::string& s) {
     long n;
     get(n);
@@ -58,10 +84,25 @@ class Reader {
     at_ += n;
   }
   template <class E, std::enable_if_t<std::is_enum_v<E>, int> = 0>
-  void get(E& e) { long v; get(v); e = static_cast<E>(v); }
-  void get(Vec3& v) { for (int i = 0; i < 3; ++i) get(v[i]); }
-  void get(Quat& q) { double w, x, y, z; get(w); get(x); get(y); get(z); q = Quat(w, x, y, z); }
-  void get(Mat3& m) { for (int i = 0; i < 9; ++i) get(m.data()[i]); }
+  void get(E& e) {
+    long v;
+    get(v);
+    e = static_cast<E>(v);
+  }
+  void get(Vec3& v) {
+    for (int i = 0; i < 3; ++i) get(v[i]);
+  }
+  void get(Quat& q) {
+    double w, x, y, z;
+    get(w);
+    get(x);
+    get(y);
+    get(z);
+    q = Quat(w, x, y, z);
+  }
+  void get(Mat3& m) {
+    for (int i = 0; i < 9; ++i) get(m.data()[i]);
+  }
   bool done() const { return at_ == in_.size(); }
 
  private:
@@ -279,7 +320,8 @@ void ResultCache::store(const std::string& key, const ContactResult& c, double r
   write(key, w.str());
 }
 
-std::optional<CachedResult<DynamicsResult>> ResultCache::load_dynamics(const std::string& key) const {
+std::optional<CachedResult<DynamicsResult>> ResultCache::load_dynamics(
+    const std::string& key) const {
   return decode<DynamicsResult>(read(key), [](Reader& r, DynamicsResult& d) {
     auto count = [&r]() {
       long n;
@@ -347,13 +389,14 @@ std::string derived_key(const std::string& run_key, const std::string& what) {
 
 std::optional<std::vector<double>> ResultCache::load_derived(const std::string& run_key,
                                                              const std::string& what) const {
-  const auto c = decode<std::vector<double>>(read(derived_key(run_key, what)), [](Reader& r, std::vector<double>& v) {
-    long n;
-    r.get(n);
-    if (n < 0) throw std::runtime_error("bad count");
-    v.resize(n);
-    for (double& x : v) r.get(x);
-  });
+  const auto c = decode<std::vector<double>>(read(derived_key(run_key, what)),
+                                             [](Reader& r, std::vector<double>& v) {
+                                               long n;
+                                               r.get(n);
+                                               if (n < 0) throw std::runtime_error("bad count");
+                                               v.resize(n);
+                                               for (double& x : v) r.get(x);
+                                             });
   if (!c) return std::nullopt;
   return c->result;
 }

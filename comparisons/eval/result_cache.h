@@ -57,8 +57,10 @@ class ResultCache {
   std::optional<CachedResult<MassResult>> load_mass(const std::string& key) const;
   /// Numbers the harness derives from a cached run (keyed by the run's key; the harness's own
   /// code hash is added, so an edit of harness.cpp recomputes them).
-  std::optional<std::vector<double>> load_derived(const std::string& run_key, const std::string& what) const;
-  void store_derived(const std::string& run_key, const std::string& what, const std::vector<double>& v) const;
+  std::optional<std::vector<double>> load_derived(const std::string& run_key,
+                                                  const std::string& what) const;
+  void store_derived(const std::string& run_key, const std::string& what,
+                     const std::vector<double>& v) const;
 
   /// Stores (atomically: a temporary file renamed into place); failures to write are ignored
   /// (the cache only saves time).

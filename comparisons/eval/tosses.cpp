@@ -132,8 +132,9 @@ std::vector<Toss> parse_tosses(const std::string& text, const std::string& path)
     }
     tosses.back().samples.push_back(s);
   }
-  if (row == 0) throw InputError(path + ":row 1: empty file (expected the header '" +
-                                 std::string(kHeader) + "')");
+  if (row == 0)
+    throw InputError(path + ":row 1: empty file (expected the header '" + std::string(kHeader) +
+                     "')");
   if (tosses.empty()) throw InputError(path + ": no tosses (only a header)");
   if (tosses.back().samples.size() < 2)
     throw InputError(path + ":row " + std::to_string(tosses.back().first_row) + ": toss " +
@@ -190,8 +191,8 @@ TossErrors toss_errors(const Toss& real, const PoseTrack& sim, double cube_width
   for (size_t i = 1; i < n; ++i) {
     const double d = (sim.position[i] - real.samples[i].position).norm() / cube_width;
     e.position_by_sample.push_back(d);
-    e.horizontal_by_sample.push_back(
-        (sim.position[i] - real.samples[i].position).head<2>().norm() / cube_width);
+    e.horizontal_by_sample.push_back((sim.position[i] - real.samples[i].position).head<2>().norm() /
+                                     cube_width);
     e.position += d;
     e.orientation_deg += rotation_angle_deg(sim.orientation[i], real.samples[i].orientation);
   }
@@ -321,8 +322,8 @@ FitResult fit_backend(const Backend& backend, const std::vector<Toss>& tosses,
     ++fit.evaluations;
     const double v = fit_objective(backend, tosses, {x[0], x[1]}, model);
     if (progress)
-      progress(backend.name + ": e = " + fmt_num(x[0], 4) + ", mu = " + fmt_num(x[1], 4) +
-               " -> " + fmt_num(v, 5) + " (" + fmt_num(clock.seconds(), 3) + " s)");
+      progress(backend.name + ": e = " + fmt_num(x[0], 4) + ", mu = " + fmt_num(x[1], 4) + " -> " +
+               fmt_num(v, 5) + " (" + fmt_num(clock.seconds(), 3) + " s)");
     return v;
   };
   // Coarse grid: the error surface has plateaus (e.g. any friction that stops sliding), so a
@@ -359,8 +360,10 @@ FitResult fit_backend(const Backend& backend, const std::vector<Toss>& tosses,
       const Eigen::Vector2d e = clamp(c + 2.0 * (c - x[2]));
       const double fe = f(e);
       ++used;
-      if (fe < fr) x[2] = e, fx[2] = fe;
-      else x[2] = r, fx[2] = fr;
+      if (fe < fr)
+        x[2] = e, fx[2] = fe;
+      else
+        x[2] = r, fx[2] = fr;
     } else if (fr < fx[1]) {
       x[2] = r, fx[2] = fr;
     } else {
@@ -397,7 +400,8 @@ std::vector<std::pair<std::string, ContactParams>> read_params_file(const std::s
     throw InputError(path + ": not valid JSON (" + e.what() + ")");
   }
   if (!j.contains("backends") || !j["backends"].is_object())
-    throw InputError(path + ": backends: missing (expected backends.<name>.{restitution, friction})");
+    throw InputError(path +
+                     ": backends: missing (expected backends.<name>.{restitution, friction})");
   for (const auto& [name, b] : j["backends"].items()) {
     const std::string key = "backends." + name;
     ContactParams p;
@@ -418,7 +422,9 @@ std::vector<std::pair<std::string, ContactParams>> read_params_file(const std::s
 
 namespace {
 
-Json spread_json(const Spread& s) { return {{"median", s.median}, {"mean", s.mean}, {"p90", s.p90}}; }
+Json spread_json(const Spread& s) {
+  return {{"median", s.median}, {"mean", s.mean}, {"p90", s.p90}};
+}
 
 // The three statistics of one error kind over a backend's tosses.
 Spread spread_by(const BackendTosses& r, double TossErrors::*field) {
@@ -443,7 +449,8 @@ Json backend_tosses_json(const BackendTosses& r) {
   j["runtime_s"] = r.runtime_s;
   Json per = Json::array();
   for (const TossErrors& e : r.tosses)
-    per.push_back({{"toss", e.toss_id}, {"position_error", e.position},
+    per.push_back({{"toss", e.toss_id},
+                   {"position_error", e.position},
                    {"orientation_error_deg", e.orientation_deg},
                    {"final_position_error", e.final_position},
                    {"final_orientation_error_deg", e.final_orientation_deg}});

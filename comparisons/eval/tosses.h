@@ -19,10 +19,10 @@ namespace rbx {
 
 /// The tossed cube and its world (ContactNets README; Acosta, Yang & Posa 2022).
 struct CubeTossModel {
-  double half_width = 0.0524;   // m: vertices at +-half_width on each body axis
-  double mass = 0.37;           // kg, uniform density
-  double gravity = 9.81;        // m/s^2, along -z
-  double sample_rate = 148.0;   // Hz, motion capture
+  double half_width = 0.0524;  // m: vertices at +-half_width on each body axis
+  double mass = 0.37;          // kg, uniform density
+  double gravity = 9.81;       // m/s^2, along -z
+  double sample_rate = 148.0;  // Hz, motion capture
   // Time step = 1 / (sample_rate * substeps). 10 substeps (0.68 ms): a cube falling at 2 m/s
   // moves 1.4 mm (1.3 % of its width) per step, and MuJoCo's soft contact, which lasts a fixed
   // number of steps, resolves an impact in ~17 ms; every simulated sample falls exactly on a
@@ -31,8 +31,8 @@ struct CubeTossModel {
   // -> 0.248; bullet 0.147 -> 0.147 -> 0.162, ode 0.190 -> 0.191 -> 0.192), well below the
   // gaps between backends, at 2 and 4 times the cost (which the fit pays ~60 times).
   int substeps = 10;
-  double floor_size = 4.0;      // m, width of the static floor box (tosses span < 1.1 m)
-  double floor_thickness = 0.2; // m; its top face is the plane z = 0
+  double floor_size = 4.0;       // m, width of the static floor box (tosses span < 1.1 m)
+  double floor_thickness = 0.2;  // m; its top face is the plane z = 0
 };
 
 /// One measured sample: the cube's state at time t.
@@ -46,9 +46,9 @@ struct TossSample {
 
 /// One toss: release (in the air) to rest.
 struct Toss {
-  long id = 0;                       // the data's toss id
-  long first_row = 0;                // 1-based line of its first sample in the file
-  std::vector<TossSample> samples;   // time increasing, >= 2 samples
+  long id = 0;                      // the data's toss id
+  long first_row = 0;               // 1-based line of its first sample in the file
+  std::vector<TossSample> samples;  // time increasing, >= 2 samples
 };
 
 /// Reads tosses from a CSV file (plain or gzip, told apart by content) with the header
@@ -76,11 +76,11 @@ Scene toss_scene(const Toss& toss, const ContactParams& params, const CubeTossMo
 /// Errors of one simulated toss against its measurement.
 struct TossErrors {
   long toss_id = 0;
-  double position = 0.0;          // mean |p_sim - p_real| / cube width over samples after t = 0
-  double orientation_deg = 0.0;   // mean rotation angle between sim and real, same samples
-  double final_position = 0.0;    // |p_sim - p_real| / cube width at the last sample
-  double final_orientation_deg = 0.0;  // rotation angle between sim and real at the last sample
-  std::vector<double> position_by_sample;    // |p_sim - p_real| / width at samples 1..n-1
+  double position = 0.0;         // mean |p_sim - p_real| / cube width over samples after t = 0
+  double orientation_deg = 0.0;  // mean rotation angle between sim and real, same samples
+  double final_position = 0.0;   // |p_sim - p_real| / cube width at the last sample
+  double final_orientation_deg = 0.0;      // rotation angle between sim and real at the last sample
+  std::vector<double> position_by_sample;  // |p_sim - p_real| / width at samples 1..n-1
   std::vector<double> horizontal_by_sample;  // the same, x and y only (sliding, rolling away)
 };
 
@@ -156,8 +156,8 @@ Json backend_tosses_json(const BackendTosses& r);
 /// Runs the tosses data set in folder `dir` (test.csv[.gz] with params.json) through every
 /// dynamics backend (or those named in `backend_list`), at the stored and at the published
 /// parameters; writes tosses.json, tosses_per_toss.csv and tosses_traj.csv into `out_dir`,
-/// the figures into out_dir/figures (through comparisons/output/tosses_plots.py when python3 is there)
-/// and returns the report's "Real impacts" markdown section.
+/// the figures into out_dir/figures (through comparisons/output/tosses_plots.py when python3 is
+/// there) and returns the report's "Real impacts" markdown section.
 std::string tosses_report_section(const std::string& dir, const std::string& out_dir,
                                   const std::string& backend_list);
 

@@ -23,8 +23,10 @@ Json trajectory_json(const std::vector<StateSample>& samples, const std::vector<
   std::vector<size_t> picks;
   const size_t n = samples.size(), frames = std::min(n, std::max<size_t>(max_frames, 2));
   for (size_t k = 0; k < frames; ++k) {
-    const size_t i = frames == 1 ? 0 : static_cast<size_t>(std::llround(
-                                           static_cast<double>(k) * (n - 1) / (frames - 1)));
+    const size_t i =
+        frames == 1
+            ? 0
+            : static_cast<size_t>(std::llround(static_cast<double>(k) * (n - 1) / (frames - 1)));
     if (picks.empty() || picks.back() != i) picks.push_back(i);
   }
   Json time = Json::array();

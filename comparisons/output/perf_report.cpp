@@ -68,18 +68,16 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
   // Against FCL with its shapes built once (custom keeps its hierarchies per shape too): the
   // per-call `fcl` row also pays for building fcl::Convex, which would flatter custom.
   const double fcl_2048 = find_time(results.narrow, "fcl", "prebuilt", "touching", 2048);
-  goals.push_back(
-      {"custom (fast) no slower than fcl (shapes prebuilt) at N = 2048, touching",
-       fmt_duration_ns(fast_2048) + " vs " + fmt_duration_ns(fcl_2048) + ": ratio " +
-           bench_num(fast_2048 / fcl_2048),
-       fast_2048 <= fcl_2048});
+  goals.push_back({"custom (fast) no slower than fcl (shapes prebuilt) at N = 2048, touching",
+                   fmt_duration_ns(fast_2048) + " vs " + fmt_duration_ns(fcl_2048) + ": ratio " +
+                       bench_num(fast_2048 / fcl_2048),
+                   fast_2048 <= fcl_2048});
   const double fast_box = find_time(results.narrow, "custom", "fast", "touching", 8);
   const double fclbox = find_time(results.narrow, "fcl-box", "default", "touching", 8);
-  goals.push_back(
-      {"custom (fast) within 1.5x of fcl-box on two boxes, touching",
-       fmt_duration_ns(fast_box) + " vs " + fmt_duration_ns(fclbox) + ": ratio " +
-           bench_num(fast_box / fclbox),
-       fast_box <= 1.5 * fclbox});
+  goals.push_back({"custom (fast) within 1.5x of fcl-box on two boxes, touching",
+                   fmt_duration_ns(fast_box) + " vs " + fmt_duration_ns(fclbox) + ": ratio " +
+                       bench_num(fast_box / fclbox),
+                   fast_box <= 1.5 * fclbox});
   for (BroadPhaseMethod m : kBenchBroadPhaseMethods) {
     std::vector<std::pair<double, double>> pts;
     for (const BroadRow& r : results.broad)
@@ -108,20 +106,17 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
   Json j;
   j["generated_by"] = "rbx bench";
   j["mode"] = plan.quick ? "quick" : "full";
-  j["machine"] = {{"cpu", cpu_model()},
-                  {"cpus", results.cpus},
-                  {"mhz", results.mhz},
-                  {"hostname", [] {
-                     char h[256] = {0};
-                     gethostname(h, sizeof h - 1);
-                     return std::string(h);
-                   }()}};
-  j["settings"] = {{"poses_per_kind", plan.poses},
-                   {"min_time_s", plan.min_time},
-                   {"shape_size_m", kBenchShapeSize},
-                   {"touching_offset", kPoseKinds[0].offset},
-                   {"deep_offset", kPoseKinds[1].offset},
-                   {"separated_offset", kPoseKinds[2].offset}};
+  j["machine"] = {
+      {"cpu", cpu_model()}, {"cpus", results.cpus}, {"mhz", results.mhz}, {"hostname", [] {
+                                                                             char h[256] = {0};
+                                                                             gethostname(
+                                                                                 h, sizeof h - 1);
+                                                                             return std::string(h);
+                                                                           }()}};
+  j["settings"] = {
+      {"poses_per_kind", plan.poses},        {"min_time_s", plan.min_time},
+      {"shape_size_m", kBenchShapeSize},     {"touching_offset", kPoseKinds[0].offset},
+      {"deep_offset", kPoseKinds[1].offset}, {"separated_offset", kPoseKinds[2].offset}};
   j["rows"] = Json::array();
   for (const NarrowRow& r : results.narrow)
     j["rows"].push_back(
@@ -237,7 +232,8 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
           }
         md << " " << fmt_duration_ns(t) << note << " |";
       }
-      md << " " << bench_num(series_exponent(results.narrow, b.backend, b.variant, k.name), 2) << " |\n";
+      md << " " << bench_num(series_exponent(results.narrow, b.backend, b.variant, k.name), 2)
+         << " |\n";
     }
     md << "\n![narrow phase, " << k.name << "](figures/perf_narrowphase_" << k.name << ".png)\n\n";
   }

@@ -20,7 +20,7 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
 
 /// Writes perf.md, perf.json, perf.csv and the figures into `out`, each file built in a
 /// temporary folder and moved in (other files there, such as `rbx report`'s, are kept). With
-/// `contract_copy`, reports/perf.md (the path CONTRACT.md names, beside `out`) gets a copy of
+/// `contract_copy`, reports/perf.md (the path docs/contract.md names, beside `out`) gets a copy of
 /// perf.md whose figure links point into `out`'s folder name "latest/". `timing_s` is the wall
 /// time of the timing, written into perf.md.
 void write_perf_pages(const BenchPlan& plan, const BenchResults& results,

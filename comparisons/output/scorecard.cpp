@@ -26,7 +26,8 @@ bool about(const std::vector<std::string>& lines, const std::string& name) {
 
 // The largest value of metric `name` of a backend against a truth (closed form, exact oracle or
 // exact solid), or -1 when there is none.
-double truth_metric(const SceneEvaluation& ev, const std::string& backend, const std::string& name) {
+double truth_metric(const SceneEvaluation& ev, const std::string& backend,
+                    const std::string& name) {
   double worst = -1.0;
   for (const Metric& m : ev.metrics)
     if (m.backend == backend && m.name == name &&
@@ -43,7 +44,8 @@ std::string cause(const SceneEvaluation& ev, const std::string& backend) {
     if (msg.size() > 70) msg = msg.substr(0, 67) + "...";
     return "error: " + msg;
   }
-  if (truth_metric(ev, backend, "touching_err") > 0) return "misses a contact or reports a false one";
+  if (truth_metric(ev, backend, "touching_err") > 0)
+    return "misses a contact or reports a false one";
   const double angle = truth_metric(ev, backend, "normal_err_deg");
   const double depth = truth_metric(ev, backend, "depth_err");
   if (angle > kMarkAngleDeg) return "wrong contact normal (> 1°)";
@@ -53,7 +55,8 @@ std::string cause(const SceneEvaluation& ev, const std::string& backend) {
         return "wrong depth, normal within 1°";
   }
   for (const Metric& m : ev.metrics)
-    if (m.backend == backend && (m.name == "inertia_err_rel" || m.name == "mass_err_rel" || m.name == "com_err_rel") &&
+    if (m.backend == backend &&
+        (m.name == "inertia_err_rel" || m.name == "mass_err_rel" || m.name == "com_err_rel") &&
         m.value > 1e-6)
       return "mass properties off (relative > 1e-6)";
   if (ev.json["stability"].contains(backend)) {
@@ -64,7 +67,8 @@ std::string cause(const SceneEvaluation& ev, const std::string& backend) {
     if (d.rfind(backend + ":", 0) == 0) {
       if (d.find("angular_velocity") != std::string::npos)
         return "post-impact angular velocity off (> 0.1 %, energy norm)";
-      if (d.find("velocity") != std::string::npos) return "post-impact velocity off (> 0.1 %, energy norm)";
+      if (d.find("velocity") != std::string::npos)
+        return "post-impact velocity off (> 0.1 %, energy norm)";
       if (d.find("position") != std::string::npos) return "final position off";
     }
   return "outside the scene's tolerance (within the ✗ bounds)";
@@ -122,15 +126,19 @@ std::string scorecard_markdown(const std::vector<Scene>& scenes,
         const Json& bj = ev.json["backends"][b];
         if (bj["status"] == "unsupported") continue;
         ++run;
-        const bool bad = bj["status"] == "error" || about(ev.disagreements, b) || about(ev.deviations, b);
-        if (!bad) ++within;
+        const bool bad =
+            bj["status"] == "error" || about(ev.disagreements, b) || about(ev.deviations, b);
+        if (!bad)
+          ++within;
         else {
           const std::string c = cause(ev, b);
           auto& list = causes[b];
-          auto it = std::find_if(list.begin(), list.end(), [&](const auto& p) { return p.first == c; });
+          auto it =
+              std::find_if(list.begin(), list.end(), [&](const auto& p) { return p.first == c; });
           if (it == list.end()) it = list.insert(list.end(), {c, {}});
           const std::string name = md_escape(fam + "/" + scenes[i].name);
-          it->second.push_back(views ? "[" + name + "](views/" + scene_slug(fam, scenes[i].file) + ".html)" : name);
+          it->second.push_back(
+              views ? "[" + name + "](views/" + scene_slug(fam, scenes[i].file) + ".html)" : name);
         }
         if (bj["status"] != "ok") continue;
         if (const double a = truth_metric(ev, b, "normal_err_deg"); a >= 0) {
@@ -169,7 +177,8 @@ std::string scorecard_markdown(const std::vector<Scene>& scenes,
       if (!times.empty())
         time = fmt_num(median_of(times) * 1e6, 3) + (contact ? " µs/query" : " µs/step");
       t.add({"**" + b + "**", fam, std::to_string(run),
-             std::to_string(within) + (within == run ? "" : " (" + std::to_string(run - within) + " not)"),
+             std::to_string(within) +
+                 (within == run ? "" : " (" + std::to_string(run - within) + " not)"),
              med, worst, time});
     }
   }

@@ -2,6 +2,8 @@
 // tinyobjloader (double build). Both end in ConvexPolyhedron::from_triangles, the one validator.
 #include "comparisons/scene/mesh_io.h"
 
+#include <tiny_obj_loader.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -12,8 +14,6 @@
 #include <map>
 #include <regex>
 #include <sstream>
-
-#include <tiny_obj_loader.h>
 
 extern "C" {
 #include <libqhull_r/qhull_ra.h>
@@ -88,7 +88,8 @@ ConvexPolyhedron convex_hull(const std::vector<Vec3>& points) {
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
-  const double eps = 1e-10 * std::max((hi - lo).norm(), hi.cwiseAbs().cwiseMax(lo.cwiseAbs()).maxCoeff());
+  const double eps =
+      1e-10 * std::max((hi - lo).norm(), hi.cwiseAbs().cwiseMax(lo.cwiseAbs()).maxCoeff());
   const std::string count = "the " + std::to_string(points.size()) + " points";
   auto farthest = [&](auto distance) {
     size_t best = 0;
@@ -106,7 +107,8 @@ ConvexPolyhedron convex_hull(const std::vector<Vec3>& points) {
   const Vec3 n = u.cross(points[i2] - p0).normalized();
   const auto [i3, d3] = farthest([&](const Vec3& p) { return std::abs((p - p0).dot(n)); });
   (void)i3;
-  if (!(d3 > eps)) throw GeometryError(count + " all lie in one plane, so their hull has no volume");
+  if (!(d3 > eps))
+    throw GeometryError(count + " all lie in one plane, so their hull has no volume");
 
   // Qhull wants a flat, mutable coordinate array.
   std::vector<coordT> coords;
@@ -121,8 +123,8 @@ ConvexPolyhedron convex_hull(const std::vector<Vec3>& points) {
   QHULL_LIB_CHECK
   qh_zero(qh, errors.file());
   char flags[] = "qhull Qt";
-  const int exitcode = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coords.data(),
-                                    False, flags, nullptr, errors.file());
+  const int exitcode = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coords.data(), False,
+                                    flags, nullptr, errors.file());
 
   // Read the facets, mapping Qhull point ids to a compact vertex list (interior and coplanar
   // points are dropped: ConvexPolyhedron refuses unused vertices).
@@ -163,8 +165,7 @@ ConvexPolyhedron convex_hull(const std::vector<Vec3>& points) {
   int curlong = 0, totlong = 0;
   qh_memfreeshort(qh, &curlong, &totlong);
 
-  if (exitcode != 0)
-    throw GeometryError("Qhull could not build the hull: " + one_line(diagnosis));
+  if (exitcode != 0) throw GeometryError("Qhull could not build the hull: " + one_line(diagnosis));
   return ConvexPolyhedron::from_triangles(std::move(vertices), std::move(triangles));
 }
 
@@ -333,8 +334,8 @@ ConvexPolyhedron load_obj(const std::string& path, bool hull) {
   const int nv = static_cast<int>(attrib.vertices.size() / 3);
   std::vector<Vec3> vertices(nv);
   for (int i = 0; i < nv; ++i)
-    vertices[i] = Vec3(attrib.vertices[3 * i], attrib.vertices[3 * i + 1],
-                       attrib.vertices[3 * i + 2]);
+    vertices[i] =
+        Vec3(attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]);
   // Coordinates beyond kMaxLength overflow squared lengths and volumes (polyhedron.h).
   for (int i = 0; i < nv; ++i)
     if (!(vertices[i].cwiseAbs().maxCoeff() <= kMaxLength))
@@ -369,8 +370,8 @@ ConvexPolyhedron load_obj(const std::string& path, bool hull) {
       for (size_t k = 0; k < corners; ++k) {
         const int v = shape.mesh.indices[offset + k].vertex_index;
         if (v < 0 || v >= nv) {
-          const int line = face < static_cast<int>(lines.face_line.size())
-                               ? lines.face_line[face] : -1;
+          const int line =
+              face < static_cast<int>(lines.face_line.size()) ? lines.face_line[face] : -1;
           throw GeometryError(path + ": line " + std::to_string(line) + ": face refers to vertex " +
                               std::to_string(v + 1) + ", but the file has " + std::to_string(nv) +
                               " vertices (OBJ counts from 1)");

@@ -11,7 +11,8 @@ std::string default_repo_path(const std::string& relative) {
   std::error_code ec;
   // At the root (or when the source tree is gone: a binary moved elsewhere) the plain relative
   // path, as before; elsewhere the repository's own folder.
-  if (!fs::is_directory(root, ec) || fs::equivalent(fs::current_path(ec), root, ec)) return relative;
+  if (!fs::is_directory(root, ec) || fs::equivalent(fs::current_path(ec), root, ec))
+    return relative;
   return (root / relative).string();
 }
 

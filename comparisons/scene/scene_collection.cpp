@@ -19,7 +19,8 @@ std::vector<std::string> collect_scene_files(const std::vector<std::string>& inp
     if (fs::is_directory(root, ec)) {
       std::vector<std::string> found;
       for (const auto& e : fs::recursive_directory_iterator(root))
-        if (e.is_regular_file() && e.path().extension() == ".toml") found.push_back(e.path().string());
+        if (e.is_regular_file() && e.path().extension() == ".toml")
+          found.push_back(e.path().string());
       std::sort(found.begin(), found.end());
       files.insert(files.end(), found.begin(), found.end());
     } else if (fs::exists(root, ec)) {

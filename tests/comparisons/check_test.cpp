@@ -5,10 +5,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "comparisons/cli/commands.h"
 #include "reference/backend.h"
@@ -88,7 +87,8 @@ TEST(Check, ABrokenEngineCopyFailsAndEveryChangedMetricIsNamed) {
   // Grouped: the scene, then the backend, then the metric with old -> new and the change.
   const size_t contact = r.out.find("contact/axis_x\n  custom\n");
   ASSERT_NE(contact, std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("worse   contact A-B normal_err_deg: 0 -> 2 (+2 deg)", contact), std::string::npos)
+  EXPECT_NE(r.out.find("worse   contact A-B normal_err_deg: 0 -> 2 (+2 deg)", contact),
+            std::string::npos)
       << r.out;
   const size_t impact = r.out.find("analytic/headon_e05\n  custom\n");
   ASSERT_NE(impact, std::string::npos) << r.out;
@@ -114,7 +114,8 @@ TEST(Check, ABrokenEngineCopyFailsAndEveryChangedMetricIsNamed) {
   opt.update = false;
   const CheckRun healed = run_check(opt);
   EXPECT_EQ(healed.code, 0) << healed.out;
-  EXPECT_NE(healed.out.find("better  contact A-B normal_err_deg: 2 -> 0 (-2 deg)"), std::string::npos)
+  EXPECT_NE(healed.out.find("better  contact A-B normal_err_deg: 2 -> 0 (-2 deg)"),
+            std::string::npos)
       << healed.out;
   EXPECT_NE(healed.out.find("some errors shrank"), std::string::npos) << healed.out;
   fs::remove_all(dir);
@@ -133,7 +134,8 @@ TEST(Check, BackendsLimitTheComparisonAndUpdateMergesOnlyWhatRan) {
   b["metrics"]["other/not_run | contact | fcl | A-B | depth_err"] = 0.25;
   std::string bullet_key;
   for (auto& [k, v] : b["metrics"].items())
-    if (k.find(" | bullet | ") != std::string::npos && k.find("normal_err_deg") != std::string::npos) {
+    if (k.find(" | bullet | ") != std::string::npos &&
+        k.find("normal_err_deg") != std::string::npos) {
       bullet_key = k;
       v = -1.0;  // below any error: the rerun is worse
     }

@@ -11,13 +11,12 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "tests/common/bad_input.h"
 
@@ -64,7 +63,8 @@ TEST(Cli, BadSceneExitsTwoWithOneLineAndNoOutputFile) {
   const fs::path dir = temp_dir("bad");
   std::ofstream(dir / "bad.toml") << "[[body]]\nname = \"A\"\nmass = -1\n";
   const fs::path json = dir / "out.json";
-  const CmdResult r = rbx("run '" + (dir / "bad.toml").string() + "' --json '" + json.string() + "'");
+  const CmdResult r =
+      rbx("run '" + (dir / "bad.toml").string() + "' --json '" + json.string() + "'");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find("bad.toml:3"), std::string::npos) << r.err;
@@ -171,7 +171,8 @@ TEST(Cli, ContactsRunsEveryBackendInTheContractConvention) {
   const auto j = nlohmann::json::parse(r.out);
   int answered = 0;
   for (const auto& [name, b] : j["backends"].items()) {
-    if (b["status"] != "ok" || name == "fcl-indep") continue;  // INDEP: known defects, pinned elsewhere
+    if (b["status"] != "ok" || name == "fcl-indep")
+      continue;  // INDEP: known defects, pinned elsewhere
     ASSERT_FALSE(b["contacts"].empty()) << name;
     const auto& c = b["contacts"][0];
     EXPECT_EQ(c["bodies"], nlohmann::json::array({"A", "B"})) << name;
@@ -194,7 +195,8 @@ TEST(Cli, CompareExitsOneOnAWrongExpectation) {
   std::ofstream(dir / "right.toml") << body << "depth = 0.1\n";
   std::ofstream(dir / "wrong.toml") << body << "depth = 0.2\n";
   EXPECT_EQ(rbx("compare '" + (dir / "right.toml").string() + "' --backends exact,custom").code, 0);
-  const CmdResult wrong = rbx("compare '" + (dir / "wrong.toml").string() + "' --backends exact,custom");
+  const CmdResult wrong =
+      rbx("compare '" + (dir / "wrong.toml").string() + "' --backends exact,custom");
   EXPECT_EQ(wrong.code, 1);
   EXPECT_NE(wrong.out.find("[expect] FAILED"), std::string::npos) << wrong.out;
   fs::remove_all(dir);
@@ -231,7 +233,8 @@ TEST(Cli, ReportWritesEverythingIntoItsFolder) {
   std::ofstream(dir / "out/perf.md") << "bench page";
   std::ofstream(dir / "out/figures/perf_step.png") << "bench figure";
   std::ofstream(dir / "out/stale.md") << "old";
-  const CmdResult r = rbx("report scenes/seed/face_face.toml --out '" + (dir / "out").string() + "'");
+  const CmdResult r =
+      rbx("report scenes/seed/face_face.toml --out '" + (dir / "out").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* f : {"report.md", "results.json", "metrics.csv", "sweep.csv", "stability.csv"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
@@ -252,7 +255,8 @@ TEST(Cli, ReportWritesEverythingIntoItsFolder) {
 namespace {
 
 // Text of a library scene with one substitution applied (sed-like, first match of a line).
-std::string scene_text(const std::string& file, const std::string& from = "", const std::string& to = "") {
+std::string scene_text(const std::string& file, const std::string& from = "",
+                       const std::string& to = "") {
   std::ifstream in(std::string(RBX_SOURCE_DIR) + "/" + file);
   std::stringstream s;
   s << in.rdbuf();
@@ -279,7 +283,8 @@ TEST(CompareExpect, ContactExpectationIsCheckedWithoutTheExactBackend) {
   // axis_x with a wrong depth (0.2 instead of 0.1), exact not among the backends: the oracle's
   // answer is computed anyway and must contradict the scene.
   const fs::path dir = temp_dir("expect_noexact");
-  std::ofstream(dir / "w.toml") << scene_text("scenes/contact/axis_x.toml", "\ndepth = 0.1", "\ndepth = 0.2");
+  std::ofstream(dir / "w.toml") << scene_text("scenes/contact/axis_x.toml", "\ndepth = 0.1",
+                                              "\ndepth = 0.2");
   const CmdResult r = rbx("compare '" + (dir / "w.toml").string() + "' --backends custom,fcl");
   EXPECT_EQ(r.code, 1) << r.out;
   EXPECT_NE(r.out.find("[expect] FAILED: exact: contact depth"), std::string::npos) << r.out;
@@ -291,10 +296,12 @@ TEST(CompareExpect, ContactExpectationBindsCustomUnlessAKnownFailure) {
   // As committed (known_failure set) compare passes and says why; without the marker it fails.
   const CmdResult known = rbx("compare scenes/contact/fcl_rotated_45.toml --backends custom");
   EXPECT_EQ(known.code, 0) << known.out;
-  EXPECT_NE(known.out.find("[expect] FAILED: custom: contact normal"), std::string::npos) << known.out;
+  EXPECT_NE(known.out.find("[expect] FAILED: custom: contact normal"), std::string::npos)
+      << known.out;
   EXPECT_NE(known.out.find("[expect] known failure:"), std::string::npos) << known.out;
   const fs::path dir = temp_dir("expect_custom");
-  std::ofstream(dir / "w.toml") << scene_text("scenes/contact/fcl_rotated_45.toml", "\nknown_failure", "\n# known_failure");
+  std::ofstream(dir / "w.toml") << scene_text("scenes/contact/fcl_rotated_45.toml",
+                                              "\nknown_failure", "\n# known_failure");
   const CmdResult r = rbx("compare '" + (dir / "w.toml").string() + "' --backends custom");
   EXPECT_EQ(r.code, 1) << r.out;
   EXPECT_NE(r.out.find("[expect] FAILED: custom: contact normal"), std::string::npos) << r.out;
@@ -308,7 +315,8 @@ TEST(CompareMetrics, EveryDynamicsBackendGetsTheSameMetricNames) {
   ASSERT_LE(r.code, 1) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   std::map<std::string, std::set<std::string>> names;
-  for (const auto& m : j["scenes"][0]["metrics"]) names[m["backend"]].insert(m["name"].get<std::string>());
+  for (const auto& m : j["scenes"][0]["metrics"])
+    names[m["backend"]].insert(m["name"].get<std::string>());
   ASSERT_GE(names.size(), 2u);
   for (const auto& [backend, set] : names) EXPECT_EQ(set, names.begin()->second) << backend;
 }
@@ -399,8 +407,9 @@ TEST(CompareMetrics, EnergyErrorIsAgainstTheClosedFormWhereThereIsOne) {
 
 TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSeedSinksOnTheStack) {
   const fs::path dir = temp_dir("report_stab");
-  const CmdResult r = rbx("report scenes/stress/resting_stack.toml scenes/stress/tunnel_thin_wall.toml --out '" +
-                          (dir / "out").string() + "'");
+  const CmdResult r =
+      rbx("report scenes/stress/resting_stack.toml scenes/stress/tunnel_thin_wall.toml --out '" +
+          (dir / "out").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   std::stringstream csv, md;
   csv << std::ifstream(dir / "out/stability.csv").rdbuf();
@@ -410,8 +419,10 @@ TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSeedSinksOnTheStack) {
   std::string header;
   std::getline(csv, header);
   EXPECT_NE(header.find(",dt,restitution,"), std::string::npos) << header;
-  EXPECT_NE(csv.str().find("resting_stack,stress,custom-seed,0.001,0,sinks,"), std::string::npos) << csv.str();
-  EXPECT_EQ(csv.str().find("resting_stack,stress,custom,0.001,0,sinks,"), std::string::npos) << csv.str();
+  EXPECT_NE(csv.str().find("resting_stack,stress,custom-seed,0.001,0,sinks,"), std::string::npos)
+      << csv.str();
+  EXPECT_EQ(csv.str().find("resting_stack,stress,custom,0.001,0,sinks,"), std::string::npos)
+      << csv.str();
   // report.md: the stability table shows them too.
   EXPECT_NE(md.str().find("| scene | backend | dt (s) | e | verdict |"), std::string::npos);
   // Summary: custom-seed's cells are marked like everyone else's; the known failure says so.
@@ -485,7 +496,8 @@ TEST(CliElsewhere, DefaultPathsResolveInsideTheRepository) {
   EXPECT_EQ(there.out, here.out);
   // The committed baseline is found from another directory (a scene path given by the caller
   // stays the caller's).
-  const CmdResult check = rbx_in(dir.string(), "check '" RBX_SOURCE_DIR "/scenes/seed/face_face.toml'");
+  const CmdResult check =
+      rbx_in(dir.string(), "check '" RBX_SOURCE_DIR "/scenes/seed/face_face.toml'");
   EXPECT_EQ(check.code, 0) << check.out << check.err;
   EXPECT_NE(check.out.find("0 worse"), std::string::npos) << check.out;
   fs::remove_all(dir);
@@ -507,7 +519,8 @@ TEST(CompareExpect, AnExpectationNoBackendRunCanBindIsNotChecked) {
   const fs::path dir = temp_dir("unbound");
   // Head-on, equal unit masses at e = 1: they swap velocities. The scene claims they stop.
   std::ofstream(dir / "wrong.toml")
-      << "checks = [\"impulse\"]\n[[body]]\nname = \"A\"\nposition = [-1, 0, 0]\nvelocity = [1, 0, 0]\n"
+      << "checks = [\"impulse\"]\n[[body]]\nname = \"A\"\nposition = [-1, 0, 0]\nvelocity = [1, 0, "
+         "0]\n"
          "[[body]]\nname = \"B\"\nposition = [1, 0, 0]\nvelocity = [-1, 0, 0]\n"
          "[expect]\ntolerance = 1e-6\n[expect.body.A]\nvelocity = [0, 0, 0]\n";
   const std::string scene = "'" + (dir / "wrong.toml").string() + "'";
@@ -550,11 +563,13 @@ TEST(CliContacts, FirstContactQueriesWhereAPairFirstTouches) {
 
 TEST(CliContacts, DisagreementsAreFlaggedAsCompareFlagsThem) {
   // fcl_rotated_45: fcl-indep returns the normal in A's local frame, 45 deg off (a known defect).
-  const CmdResult r = rbx("contacts scenes/contact/fcl_rotated_45.toml --backends exact,fcl-indep,ode --json -");
+  const CmdResult r =
+      rbx("contacts scenes/contact/fcl_rotated_45.toml --backends exact,fcl-indep,ode --json -");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["disagreements"].size(), 1u) << j["disagreements"];
-  EXPECT_EQ(j["disagreements"][0].get<std::string>().rfind("fcl-indep on A-B: normal off by 45", 0), 0u)
+  EXPECT_EQ(j["disagreements"][0].get<std::string>().rfind("fcl-indep on A-B: normal off by 45", 0),
+            0u)
       << j["disagreements"];
   EXPECT_NE(r.err.find("disagrees: fcl-indep on A-B"), std::string::npos) << r.err;
   EXPECT_EQ(j["backends"]["fcl-indep"]["pairs"][0]["mark"], "disagrees");

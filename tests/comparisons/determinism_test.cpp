@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <random>
@@ -122,12 +122,18 @@ Scene built_scene(Integrator integrator) {
     for (int j = 0; j < 4; ++j)
       for (int k = 0; k < 5; ++k, ++n) {
         const int kind = n % 3;
-        BodySpec& b = add("b" + std::to_string(n), kind == 0 ? box : kind == 1 ? sphere : prism,
-                          kind == 0 ? ShapeKind::Box : kind == 1 ? ShapeKind::Icosphere : ShapeKind::Prism);
+        BodySpec& b = add("b" + std::to_string(n),
+                          kind == 0   ? box
+                          : kind == 1 ? sphere
+                                      : prism,
+                          kind == 0   ? ShapeKind::Box
+                          : kind == 1 ? ShapeKind::Icosphere
+                                      : ShapeKind::Prism);
         if (kind == 0) b.box_size = Vec3(0.3, 0.25, 0.2);
         b.mass = 1.0 + 0.5 * kind;
         b.position = Vec3(-0.55 + 0.55 * i, -0.825 + 0.55 * j, -1.1 + 0.55 * k);
-        b.orientation = Quat(Eigen::AngleAxisd(3.0 * unit(rng), Vec3(unit(rng), unit(rng), 1).normalized()));
+        b.orientation =
+            Quat(Eigen::AngleAxisd(3.0 * unit(rng), Vec3(unit(rng), unit(rng), 1).normalized()));
         b.velocity = 4.0 * Vec3(unit(rng), unit(rng), unit(rng));
         b.angular_velocity = 5.0 * Vec3(unit(rng), unit(rng), unit(rng));
       }
@@ -155,9 +161,8 @@ void expect_deterministic(const Scene& scene, size_t min_events) {
 TEST(Determinism, LibraryScene64CubesInABox) {
   // 0.15 s of the 2 s scene keeps the test short; 64 cubes at up to 2 m/s in a 3 m box already
   // collide with each other and the walls dozens of times by then.
-  const Scene scene =
-      load_scene(std::string(RBX_SOURCE_DIR) + "/scenes/stress/many_bodies_walls.toml",
-                 {"sim.duration=0.15"});
+  const Scene scene = load_scene(
+      std::string(RBX_SOURCE_DIR) + "/scenes/stress/many_bodies_walls.toml", {"sim.duration=0.15"});
   ASSERT_GE(scene.bodies.size(), 60u);
   expect_deterministic(scene, 20);
 }

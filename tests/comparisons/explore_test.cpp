@@ -1,5 +1,7 @@
 // rbx explore: samples reproducible from (seed, index), the same results on any number of
 // threads, shrinking that keeps the disagreement, and shrunk scenes the harness reproduces.
+#include "comparisons/eval/explore.h"
+
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -11,7 +13,6 @@
 #include <string>
 
 #include "comparisons/cli/commands.h"
-#include "comparisons/eval/explore.h"
 #include "comparisons/eval/parallel.h"
 
 namespace fs = std::filesystem;

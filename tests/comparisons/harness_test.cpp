@@ -99,7 +99,8 @@ TEST(Harness, WithoutATableTheRegistryIsUsed) {
 TEST(HarnessExpect, AnEngineRunThatStopsFailsItsExpectationAndReferencesDoNotBindIt) {
   // Head-on equal masses, e = 1: they swap velocities (A ends at -1 m/s), as [expect] says.
   const Scene scene = parse_scene(
-      "checks = [\"impulse\"]\n[[body]]\nname = \"A\"\nposition = [-1, 0, 0]\nvelocity = [1, 0, 0]\n"
+      "checks = [\"impulse\"]\n[[body]]\nname = \"A\"\nposition = [-1, 0, 0]\nvelocity = [1, 0, "
+      "0]\n"
       "[[body]]\nname = \"B\"\nposition = [1, 0, 0]\nvelocity = [-1, 0, 0]\n"
       "[expect]\n[expect.body.A]\nvelocity = [-1, 0, 0]\n",
       "headon.toml");

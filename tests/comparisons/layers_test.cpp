@@ -16,9 +16,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // The layers, lowest first, as path prefixes relative to the source root.
-const std::vector<std::string> kLayers = {"engine/",           "reference/",
-                                          "comparisons/scene/", "comparisons/eval/",
-                                          "comparisons/output/", "comparisons/cli/"};
+const std::vector<std::string> kLayers = {
+    "engine/",           "reference/",          "comparisons/scene/",
+    "comparisons/eval/", "comparisons/output/", "comparisons/cli/"};
 
 // Rank of a path in kLayers, or -1 when it is in none (system headers, tests).
 int layer_of(const std::string& path) {
@@ -68,14 +68,16 @@ std::string read(const std::string& relative) {
 TEST(Layers, AnUpwardIncludeIsFound) {
   // The checker itself: an eval file including the CLI header is a violation; the same file
   // including scene and engine headers is not.
-  EXPECT_EQ(upward_includes("comparisons/eval/x.cpp", "#include \"comparisons/cli/commands.h\"\n"),
-            std::vector<std::string>{"comparisons/eval/x.cpp: includes comparisons/cli/commands.h"});
+  EXPECT_EQ(
+      upward_includes("comparisons/eval/x.cpp", "#include \"comparisons/cli/commands.h\"\n"),
+      std::vector<std::string>{"comparisons/eval/x.cpp: includes comparisons/cli/commands.h"});
   EXPECT_EQ(upward_includes("reference/x.cpp", "  # include \"comparisons/scene/scene_file.h\""),
             std::vector<std::string>{"reference/x.cpp: includes comparisons/scene/scene_file.h"});
-  EXPECT_TRUE(upward_includes("comparisons/eval/x.cpp",
-                              "#include \"comparisons/scene/mesh_io.h\"\n#include \"engine/body.h\"\n"
-                              "#include <vector>\n")
-                  .empty());
+  EXPECT_TRUE(
+      upward_includes("comparisons/eval/x.cpp",
+                      "#include \"comparisons/scene/mesh_io.h\"\n#include \"engine/body.h\"\n"
+                      "#include <vector>\n")
+          .empty());
 }
 
 TEST(Layers, NoSourceFileIncludesAHigherLayer) {

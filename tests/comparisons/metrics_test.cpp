@@ -1,13 +1,14 @@
 // The harness's metric functions against hand-computed cases: the kinetic-energy-norm velocity
 // error, the energy rule, the distance to a contact region, touch agreement and the stability
 // verdict rules.
+#include "comparisons/eval/metrics.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <functional>
 #include <limits>
 
-#include "comparisons/eval/metrics.h"
 #include "comparisons/scene/scene_file.h"
 #include "reference/backend.h"
 
@@ -36,8 +37,8 @@ TEST(KeNormError, TwoBodiesByHand) {
       "position = [3, 0, 0]\n");
   const std::vector<BodyFinal> fin = {final_state(in[0], {-1.0, 0, 0}),
                                       final_state(in[1], {-0.5, 0, 0}, {1.0, 0, 0})};
-  const std::vector<std::optional<RefState>> ref = {
-      RefState{Vec3(-1.25, 0, 0), Vec3::Zero()}, RefState{Vec3(-0.25, 0, 0), Vec3::Zero()}};
+  const std::vector<std::optional<RefState>> ref = {RefState{Vec3(-1.25, 0, 0), Vec3::Zero()},
+                                                    RefState{Vec3(-0.25, 0, 0), Vec3::Zero()}};
   // num = 1 * 0.25^2 + 6 * 0.25^2 + (1, 0, 0).I_world.(1, 0, 0) = 0.0625 + 0.375 + 5 = 5.4375
   // E_ref = 0.5 * 1 * 1.25^2 + 0.5 * 6 * 0.25^2 = 0.78125 + 0.1875 = 0.96875
   // error = sqrt(5.4375 / (2 * 0.96875)) = sqrt(2.806451...)
@@ -46,7 +47,8 @@ TEST(KeNormError, TwoBodiesByHand) {
 }
 
 TEST(KeNormError, OnlyBodiesAndQuantitiesInTheReferenceCount) {
-  const auto in = bodies_of("[[body]]\nname = \"A\"\n[[body]]\nname = \"B\"\nposition = [3, 0, 0]\n");
+  const auto in =
+      bodies_of("[[body]]\nname = \"A\"\n[[body]]\nname = \"B\"\nposition = [3, 0, 0]\n");
   const std::vector<BodyFinal> fin = {final_state(in[0], {2.0, 0, 0}, {0, 0, 7.0}),
                                       final_state(in[1], {5.0, 0, 0})};
   // Only A's velocity is referenced: B and A's spin do not count. num = 1, E_ref = 0.5 * 9.
@@ -64,9 +66,11 @@ TEST(KeNormError, ReferenceAtRestFallsBackToTheInitialEnergy) {
 }
 
 TEST(KeNormError, StaticBodiesNeverCount) {
-  const auto in = bodies_of("[[body]]\nname = \"A\"\nstatic = true\n[[body]]\nname = \"B\"\n"
-                            "position = [3, 0, 0]\n");
-  const std::vector<BodyFinal> fin = {final_state(in[0], {9.0, 0, 0}), final_state(in[1], {1.0, 0, 0})};
+  const auto in = bodies_of(
+      "[[body]]\nname = \"A\"\nstatic = true\n[[body]]\nname = \"B\"\n"
+      "position = [3, 0, 0]\n");
+  const std::vector<BodyFinal> fin = {final_state(in[0], {9.0, 0, 0}),
+                                      final_state(in[1], {1.0, 0, 0})};
   const std::vector<std::optional<RefState>> ref = {RefState{Vec3::Zero(), Vec3::Zero()},
                                                     RefState{Vec3(1.0, 0, 0), Vec3::Zero()}};
   EXPECT_EQ(ke_norm_error(in, fin, ref, 1.0), 0.0);
@@ -93,14 +97,18 @@ TEST(EnergyError, AgainstTheClosedFormALossBeyondWhatEAllowsCounts) {
 TEST(ExpectedKineticEnergy, NeedsBothVelocitiesOfEveryMovingBody) {
   // A: 1 kg unit cube (I = diag(1/6)); C: static. A at v = (1, 2, 0), w = (0, 0, 6):
   // 0.5 * 1 * 5 + 0.5 * 36 / 6 = 2.5 + 3 = 5.5 J.
-  const auto in = bodies_of("[[body]]\nname = \"A\"\n[[body]]\nname = \"C\"\nstatic = true\n"
-                            "position = [5, 0, 0]\n");
-  const std::vector<BodyFinal> fin = {final_state(in[0], Vec3::Zero()), final_state(in[1], Vec3::Zero())};
-  const auto e = expected_kinetic_energy(in, fin, {RefState{Vec3(1, 2, 0), Vec3(0, 0, 6)}, std::nullopt});
+  const auto in = bodies_of(
+      "[[body]]\nname = \"A\"\n[[body]]\nname = \"C\"\nstatic = true\n"
+      "position = [5, 0, 0]\n");
+  const std::vector<BodyFinal> fin = {final_state(in[0], Vec3::Zero()),
+                                      final_state(in[1], Vec3::Zero())};
+  const auto e =
+      expected_kinetic_energy(in, fin, {RefState{Vec3(1, 2, 0), Vec3(0, 0, 6)}, std::nullopt});
   ASSERT_TRUE(e.has_value());
   EXPECT_NEAR(*e, 5.5, kRoundOff);
   // Without A's angular velocity the closed form says nothing about its energy.
-  EXPECT_FALSE(expected_kinetic_energy(in, fin, {RefState{Vec3(1, 2, 0), std::nullopt}, std::nullopt}));
+  EXPECT_FALSE(
+      expected_kinetic_energy(in, fin, {RefState{Vec3(1, 2, 0), std::nullopt}, std::nullopt}));
   EXPECT_FALSE(expected_kinetic_energy(in, fin, {std::nullopt, std::nullopt}));
 }
 
@@ -122,8 +130,10 @@ TEST(DistanceToRegion, SquareSegmentPointAndEmpty) {
 TEST(ContactPointError, ZeroInsideBothBodiesElseTheDistanceToTheManifold) {
   // Two unit cubes overlapping 0.1 along x (A at the origin, B at x = 0.9): the intersection
   // is the slab 0.4 <= x <= 0.5, |y|, |z| <= 0.5. Take as manifold the square on A's face x = 0.5.
-  const auto in = bodies_of("[[body]]\nname = \"A\"\n[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n");
-  const std::vector<Vec3> face = {{0.5, -0.5, -0.5}, {0.5, 0.5, -0.5}, {0.5, 0.5, 0.5}, {0.5, -0.5, 0.5}};
+  const auto in =
+      bodies_of("[[body]]\nname = \"A\"\n[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n");
+  const std::vector<Vec3> face = {
+      {0.5, -0.5, -0.5}, {0.5, 0.5, -0.5}, {0.5, 0.5, 0.5}, {0.5, -0.5, 0.5}};
   // Inside the overlap, 0.05 from the manifold's plane: on the true contact region.
   EXPECT_EQ(contact_point_error({0.45, 0.1, 0.0}, in[0], in[1], face), 0.0);
   // On the overlap's boundary (A's face): inside both within the round-off tolerance.
@@ -141,8 +151,8 @@ TEST(TouchingError, ZeroExactlyWhenTheAnswerMatchesTheTruth) {
   one.contacts.push_back(ContactPoint{});
   EXPECT_EQ(touching_error(none, false), 0.0);
   EXPECT_EQ(touching_error(one, true), 0.0);
-  EXPECT_EQ(touching_error(none, true), 1.0);   // a missed contact
-  EXPECT_EQ(touching_error(one, false), 1.0);   // a false contact
+  EXPECT_EQ(touching_error(none, true), 1.0);  // a missed contact
+  EXPECT_EQ(touching_error(one, false), 1.0);  // a false contact
 }
 
 TEST(StabilityVerdict, StableWhenNoRuleFires) {
@@ -196,8 +206,16 @@ TEST(StabilityVerdict, EachUnstableRuleFiresAlone) {
       {"non-finite", [](StabilityFacts& f) { f.nonfinite = true; }},
       {"energy grew", [](StabilityFacts& f) { f.energy_growth = 0.011; }},
       {"tunnelled", [](StabilityFacts& f) { f.tunnelled_pairs = 1; }},
-      {"guard tripped", [](StabilityFacts& f) { f.stopped = true; f.stop_message = "guard tripped"; }},
-      {"momentum drift", [](StabilityFacts& f) { f.closed = true; f.momentum_drift = 2e-6; }},
+      {"guard tripped",
+       [](StabilityFacts& f) {
+         f.stopped = true;
+         f.stop_message = "guard tripped";
+       }},
+      {"momentum drift",
+       [](StabilityFacts& f) {
+         f.closed = true;
+         f.momentum_drift = 2e-6;
+       }},
       {"penetration", [](StabilityFacts& f) { f.max_penetration = 0.51; }},
   };
   for (const auto& [text, set] : rules) {

@@ -65,9 +65,9 @@ TEST_P(CacheScenes, CachedResultsAreByteIdenticalToAnUncachedRun) {
 
 // Contact, impact with a closed form, trajectory, mass and stability scenes.
 INSTANTIATE_TEST_SUITE_P(Library, CacheScenes,
-                         ::testing::Values("contact/fcl_rotated_45.toml", "analytic/headon_e05.toml",
-                                           "seed/edge_drop.toml", "mass/box_1x2x3.toml",
-                                           "stress/resting_stack.toml"));
+                         ::testing::Values("contact/fcl_rotated_45.toml",
+                                           "analytic/headon_e05.toml", "seed/edge_drop.toml",
+                                           "mass/box_1x2x3.toml", "stress/resting_stack.toml"));
 
 TEST(ResultCache, OursAreNeverCached) {
   EXPECT_FALSE(ResultCache::caches("custom"));
@@ -82,7 +82,8 @@ TEST(ResultCache, AnotherReferenceCodeOrOtherInputsMiss) {
       "[[body]]\nname = \"A\"\n[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n", "pair.toml");
   const std::vector<RigidBody> bodies = make_bodies(scene);
   const ResultCache before(dir.string(), "adapters 1111"), after(dir.string(), "adapters 2222");
-  ContactResult r{Status::Ok, "note", {ContactPoint{Vec3(0.45, 0, 0), Vec3(-1, 0, 0), 0.1, "face"}}};
+  ContactResult r{
+      Status::Ok, "note", {ContactPoint{Vec3(0.45, 0, 0), Vec3(-1, 0, 0), 0.1, "face"}}};
   before.store(before.contact_key("fcl", bodies[0], bodies[1]), r, 1.5e-6);
   const auto hit = before.load_contact(before.contact_key("fcl", bodies[0], bodies[1]));
   ASSERT_TRUE(hit);
@@ -97,7 +98,8 @@ TEST(ResultCache, AnotherReferenceCodeOrOtherInputsMiss) {
   moved[1].position.x() = std::nextafter(0.9, 1.0);
   EXPECT_FALSE(before.load_contact(before.contact_key("fcl", moved[0], moved[1])));
   // A truncated file is a miss, not a crash.
-  for (const auto& e : fs::directory_iterator(dir)) fs::resize_file(e.path(), fs::file_size(e.path()) - 3);
+  for (const auto& e : fs::directory_iterator(dir))
+    fs::resize_file(e.path(), fs::file_size(e.path()) - 3);
   EXPECT_FALSE(before.load_contact(before.contact_key("fcl", bodies[0], bodies[1])));
   fs::remove_all(dir);
 }
@@ -109,10 +111,10 @@ TEST(ResultCache, EditingAnAdapterChangesTheSourceHash) {
   std::ofstream(dir / "fcl.cpp") << "int answer() { return 42; }\n";
   std::ofstream(dir / "ode.cpp") << "int other() { return 1; }\n";
   const auto hash = [&] {
-    const std::string cmd = "cmake -DOUT='" + (dir / "h.h").string() + "' '-DFILES=" +
-                            (dir / "fcl.cpp").string() + "|" + (dir / "ode.cpp").string() +
-                            "' -DROOT='" + dir.string() + "' -P '" RBX_SOURCE_DIR
-                            "/comparisons/hash_sources.cmake'";
+    const std::string cmd = "cmake -DOUT='" + (dir / "h.h").string() +
+                            "' '-DFILES=" + (dir / "fcl.cpp").string() + "|" +
+                            (dir / "ode.cpp").string() + "' -DROOT='" + dir.string() +
+                            "' -P '" RBX_SOURCE_DIR "/comparisons/hash_sources.cmake'";
     EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
     std::ifstream in(dir / "h.h");
     return std::string(std::istreambuf_iterator<char>(in), {});

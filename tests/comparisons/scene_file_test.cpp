@@ -80,17 +80,50 @@ INSTANTIATE_TEST_SUITE_P(Catalogue, BadInput, ::testing::ValuesIn(bad_input_cata
 TEST(BadInputCatalogue, CoversEveryCaseOfTheBrief) {
   const std::vector<std::string> names = bad_input_catalogue();
   EXPECT_GE(names.size(), 35u);
-  for (const char* required :
-       {"malformed_toml", "empty", "no_body", "unknown_key", "unknown_section", "wrong_type",
-        "vector_length", "nan_value", "inf_value", "negative_mass", "zero_mass", "negative_size",
-        "zero_radius", "negative_height", "few_sides", "subdivisions_range", "restitution_range",
-        "negative_friction", "zero_dt", "negative_duration", "absurd_duration", "duplicate_body",
-        "expect_unknown_body", "unknown_check", "unknown_backend", "unknown_integrator",
-        "unknown_mass_model", "unknown_shape", "non_unit_quaternion", "rotation_and_orientation",
-        "mesh_missing", "mesh_folder", "mesh_open", "mesh_nonconvex", "mesh_degenerate",
-        "mesh_self_intersecting", "mesh_index_out_of_range", "binary_junk", "mesh_vertex_nan",
-        "mesh_vertex_not_number", "mesh_vertex_missing_z", "huge_size", "huge_radius",
-        "sweep_dt_absurd"})
+  for (const char* required : {"malformed_toml",
+                               "empty",
+                               "no_body",
+                               "unknown_key",
+                               "unknown_section",
+                               "wrong_type",
+                               "vector_length",
+                               "nan_value",
+                               "inf_value",
+                               "negative_mass",
+                               "zero_mass",
+                               "negative_size",
+                               "zero_radius",
+                               "negative_height",
+                               "few_sides",
+                               "subdivisions_range",
+                               "restitution_range",
+                               "negative_friction",
+                               "zero_dt",
+                               "negative_duration",
+                               "absurd_duration",
+                               "duplicate_body",
+                               "expect_unknown_body",
+                               "unknown_check",
+                               "unknown_backend",
+                               "unknown_integrator",
+                               "unknown_mass_model",
+                               "unknown_shape",
+                               "non_unit_quaternion",
+                               "rotation_and_orientation",
+                               "mesh_missing",
+                               "mesh_folder",
+                               "mesh_open",
+                               "mesh_nonconvex",
+                               "mesh_degenerate",
+                               "mesh_self_intersecting",
+                               "mesh_index_out_of_range",
+                               "binary_junk",
+                               "mesh_vertex_nan",
+                               "mesh_vertex_not_number",
+                               "mesh_vertex_missing_z",
+                               "huge_size",
+                               "huge_radius",
+                               "sweep_dt_absurd"})
     EXPECT_NE(std::find(names.begin(), names.end(), required), names.end()) << required;
 }
 
@@ -306,9 +339,10 @@ TEST(SceneFile, ReadsEveryKey) {
 }
 
 TEST(SceneFile, DefaultsAreTheContracts) {
-  const Scene s = parse_scene("[[body]]\nname = \"A\"\n[[body]]\nname = \"S\"\nshape = "
-                              "\"icosphere\"\n[[body]]\nname = \"P\"\nshape = \"prism\"\n",
-                              "tests/data/minimal_scene.toml");
+  const Scene s = parse_scene(
+      "[[body]]\nname = \"A\"\n[[body]]\nname = \"S\"\nshape = "
+      "\"icosphere\"\n[[body]]\nname = \"P\"\nshape = \"prism\"\n",
+      "tests/data/minimal_scene.toml");
   EXPECT_EQ(s.name, "minimal_scene");  // the file stem
   EXPECT_EQ(s.description, "");
   EXPECT_TRUE(s.checks.empty());
@@ -361,8 +395,9 @@ TEST(SceneFile, QuaternionWithinOneBillionthIsAccepted) {
   // 45 deg about z to 16 digits (norm 1 to round-off), and one off by 5e-10 (inside 1e-9).
   const std::string head = "[[body]]\nname = \"A\"\norientation = ";
   const Scene s = parse_scene(head + "[0.9238795325112867, 0, 0, 0.3826834323650898]\n", "t.toml");
-  EXPECT_LT((s.bodies[0].orientation * Vec3::UnitX() -
-             Vec3(std::sqrt(0.5), std::sqrt(0.5), 0)).norm(), kRoundOff);
+  EXPECT_LT(
+      (s.bodies[0].orientation * Vec3::UnitX() - Vec3(std::sqrt(0.5), std::sqrt(0.5), 0)).norm(),
+      kRoundOff);
   EXPECT_NO_THROW(parse_scene(head + "[1.0000000005, 0, 0, 0]\n", "t.toml"));
   EXPECT_THROW(parse_scene(head + "[1.000000002, 0, 0, 0]\n", "t.toml"), InputError);
 }
@@ -384,10 +419,10 @@ velocity = [0, 1, 0]
 )";
 
 TEST(SceneOverrides, SetKeysOfEveryLevel) {
-  const Scene s = parse_scene(kTwoBodies, "tests/data/two.toml",
-                              {"sim.dt=1e-4", "body.A.mass=2.5", "body.B.velocity=[0,-1,0]",
-                               "name=\"renamed\"", "expect.tolerance=1e-9",
-                               "expect.body.B.velocity=[0, 0, 0]"});
+  const Scene s =
+      parse_scene(kTwoBodies, "tests/data/two.toml",
+                  {"sim.dt=1e-4", "body.A.mass=2.5", "body.B.velocity=[0,-1,0]", "name=\"renamed\"",
+                   "expect.tolerance=1e-9", "expect.body.B.velocity=[0, 0, 0]"});
   EXPECT_EQ(s.sim.dt, 1e-4);
   EXPECT_EQ(s.bodies[0].mass, 2.5);
   EXPECT_EQ(s.bodies[1].velocity, Vec3(0, -1, 0));
@@ -410,8 +445,9 @@ TEST(SceneOverrides, BadOverridesNameSetAndTheKey) {
                 "body.A.mass? (bodies: A, B)");
   EXPECT_EQ(with("body.A.mas=2"),
             f + ": --set body.A.mas: unknown body key \"mas\"; did you mean body.A.mass?");
-  EXPECT_EQ(with("sim.dt"),
-            f + ": --set sim.dt: missing \"=VALUE\"; write --set KEY=VALUE, e.g. --set sim.dt=1e-4");
+  EXPECT_EQ(
+      with("sim.dt"),
+      f + ": --set sim.dt: missing \"=VALUE\"; write --set KEY=VALUE, e.g. --set sim.dt=1e-4");
   // Values go through the same validation as the file's, without a file line.
   EXPECT_EQ(with("body.A.mass=-2"),
             f + ": --set body.A.mass: must be > 0 kg, got -2; give a positive mass (static = "
@@ -530,9 +566,9 @@ TEST(SceneFile, MissingSceneFileSaysSo) {
 
 TEST(SceneFile, KeysListEveryLevel) {
   const auto& keys = scene_keys();
-  for (const char* k : {"name", "checks", "sim.dt", "sim.max_energy_ratio", "body.mass",
-                        "body.orientation", "expect.tolerance", "expect.body.velocity",
-                        "expect.contact.depth"})
+  for (const char* k :
+       {"name", "checks", "sim.dt", "sim.max_energy_ratio", "body.mass", "body.orientation",
+        "expect.tolerance", "expect.body.velocity", "expect.contact.depth"})
     EXPECT_NE(std::find(keys.begin(), keys.end(), k), keys.end()) << k;
 }
 
@@ -564,10 +600,10 @@ TEST(ConvexHull, PointsOnFacesAndEdgesAreNotVertices) {
     for (double s : {-1.0, 1.0}) {
       Vec3 c = Vec3::Zero();
       c[axis] = s;
-      points.push_back(c);                        // face centre
+      points.push_back(c);  // face centre
       Vec3 m = Vec3::Constant(s);
       m[axis] = 0;
-      points.push_back(m);                        // an edge midpoint
+      points.push_back(m);  // an edge midpoint
     }
   const ConvexPolyhedron hull = convex_hull(points);
   EXPECT_EQ(hull.vertices().size(), 8u);
@@ -582,7 +618,8 @@ TEST(ConvexHull, PointsOnASphereAreAllVertices) {
   std::mt19937 rng(12345);
   std::normal_distribution<double> gauss;
   std::vector<Vec3> points;
-  for (int i = 0; i < 200; ++i) points.push_back(Vec3(gauss(rng), gauss(rng), gauss(rng)).normalized());
+  for (int i = 0; i < 200; ++i)
+    points.push_back(Vec3(gauss(rng), gauss(rng), gauss(rng)).normalized());
   const ConvexPolyhedron hull = convex_hull(points);
   EXPECT_EQ(hull.vertices().size(), 200u);
   EXPECT_EQ(hull.triangles().size(), 396u);
@@ -603,7 +640,8 @@ TEST(ConvexHull, RefusesInputWithoutVolume) {
   }
 }
 
-// ---- OBJ files -----------------------------------------------------------------------------------
+// ---- OBJ files
+// -----------------------------------------------------------------------------------
 
 TEST(LoadObj, CubeOfQuads) {
   const ConvexPolyhedron cube = load_obj("tests/data/meshes/cube.obj", false);
@@ -620,8 +658,9 @@ TEST(LoadObj, ExtraInteriorVertexNeedsHull) {
     load_obj("tests/data/meshes/cube_interior.obj", false);
     ADD_FAILURE() << "an unused vertex was accepted";
   } catch (const GeometryError& e) {
-    EXPECT_STREQ(e.what(),
-                 "tests/data/meshes/cube_interior.obj: vertex 8 (OBJ line 10) is not used by any face");
+    EXPECT_STREQ(
+        e.what(),
+        "tests/data/meshes/cube_interior.obj: vertex 8 (OBJ line 10) is not used by any face");
   }
   const ConvexPolyhedron hull = load_obj("tests/data/meshes/cube_interior.obj", true);
   EXPECT_EQ(hull.vertices().size(), 8u);
@@ -629,7 +668,8 @@ TEST(LoadObj, ExtraInteriorVertexNeedsHull) {
   EXPECT_NEAR(hull.volume(), 8.0, kRoundOff);
 
   // The same through a scene: the error carries the scene's file, line and key.
-  const std::string scene = "[[body]]\nname = \"A\"\nshape = \"mesh\"\nfile = \"meshes/cube_interior.obj\"\n";
+  const std::string scene =
+      "[[body]]\nname = \"A\"\nshape = \"mesh\"\nfile = \"meshes/cube_interior.obj\"\n";
   EXPECT_EQ(input_error([&] { parse_scene(scene, "tests/data/s.toml"); }),
             "tests/data/s.toml:4: body.A.file: tests/data/meshes/cube_interior.obj: vertex 8 (OBJ "
             "line 10) is not used by any face; fix the OBJ file, or set hull = true to use the "

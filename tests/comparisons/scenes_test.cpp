@@ -35,9 +35,8 @@ TEST(SceneLibrary, EveryFamilyIsPresentWithAtLeastFortyScenes) {
   const auto files = library();
   EXPECT_GE(files.size(), 40u);
   for (const char* family : {"seed", "analytic", "contact", "stress", "many"}) {
-    const bool found = std::any_of(files.begin(), files.end(), [&](const std::string& f) {
-      return scene_family(f) == family;
-    });
+    const bool found = std::any_of(files.begin(), files.end(),
+                                   [&](const std::string& f) { return scene_family(f) == family; });
     EXPECT_TRUE(found) << family;
   }
 }
@@ -52,8 +51,8 @@ TEST_P(SceneLoads, ParsesWithDescriptionAndChecks) {
 
 INSTANTIATE_TEST_SUITE_P(Library, SceneLoads, testing::ValuesIn(library()), test_name);
 
-// [expect] binds the subjects: both custom engines (extended and seed) for final states, the exact oracle for
-// contacts. The tolerance is the scene's own, justified in its file.
+// [expect] binds the subjects: both custom engines (extended and seed) for final states, the exact
+// oracle for contacts. The tolerance is the scene's own, justified in its file.
 class SceneExpect : public testing::TestWithParam<std::string> {};
 
 TEST_P(SceneExpect, ClosedFormHolds) {

@@ -1,6 +1,8 @@
 // Real cube tosses: reading (.csv and .csv.gz), every bad-row kind, the error metrics on a
 // hand-made trajectory, free fall against its closed form for every dynamics backend, the fit
 // recovering parameters that generated a toss, and deterministic JSON from `rbx tosses`.
+#include "comparisons/eval/tosses.h"
+
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -9,13 +11,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
 #include "comparisons/scene/scene_file.h"
-#include "comparisons/eval/tosses.h"
 
 namespace fs = std::filesystem;
 using namespace rbx;
@@ -25,7 +25,8 @@ namespace {
 const char* const kHeader = "toss,t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("rbx_tosses_" + name + "_" + std::to_string(getpid()));
+  const fs::path p =
+      fs::temp_directory_path() / ("rbx_tosses_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(p);
   fs::create_directories(p);
   return p;
@@ -53,8 +54,9 @@ struct CmdResult {
 // Runs the built rbx binary from the source folder with stdout and stderr captured.
 CmdResult run_rbx(const std::string& args) {
   const fs::path tmp = temp_dir("cmd");
-  const std::string cmd = "cd '" RBX_SOURCE_DIR "' && '" RBX_BINARY_DIR "/comparisons/rbx' " + args +
-                          " > '" + (tmp / "out").string() + "' 2> '" + (tmp / "err").string() + "'";
+  const std::string cmd = "cd '" RBX_SOURCE_DIR "' && '" RBX_BINARY_DIR "/comparisons/rbx' " +
+                          args + " > '" + (tmp / "out").string() + "' 2> '" +
+                          (tmp / "err").string() + "'";
   CmdResult r;
   const int status = std::system(cmd.c_str());
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -124,8 +126,8 @@ TEST_P(TossesBadRow, ExitsTwoNamingFileAndRow) {
   const fs::path dir = temp_dir(b.name);
   std::ofstream(dir / "bad.csv") << b.csv;
   const fs::path json = dir / "out.json";
-  const CmdResult r = run_rbx("tosses '" + (dir / "bad.csv").string() + "' --backends ode --json '" +
-                          json.string() + "'");
+  const CmdResult r = run_rbx("tosses '" + (dir / "bad.csv").string() +
+                              "' --backends ode --json '" + json.string() + "'");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find(b.where), std::string::npos) << r.err;
@@ -137,24 +139,35 @@ TEST_P(TossesBadRow, ExitsTwoNamingFileAndRow) {
 INSTANTIATE_TEST_SUITE_P(
     Kinds, TossesBadRow,
     ::testing::Values(
-        BadRow{"nan", std::string(kHeader) + row(1, 0, 0.2) + "1,0.00675675675675,0.1,0.2,nan,1,0,0,0,0.5,0,0,0,0,1\n",
+        BadRow{"nan",
+               std::string(kHeader) + row(1, 0, 0.2) +
+                   "1,0.00675675675675,0.1,0.2,nan,1,0,0,0,0.5,0,0,0,0,1\n",
                "bad.csv:row 3", "pz"},
-        BadRow{"text", std::string(kHeader) + row(1, 0, 0.2) + "1,0.00675675675675,0.1,abc,0.2,1,0,0,0,0.5,0,0,0,0,1\n",
+        BadRow{"text",
+               std::string(kHeader) + row(1, 0, 0.2) +
+                   "1,0.00675675675675,0.1,abc,0.2,1,0,0,0,0.5,0,0,0,0,1\n",
                "bad.csv:row 3", "py"},
-        BadRow{"non_unit_quaternion", std::string(kHeader) + row(1, 0, 0.2) + row(1, 1 / 148.0, 0.2, "1,0,0,0.1"),
+        BadRow{"non_unit_quaternion",
+               std::string(kHeader) + row(1, 0, 0.2) + row(1, 1 / 148.0, 0.2, "1,0,0,0.1"),
                "bad.csv:row 3", "quaternion"},
-        BadRow{"time_not_increasing", std::string(kHeader) + row(1, 0, 0.2) + row(1, 1 / 148.0, 0.2) + row(1, 1 / 148.0, 0.2),
-               "bad.csv:row 4", "time"},
+        BadRow{
+            "time_not_increasing",
+            std::string(kHeader) + row(1, 0, 0.2) + row(1, 1 / 148.0, 0.2) + row(1, 1 / 148.0, 0.2),
+            "bad.csv:row 4", "time"},
         BadRow{"off_grid", std::string(kHeader) + row(1, 0, 0.2) + row(1, 0.004, 0.2),
                "bad.csv:row 3", "148 Hz"},
-        BadRow{"one_sample", std::string(kHeader) + row(1, 0, 0.2) + row(2, 0, 0.2) + row(2, 1 / 148.0, 0.2),
+        BadRow{"one_sample",
+               std::string(kHeader) + row(1, 0, 0.2) + row(2, 0, 0.2) + row(2, 1 / 148.0, 0.2),
                "bad.csv:row 2", "one sample"},
-        BadRow{"one_sample_last", std::string(kHeader) + row(1, 0, 0.2) + row(1, 1 / 148.0, 0.2) + row(2, 0, 0.2),
+        BadRow{"one_sample_last",
+               std::string(kHeader) + row(1, 0, 0.2) + row(1, 1 / 148.0, 0.2) + row(2, 0, 0.2),
                "bad.csv:row 4", "one sample"},
-        BadRow{"columns", std::string(kHeader) + row(1, 0, 0.2) + "1,0.0067,0.1\n", "bad.csv:row 3", "columns"},
+        BadRow{"columns", std::string(kHeader) + row(1, 0, 0.2) + "1,0.0067,0.1\n", "bad.csv:row 3",
+               "columns"},
         BadRow{"header", std::string("toss,t,x\n") + row(1, 0, 0.2), "bad.csv:row 1", "header"},
-        BadRow{"id_again", std::string(kHeader) + row(1, 0, 0.2) + row(1, 1 / 148.0, 0.2) + row(2, 0, 0.2) +
-                               row(2, 1 / 148.0, 0.2) + row(1, 0, 0.2),
+        BadRow{"id_again",
+               std::string(kHeader) + row(1, 0, 0.2) + row(1, 1 / 148.0, 0.2) + row(2, 0, 0.2) +
+                   row(2, 1 / 148.0, 0.2) + row(1, 0, 0.2),
                "bad.csv:row 6", "again"}),
     [](const ::testing::TestParamInfo<BadRow>& i) { return std::string(i.param.name); });
 
@@ -162,7 +175,8 @@ TEST(TossesMetrics, HandMadeTrajectoryGivesTheHandComputedErrors) {
   // Measured: three samples at rest at the origin, identity orientation.
   Toss real;
   real.id = 4;
-  for (int i = 0; i < 3; ++i) real.samples.push_back({i / 148.0, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3::Zero()});
+  for (int i = 0; i < 3; ++i)
+    real.samples.push_back({i / 148.0, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3::Zero()});
   // Simulated: sample 1 off by (0.03, 0.04, 0) = 5 cm and turned 90 deg about z; sample 2 off
   // by 2 cm along z and turned 30 deg about x (sign of the quaternion flipped: same rotation).
   PoseTrack sim;
@@ -236,9 +250,11 @@ TEST(TossesFit, RecoversTheParametersThatGeneratedATossOnTheGrid) {
   Toss seed;
   seed.id = 0;
   for (int i = 0; i < 90; ++i)
-    seed.samples.push_back({i / model.sample_rate, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3::Zero()});
-  seed.samples[0] = {0.0, Vec3(0, 0, 0.15), Quat(Eigen::AngleAxisd(0.4, Vec3(1, 2, 0).normalized())),
-                     Vec3(0.8, 0.1, -0.5), Vec3(3, -2, 1)};
+    seed.samples.push_back(
+        {i / model.sample_rate, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3::Zero()});
+  seed.samples[0] = {0.0, Vec3(0, 0, 0.15),
+                     Quat(Eigen::AngleAxisd(0.4, Vec3(1, 2, 0).normalized())), Vec3(0.8, 0.1, -0.5),
+                     Vec3(3, -2, 1)};
   const TossRun truth = simulate_toss(ode->dynamics, seed, {0.5, 0.3}, model);
   ASSERT_EQ(truth.status, Status::Ok) << truth.message;
   Toss measured = seed;
@@ -271,11 +287,13 @@ TEST(TossesCommand, JsonIsDeterministicAndHasTheContractFields) {
           << s.velocity.y() << "," << s.velocity.z() << "," << s.angular_velocity.x() << ","
           << s.angular_velocity.y() << "," << s.angular_velocity.z() << "\n";
   csv.close();
-  std::ofstream(dir / "params.json") << R"({"backends": {"ode": {"restitution": 0.3, "friction": 0.2}}})";
+  std::ofstream(dir / "params.json")
+      << R"({"backends": {"ode": {"restitution": 0.3, "friction": 0.2}}})";
   nlohmann::json j[2];
   for (int run = 0; run < 2; ++run) {
     const fs::path out = dir / ("out" + std::to_string(run) + ".json");
-    const CmdResult r = run_rbx("tosses '" + (dir / "three.csv").string() + "' --json '" + out.string() + "'");
+    const CmdResult r =
+        run_rbx("tosses '" + (dir / "three.csv").string() + "' --json '" + out.string() + "'");
     ASSERT_EQ(r.code, 0) << r.err;
     j[run] = nlohmann::json::parse(std::ifstream(out));
     // Run times are the only non-deterministic numbers.
@@ -288,7 +306,8 @@ TEST(TossesCommand, JsonIsDeterministicAndHasTheContractFields) {
     ASSERT_TRUE(b.contains(name)) << name;
     EXPECT_EQ(b[name]["tosses"], 3) << name;
     for (const char* k : {"position_error", "orientation_error_deg", "final_position_error"})
-      for (const char* s : {"median", "mean", "p90"}) EXPECT_TRUE(b[name][k][s].is_number()) << name << k << s;
+      for (const char* s : {"median", "mean", "p90"})
+        EXPECT_TRUE(b[name][k][s].is_number()) << name << k << s;
     EXPECT_TRUE(b[name]["status"].is_string());
     EXPECT_TRUE(b[name]["message"].is_string());
   }

@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "comparisons/eval/harness.h"
-#include "comparisons/scene/scene_file.h"
 #include "comparisons/output/scorecard.h"
+#include "comparisons/scene/scene_file.h"
 
 namespace fs = std::filesystem;
 
@@ -32,7 +32,8 @@ std::string read_file(const fs::path& p) {
 }
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("rbx_view_" + name + "_" + std::to_string(getpid()));
+  const fs::path p =
+      fs::temp_directory_path() / ("rbx_view_" + name + "_" + std::to_string(getpid()));
   fs::remove_all(p);
   fs::create_directories(p);
   return p;
@@ -92,8 +93,8 @@ std::pair<long, long> screenshot_pixels(const fs::path& a, const fs::path& b, in
       "print(col, diff)\n";
   const fs::path script = a.string() + ".py";
   std::ofstream(script) << py;
-  if (shell("/usr/bin/python3 '" + script.string() + "' '" + a.string() + "' '" + b.string() + "' " +
-            std::to_string(top) + " > '" + out.string() + "' 2>&1") != 0)
+  if (shell("/usr/bin/python3 '" + script.string() + "' '" + a.string() + "' '" + b.string() +
+            "' " + std::to_string(top) + " > '" + out.string() + "' 2>&1") != 0)
     return {-1, -1};
   std::istringstream in(read_file(out));
   long col = -1, diff = -1;
@@ -107,11 +108,13 @@ std::vector<std::string> check_page(const fs::path& page, const nlohmann::json& 
   // Played from the start for 2 s of virtual time (the page plays a run in 4 s).
   const nlohmann::json st = page_state(page, "#play", 2000);
   if (st.is_discarded() || !st.is_object()) return {"no page state (the script did not run)"};
-  if (!st.value("loaded", false)) bad.push_back("page did not finish loading: " + st.value("error", ""));
+  if (!st.value("loaded", false))
+    bad.push_back("page did not finish loading: " + st.value("error", ""));
   if (!st.value("webgl", false)) bad.push_back("no WebGL renderer");
   for (const auto& [name, b] : expected["backends"].items()) {
     const size_t frames = b["time"].size();
-    if (!st["backends"].contains(name)) bad.push_back("backend " + name + " not loaded");
+    if (!st["backends"].contains(name))
+      bad.push_back("backend " + name + " not loaded");
     else if (st["backends"][name].value("frames", 0ul) != frames)
       bad.push_back("backend " + name + ": " + st["backends"][name]["frames"].dump() +
                     " frames loaded, " + std::to_string(frames) + " expected");
@@ -125,13 +128,18 @@ std::vector<std::string> check_page(const fs::path& page, const nlohmann::json& 
   // Screenshots at the start and at the end of the run: bodies drawn, and moved.
   const fs::path s0 = page.string() + ".0.png", s1 = page.string() + ".1.png";
   for (const auto& [shot, hash] : {std::pair{s0, "#t=0"}, std::pair{s1, "#t=1"}})
-    shell(chromium("--screenshot='" + shot.string() + "' 'file://" + page.string() + hash + "'", 2000) +
+    shell(chromium("--screenshot='" + shot.string() + "' 'file://" + page.string() + hash + "'",
+                   2000) +
           " > /dev/null 2>&1");
   const auto [coloured, moved] = screenshot_pixels(s0, s1, st.value("canvas_top", 0));
   // A body covers thousands of pixels of a 900x800 window; an empty scene none.
-  if (coloured < 500) bad.push_back("bodies not visible in the screenshot (" + std::to_string(coloured) + " coloured pixels)");
+  if (coloured < 500)
+    bad.push_back("bodies not visible in the screenshot (" + std::to_string(coloured) +
+                  " coloured pixels)");
   // A 1 m cube moving 1.25 m in a panel changes thousands of pixels.
-  if (moved < 200) bad.push_back("bodies did not move between t = 0 and the end (" + std::to_string(moved) + " pixels differ)");
+  if (moved < 200)
+    bad.push_back("bodies did not move between t = 0 and the end (" + std::to_string(moved) +
+                  " pixels differ)");
   return bad;
 }
 
@@ -148,18 +156,22 @@ std::string three_js() { return read_file(three_js_path()); }
 TEST(ViewPage, SceneTextIsEscapedInHtmlAndJsonAndMarkdown) {
   const fs::path dir = temp_dir("escape");
   const std::string evil = "</script><img src=x onerror=alert(1)> & \"'";
-  std::ofstream(dir / "evil.toml") << "name = \"" << "</script><img src=x onerror=alert(1)> & \\\"'"
-                                   << "\"\ndescription = \"<b>bold</b>\"\nchecks = [\"contact\"]\n"
-                                      "backends = [\"exact\"]\n[[body]]\nname = \"A\"\nshape = \"box\"\n"
-                                      "[[body]]\nname = \"B</script>\"\nshape = \"box\"\nposition = [0.9, 0, 0]\n";
+  std::ofstream(dir / "evil.toml")
+      << "name = \""
+      << "</script><img src=x onerror=alert(1)> & \\\"'"
+      << "\"\ndescription = \"<b>bold</b>\"\nchecks = [\"contact\"]\n"
+         "backends = [\"exact\"]\n[[body]]\nname = \"A\"\nshape = \"box\"\n"
+         "[[body]]\nname = \"B</script>\"\nshape = \"box\"\nposition = [0.9, 0, 0]\n";
   const Scene scene = load_scene((dir / "evil.toml").string());
   ASSERT_EQ(scene.name, evil);
   HarnessOptions opt;
   opt.sweep = false;
-  const std::string page = view_page(view_data(scene, evaluate_scene(scene, opt).json), "/*three*/");
+  const std::string page =
+      view_page(view_data(scene, evaluate_scene(scene, opt).json), "/*three*/");
   // The only </script> closings are the page's own script elements.
   size_t closings = 0;
-  for (size_t k = page.find("</script>"); k != std::string::npos; k = page.find("</script>", k + 1)) ++closings;
+  for (size_t k = page.find("</script>"); k != std::string::npos; k = page.find("</script>", k + 1))
+    ++closings;
   EXPECT_EQ(closings, 3u);  // three.js, the data, the page script
   EXPECT_EQ(page.find("<img"), std::string::npos);
   EXPECT_EQ(page.find("<b>bold"), std::string::npos);
@@ -184,7 +196,8 @@ TEST(ViewPage, TrajectoriesAreSampledSoAPageStaysSmall) {
 class ViewBrowser : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!have_chromium()) GTEST_SKIP() << "chromium not installed (./rbx installs it): browser test skipped";
+    if (!have_chromium())
+      GTEST_SKIP() << "chromium not installed (./rbx installs it): browser test skipped";
   }
 };
 
@@ -210,7 +223,8 @@ TEST_F(ViewBrowser, FailsOnABrokenPage) {
   const std::vector<std::string> bad1 = check_page(dir / "missing.html", d);
   for (const std::string& b : bad1) std::cout << "missing-backend page: " << b << "\n";
   ASSERT_FALSE(bad1.empty());
-  EXPECT_NE(bad1.front().find("backend " + dropped + " not loaded"), std::string::npos) << bad1.front();
+  EXPECT_NE(bad1.front().find("backend " + dropped + " not loaded"), std::string::npos)
+      << bad1.front();
   // An empty scene: no bodies, so nothing drawn and nothing moves.
   nlohmann::json empty = d;
   empty["bodies"] = nlohmann::json::array();

@@ -57,15 +57,16 @@ TEST(Body, MovingBodyKeepsItsStateAndInvertsItsInertia) {
   EXPECT_LT((b.inverse_inertia_body * b.inertia_body - Mat3::Identity()).norm(), 1e-13);
   EXPECT_EQ(b.velocity, Vec3(0.5, 0, 0));
   EXPECT_EQ(b.angular_velocity, Vec3(0, 0, 2));
-  // World inverse inertia is R I^-1 R^T (SEED_NOTES 5).
+  // World inverse inertia is R I^-1 R^T (seed correction 5 (world-frame inverse inertia, static
+  // bodies zero)).
   const Mat3 r = b.orientation.toRotationMatrix();
-  EXPECT_LT((b.inverse_inertia_world() - r * b.inverse_inertia_body * r.transpose()).norm(),
-            1e-15);
+  EXPECT_LT((b.inverse_inertia_world() - r * b.inverse_inertia_body * r.transpose()).norm(), 1e-15);
 }
 
 TEST(Body, StaticBodyHasZeroInversesAndNoMotion) {
-  // SEED_NOTES 5: static bodies have inverse mass and inverse inertia zero; the velocities a
-  // scene gives them are dropped (an immovable body has none).
+  // seed correction 5 (world-frame inverse inertia, static bodies zero): static bodies have inverse
+  // mass and inverse inertia zero; the velocities a scene gives them are dropped (an immovable body
+  // has none).
   const RigidBody b = make_body(pyramid_spec(MassModel::Solid, true));
   EXPECT_TRUE(b.is_static);
   EXPECT_EQ(b.inverse_mass, 0.0);

@@ -1,5 +1,5 @@
 // The seed's bounding check: sphere from a body's box centre to a corner, and the corrected
-// sum-of-radii rule (SEED_NOTES 7).
+// sum-of-radii rule (seed correction 7 (bounding check on the sum of radii)).
 #include "engine/bounding.h"
 
 #include <gtest/gtest.h>
@@ -56,7 +56,8 @@ TEST(BoundingCheck, SumOfRadiiIsTheThreshold) {
   const Vec3 dir = Vec3(1, 2, -2).normalized();
   const RigidBody a = body_with(make_box(Vec3(1, 1, 1)), Vec3(0.5, 0.25, 0));
   const RigidBody inside = body_with(make_box(Vec3(2, 2, 2)), a.position + (r_a + r_b - eps) * dir);
-  const RigidBody outside = body_with(make_box(Vec3(2, 2, 2)), a.position + (r_a + r_b + eps) * dir);
+  const RigidBody outside =
+      body_with(make_box(Vec3(2, 2, 2)), a.position + (r_a + r_b + eps) * dir);
   EXPECT_TRUE(bounding_check(a, inside));
   EXPECT_TRUE(bounding_check(inside, a));
   EXPECT_FALSE(bounding_check(a, outside));
@@ -64,9 +65,9 @@ TEST(BoundingCheck, SumOfRadiiIsTheThreshold) {
 }
 
 TEST(BoundingCheck, LiteralLessThanBothRadiiMissesOverlappingBoxes) {
-  // SEED_NOTES 7. Two unit cubes whose centres are 0.9 apart along x overlap by 0.1 (the
-  // detector sees it), but 0.9 > r = sqrt(3)/2 = 0.866: the seed's "distance less than both
-  // radii" drops the pair; the sum rule (0.9 <= 1.732) keeps it.
+  // seed correction 7 (bounding check on the sum of radii). Two unit cubes whose centres are 0.9
+  // apart along x overlap by 0.1 (the detector sees it), but 0.9 > r = sqrt(3)/2 = 0.866: the
+  // seed's "distance less than both radii" drops the pair; the sum rule (0.9 <= 1.732) keeps it.
   const ConvexPolyhedron cube = make_box(Vec3(1, 1, 1));
   const RigidBody a = body_with(cube, Vec3(0, 0, 0));
   const RigidBody b = body_with(cube, Vec3(0.9, 0, 0));
@@ -87,7 +88,8 @@ TEST(BoundingCheck, NeverRejectsATouchingPair) {
   const ConvexPolyhedron cube = make_box(Vec3(0.8, 0.8, 0.8));
   int touching = 0;
   for (int trial = 0; trial < 300; ++trial) {
-    const RigidBody a = body_with(long_box, Vec3::Zero(), Quat(u(rng), u(rng), u(rng), u(rng)).normalized());
+    const RigidBody a =
+        body_with(long_box, Vec3::Zero(), Quat(u(rng), u(rng), u(rng), u(rng)).normalized());
     const RigidBody b = body_with(cube, 1.5 * Vec3(u(rng), u(rng), u(rng)),
                                   Quat(u(rng), u(rng), u(rng), u(rng)).normalized());
     if (!detect(long_box, a.pose(), cube, b.pose()).has_value()) continue;

@@ -36,9 +36,9 @@ std::vector<RigidBody> crowd(int n, double extent, std::mt19937_64& rng) {
   std::vector<RigidBody> bodies;
   for (int i = 0; i < n; ++i) {
     const bool slab = i % 50 == 7;
-    const Vec3 size = slab ? Vec3(20.0, 0.2, 20.0)
-                           : Vec3(0.05 + 0.45 * unit(rng), 0.05 + 0.45 * unit(rng),
-                                  0.05 + 0.45 * unit(rng));
+    const Vec3 size =
+        slab ? Vec3(20.0, 0.2, 20.0)
+             : Vec3(0.05 + 0.45 * unit(rng), 0.05 + 0.45 * unit(rng), 0.05 + 0.45 * unit(rng));
     const Vec3 position = extent * Vec3(unit(rng), unit(rng), unit(rng));
     const Quat orientation = Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
     bodies.push_back(test::box_body("b" + std::to_string(i), size, 1.0, position, orientation,
@@ -74,8 +74,8 @@ TEST(BroadPhase, EveryMethodFindsTheOraclePairs) {
 TEST(BroadPhase, ExactlyTouchingSpheresArePairs) {
   // A (6, 4, 12) box has half extents (3, 2, 6), so its bounding sphere has radius
   // sqrt(9 + 4 + 36) = 7 exactly. Centres 14 apart: |c_a - c_b| = 14 = 7 + 7, touching
-  // (SEED_NOTES 7 counts equality); 14.000001 apart: separated. Both distances and the radii
-  // are exact in floating point, so the answers are exact.
+  // (seed correction 7 (bounding check on the sum of radii) counts equality); 14.000001 apart:
+  // separated. Both distances and the radii are exact in floating point, so the answers are exact.
   std::vector<RigidBody> bodies = {
       test::box_body("a", Vec3(6, 4, 12), 1.0, Vec3(0, 0, 0)),
       test::box_body("b", Vec3(6, 4, 12), 1.0, Vec3(14, 0, 0)),

@@ -1,10 +1,10 @@
 // Simultaneous impulses: restitution, Coulomb friction, energy, position projection.
 #include "engine/contact_solver.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "engine/response.h"
 #include "tests/common/fixtures.h"
@@ -37,12 +37,14 @@ double kinetic(const std::vector<RigidBody>& bodies) {
 
 TEST(ContactSolver, OnePointFrictionlessIsTheSeedImpulse) {
   // A corner-down cube hitting a free cube off-centre (seed/vertex_corner's kind): one manifold
-  // point, so the simultaneous solve must equal the single-point formula (SEED_NOTES 3-4).
+  // point, so the simultaneous solve must equal the single-point formula (seed correction 3 ((1 +
+  // e) on the whole impulse, only while approaching)-4).
   const Quat q = Quat(Eigen::AngleAxisd(std::atan(std::sqrt(2.0)), Vec3(1, -1, 0).normalized()));
   std::vector<RigidBody> bodies = {
       box_body("A", Vec3::Ones(), 1.0, Vec3(0.25, 0.1, std::sqrt(3.0) / 2 + 0.5 - 0.001), q,
                Vec3(0.1, 0, -1), Vec3(0.3, -0.2, 0.5)),
-      box_body("B", Vec3::Ones(), 2.0, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3(0, 0.1, 0))};
+      box_body("B", Vec3::Ones(), 2.0, Vec3::Zero(), Quat::Identity(), Vec3::Zero(),
+               Vec3(0, 0.1, 0))};
   const auto m = manifolds_of(bodies);
   ASSERT_EQ(m.size(), 1u);
   ASSERT_EQ(m[0].manifold.points.size(), 1u);
@@ -66,7 +68,8 @@ TEST(ContactSolver, FlatLandingStopsWithoutTurningAndFrictionTakesMuJ) {
                Vec3::Zero(), true)};
   const auto m = manifolds_of(bodies);
   ASSERT_EQ(m[0].manifold.points.size(), 4u);
-  const auto solved = solve_contact_velocities(bodies, m, normal_velocities(bodies, m), settings(0.0, 0.3));
+  const auto solved =
+      solve_contact_velocities(bodies, m, normal_velocities(bodies, m), settings(0.0, 0.3));
   double jn = 0.0;
   Vec3 jt = Vec3::Zero();
   for (const SolvedPoint& p : solved) {
@@ -84,10 +87,10 @@ TEST(ContactSolver, FlatLandingStopsWithoutTurningAndFrictionTakesMuJ) {
 TEST(ContactSolver, SticksWhenTheConeHoldsTheSlip) {
   // Slow slip (0.1 m/s) under a 1 N s landing with mu = 0.5: stopping the slip needs 0.1 N s
   // < 0.5 N s, so the base sticks: no tangential velocity left.
-  std::vector<RigidBody> bodies = {
-      box_body("cube", Vec3::Ones(), 1.0, Vec3(0, 0, 0.4999), Quat::Identity(), Vec3(0.1, 0.05, -1)),
-      box_body("slab", Vec3(10, 10, 1), 1.0, Vec3(0, 0, -0.5), Quat::Identity(), Vec3::Zero(),
-               Vec3::Zero(), true)};
+  std::vector<RigidBody> bodies = {box_body("cube", Vec3::Ones(), 1.0, Vec3(0, 0, 0.4999),
+                                            Quat::Identity(), Vec3(0.1, 0.05, -1)),
+                                   box_body("slab", Vec3(10, 10, 1), 1.0, Vec3(0, 0, -0.5),
+                                            Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true)};
   const auto m = manifolds_of(bodies);
   solve_contact_velocities(bodies, m, normal_velocities(bodies, m), settings(0.0, 0.5));
   EXPECT_NEAR(bodies[0].velocity.norm(), 0.0, 1e-12);
@@ -106,10 +109,12 @@ TEST(ContactSolver, FrictionNeverAddsEnergy) {
     const Quat q = Quat(Eigen::AngleAxisd(0.3 * u(rng), Vec3(u(rng), u(rng), u(rng)).normalized()));
     const bool free_b = trial % 2 == 1;
     std::vector<RigidBody> bodies = {
-        box_body("A", Vec3(1, 0.7, 0.5), 1.0 + pos(rng), Vec3(0.3 * u(rng), 0.3 * u(rng), 0.25 + 0.05 * u(rng)), q,
+        box_body("A", Vec3(1, 0.7, 0.5), 1.0 + pos(rng),
+                 Vec3(0.3 * u(rng), 0.3 * u(rng), 0.25 + 0.05 * u(rng)), q,
                  Vec3(u(rng), u(rng), -pos(rng)), Vec3(u(rng), u(rng), u(rng))),
         box_body("B", Vec3(3, 3, 1), 2.0, Vec3(0, 0, -0.5), Quat::Identity(),
-                 free_b ? Vec3(u(rng), u(rng), 0.2 * pos(rng)) : Vec3::Zero(), Vec3::Zero(), !free_b)};
+                 free_b ? Vec3(u(rng), u(rng), 0.2 * pos(rng)) : Vec3::Zero(), Vec3::Zero(),
+                 !free_b)};
     const auto m = manifolds_of(bodies);
     if (m.empty()) continue;
     ++contacts;

@@ -1,7 +1,7 @@
 // Moore & Wilhelms detector: face, vertex and edge tests on hand-built poses, the argument-order
-// symmetry, separated and touching bodies, rotated poses, one test per SEED_NOTES correction
-// (1, 2, 8, 9, 10) that fails on the literal seed text, and a fixed-seed cross-check against an
-// independent separating-axis oracle.
+// symmetry, separated and touching bodies, rotated poses, one test per docs/seed_corrections.md
+// correction (1, 2, 8, 9, 10) that fails on the literal seed text, and a fixed-seed cross-check
+// against an independent separating-axis oracle.
 #include "engine/detect.h"
 
 #include <gtest/gtest.h>
@@ -35,9 +35,7 @@ void expect_vec_near(const Vec3& actual, const Vec3& expected, double tol) {
 
 // Rotation taking a unit cube's corner direction (-1,-1,-1)/sqrt(3) to -z: the corner at
 // local (-1/2,-1/2,-1/2) becomes the lowest point, sqrt(3)/2 below the centre.
-Quat corner_down() {
-  return Quat::FromTwoVectors(Vec3(-1, -1, -1).normalized(), Vec3(0, 0, -1));
-}
+Quat corner_down() { return Quat::FromTwoVectors(Vec3(-1, -1, -1).normalized(), Vec3(0, 0, -1)); }
 
 // A fixed, generic rotation (0.7 rad about (1, 2, 3)) for the rotated-pose tests.
 Quat generic_rotation() { return Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())); }
@@ -48,7 +46,9 @@ Pose rotate_pose(const Quat& r, const Pose& p) {
 }
 
 // Pose moved by an offset (m, world).
-Pose shifted(const Pose& p, const Vec3& offset) { return pose_at(p.position + offset, p.orientation); }
+Pose shifted(const Pose& p, const Vec3& offset) {
+  return pose_at(p.position + offset, p.orientation);
+}
 
 // ---- Configurations shared by several tests -----------------------------------------------
 
@@ -119,8 +119,8 @@ TEST(Detect, FaceFaceBoxesAlongX) {
   // A's +x face (x = 0.5) is split into triangles {1,3,7} and {1,7,5} with centroids
   // (0.5, 1/6, -1/6) and (0.5, -1/6, 1/6), both inside B (|y|, |z| <= 0.4); every other centroid
   // of A has x <= 1/6 < 0.4. Their average is (0.5, 0, 0). A's triangle normal +x points toward
-  // B, so the normal from B toward A is -x (SEED_NOTES 9). Depth: max_b(-x) - min_a(-x)
-  // = -0.4 - (-0.5) = 0.1.
+  // B, so the normal from B toward A is -x (seed correction 9 (face normal negated)). Depth:
+  // max_b(-x) - min_a(-x) = -0.4 - (-0.5) = 0.1.
   for (const auto& hit : {face_test(s.a, s.pa, s.b, s.pb), detect(s.a, s.pa, s.b, s.pb)}) {
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->feature, "face");
@@ -155,8 +155,8 @@ TEST(Detect, EdgeLandingFlatAveragesItsVerticesOnTheSameFace) {
   // midpoint (0, 0, top - 0.02), so the impulse acts on the symmetry plane (no spurious spin).
   const ConvexPolyhedron a = make_box(Vec3::Ones()), b = make_box(Vec3(4, 4, 1));
   const double h = std::sqrt(2.0) / 2;
-  const Pose pa = pose_at(Vec3(0, 0, 0.5 + h - 0.02),
-                          Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX())));
+  const Pose pa =
+      pose_at(Vec3(0, 0, 0.5 + h - 0.02), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX())));
   const Pose pb = pose_at(Vec3::Zero());
   const auto hit = vertex_test(a, pa, b, pb);
   ASSERT_TRUE(hit.has_value());
@@ -384,10 +384,10 @@ TEST(Detect, TestBeforePrepareIsRejected) {
 // ---- One test per seed correction ----------------------------------------------------------
 
 TEST(SeedCorrection, PointInMeshUsesPMinusQ) {
-  // SEED_NOTES 1. The seed dots p itself with each face normal and calls p outside if any
-  // product is not negative. Take a unit cube centred at (10, 0, 0) and its own centre p: p . n
-  // is +10 on the +x face, so the literal rule says "outside"; (p - q_f) . n_f = -0.5 on every
-  // face, inside.
+  // seed correction 1 (point in mesh uses p - q_f). The seed dots p itself with each face normal
+  // and calls p outside if any product is not negative. Take a unit cube centred at (10, 0, 0) and
+  // its own centre p: p . n is +10 on the +x face, so the literal rule says "outside"; (p - q_f) .
+  // n_f = -0.5 on every face, inside.
   const ConvexPolyhedron box = make_box(Vec3(1, 1, 1));
   const Pose pose = pose_at(Vec3(10, 0, 0));
   const Vec3 p(10, 0, 0);
@@ -406,8 +406,9 @@ TEST(SeedCorrection, PointInMeshUsesPMinusQ) {
 }
 
 TEST(SeedCorrection, EdgeCrossingIsVjMinusVi) {
-  // SEED_NOTES 2. Crossed bars, A's edge (0,1) from v_i = (-2, -0.5, 0.4) to v_j = (2, -0.5, 0.4)
-  // against B's plane x = -0.5 (outward normal -x): d_i = 1.5, d_j = -2.5, t = 1.5 / 4.
+  // seed correction 2 (edge crossing at v_i + t (v_j - v_i)). Crossed bars, A's edge (0,1) from v_i
+  // = (-2, -0.5, 0.4) to v_j = (2, -0.5, 0.4) against B's plane x = -0.5 (outward normal -x): d_i
+  // = 1.5, d_j = -2.5, t = 1.5 / 4.
   const CrossedBars s;
   const Vec3 v_i(-2, -0.5, 0.4), v_j(2, -0.5, 0.4);
   const double t = 1.5 / 4.0;
@@ -427,10 +428,10 @@ TEST(SeedCorrection, EdgeCrossingIsVjMinusVi) {
 }
 
 TEST(SeedCorrection, BothOrdersSeeAVertexOfBInAFaceOfA) {
-  // SEED_NOTES 8. The corner configuration with the roles swapped: the cube (now B) pokes its
-  // corner into the flat box (now A). Looping A's vertices against B alone finds nothing; the
-  // (B, A) pass finds the corner at (0, 0, 0.4) with A's top normal +z (from A toward B),
-  // flipped to -z: from B (above) toward A.
+  // seed correction 8 (both orders, normal flipped). The corner configuration with the roles
+  // swapped: the cube (now B) pokes its corner into the flat box (now A). Looping A's vertices
+  // against B alone finds nothing; the (B, A) pass finds the corner at (0, 0, 0.4) with A's top
+  // normal +z (from A toward B), flipped to -z: from B (above) toward A.
   const CornerIntoFace s;
   EXPECT_FALSE(vertex_test(s.b, s.pb, s.a, s.pa).has_value());  // the seed's single order
   const auto hit = detect_feature(Feature::Vertex, s.b, s.pb, s.a, s.pa);
@@ -441,9 +442,10 @@ TEST(SeedCorrection, BothOrdersSeeAVertexOfBInAFaceOfA) {
 }
 
 TEST(SeedCorrection, FaceNormalIsNegated) {
-  // SEED_NOTES 9. In the face-face configuration the first of A's triangles inside B is
-  // triangle 2 ({1,3,7}, on the +x face): the seed takes its normal, +x, which points from A
-  // toward B. Moving A along it deepens the overlap; moving A along ours by the depth separates.
+  // seed correction 9 (face normal negated). In the face-face configuration the first of A's
+  // triangles inside B is triangle 2 ({1,3,7}, on the +x face): the seed takes its normal, +x,
+  // which points from A toward B. Moving A along it deepens the overlap; moving A along ours by the
+  // depth separates.
   const FaceFace s;
   const Vec3 literal = s.a.planes()[2].normal;
   expect_vec_near(literal, Vec3(1, 0, 0), kRoundOff);
@@ -463,8 +465,8 @@ TEST(SeedCorrection, FaceNormalIsNegated) {
 }
 
 TEST(SeedCorrection, EdgeNormalIsEaCrossEb) {
-  // SEED_NOTES 10. The seed's "cross product of the edge with the plane it is intersecting",
-  // e_a x n_plane, lies in that plane.
+  // seed correction 10 (edge normal e_a x e_b). The seed's "cross product of the edge with the
+  // plane it is intersecting", e_a x n_plane, lies in that plane.
   {
     // Crossed bars: A's edge (along x) crosses B's planes x = -+0.5, whose normals are -+x, so
     // e_a x n_plane = 0: no direction at all. Ours is +z.
@@ -532,9 +534,7 @@ TEST(Detect, AgreesWithSeparatingAxisOracle) {
   // Pairs within 1e-6 of touching are skipped: there the verdict rests on the 1e-9 tolerance.
   std::mt19937 rng(12345);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  auto random_rotation = [&] {
-    return Quat(u(rng), u(rng), u(rng), u(rng)).normalized();
-  };
+  auto random_rotation = [&] { return Quat(u(rng), u(rng), u(rng), u(rng)).normalized(); };
   const ConvexPolyhedron box = make_box(Vec3(1.0, 0.6, 0.8));
   const std::vector<ConvexPolyhedron> others = {make_icosphere(0.5, 0), make_prism(0.4, 1.0, 5)};
   int hits = 0, misses = 0;
@@ -542,8 +542,8 @@ TEST(Detect, AgreesWithSeparatingAxisOracle) {
     for (int trial = 0; trial < 150; ++trial) {
       const Pose pa = pose_at(Vec3::Zero(), random_rotation());
       const double distance = 0.5 + 0.9 * (u(rng) + 1) / 2;  // m, in [0.5, 1.4]
-      const Pose pb = pose_at(Vec3(u(rng), u(rng), u(rng)).normalized() * distance,
-                              random_rotation());
+      const Pose pb =
+          pose_at(Vec3(u(rng), u(rng), u(rng)).normalized() * distance, random_rotation());
       const double truth = sat_min_overlap(box, pa, other, pb);
       if (std::abs(truth) < 1e-6) continue;
       const auto hit = detect(box, pa, other, pb);

@@ -2,8 +2,6 @@
 // poses of boxes, prisms and (sheared) icospheres from 8 to 642 vertices, touching, deep and
 // separated, the fast path returns the same hit or miss, feature, point, normal and depth as
 // the seed path, for the full detector and for each feature test alone (the world calls those).
-#include "engine/detect.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +10,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include "engine/detect.h"
 
 namespace rbx {
 namespace {
@@ -24,10 +24,10 @@ void expect_same(const std::optional<ContactPoint>& fast, const std::optional<Co
   ASSERT_EQ(fast.has_value(), seed.has_value()) << where;
   if (!seed) return;
   EXPECT_EQ(fast->feature, seed->feature) << where;
-  EXPECT_EQ(fast->point, seed->point) << where << "\n fast " << fast->point.transpose()
-                                      << "\n seed " << seed->point.transpose();
-  EXPECT_EQ(fast->normal, seed->normal) << where << "\n fast " << fast->normal.transpose()
-                                        << "\n seed " << seed->normal.transpose();
+  EXPECT_EQ(fast->point, seed->point)
+      << where << "\n fast " << fast->point.transpose() << "\n seed " << seed->point.transpose();
+  EXPECT_EQ(fast->normal, seed->normal)
+      << where << "\n fast " << fast->normal.transpose() << "\n seed " << seed->normal.transpose();
   EXPECT_EQ(fast->depth, seed->depth) << where;
 }
 
@@ -93,8 +93,8 @@ void random_poses(const ConvexPolyhedron& a, const ConvexPolyhedron& b, int coun
                   const std::string& name, Tally& tally) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const double size = std::max((a.bounds().max - a.bounds().min).norm(),
-                               (b.bounds().max - b.bounds().min).norm());
+  const double size =
+      std::max((a.bounds().max - a.bounds().min).norm(), (b.bounds().max - b.bounds().min).norm());
   for (int i = 0; i < count; ++i) {
     Pose pa, pb;
     pa.position = Vec3(unit(rng), unit(rng), unit(rng)) - Vec3::Constant(0.5);
@@ -102,13 +102,19 @@ void random_poses(const ConvexPolyhedron& a, const ConvexPolyhedron& b, int coun
     pb.orientation = random_rotation(rng);
     const Vec3 d = random_direction(rng);
     pb.position = pa.position;
-    const double reach = support(a, pa, d) + support(b, pb, -d) - pb.position.dot(d) +
-                         pa.position.dot(d);
+    const double reach =
+        support(a, pa, d) + support(b, pb, -d) - pb.position.dot(d) + pa.position.dot(d);
     double offset;
     switch (i % 3) {
-      case 0: offset = 0.02 * unit(rng) - 0.01; break;   // touching
-      case 1: offset = -0.1 - 0.2 * unit(rng); break;    // deep
-      default: offset = 0.01 + 0.09 * unit(rng); break;  // separated
+      case 0:
+        offset = 0.02 * unit(rng) - 0.01;
+        break;  // touching
+      case 1:
+        offset = -0.1 - 0.2 * unit(rng);
+        break;  // deep
+      default:
+        offset = 0.01 + 0.09 * unit(rng);
+        break;  // separated
     }
     pb.position = pa.position + (reach + offset * size) * d + 0.05 * size * random_direction(rng);
     compare_at(a, pa, b, pb, name + " pose " + std::to_string(i), tally);
@@ -120,8 +126,7 @@ void random_poses(const ConvexPolyhedron& a, const ConvexPolyhedron& b, int coun
 // on faces and edges on edges.
 void grid_poses(const ConvexPolyhedron& a, const ConvexPolyhedron& b, const std::string& name,
                 Tally& tally) {
-  const Quat quarter_turns[] = {Quat::Identity(),
-                                Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX())),
+  const Quat quarter_turns[] = {Quat::Identity(), Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX())),
                                 Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ())),
                                 Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()))};
   const double step = 0.25 * (b.bounds().max - b.bounds().min).maxCoeff();
@@ -217,7 +222,8 @@ TEST(FastDetect, SamePosesNewShapes) {
                   detect_feature(feature, a, pa, b, pb, DetectorVariant::Faithful),
                   "size " + std::to_string(k) + " " + to_string(feature));
     const auto seed = detect(a, pa, b, pb, DetectorVariant::Faithful);
-    expect_same(detect(a, pa, b, pb, DetectorVariant::Accelerated), seed, "size " + std::to_string(k));
+    expect_same(detect(a, pa, b, pb, DetectorVariant::Accelerated), seed,
+                "size " + std::to_string(k));
     hits += seed ? 1 : 0;
   }
   // B (half extents 0.5, 0.4, 0.3, any rotation) lies within its circumsphere of radius
@@ -281,8 +287,8 @@ TEST(FastDetect, InterleavedQueriesOnTwoCachesDoNotInterfere) {
       c1.prepare(sphere, p1a, box, p1b, v);
       c2.prepare(cube, p2a, box, p2b, v);
       for (int f = 0; f < 3; ++f) {
-        const std::string where = "pose " + std::to_string(i) + " " + to_string(kFeatures[f]) +
-                                  " " + to_string(v);
+        const std::string where =
+            "pose " + std::to_string(i) + " " + to_string(kFeatures[f]) + " " + to_string(v);
         expect_same(c1.test(kFeatures[f]), alone1[f], where + " pair 1");
         expect_same(c2.test(kFeatures[f]), alone2[f], where + " pair 2");
         hits += alone1[f].has_value() + alone2[f].has_value();

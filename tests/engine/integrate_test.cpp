@@ -36,8 +36,8 @@ TEST(Integrate, EulerMovesWithTheOldVelocity) {
 
 TEST(Integrate, EulerRotatesAboutOneAxisExactly) {
   // Rotations about one fixed axis compose exactly: n steps of w dt about z = Rz(n w dt).
-  RigidBody b = box_body("A", Vec3::Ones(), 1, Vec3::Zero(), Quat::Identity(), Vec3::Zero(),
-                         Vec3(0, 0, 2.0));
+  RigidBody b =
+      box_body("A", Vec3::Ones(), 1, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3(0, 0, 2.0));
   for (int k = 0; k < 250; ++k) integrate_euler(b, Vec3::Zero(), 1e-3);
   const Mat3 expected = rotation_z(0.5);
   EXPECT_LT((b.orientation.toRotationMatrix() - expected).norm(), 1e-13);

@@ -1,9 +1,9 @@
 // Contact manifolds: every contact point of a pair, one normal.
 #include "engine/manifold.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "engine/detect.h"
 

@@ -30,10 +30,11 @@ ConvexPolyhedron unit_tetrahedron() {
 // (vertex n) at (0, 0, h). Most vertices sit on the base.
 ConvexPolyhedron pyramid(int n, double h) {
   std::vector<Vec3> v;
-  for (int k = 0; k < n; ++k) v.emplace_back(std::cos(2 * M_PI * k / n), std::sin(2 * M_PI * k / n), 0);
+  for (int k = 0; k < n; ++k)
+    v.emplace_back(std::cos(2 * M_PI * k / n), std::sin(2 * M_PI * k / n), 0);
   v.emplace_back(0, 0, h);
   std::vector<std::array<int, 3>> t;
-  for (int k = 1; k + 1 < n; ++k) t.push_back({0, k + 1, k});  // base fan, facing -z
+  for (int k = 1; k + 1 < n; ++k) t.push_back({0, k + 1, k});    // base fan, facing -z
   for (int k = 0; k < n; ++k) t.push_back({k, (k + 1) % n, n});  // sides
   return ConvexPolyhedron::from_triangles(std::move(v), std::move(t));
 }
@@ -47,7 +48,8 @@ TEST(MassProperties, SolidBox) {
   EXPECT_EQ(mp.mass, m);
   EXPECT_LE(mp.center_of_mass.norm(), kRelRoundOff);
   const Mat3 expected =
-      Vec3(m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12).asDiagonal();
+      Vec3(m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12)
+          .asDiagonal();
   expect_mat_near(mp.inertia, expected, expected.maxCoeff() * kRelRoundOff);
 }
 
@@ -94,7 +96,8 @@ TEST(MassProperties, VertexTetrahedron) {
 
 TEST(MassProperties, DispatchFollowsTheModel) {
   const ConvexPolyhedron t = unit_tetrahedron();
-  EXPECT_EQ(mass_properties(t, 2.0, MassModel::Solid).inertia, solid_mass_properties(t, 2.0).inertia);
+  EXPECT_EQ(mass_properties(t, 2.0, MassModel::Solid).inertia,
+            solid_mass_properties(t, 2.0).inertia);
   EXPECT_EQ(mass_properties(t, 2.0, MassModel::Vertices).inertia,
             vertex_mass_properties(t, 2.0).inertia);
 }

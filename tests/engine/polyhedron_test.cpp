@@ -225,8 +225,7 @@ TEST(PolyhedronValidation, PrunedConvexityCheckNamesWhatTheFullScanNames) {
     for (size_t f = 0; f < t.size() && expected.empty(); ++f) {
       const Vec3 n = (v[t[f][1]] - v[t[f][0]]).cross(v[t[f][2]] - v[t[f][0]]).normalized();
       for (int i = 0; i < static_cast<int>(v.size()) && expected.empty(); ++i)
-        if (n.dot(v[i]) - n.dot(v[t[f][0]]) > tol)
-          expected = "vertex " + std::to_string(i) + " ";
+        if (n.dot(v[i]) - n.dot(v[t[f][0]]) > tol) expected = "vertex " + std::to_string(i) + " ";
       if (!expected.empty()) expected += "* face " + std::to_string(f) + " ";
     }
     ASSERT_FALSE(expected.empty()) << "the push of vertex " << k << " made no dent";
@@ -238,8 +237,7 @@ TEST(PolyhedronValidation, PrunedConvexityCheckNamesWhatTheFullScanNames) {
       const std::string vertex = expected.substr(0, expected.find('*'));
       const std::string face = expected.substr(expected.find('*') + 2);
       EXPECT_NE(m.find("not convex: " + vertex), std::string::npos) << m << " / " << expected;
-      EXPECT_NE(m.find("plane of " + face + "("), std::string::npos)
-          << m << " / " << expected;
+      EXPECT_NE(m.find("plane of " + face + "("), std::string::npos) << m << " / " << expected;
     }
   }
 }

@@ -81,8 +81,10 @@ TEST(Response, HeadOnUnequalMassesMatchOneDimensionalClosedForm) {
   // v2' = (m1 v1 + m2 v2 + m1 e (v1 - v2)) / (m1 + m2).
   const double m1 = 1.0, m2 = 3.0, v1 = 2.0, v2 = -1.0;
   for (double e : {0.0, 0.25, 0.5, 1.0}) {
-    RigidBody a = box_body("A", Vec3::Ones(), m1, Vec3(-0.5, 0, 0), Quat::Identity(), Vec3(v1, 0, 0));
-    RigidBody b = box_body("B", Vec3::Ones(), m2, Vec3(0.5, 0, 0), Quat::Identity(), Vec3(v2, 0, 0));
+    RigidBody a =
+        box_body("A", Vec3::Ones(), m1, Vec3(-0.5, 0, 0), Quat::Identity(), Vec3(v1, 0, 0));
+    RigidBody b =
+        box_body("B", Vec3::Ones(), m2, Vec3(0.5, 0, 0), Quat::Identity(), Vec3(v2, 0, 0));
     ContactPoint c{Vec3::Zero(), Vec3(-1, 0, 0), 0.0, "face"};
     apply_impulse(a, b, c, e);
     const double v1p = (m1 * v1 + m2 * v2 + m2 * e * (v2 - v1)) / (m1 + m2);
@@ -136,13 +138,15 @@ TEST(Response, CornerImpactClosedForm) {
 
 // The seed's printed impulse: (1 + e) on the linear term only, the angular terms added outside,
 // j = (-(1+e)(v_a - v_b).n + (r_a x n).w_a - (r_b x n).w_b) / denominator.
-double literal_seed_impulse(const RigidBody& a, const RigidBody& b, const ContactPoint& c, double e) {
+double literal_seed_impulse(const RigidBody& a, const RigidBody& b, const ContactPoint& c,
+                            double e) {
   const Vec3 ra = c.point - a.position, rb = c.point - b.position, n = c.normal;
   const Vec3 ran = ra.cross(n), rbn = rb.cross(n);
   const double denom = a.inverse_mass + b.inverse_mass + ran.dot(a.inverse_inertia_world() * ran) +
                        rbn.dot(b.inverse_inertia_world() * rbn);
   return (-(1 + e) * (a.velocity - b.velocity).dot(n) + ran.dot(a.angular_velocity) -
-          rbn.dot(b.angular_velocity)) / denom;
+          rbn.dot(b.angular_velocity)) /
+         denom;
 }
 
 TEST(Response, SeedNote3LiteralImpulseBreaksEnergyConservation) {
@@ -186,8 +190,9 @@ TEST(Response, SeedNote4LiteralUpdatesBreakMomentumConservation) {
 }
 
 TEST(Response, WorldInverseInertiaUsesRotation) {
-  // SEED_NOTES 5: the impulse uses R Ib^-1 R^T. A 1 x 2 x 3 box rotated 90 deg about z swaps its
-  // x and y principal moments in the world frame.
+  // seed correction 5 (world-frame inverse inertia, static bodies zero): the impulse uses R Ib^-1
+  // R^T. A 1 x 2 x 3 box rotated 90 deg about z swaps its x and y principal moments in the world
+  // frame.
   const Quat q(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()));
   RigidBody a = box_body("A", Vec3(1, 2, 3), 12, Vec3::Zero(), q);
   const Mat3 iw = a.inertia_world();
@@ -199,9 +204,10 @@ TEST(Response, WorldInverseInertiaUsesRotation) {
 }
 
 TEST(Response, ImpulseOnARotatedBodyUsesTheWorldInertia) {
-  // SEED_NOTES 5 inside the impulse. The same box (world moments 10, 13, 5) moves at -1 m/s
-  // along x into a static body; contact normal n = +x at r = (0, 0, 1) from its centre, so
-  // r x n = (0, 1, 0) and only the world yy moment (13) enters:
+  // seed correction 5 (world-frame inverse inertia, static bodies zero) inside the impulse. The
+  // same box (world moments 10, 13, 5) moves at -1 m/s along x into a static body; contact normal n
+  // = +x at r = (0, 0, 1) from its centre, so r x n = (0, 1, 0) and only the world yy moment (13)
+  // enters:
   //   j = -(1 + e) v_rel.n / (1/m + 1/13) = 2 / (1/12 + 1/13) = 12.48 (e = 1),
   //   dw = I_w^-1 (r x j n) = (0, j/13, 0) = (0, 0.96, 0),  dv = j/m n = (1.04, 0, 0).
   // With the body-frame inverse the yy moment would be 10: j = 10.909, dw_y = 1.0909.

@@ -1,9 +1,9 @@
 // Time of impact on the detector, and the extended world's step: resting, no tunnelling.
 #include "engine/time_of_impact.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "engine/world.h"
 #include "tests/common/fixtures.h"
@@ -61,7 +61,8 @@ TEST(ExtendedWorld, StackRestsWithoutAddingEnergy) {
   sim.friction = 0.5;
   std::vector<RigidBody> bodies = {box_body("floor", Vec3(4, 4, 1), 1.0, Vec3(0, 0, -0.5),
                                             Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true)};
-  for (int k = 0; k < 3; ++k) bodies.push_back(box_body("box", Vec3::Ones(), 1.0, Vec3(0, 0, 0.5 + k)));
+  for (int k = 0; k < 3; ++k)
+    bodies.push_back(box_body("box", Vec3::Ones(), 1.0, Vec3(0, 0, 0.5 + k)));
   World world(sim, bodies);
   world.set_contact_model(ContactModel::Extended);
   const double e0 = world.energy();

@@ -85,8 +85,12 @@ TEST(World, RunsAreBitwiseDeterministic) {
   ASSERT_EQ(r1.events.size(), r2.events.size());
   EXPECT_GT(r1.events.size(), 0u);
   for (size_t i = 0; i < r1.bodies.size(); ++i) {
-    EXPECT_EQ(std::memcmp(r1.bodies[i].position.data(), r2.bodies[i].position.data(), 3 * sizeof(double)), 0);
-    EXPECT_EQ(std::memcmp(r1.bodies[i].velocity.data(), r2.bodies[i].velocity.data(), 3 * sizeof(double)), 0);
+    EXPECT_EQ(
+        std::memcmp(r1.bodies[i].position.data(), r2.bodies[i].position.data(), 3 * sizeof(double)),
+        0);
+    EXPECT_EQ(
+        std::memcmp(r1.bodies[i].velocity.data(), r2.bodies[i].velocity.data(), 3 * sizeof(double)),
+        0);
   }
 }
 
@@ -97,7 +101,8 @@ TEST(World, NonFiniteStateStopsTheRunNamingBodyAndQuantity) {
   const RunResult r = w.run();
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.steps_taken, 1);
-  EXPECT_NE(r.message.find("non-finite position of body A at step 1"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("non-finite position of body A at step 1"), std::string::npos)
+      << r.message;
 }
 
 TEST(World, EnergyGuardStopsARunawayRun) {
@@ -158,8 +163,10 @@ TEST(World, EnergyGuardMessageShowsTheRatioAsGiven) {
 
 TEST(World, StaticPairsAndDistantPairsProduceNoEvents) {
   std::vector<RigidBody> bodies = {
-      box_body("A", Vec3::Ones(), 1, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true),
-      box_body("B", Vec3::Ones(), 1, Vec3(0.5, 0, 0), Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true),
+      box_body("A", Vec3::Ones(), 1, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3::Zero(),
+               true),
+      box_body("B", Vec3::Ones(), 1, Vec3(0.5, 0, 0), Quat::Identity(), Vec3::Zero(), Vec3::Zero(),
+               true),
       box_body("C", Vec3::Ones(), 1, Vec3(10, 0, 0), Quat::Identity(), Vec3(1, 0, 0))};
   World w(sim_with(1e-3, 0.1, 1.0), bodies);
   const RunResult r = w.run();
@@ -176,7 +183,8 @@ TEST(World, VertexOnStaticSlabBouncesWithClosedFormSpin) {
   const double h = std::sqrt(3.0) / 2;
   std::vector<RigidBody> bodies = {
       box_body("A", Vec3::Ones(), 1, Vec3(0, 0, h + 0.05), q, Vec3(0, 0, -1)),
-      box_body("B", Vec3(4, 4, 1), 1, Vec3(0, 0, -0.5), Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true)};
+      box_body("B", Vec3(4, 4, 1), 1, Vec3(0, 0, -0.5), Quat::Identity(), Vec3::Zero(),
+               Vec3::Zero(), true)};
   World w(sim_with(1e-3, 0.2, 0.5), bodies);
   const RunResult r = w.run();
   ASSERT_TRUE(r.ok) << r.message;

@@ -100,9 +100,12 @@ void convex_detect(const uint8_t* data, size_t size) {
   // grid allows angles down to ~1e-5 rad, so only a gap above 1e-3 of the larger size is
   // certainly no touch.
   const Aabb box_a = world_box(*a, pa), box_b = world_box(*b, pb);
-  const double gap = std::max((box_a.min - box_b.max).maxCoeff(), (box_b.min - box_a.max).maxCoeff());
+  const double gap =
+      std::max((box_a.min - box_b.max).maxCoeff(), (box_b.min - box_a.max).maxCoeff());
   const double larger = std::max(size_of(*a), size_of(*b));
-  if (gap > 1e-3 * larger) require(!seed, "contact between shapes " + std::to_string(gap) + " m apart: " + describe(*seed));
+  if (gap > 1e-3 * larger)
+    require(!seed,
+            "contact between shapes " + std::to_string(gap) + " m apart: " + describe(*seed));
 
   // Fast must give Seed's answer (engine/detect.h), to round-off: both sum the same handful of
   // terms of order `reach`, so 1e-9 of it is ~10^6 ulps of room for a different order of sums.
@@ -111,7 +114,8 @@ void convex_detect(const uint8_t* data, size_t size) {
     const double tol = 1e-9 * reach;
     require(seed->feature == fast->feature,
             "Fast and Seed disagree on the feature: " + describe(*seed) + " vs " + describe(*fast));
-    require((seed->point - fast->point).norm() <= tol && (seed->normal - fast->normal).norm() <= 1e-9 &&
+    require((seed->point - fast->point).norm() <= tol &&
+                (seed->normal - fast->normal).norm() <= 1e-9 &&
                 std::abs(seed->depth - fast->depth) <= tol,
             "Fast and Seed disagree: " + describe(*seed) + " vs " + describe(*fast));
   }

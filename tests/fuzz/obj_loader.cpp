@@ -79,7 +79,8 @@ void check_polyhedron(const ConvexPolyhedron& p, const std::string& origin) {
 void decode_mesh(ByteReader& in, std::vector<Vec3>& vertices,
                  std::vector<std::array<int, 3>>& triangles) {
   const int nv = in.u8() % 33;
-  for (int i = 0; i < nv; ++i) vertices.emplace_back(in.coordinate(), in.coordinate(), in.coordinate());
+  for (int i = 0; i < nv; ++i)
+    vertices.emplace_back(in.coordinate(), in.coordinate(), in.coordinate());
   const int nt = in.u8() % 65;
   for (int f = 0; f < nt; ++f) triangles.push_back({in.i8(), in.i8(), in.i8()});
 }
@@ -95,8 +96,10 @@ void obj_loader(const uint8_t* data, size_t size) {
       check_polyhedron(load_obj(path, hull), origin);
     } catch (const GeometryError& e) {
       const std::string message = e.what();
-      require(message.find('\n') == std::string::npos, origin + ": message spans lines: " + message);
-      require(message.rfind(path, 0) == 0, origin + ": message does not start with the path: " + message);
+      require(message.find('\n') == std::string::npos,
+              origin + ": message spans lines: " + message);
+      require(message.rfind(path, 0) == 0,
+              origin + ": message does not start with the path: " + message);
     }
   }
 

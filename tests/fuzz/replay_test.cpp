@@ -41,7 +41,8 @@ std::vector<fs::path> files_in(const fs::path& dir) {
 // naming the file (a crash names it through the line printed first).
 void replay(const Target& target, const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)),
+                                std::istreambuf_iterator<char>());
   std::fprintf(stderr, "replaying %s\n", file.string().c_str());
   try {
     target.entry(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());

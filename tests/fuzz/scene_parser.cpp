@@ -1,4 +1,5 @@
 // Fuzz target `scene_parser`: rbx::parse_scene on arbitrary bytes (see targets.h).
+#include <toml++/toml.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -6,8 +7,6 @@
 #include <set>
 #include <string>
 #include <vector>
-
-#include <toml++/toml.h>
 
 #include "comparisons/scene/scene_file.h"
 #include "tests/fuzz/targets.h"
@@ -80,7 +79,7 @@ void split_overrides(const std::string& input, std::string& text,
   }
 }
 
-// The contract of an accepted scene (CONTRACT.md "Scene files", and the bad-input catalogue's
+// The contract of an accepted scene (docs/contract.md "Scene files", and the bad-input catalogue's
 // promises: each of these values is refused with exit 2 when wrong, so none may get through).
 void check_scene(const Scene& scene, bool forced) {
   require(!scene.bodies.empty(), "scene accepted without bodies");
@@ -130,7 +129,8 @@ bool asks_for_slow_shape(const std::string& text, const std::vector<std::string>
     if (const toml::array* bodies = root["body"].as_array())
       for (const toml::node& b : *bodies)
         if (const toml::table* t = b.as_table())
-          if (too_fine("subdivisions", t->get("subdivisions")) || too_fine("sides", t->get("sides")))
+          if (too_fine("subdivisions", t->get("subdivisions")) ||
+              too_fine("sides", t->get("sides")))
             return true;
   } catch (const toml::parse_error&) {
     // Not TOML: the parser under test rejects it before building any shape.

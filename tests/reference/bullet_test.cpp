@@ -147,7 +147,8 @@ TEST(BulletContact, KnownDefectZeroDepthNormal) {
   ASSERT_EQ(touching.contacts.size(), 1u);
   EXPECT_LT(touching.contacts[0].normal.z(), std::cos(5 * kPi / 180))
       << "zero-depth normal now right: defect fixed?";
-  const ContactResult deeper = bullet_hull_contact(unit_cube("A", Vec3(0, 0, corner - 1e-9), q), slab);
+  const ContactResult deeper =
+      bullet_hull_contact(unit_cube("A", Vec3(0, 0, corner - 1e-9), q), slab);
   ASSERT_EQ(deeper.status, Status::Ok) << deeper.message;
   ASSERT_EQ(deeper.contacts.size(), 1u);
   EXPECT_LT((deeper.contacts[0].normal - Vec3(0, 0, 1)).norm(), 1e-6);

@@ -57,7 +57,8 @@ TEST(CErrorTrap, WarningsKeepTheFirstUntilCleared) {
 }
 
 TEST(CErrorTrapDeathTest, AnErrorOutsideGuardedAbortsWithTheMessage) {
-  EXPECT_DEATH(library_error("no handler", 3), "lib error 3: no handler \\(outside a guarded call\\)");
+  EXPECT_DEATH(library_error("no handler", 3),
+               "lib error 3: no handler \\(outside a guarded call\\)");
 }
 
 TEST(CErrorTrap, LongMessagesAreTruncatedToTheBuffer) {

@@ -100,9 +100,9 @@ Case offcentre(double s, const std::string& name) {
                   Eigen::AngleAxisd(30 * kPi / 180, Vec3::UnitX()));
   BodySpec slab = box("B", Vec3(4, 4, 1) * s, 1, Vec3(0, 0, -0.5) * s, Vec3::Zero());
   slab.is_static = true;
-  c.scene.bodies = {box("A", Vec3::Ones() * s, 1, Vec3(0, 0, 0.8915063509461096) * s,
-                        Vec3(0, 0, -1) * s, tilt),
-                    slab};
+  c.scene.bodies = {
+      box("A", Vec3::Ones() * s, 1, Vec3(0, 0, 0.8915063509461096) * s, Vec3(0, 0, -1) * s, tilt),
+      slab};
   c.velocity = {Vec3(0, 0, 0.5984624480451497) * s, Vec3::Zero()};
   c.angular_velocity = {Vec3(-1.7552335889399642, -0.8776167944699821, 0), Vec3::Zero()};
   return c;
@@ -208,9 +208,9 @@ TEST(BulletSettingsMeasured, BoxShapeIsExactWhereTheHullIsWrong) {
   for (const Case& c : {box_cases()[0], box_cases()[1], box_cases()[2]}) {
     EXPECT_LT(measured("bullet btBoxShape", c, ke_error(c, bullet_dynamics(c.scene, {}))), kExact)
         << c.name;
-    EXPECT_GT(measured("bullet-hull (GJK+EPA hull)", c,
-                       ke_error(c, bullet_hull_dynamics(c.scene, {}))),
-              kWrong)
+    EXPECT_GT(
+        measured("bullet-hull (GJK+EPA hull)", c, ke_error(c, bullet_hull_dynamics(c.scene, {}))),
+        kWrong)
         << c.name;
   }
 }
@@ -222,9 +222,8 @@ TEST(BulletSettingsMeasured, BoxMarginZeroOrDefaultMakesNoDifference) {
   for (const Case& c : box_cases()) {
     const double with_default = ke_error(c, bullet_dynamics(c.scene, {}));
     const double with_zero =
-        ke_error(c, bullet_dynamics_with(c.scene, {}, bullet_with([](BulletSettings& s) {
-                                           s.box_margin = 0.0;
-                                         })));
+        ke_error(c, bullet_dynamics_with(
+                        c.scene, {}, bullet_with([](BulletSettings& s) { s.box_margin = 0.0; })));
     EXPECT_LT(measured("bullet box margin default", c, with_default), kExact) << c.name;
     EXPECT_LT(measured("bullet box margin 0", c, with_zero), kExact) << c.name;
   }
@@ -237,14 +236,13 @@ TEST(BulletSettingsMeasured, PolyhedralHullsClippedAboutTheGjkAxisNotSat) {
   const Case c = prism_headon();
   BulletSettings sat = bullet_native_settings();
   sat.sat_convex = true;
-  EXPECT_LT(measured("bullet polyhedral hull, GJK axis", c,
-                     ke_error(c, bullet_dynamics(c.scene, {}))),
-            kExact);
+  EXPECT_LT(
+      measured("bullet polyhedral hull, GJK axis", c, ke_error(c, bullet_dynamics(c.scene, {}))),
+      kExact);
   EXPECT_GT(measured("bullet polyhedral hull, SAT axis", c,
                      ke_error(c, bullet_dynamics_with(c.scene, {}, sat))),
             kWrong);
-  EXPECT_LT(measured("bullet-hull GJK+EPA hull", c,
-                     ke_error(c, bullet_hull_dynamics(c.scene, {}))),
+  EXPECT_LT(measured("bullet-hull GJK+EPA hull", c, ke_error(c, bullet_hull_dynamics(c.scene, {}))),
             kExact);
 }
 
@@ -256,8 +254,8 @@ TEST(BulletSettingsMeasured, PolyhedralFeaturesMendACoplanarSidedHull) {
   for (BodySpec& b : c.scene.bodies) b.shape_kind = ShapeKind::Convex;
   const double polyhedral = measured("bullet polyhedral hull (cube as convex)", c,
                                      ke_error(c, bullet_dynamics(c.scene, {})));
-  const double plain = measured("bullet-hull (cube as convex)", c,
-                                ke_error(c, bullet_hull_dynamics(c.scene, {})));
+  const double plain =
+      measured("bullet-hull (cube as convex)", c, ke_error(c, bullet_hull_dynamics(c.scene, {})));
   EXPECT_GT(plain, kWrong);
   EXPECT_LT(polyhedral, plain);
 }
@@ -270,7 +268,8 @@ TEST(BulletSettingsMeasured, HullMarginZero) {
   const Case c = prism_headon();
   BulletSettings inflated = bullet_native_settings();
   inflated.hull_margin = 0.04;
-  const double zero = measured("bullet hull margin 0", c, ke_error(c, bullet_dynamics(c.scene, {})));
+  const double zero =
+      measured("bullet hull margin 0", c, ke_error(c, bullet_dynamics(c.scene, {})));
   const double with_margin = measured("bullet hull margin 0.04", c,
                                       ke_error(c, bullet_dynamics_with(c.scene, {}, inflated)));
   EXPECT_LT(zero, kExact);
@@ -302,9 +301,9 @@ TEST(BulletSettingsMeasured, RestitutionAtAnyApproachSpeed) {
   c.scene.sim.dt = 1e-2;
   BulletSettings default_threshold = bullet_native_settings();
   default_threshold.restitution_threshold = 0.2;
-  EXPECT_LT(measured("bullet restitution threshold 0", c,
-                     ke_error(c, bullet_dynamics(c.scene, {}))),
-            kExact);
+  EXPECT_LT(
+      measured("bullet restitution threshold 0", c, ke_error(c, bullet_dynamics(c.scene, {}))),
+      kExact);
   EXPECT_GT(measured("bullet restitution threshold 0.2 (default)", c,
                      ke_error(c, bullet_dynamics_with(c.scene, {}, default_threshold))),
             kWrong);
@@ -369,8 +368,8 @@ TEST(OdeSettingsMeasured, DefaultCfmAgainstHardAndSoft) {
   }
   const double drift_default = stack_drift(ode_dynamics(resting_stack(), {}));
   const double drift_hard = stack_drift(ode_dynamics_with(resting_stack(), {}, hard));
-  std::printf("[measured] ode resting stack drift: CFM 1e-10 %.3g m, CFM 0 %.3g m\n",
-              drift_default, drift_hard);
+  std::printf("[measured] ode resting stack drift: CFM 1e-10 %.3g m, CFM 0 %.3g m\n", drift_default,
+              drift_hard);
   // Resting under gravity with CFM 1e-10: the contact yields by ~CFM * m g per step, ~1e-10 m.
   EXPECT_LT(drift_default, 1e-9);
   EXPECT_GT(drift_hard, 100 * drift_default);
@@ -416,8 +415,8 @@ TEST(MujocoSettingsMeasured, BoxGeomsWithDoubledStiffnessAgainstMeshes) {
   const MujocoSettings mesh = mujoco_hull_settings();
   double log_box2 = 0, log_box1 = 0, log_multi = 0, log_mesh = 0;
   for (const Case& c : box_cases()) {
-    const double box2 = measured("mujoco box geoms, stiffness x2", c,
-                                 ke_error(c, mujoco_dynamics(c.scene, {})));
+    const double box2 =
+        measured("mujoco box geoms, stiffness x2", c, ke_error(c, mujoco_dynamics(c.scene, {})));
     log_box2 += std::log(box2);
     log_box1 += std::log(measured("mujoco box geoms, stiffness x1", c,
                                   ke_error(c, mujoco_dynamics_with(c.scene, {}, box_x1))));
@@ -436,9 +435,10 @@ TEST(MujocoSettingsMeasured, MulticcdOnNonBoxMeshes) {
   // Prisms (no box geom possible): mesh + multiccd (a multi-point face manifold) against the
   // plain mesh's single MPR point.
   const Case c = prism_headon();
-  const double multi = measured("mujoco mesh + multiccd", c, ke_error(c, mujoco_dynamics(c.scene, {})));
-  const double one = measured("mujoco-hull mesh (one point)", c,
-                              ke_error(c, mujoco_hull_dynamics(c.scene, {})));
+  const double multi =
+      measured("mujoco mesh + multiccd", c, ke_error(c, mujoco_dynamics(c.scene, {})));
+  const double one =
+      measured("mujoco-hull mesh (one point)", c, ke_error(c, mujoco_hull_dynamics(c.scene, {})));
   EXPECT_LT(multi, kMujocoSoftLimit);
   EXPECT_LE(multi, one);
 }
@@ -477,8 +477,8 @@ TEST(FairReferences, NativeBoxQueriesGiveTheFourCornerFaceManifold) {
   // gives it), the four corners (x, +-0.5, +-0.5) among them. (Bullet adds a fifth point at
   // y = z = 0.46, its box margin in from a corner: passed on, it is inside the overlap.)
   const RigidBody a = cube("A", Vec3::Zero()), b = cube("B", Vec3(0.9, 0, 0));
-  for (auto [name, query] : {std::pair{"bullet", bullet_contact}, {"ode", ode_contact},
-                             {"fcl", fcl_contact}}) {
+  for (auto [name, query] :
+       {std::pair{"bullet", bullet_contact}, {"ode", ode_contact}, {"fcl", fcl_contact}}) {
     const ContactResult r = query(a, b);
     ASSERT_EQ(r.status, Status::Ok) << name << ": " << r.message;
     for (const ContactPoint& c : r.contacts) {
@@ -491,9 +491,10 @@ TEST(FairReferences, NativeBoxQueriesGiveTheFourCornerFaceManifold) {
     }
     for (double y : {-0.5, 0.5})
       for (double z : {-0.5, 0.5}) {
-        const bool found = std::any_of(r.contacts.begin(), r.contacts.end(), [&](const ContactPoint& c) {
-          return std::abs(c.point.y() - y) < kExact && std::abs(c.point.z() - z) < kExact;
-        });
+        const bool found =
+            std::any_of(r.contacts.begin(), r.contacts.end(), [&](const ContactPoint& c) {
+              return std::abs(c.point.y() - y) < kExact && std::abs(c.point.z() - z) < kExact;
+            });
         EXPECT_TRUE(found) << name << ": corner " << y << ", " << z;
       }
   }
@@ -528,7 +529,8 @@ TEST(FairReferences, NativeBoxMassRoutinesAreTheSolidBox) {
     const char* name;
     MassResult r;
     double tol;
-  } rows[] = {{"bullet", bullet_mass(body), 1e-7}, {"fcl", fcl_mass(body), 1e-12},
+  } rows[] = {{"bullet", bullet_mass(body), 1e-7},
+              {"fcl", fcl_mass(body), 1e-12},
               {"mujoco", mujoco_mass(body), 1e-12}};
   for (const auto& row : rows) {
     ASSERT_EQ(row.r.status, Status::Ok) << row.name << ": " << row.r.message;
@@ -573,10 +575,11 @@ TEST(FairReferences, FirstImpulseRecordsWhatEachLibrarySaw) {
                       {"mujoco-hull", mujoco_hull_dynamics(c.scene, {}), 1, 1}};
   for (const Row& row : rows) {
     const FirstImpulse& f = row.r.first_impulse;
-    std::printf("[measured] first impulse %-12s points %d normal (%.3g %.3g %.3g) depth %.3g "
-                "approach %.6g phase %.3g step %ld\n",
-                row.name, f.contact_points, f.normal.x(), f.normal.y(), f.normal.z(), f.depth,
-                f.approach_speed, f.entry_phase, f.step);
+    std::printf(
+        "[measured] first impulse %-12s points %d normal (%.3g %.3g %.3g) depth %.3g "
+        "approach %.6g phase %.3g step %ld\n",
+        row.name, f.contact_points, f.normal.x(), f.normal.y(), f.normal.z(), f.depth,
+        f.approach_speed, f.entry_phase, f.step);
     ASSERT_TRUE(f.seen) << row.name;
     EXPECT_EQ(f.body_a, "A") << row.name;
     EXPECT_EQ(f.body_b, "B") << row.name;

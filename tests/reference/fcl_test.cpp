@@ -133,7 +133,8 @@ TEST(FclMpr, ExactTouchingOffCentreHasNoNormalAndIsAnError) {
 }
 
 TEST(FclMpr, OneContactLabelledMpr) {
-  const ContactResult r = fcl_hull_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
+  const ContactResult r =
+      fcl_hull_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
   ASSERT_EQ(r.contacts.size(), 1u);  // Convex-Convex through MPR yields a single point
   EXPECT_EQ(r.contacts[0].feature, "mpr");
 }
@@ -382,15 +383,12 @@ TEST(FclIndep, SeparatedIsNoContact) {
 // ---------------------------------------------------------------------------------------------
 // fcl on two boxes: fcl::Box, boxBoxIntersect (the former fcl-box).
 
-TEST(FclBox, FacePairConventionBothOrdersAndRotated) {
-  check_face_pair(fcl_contact, kRoundOff);
-}
+TEST(FclBox, FacePairConventionBothOrdersAndRotated) { check_face_pair(fcl_contact, kRoundOff); }
 
 TEST(FclBox, FacePairGivesTheFourCornersOfTheOverlapFace) {
   // B's -x face clipped by A's +x face is the whole unit square: 4 corners (0.45, +-0.5, +-0.5)
   // on the mid-plane, each at depth 0.1.
-  const ContactResult r =
-      fcl_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
+  const ContactResult r = fcl_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
   ASSERT_EQ(r.contacts.size(), 4u);
   for (const ContactPoint& c : r.contacts) {
     EXPECT_NEAR(std::abs(c.point.y()), 0.5, kRoundOff);
@@ -414,8 +412,7 @@ TEST(FclBox, VertexMassModelGivesTheSameBoxFrame) {
   // the answer is the solid model's: n = -x, depth 0.1.
   const RigidBody a =
       box_at("A", Vec3::Ones(), Vec3::Zero(), Quat::Identity(), MassModel::Vertices);
-  const RigidBody b =
-      box_at("B", Vec3::Ones(), kFaceOffset, Quat::Identity(), MassModel::Vertices);
+  const RigidBody b = box_at("B", Vec3::Ones(), kFaceOffset, Quat::Identity(), MassModel::Vertices);
   expect_all_contacts(fcl_contact(a, b), kFaceNormal, kFaceDepth, kRoundOff);
 }
 
@@ -529,7 +526,8 @@ TEST(FclRandomBoxes, AgainstSeparatingAxes) {
   //  - separated by SAT: no contact from any backend;
   //  - fcl-epa: depth = the SAT minimum and = the overlap along its own normal;
   //  - fcl (MPR): depth >= the SAT minimum (no direction needs less than the minimum);
-  //  - fcl on boxes (Box-Box): deepest point between the SAT minimum and 1.05 times it: boxBox2 prefers a face
+  //  - fcl on boxes (Box-Box): deepest point between the SAT minimum and 1.05 times it: boxBox2
+  //  prefers a face
   //    axis over an edge axis unless the edge is 5% shallower (fudge_factor = 1.05 in
   //    box_box-inl.h, inherited from ODE), so up to 5% too deep by design.
   std::mt19937 rng(12345);

@@ -163,8 +163,9 @@ TEST(RunIsolated, StatusAndEmptyResultsPassThrough) {
   EXPECT_EQ(apart.status, Status::Ok);
   EXPECT_TRUE(apart.message.empty());
   EXPECT_TRUE(apart.contacts.empty());
-  const ContactResult unsupported =
-      run_isolated([] { return ContactResult{Status::Unsupported, "no prisms", {}}; });
+  const ContactResult unsupported = run_isolated([] {
+    return ContactResult{Status::Unsupported, "no prisms", {}};
+  });
   EXPECT_EQ(unsupported.status, Status::Unsupported);
   EXPECT_EQ(unsupported.message, "no prisms");
   expect_no_child_left();

@@ -156,7 +156,8 @@ TEST(MujocoKnownWrongAnswer, SmallCubeOnTheDiagonalPinned) {
   // Against the truth (an axis, 0.15): 54.7 deg off and sqrt(3) too deep.
   EXPECT_GT(c.depth - 0.15, 0.1);
   // Swapped (the scene's order, small cube first): the same wrong answer, flipped.
-  const ContactResult swapped = mujoco_hull_contact(diagonal_small(Vec3::Constant(0.4)), diagonal_big());
+  const ContactResult swapped =
+      mujoco_hull_contact(diagonal_small(Vec3::Constant(0.4)), diagonal_big());
   ASSERT_EQ(swapped.status, Status::Ok) << swapped.message;
   ASSERT_EQ(swapped.contacts.size(), 1u);
   EXPECT_NEAR((swapped.contacts[0].normal - Vec3::Ones().normalized()).norm(), 0.0, kFloatGeometry)
@@ -177,8 +178,8 @@ TEST(MujocoKnownWrongAnswer, SmallCubeNearTheDiagonalPinned) {
   const double measured_depth = 0.17233688105783818;
   for (bool swapped : {false, true}) {
     const RigidBody small = diagonal_small(Vec3(0.4, 0.39, 0.39));
-    const ContactResult r =
-        swapped ? mujoco_hull_contact(diagonal_big(), small) : mujoco_hull_contact(small, diagonal_big());
+    const ContactResult r = swapped ? mujoco_hull_contact(diagonal_big(), small)
+                                    : mujoco_hull_contact(small, diagonal_big());
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_EQ(r.contacts.size(), 1u);
     const ContactPoint& c = r.contacts[0];
