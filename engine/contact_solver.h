@@ -1,6 +1,6 @@
 // Simultaneous contact response over manifolds: Newton restitution, Coulomb friction (exact
 // cone), resting contact, and position projection. The extended engine's answer to what the
-// seed admits it lacks (seed correction 12 (contact point and plane in one pass): resting contact
+// seed admits it lacks (seed correction 12 (what the seed admits it lacks): resting contact
 // and friction).
 //
 // Design note. Of the two resting-contact schemes the issue names, sequential impulses to

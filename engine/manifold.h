@@ -1,7 +1,7 @@
 // Contact manifold: every contact point of a pair in one pass, with one normal.
 //
 // Departure from the seed, which resolves the first face / vertex / edge hit (or an average of
-// one kind) as a single point (seed correction 12 (contact point and plane in one pass) names a
+// one kind) as a single point (seed correction 12 (what the seed admits it lacks) names a
 // contact plane from the detector as future work): the manifold keeps the detector's normal (Moore
 // & Wilhelms, engine/detect.h) and collects, against it, every vertex of A inside B, every vertex
 // of B inside A and every crossing of a real edge of A with a real edge of B (the closest points of

@@ -1,7 +1,7 @@
 // Time of impact for the extended engine: the first contact time of two bodies that were
 // separated at the start of a step, found on the Moore & Wilhelms detector itself. The seed
 // names this as missing ("a time-of-impact method ... is obvious when the bounding box check
-// passes", seed correction 12 (contact point and plane in one pass)); without it a body crossing
+// passes", seed correction 12 (what the seed admits it lacks)); without it a body crossing
 // another's thickness within one step passes through (stress/tunnel_thin_wall).
 #pragma once
 

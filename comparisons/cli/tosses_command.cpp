@@ -11,6 +11,7 @@
 
 #include "comparisons/eval/tosses.h"
 #include "comparisons/output/table.h"
+#include "comparisons/scene/repo_path.h"
 #include "comparisons/scene/scene_file.h"
 
 namespace fs = std::filesystem;
@@ -235,7 +236,7 @@ int tosses_command(const TossesOptions& opt) {
 
 std::vector<std::string> find_toss_datasets(const std::vector<std::string>& inputs) {
   std::vector<std::string> roots = inputs;
-  if (roots.empty()) roots.push_back("scenes");
+  if (roots.empty()) roots.push_back(default_repo_path("scenes"));
   std::vector<std::string> found;
   for (const std::string& root : roots) {
     std::error_code ec;

@@ -67,7 +67,7 @@ const KeyInfo kKeys[] = {
     {"body.angular_velocity", "[0, 0, 0]"},
     {"expect.tolerance", "1e-6"},
     {"expect.known_failure",
-     "\"custom: no resting contact (seed correction 12 (contact point and plane in one pass))\""},
+     "\"custom: no resting contact (seed correction 12 (what the seed admits it lacks))\""},
     {"expect.body.position", "[0, 0, 0]"},
     {"expect.body.velocity", "[0, 0, 0]"},
     {"expect.body.angular_velocity", "[0, 0, 0]"},
