@@ -13,6 +13,7 @@
 #include "comparisons/cli/commands.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/result_cache.h"
+#include "comparisons/eval/select_backends.h"
 #include "comparisons/output/table.h"
 #include "comparisons/scene/repo_path.h"
 #include "comparisons/scene/scene_file.h"
@@ -70,15 +71,6 @@ std::string change_text(double old, double cur, const std::string& unit) {
   const double d = cur - old;
   return fmt_num(old, digits) + " -> " + fmt_num(cur, digits) + " (" + (d > 0 ? "+" : "") +
          fmt_num(d, 3) + unit + ")";
-}
-
-std::vector<std::string> split_list(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream s(list);
-  std::string item;
-  while (std::getline(s, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
 }
 
 }  // namespace

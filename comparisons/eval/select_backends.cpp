@@ -13,6 +13,8 @@ bool serves(const Backend& b, Capability cap) {
   return cap == Capability::Contact ? static_cast<bool>(b.contact) : static_cast<bool>(b.dynamics);
 }
 
+}  // namespace
+
 std::vector<std::string> split_list(const std::string& list) {
   std::vector<std::string> out;
   std::stringstream s(list);
@@ -21,8 +23,6 @@ std::vector<std::string> split_list(const std::string& list) {
     if (!item.empty()) out.push_back(item);
   return out;
 }
-
-}  // namespace
 
 std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
                                          Capability cap) {

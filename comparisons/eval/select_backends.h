@@ -13,6 +13,9 @@ namespace rbx {
 /// What a backend is asked for.
 enum class Capability { Contact, Dynamics };
 
+/// The names of a comma-separated --backends LIST, in order, empty items dropped.
+std::vector<std::string> split_list(const std::string& list);
+
 /// Backends to run for a scene: --backends if given (unknown names are an InputError), else the
 /// scene's `backends`, else every backend with the capability. Names are kept in registry order.
 std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
