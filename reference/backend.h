@@ -88,7 +88,9 @@ struct FirstImpulse {
   long step = -1;               // the step whose start-of-step poses detected it
   int contact_points = 0;       // points the library solved for the pair in that step
   Vec3 normal = Vec3::Zero();   // unit, from B toward A (mean over the points)
+  Vec3 point = Vec3::Zero();    // m, world: mean of the points
   double depth = 0.0;           // m, deepest point at detection
+  double impulse = 0.0;         // N s, normal impulse the step's events of the pair report
   double approach_speed = 0.0;  // m/s, closing normal speed before the step (>= 0)
   double entry_phase = -1.0;    // depth / (approach_speed * dt); -1: not closing
 };
@@ -122,12 +124,14 @@ inline FirstImpulse first_impulse_of(const std::vector<CollisionEvent>& step_eve
     if (ev.body_a != f.body_a || ev.body_b != f.body_b) continue;
     normal += ev.contact.normal;
     point += ev.contact.point;
+    f.impulse += ev.impulse;
     f.depth = std::max(f.depth, ev.contact.depth);
     ++count;
   }
   f.contact_points = points >= 0 ? points : count;
   if (normal.norm() > 0) f.normal = normal.normalized();
   point /= count;
+  f.point = point;
   // Relative velocity of the two material points at the contact point, before the step.
   auto point_velocity = [&](const std::string& name) {
     for (const BodyFinal& b : before)

@@ -124,44 +124,93 @@ Json geometry_json(const Scene& scene) {
   return g;
 }
 
-// Why the references disagree: each cause below is pinned by a test under tests/reference/
-// (a library upgrade that changes it fails there) or measured by a scene; the adapters convert
-// conventions only, so these are the libraries' answers.
-constexpr const char* kWhy =
-    "Why (each cause pinned by a test in `tests/reference/` or shown by a scene):\n\n"
-    "- **fcl-indep**: FCL 0.7's GST_INDEP leaves the EPA normal in A's local frame and returns "
-    "the depth negated (`FclIndep.*`); its signed distance on Box-Convex aborts on an assertion "
-    "(`FclIndepDistance.*`, run in a forked process).\n"
-    "- **fcl-hull, libccd, ode-hull, mujoco-hull on `small_on_diagonal`**: MPR follows the ray "
-    "between the "
-    "centres, not the minimum-translation axis (FCL issue 545): n = (1, 1, 1)/sqrt(3), depth "
-    "0.26 for a true 0.15 (`FclMpr.*`, `Libccd.DiagonalCubeMprWrongEpaRight`, "
-    "`MujocoKnownWrongAnswer.*`). Debian's ODE runs convex-convex through libccd MPR too, so it "
-    "shares FCL's answers bit for bit.\n"
-    "- **fcl-hull, libccd, ode-hull at exact touching**: libccd's MPR zeroes its direction below "
-    "CCD_EPS "
-    "of depth; the adapters report that as `error` (no normal), not as a 180 deg miss.\n"
-    "- **bullet-sat**: the SAT + clipping path measures each point's depth to the first body's "
-    "reference face, reported along the separating normal: too deep when A touches with an edge "
-    "or a vertex; the normal is right (`BulletContact.KnownDefectSatDepth*`).\n"
-    "- **bullet-hull (contacts and dynamics)**: EPA on cubes with coplanar side faces returns a "
-    "diagonal normal, so aligned face-face impacts (head-on, seed face-face, mass ratios, "
-    "scales) spin and lose energy (`KnownDefectEpaCoplanarSides`, "
-    "`KnownDefectAlignedFaceFaceSpins`); at exactly zero depth its normal is left in A's frame "
-    "(`offcentre_vertex`, `KnownDefectZeroDepthNormal`). Led by a corner "
-    "(`headon_vertex_e05`) it is exact.\n"
-    "- **mujoco, mujoco-hull (dynamics)**: no coefficient of restitution: a soft contact "
-    "calibrated through "
-    "a negative `solref` spans several steps, so e comes out within a few % and the impact is "
-    "spread in time; `mujoco-hull`'s mesh-mesh contacts are one MPR point per step.\n"
-    "- **ode-hull (dynamics)**: one MPR point per step on face-face pairs, and its error reduction "
-    "(ERP) turns penetration into separating velocity (`headon_e0`, `zero_relative_velocity`); "
-    "corner-led impacts match to 1e-7.\n"
-    "- **mass (`-hull`)**: Bullet's hull inertia is its bounding box's; FCL 0.7's Convex inertia "
-    "is off on "
-    "every hull here, the box included (relative 0.5 to 5); MuJoCo's mesh inertia is exact to "
-    "float round-off "
-    "(`LibraryMass.*`, `scenes/mass/`).\n";
+// Contact-query causes that no dynamics record can show: each pinned by a test under
+// tests/reference/ (a library upgrade that changes it fails there). A sentence is printed only
+// when one of its backends ran and, where it cites scenes, one of them is in the run.
+struct PinnedCause {
+  std::vector<std::string> backends;
+  std::vector<std::string> scenes;  // cited scene names or "family:F"; empty: cites none
+  const char* text;
+};
+const std::vector<PinnedCause>& pinned_causes() {
+  static const std::vector<PinnedCause> causes = {
+      {{"fcl-indep"},
+       {},
+       "**fcl-indep**: FCL 0.7's GST_INDEP leaves the EPA normal in A's local frame and returns "
+       "the depth negated (`FclIndep.*`); its signed distance on Box-Convex aborts on an "
+       "assertion (`FclIndepDistance.*`, run in a forked process)."},
+      {{"fcl-hull", "libccd", "ode-hull", "mujoco-hull"},
+       {"small_on_diagonal"},
+       "**fcl-hull, libccd, ode-hull, mujoco-hull on `small_on_diagonal`**: MPR follows the ray "
+       "between the centres, not the minimum-translation axis (FCL issue 545): n = (1, 1, "
+       "1)/sqrt(3), depth 0.26 for a true 0.15 (`FclMpr.*`, `Libccd.DiagonalCubeMprWrongEpaRight`, "
+       "`MujocoKnownWrongAnswer.*`). Debian's ODE runs convex-convex through libccd MPR too, so it "
+       "shares FCL's answers bit for bit."},
+      {{"fcl-hull", "libccd", "ode-hull"},
+       {},
+       "**fcl-hull, libccd, ode-hull at exact touching**: libccd's MPR zeroes its direction below "
+       "CCD_EPS of depth; the adapters report that as `error` (no normal), not as a 180 deg miss."},
+      {{"bullet-sat"},
+       {},
+       "**bullet-sat**: the SAT + clipping path measures each point's depth to the first body's "
+       "reference face, reported along the separating normal: too deep when A touches with an "
+       "edge or a vertex; the normal is right (`BulletContact.KnownDefectSatDepth*`)."},
+      {{"bullet-hull", "fcl-hull", "mujoco-hull"},
+       {"family:mass"},
+       "**mass (`-hull`)**: Bullet's hull inertia is its bounding box's; FCL 0.7's Convex inertia "
+       "is off on every hull here, the box included (relative 0.5 to 5); MuJoCo's mesh inertia is "
+       "exact to float round-off (`LibraryMass.*`, `scenes/mass/`)."},
+  };
+  return causes;
+}
+
+// The why-list: for impacts, what each backend's first impulse saw against the exact oracle
+// (SceneEvaluation::causes, one line per measured sign, naming the scenes and the numbers);
+// then the pinned contact-query causes that apply to this run.
+std::string why_markdown(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs,
+                         const std::vector<std::string>& cols) {
+  std::ostringstream md;
+  md << "## Why\n\n";
+  md << "Impacts: for every backend that misses a closed form (velocity error above 0.1 %, as "
+        "written or with first contact 1/3 or 2/3 of a step later), what its first impulse saw "
+        "against the `exact` oracle at the poses of the step that detected it: the number of "
+        "points, the normal's angle to the truth, the offset of a lone point from the true patch's "
+        "centre, the impulse of that step against the closed form, the depth and entry phase at "
+        "detection. Each line is the first measured sign, in that order: a wrong normal, one point "
+        "on a face patch, an error only when contact begins inside a step, a contact first seen "
+        "deep; else the contact was seen as the truth and the error is in the response (e.g. a "
+        "soft contact).\n\n";
+  std::map<std::string, std::map<std::string, std::vector<std::string>>> by;  // backend, kind
+  for (size_t i = 0; i < evs.size(); ++i)
+    for (const Cause& c : evs[i].causes)
+      by[c.backend][c.kind].push_back(md_escape(scenes[i].name) + " (" + md_escape(c.detail) + ")");
+  if (by.empty()) md << "No backend misses an impact's closed form in this run.\n";
+  for (const std::string& b : cols) {
+    if (!by.count(b)) continue;
+    md << "- **" << b << "**\n";
+    for (const auto& [kind, list] : by[b]) {
+      md << "  - " << kind << ": ";
+      for (size_t k = 0; k < list.size(); ++k) md << (k ? "; " : "") << list[k];
+      md << "\n";
+    }
+  }
+  std::set<std::string> ran(cols.begin(), cols.end()), names;
+  for (const Scene& sc : scenes) names.insert(sc.name);
+  for (const SceneEvaluation& ev : evs) names.insert("family:" + ev.family);
+  std::vector<const char*> pinned;
+  for (const PinnedCause& p : pinned_causes()) {
+    bool backend_ran = false, cited = p.scenes.empty();
+    for (const std::string& b : p.backends) backend_ran = backend_ran || ran.count(b);
+    for (const std::string& sc : p.scenes) cited = cited || names.count(sc);
+    if (backend_ran && cited) pinned.push_back(p.text);
+  }
+  if (!pinned.empty()) {
+    md << "\nContact queries (each cause pinned by a test in `tests/reference/`):\n\n";
+    for (const char* t : pinned) md << "- " << t << "\n";
+  }
+  md << "\n";
+  return md.str();
+}
 
 std::string write_markdown(const std::vector<Scene>& scenes,
                            const std::vector<SceneEvaluation>& evs, double total_s, bool figures_ok,
@@ -223,6 +272,34 @@ std::string write_markdown(const std::vector<Scene>& scenes,
   }
   md << summary.markdown() << "\n" << marks << " cells marked ✗.\n\n";
 
+  // Contact phase: the impact scenes also run with first contact 1/3 and 2/3 of a step later.
+  {
+    Table phases({"scene", "backend", "as written", "1/3 later", "2/3 later", "worst"});
+    for (size_t i = 0; i < evs.size(); ++i)
+      for (const std::string& c : cols) {
+        const Json& bj = evs[i].json["backends"];
+        if (!bj.contains(c) || !bj[c].contains("contact_phase")) continue;
+        const Json& p = bj[c]["contact_phase"];
+        auto cell = [&](const char* k) {
+          if (!p.contains(k)) return std::string("-");
+          return p[k].is_number() ? fmt_num(p[k].get<double>(), 2)
+                                  : md_escape(p[k].get<std::string>());
+        };
+        phases.add({md_escape(evs[i].family + "/" + scenes[i].name), c, cell("written"),
+                    cell("1_3"), cell("2_3"), cell("worst")});
+      }
+    if (phases.size() > 0) {
+      md << "## Contact phase\n\n";
+      md << "Every analytic scene puts first contact exactly on a step boundary, at zero depth. "
+            "Each impact with a closed form and neither gravity nor spin is also run with every "
+            "moving body moved back along its velocity by 1/3 and 2/3 of a step (and one step "
+            "more of duration), so first contact falls inside a step and the closed form is "
+            "unchanged. Velocity error in the kinetic-energy norm; the summary's headline cell is "
+            "the scene **as written**; `worst` is the largest of the three.\n\n";
+      md << phases.markdown() << "\n";
+    }
+  }
+
   // Disagreements, grouped by backend.
   md << "## Who disagrees with the truth\n\n";
   std::map<std::string, std::vector<std::string>> by_backend;
@@ -240,7 +317,7 @@ std::string write_markdown(const std::vector<Scene>& scenes,
     if (list.size() > 6) md << "; and " << list.size() - 6 << " more (see the scene details)";
     md << "\n";
   }
-  md << "\n" << kWhy << "\n";
+  md << "\n" << why_markdown(scenes, evs, cols);
 
   // Error against run time.
   md << "## Error against run time\n\n";

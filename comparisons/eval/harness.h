@@ -26,6 +26,18 @@ struct HarnessOptions {
   /// byte-identical either way; a cached backend's JSON says "cached": true (its timings are
   /// those of the run that filled the cache).
   std::string cache_dir;
+  /// Run every impact scene with a closed form also with first contact 1/3 and 2/3 of a step
+  /// later (the bodies moved back along their velocities; metrics velocity_err_ke_phase_*).
+  bool phases = true;
+};
+
+/// A measured explanation of a backend's miss on an impact: what its first impulse saw against
+/// the exact oracle at the same poses.
+struct Cause {
+  std::string backend;
+  std::string scene;
+  std::string kind;    // the first measured sign (one line, shared by scenes with that sign)
+  std::string detail;  // the measurements behind it
 };
 
 /// One measured number.
@@ -64,6 +76,7 @@ struct SceneEvaluation {
                               // them: compare does not fail on them
   std::vector<std::string> disagreements;  // clearly different from the truth (see kMark*)
   std::vector<std::string> deviations;     // beyond the scene's tolerance, yet close
+  std::vector<Cause> causes;               // why each impact miss happened, measured
 };
 
 /// Thresholds between a deviation and a disagreement: a contact normal more than 1 degree off or

@@ -80,7 +80,21 @@ Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsRe
   for (const CollisionEvent& e : r.events) events.push_back(event_json(e));
   j["contacts"] = events;
   j["bodies"] = bodies_json(inputs, &r.finals);
+  j["first_impulse"] = first_impulse_json(r.first_impulse);
   return j;
+}
+
+Json first_impulse_json(const FirstImpulse& f) {
+  if (!f.seen) return nullptr;
+  return {{"pair", f.body_a + "-" + f.body_b},
+          {"step", f.step},
+          {"contact_points", f.contact_points},
+          {"normal", to_json(f.normal)},
+          {"point", to_json(f.point)},
+          {"depth", f.depth},
+          {"impulse", f.impulse},
+          {"approach_speed", f.approach_speed},
+          {"entry_phase", f.entry_phase}};
 }
 
 Json bodies_json(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>* finals) {

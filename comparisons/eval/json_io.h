@@ -37,9 +37,13 @@ Json final_json(const BodyFinal& f);
 Json settings_json(const Scene& scene);
 
 /// One backend's dynamics result in the contract's shape: status, message, runtime_s,
-/// contacts (collision events), bodies (inputs at t = 0 and final state).
+/// contacts (collision events), bodies (inputs at t = 0 and final state), first_impulse.
 Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsResult& r,
                           double runtime_s);
+
+/// What the run's first impulse saw (FirstImpulse), or null when no impulse was applied:
+/// pair, step, contact_points, normal, point, depth, impulse, approach_speed, entry_phase.
+Json first_impulse_json(const FirstImpulse& f);
 
 /// Writes text to `path` atomically (temporary file in the same folder, then rename), or to
 /// standard output when path is "-". Throws std::runtime_error on failure.

@@ -140,7 +140,7 @@ void put_body(Writer& w, const RigidBody& b) {
 // Common head of every key: what kind of call, which backend, which code.
 Writer key_head(const std::string& code, const char* kind, const std::string& backend) {
   Writer w;
-  w.put("rbx result cache v1");
+  w.put("rbx result cache v2");  // v2: dynamics entries hold the first impulse
   w.put(code);
   w.put(kind);
   w.put(backend);
@@ -348,6 +348,18 @@ std::optional<CachedResult<DynamicsResult>> ResultCache::load_dynamics(
       s.bodies.resize(count());
       for (BodyFinal& f : s.bodies) get_final(r, f);
     }
+    FirstImpulse& fi = d.first_impulse;
+    r.get(fi.seen);
+    r.get(fi.body_a);
+    r.get(fi.body_b);
+    r.get(fi.step);
+    r.get(fi.contact_points);
+    r.get(fi.normal);
+    r.get(fi.point);
+    r.get(fi.depth);
+    r.get(fi.impulse);
+    r.get(fi.approach_speed);
+    r.get(fi.entry_phase);
   });
 }
 
@@ -373,6 +385,18 @@ void ResultCache::store(const std::string& key, const DynamicsResult& d, double 
     w.put(static_cast<long>(s.bodies.size()));
     for (const BodyFinal& f : s.bodies) put_final(w, f);
   }
+  const FirstImpulse& fi = d.first_impulse;
+  w.put(fi.seen);
+  w.put(fi.body_a);
+  w.put(fi.body_b);
+  w.put(fi.step);
+  w.put(fi.contact_points);
+  w.put(fi.normal);
+  w.put(fi.point);
+  w.put(fi.depth);
+  w.put(fi.impulse);
+  w.put(fi.approach_speed);
+  w.put(fi.entry_phase);
   write(key, w.str());
 }
 

@@ -19,6 +19,8 @@ class Table {
   void print(std::ostream& out) const;
   /// GitHub markdown table.
   std::string markdown() const;
+  /// Number of rows below the header.
+  size_t size() const { return rows_.empty() ? 0 : rows_.size() - 1; }
 
  private:
   std::vector<std::vector<std::string>> rows_;
