@@ -385,7 +385,12 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
   //    e = 0 head-on impact seen 1 mm deep at dt = 1 ms separates at 0.2 m/s). Capping that
   //    velocity at 0 (dWorldSetContactMaxCorrectingVel) made e = 0 exact, but with ODE's
   //    one-point convex manifold a resting cube then tips about its single contact and sinks
-  //    (0.77 m in 2 s in a 3-cube stack), so the defaults stay.
+  //    (0.77 m in 2 s in a 3-cube stack), so the defaults stay. Measured again with dBox
+  //    (rbx compare, ode): the cap at 0 makes headon_e0 exact at every contact phase (0.23 ->
+  //    2e-24 with contact 1/3 of a step in) but resting_stack and friction/stack_five then sink
+  //    to 43 % of a body (6e-6 with the default); a 2 mm contact surface layer instead makes
+  //    both stacks blow up (jitter 77-93 m/s). No world setting serves both, so ODE's e = 0
+  //    impacts seen inside a step stay a measured limitation (the report's contact-phase table).
   WorldOwner w;
   w.world = dWorldCreate();
   w.space = dSimpleSpaceCreate(nullptr);
