@@ -9,7 +9,9 @@
 #include <iostream>
 #include <sstream>
 
+#include "comparisons/cli/view.h"
 #include "comparisons/eval/tosses.h"
+#include "comparisons/eval/trajectory.h"
 #include "comparisons/output/table.h"
 #include "comparisons/scene/repo_path.h"
 #include "comparisons/scene/scene_file.h"
@@ -316,6 +318,9 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
   }
   std::ostringstream traj;
   traj << "pick,toss,source,t,z,angle_deg\n";
+  // One 3-D replay per pick: every backend's cube, the measured cube as a ghost.
+  std::vector<std::string> replays;  // page file names, in pick order ("" : not written)
+  const fs::path views = out / "views";
   for (const auto& [label, id] : picks) {
     const Toss& t =
         *std::find_if(tosses.begin(), tosses.end(), [&](const Toss& x) { return x.id == id; });
@@ -324,13 +329,30 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
       traj << label << "," << id << ",measured," << fmt_num(s.time - t.samples.front().time, 6)
            << "," << fmt_num(s.position.z(), 7) << ","
            << fmt_num(rotation_angle_deg(q0, s.orientation), 6) << "\n";
+    std::vector<std::pair<std::string, TossRun>> runs;
     for (size_t k = 0; k < chosen.size(); ++k) {
-      const TossRun run = simulate_toss(chosen[k]->dynamics, t, ev.stored[k].params);
+      runs.emplace_back(chosen[k]->name,
+                        simulate_toss(chosen[k]->dynamics, t, ev.stored[k].params));
+      const TossRun& run = runs.back().second;
       if (run.status != Status::Ok) continue;
       for (size_t i = 0; i < run.track.position.size(); ++i)
         traj << label << "," << id << "," << chosen[k]->name << "," << fmt_num(i / rate, 6) << ","
              << fmt_num(run.track.position[i].z(), 7) << ","
              << fmt_num(rotation_angle_deg(q0, run.track.orientation[i]), 6) << "\n";
+    }
+    try {
+      fs::create_directories(views);
+      if (!fs::exists(views / "three.min.js"))
+        fs::copy_file(three_js_path(), views / "three.min.js");
+      const std::string name = "toss_" + label + "_" + std::to_string(id) + ".html";
+      const std::string title =
+          "toss " + std::to_string(id) + " (" + label + " of " + best.name + ")";
+      write_text((views / name).string(),
+                 view_page(toss_replay_data(t, runs, title), "", "three.min.js"));
+      replays.push_back(name);
+    } catch (const std::exception& e) {
+      std::cerr << "rbx report: toss replay not written: " << e.what() << "\n";
+      replays.push_back("");
     }
   }
   write_text((out / "tosses_traj.csv").string(), traj.str());
@@ -411,6 +433,11 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
             "(black) and simulated, for the best (toss "
          << picks[0].second << "), median (toss " << picks[1].second << ") and worst (toss "
          << picks[2].second << ") toss of the best backend, `" << best.name << "`.\n\n";
+    if (replays.size() == 3 && !replays[0].empty())
+      md << "3-D replays of these tosses, every backend side by side with the measured cube as "
+            "a grey ghost: [best](views/"
+         << replays[0] << "), [median](views/" << replays[1] << "), [worst](views/" << replays[2]
+         << ").\n\n";
   } else {
     md << "(figures not drawn: python3 with matplotlib missing or tosses_plots.py failed, see "
           "tosses_figures.log)\n\n";

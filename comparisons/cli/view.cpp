@@ -52,7 +52,7 @@ constexpr const char* kScript = R"JS(
   "use strict";
   var data = JSON.parse(document.getElementById("rbx-data").textContent);
   var state = {loaded: false, webgl: false, error: "", time: 0, playing: false, backends: {},
-               bodies_drawn: 0, frames_shown: {}};
+               bodies_drawn: 0, frames_shown: {}, ghost: null};
   function publish() { document.getElementById("rbx-state").textContent = JSON.stringify(state); }
   function text(el, s) { el.textContent = s; return el; }
   // Okabe-Ito: colour-blind-safe body colours.
@@ -65,12 +65,23 @@ constexpr const char* kScript = R"JS(
     state.backends[n] = {status: data.backends[n].status, frames: t.length,
                          events: (data.backends[n].events || []).length};
   });
+  // A measured trajectory drawn as a ghost in every panel (real tosses): its own timeline.
+  var ghost = data.ghost || null;
+  if (ghost) {
+    var gt = ghost.time || [];
+    if (gt.length) duration = Math.max(duration, gt[gt.length - 1]);
+    state.ghost = {label: ghost.label || "", frames: gt.length, bodies: Object.keys(ghost.frames || {}).length, shown: -1};
+  }
   // Scene size from the bodies' vertices at t = 0 and every trajectory point.
   var lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
   function grow(p) { for (var i = 0; i < 3; ++i) { lo[i] = Math.min(lo[i], p[i]); hi[i] = Math.max(hi[i], p[i]); } }
   var radius = data.shapes.map(function (s) {
     var r = 0; s.vertices.forEach(function (v) { r = Math.max(r, Math.hypot(v[0], v[1], v[2])); }); return r; });
+  // With a measured ghost the view frames the measurement and the moving bodies (a toss's floor
+  // is 40 cube widths wide).
+  if (ghost) Object.keys(ghost.frames || {}).forEach(function (b) { ghost.frames[b].forEach(grow); });
   data.bodies.forEach(function (b) {
+    if (ghost && b.static) return;
     var r = radius[b.shape];
     grow([b.position[0] - r, b.position[1] - r, b.position[2] - r]);
     grow([b.position[0] + r, b.position[1] + r, b.position[2] + r]);
@@ -174,6 +185,17 @@ constexpr const char* kScript = R"JS(
       var a = new THREE.ArrowHelper(d.normalize(), new THREE.Vector3(), arrow * 2, 0x000000, 0.3 * arrow, 0.15 * arrow);
       sc.add(a); refFinal.push({body: i, obj: a});
     });
+    // The ghost: every body it tracks, grey and faint, over the backend's own bodies.
+    var ghosts = [];
+    if (ghost) data.bodies.forEach(function (b, i) {
+      if (!(ghost.frames || {})[b.name]) return;
+      var grp = new THREE.Group();
+      grp.add(new THREE.Mesh(geoms[b.shape].mesh, new THREE.MeshBasicMaterial({color: 0x000000,
+        transparent: true, opacity: 0.18, depthWrite: false, side: THREE.DoubleSide})));
+      grp.add(new THREE.LineSegments(geoms[b.shape].edges, new THREE.LineBasicMaterial({color: 0x000000,
+        transparent: true, opacity: 0.5})));
+      sc.add(grp); ghosts.push({body: b.name, obj: grp});
+    });
     var label = document.createElement("div");
     label.className = "label";
     var st = data.backends[n].status;
@@ -181,7 +203,7 @@ constexpr const char* kScript = R"JS(
     label.title = data.backends[n].message || "";
     document.getElementById("labels").appendChild(label);
     return {name: n, scene: sc, bodies: bodies, events: events, ref: ref, refFinal: refFinal,
-            label: label, visible: true};
+            ghosts: ghosts, label: label, visible: true};
   });
 
   // Controls: per-backend toggles, reference toggle, play/pause, slider.
@@ -223,6 +245,16 @@ constexpr const char* kScript = R"JS(
       // Events near the current time (all of them when the run has no timeline).
       p.events.forEach(function (e) { e.obj.visible = duration === 0 || (e.t <= state.time + 1e-12 && e.t > state.time - window); });
       p.ref.forEach(function (e) { e.obj.visible = showRef; });
+      if (ghost) {
+        var gk = frameAt(ghost.time || [], state.time);
+        state.ghost.shown = gk;
+        p.ghosts.forEach(function (g) {
+          var f = ghost.frames[g.body], s = f[Math.min(gk, f.length - 1)];
+          g.obj.position.set(s[0], s[1], s[2]);
+          g.obj.quaternion.set(s[4], s[5], s[6], s[3]);
+          g.obj.visible = showRef;
+        });
+      }
       p.refFinal.forEach(function (r) {
         r.obj.visible = showRef && state.time >= duration - 1e-12;
         r.obj.position.copy(p.bodies[r.body].position);
@@ -419,7 +451,45 @@ Json view_data(const Scene& scene, const Json& result) {
     }
   }
   d["reference"] = ref;
+  if (result.contains("ghost")) d["ghost"] = result["ghost"];
   return d;
+}
+
+Json toss_replay_data(const Toss& toss, const std::vector<std::pair<std::string, TossRun>>& runs,
+                      const std::string& title) {
+  auto frame = [](const Vec3& p, const Quat& q) {
+    const Quat u = q.normalized();
+    return Json::array({round_sig5(p.x()), round_sig5(p.y()), round_sig5(p.z()), round_sig5(u.w()),
+                        round_sig5(u.x()), round_sig5(u.y()), round_sig5(u.z())});
+  };
+  const double t0 = toss.samples.front().time, rate = CubeTossModel{}.sample_rate;
+  Json ghost = {{"label", "the measured cube (motion capture)"},
+                {"time", Json::array()},
+                {"frames", {{"cube", Json::array()}}}};
+  for (const TossSample& s : toss.samples) {
+    ghost["time"].push_back(round_sig5(s.time - t0));
+    ghost["frames"]["cube"].push_back(frame(s.position, s.orientation));
+  }
+  Json result = {{"backends", Json::object()}, {"ghost", ghost}};
+  for (const auto& [name, run] : runs) {
+    Json time = Json::array(), frames = Json::array();
+    if (run.status == Status::Ok)
+      for (size_t i = 0; i < run.track.position.size(); ++i) {
+        time.push_back(round_sig5(i / rate));  // sample i of the run is measured sample i
+        frames.push_back(frame(run.track.position[i], run.track.orientation[i]));
+      }
+    result["backends"][name] = {{"status", to_string(run.status)},
+                                {"message", run.message},
+                                {"trajectory", {{"time", time}, {"bodies", {{"cube", frames}}}}}};
+  }
+  // The toss's own scene: the cube at its first sample and the floor.
+  Scene scene = toss_scene(toss, kPublishedParams);
+  scene.name = title;
+  scene.file = "real/cube_toss_" + std::to_string(toss.id) + ".toml";
+  scene.description =
+      "A measured toss of the ContactNets cube, replayed by every backend at its "
+      "fitted parameters; the grey ghost is the measurement.";
+  return view_data(scene, result);
 }
 
 std::string three_js_path() {
@@ -452,6 +522,9 @@ std::string view_page(const Json& data, const std::string& three_js, const std::
     << ")";
   if (!ref["finals"].empty())
     h << "; at the end of the run, arrows give the closed-form final velocity direction";
+  if (data.contains("ghost"))
+    h << ". Grey ghost in every panel: " << html_escape(data["ghost"].value("label", ""))
+      << " (shown with the reference)";
   h << ". Trajectories are sampled (at most " << kMaxFrames << " frames); at most "
     << kViewMaxEvents
     << " events per backend are drawn.</p>\n<div id=\"controls\"><button id=\"play\">play</button> "

@@ -9,6 +9,7 @@
 
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/json_io.h"
+#include "comparisons/eval/tosses.h"
 #include "engine/scene.h"
 
 namespace rbx {
@@ -19,13 +20,20 @@ namespace rbx {
 ///  backends: {NAME: {status, message, time: [s], frames: {BODY: [[x,y,z,qw,qx,qy,qz]]},
 ///            events: [{t, bodies, point, normal, depth}], events_total}},
 ///  reference: {source, contacts: [...], normal, depth, finals: {BODY: {velocity,
-///  angular_velocity}}}}.
+///  angular_velocity}}}}; and, when `scene_result` has one, ghost: {label, time: [s],
+///  frames: {BODY: [[x,y,z,qw,qx,qy,qz]]}}, a measured trajectory drawn faintly in every panel.
 /// Events beyond kViewMaxEvents per backend are counted, not listed.
 Json view_data(const Scene& scene, const Json& scene_result);
 
 /// Events listed per backend in a page (a resting stack makes thousands; the first ones show the
 /// impacts, the count says how many more there were).
 constexpr size_t kViewMaxEvents = 200;
+
+/// The view data of a measured toss: every backend's simulated cube (`runs`: backend name and
+/// its run, poses at the measured samples) on the toss's floor, and the measured cube as the
+/// ghost. `title` names the page.
+Json toss_replay_data(const Toss& toss, const std::vector<std::pair<std::string, TossRun>>& runs,
+                      const std::string& title);
 
 /// Where Debian's libjs-three installs the minified three.js (throws std::runtime_error naming
 /// the package when it is absent).

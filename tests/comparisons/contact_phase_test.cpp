@@ -22,8 +22,7 @@ const char* kHeadOn =
     "[expect]\ntolerance = 1e-6\n[expect.body.A]\nvelocity = [-0.5, 0, 0]\n"
     "[expect.body.B]\nvelocity = [0.5, 0, 0]\n";
 
-const Metric* find(const SceneEvaluation& ev, const std::string& backend,
-                   const std::string& name) {
+const Metric* find(const SceneEvaluation& ev, const std::string& backend, const std::string& name) {
   for (const Metric& m : ev.metrics)
     if (m.backend == backend && m.name == name) return &m;
   return nullptr;
@@ -69,9 +68,8 @@ TEST(ContactPhase, NotRunUnderGravity) {
   opt.sweep = false;
   const SceneEvaluation ev = evaluate_scene(scene, opt);
   EXPECT_EQ(find(ev, "custom", "velocity_err_ke_phase_1_3"), nullptr);
-  EXPECT_TRUE(std::any_of(ev.skipped.begin(), ev.skipped.end(), [](const std::string& s) {
-    return s.rfind("contact phases:", 0) == 0;
-  }));
+  EXPECT_TRUE(std::any_of(ev.skipped.begin(), ev.skipped.end(),
+                          [](const std::string& s) { return s.rfind("contact phases:", 0) == 0; }));
 }
 
 // A backend that applies no impulse at all (the bodies pass through: finals keep the initial
@@ -83,8 +81,8 @@ Backend recorder(const std::string& name, const FirstImpulse& record) {
   b.dynamics = [record](const Scene& scene, const DynamicsOptions&) {
     DynamicsResult r;
     for (const RigidBody& body : make_bodies(scene))
-      r.finals.push_back({body.name, body.position, body.orientation, body.velocity,
-                          body.angular_velocity});
+      r.finals.push_back(
+          {body.name, body.position, body.orientation, body.velocity, body.angular_velocity});
     r.first_impulse = record;
     return r;
   };
@@ -100,7 +98,7 @@ FirstImpulse face_record(int points, double tilt_deg) {
   f.contact_points = points;
   const double t = tilt_deg * M_PI / 180.0;
   f.normal = Vec3(-std::cos(t), std::sin(t), 0.0);  // from B toward A: -x, tilted
-  f.point = Vec3(0.0, 0.5, 0.0);                     // mid-edge of the patch at x = 0
+  f.point = Vec3(0.0, 0.5, 0.0);                    // mid-edge of the patch at x = 0
   f.approach_speed = 2.0;
   f.entry_phase = 0.0;
   return f;
@@ -109,10 +107,9 @@ FirstImpulse face_record(int points, double tilt_deg) {
 TEST(ContactPhase, WhyFollowsTheRecord) {
   const Scene scene = parse_scene(kHeadOn, "headon.toml");
   FirstImpulse none;  // seen = false
-  std::vector<Backend> table = {recorder("one_point", face_record(1, 0.0)),
-                                recorder("tilted", face_record(4, 10.0)),
-                                recorder("four_points", face_record(4, 0.0)),
-                                recorder("silent", none)};
+  std::vector<Backend> table = {
+      recorder("one_point", face_record(1, 0.0)), recorder("tilted", face_record(4, 10.0)),
+      recorder("four_points", face_record(4, 0.0)), recorder("silent", none)};
   HarnessOptions opt;
   opt.registry = &table;
   opt.sweep = false;

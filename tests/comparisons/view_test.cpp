@@ -119,6 +119,17 @@ std::vector<std::string> check_page(const fs::path& page, const nlohmann::json& 
       bad.push_back("backend " + name + ": " + st["backends"][name]["frames"].dump() +
                     " frames loaded, " + std::to_string(frames) + " expected");
   }
+  // A measured ghost (real tosses): loaded with every sample of every body it tracks.
+  if (expected.contains("ghost")) {
+    const nlohmann::json& g = expected["ghost"];
+    if (!st.contains("ghost") || !st["ghost"].is_object())
+      bad.push_back("ghost not loaded");
+    else if (st["ghost"].value("frames", 0ul) != g["time"].size() ||
+             st["ghost"].value("bodies", 0ul) != g["frames"].size() || g["time"].empty())
+      bad.push_back("ghost: " + st["ghost"].dump() + ", expected " +
+                    std::to_string(g["time"].size()) + " frames of " +
+                    std::to_string(g["frames"].size()) + " bodies");
+  }
   const size_t bodies = expected["bodies"].size() * expected["backends"].size();
   if (st.value("bodies_drawn", 0ul) != bodies || bodies == 0)
     bad.push_back("bodies drawn: " + st["bodies_drawn"].dump() + ", expected " +
@@ -209,6 +220,33 @@ TEST_F(ViewBrowser, PlaysEveryBackendAndTheBodiesAreDrawnAndMove) {
   std::ofstream(page) << view_page(d, three_js());
   const std::vector<std::string> bad = check_page(page, d);
   for (const std::string& b : bad) ADD_FAILURE() << b;
+  fs::remove_all(dir);
+}
+
+// A measured toss replayed by two backends with the measurement as the ghost; and the same page
+// with the ghost's samples cut short must fail the check.
+TEST_F(ViewBrowser, TossReplayShowsTheMeasuredGhost) {
+  const fs::path dir = temp_dir("toss");
+  const std::vector<Toss> tosses =
+      read_tosses(std::string(RBX_SOURCE_DIR) + "/scenes/real/cube_toss/test.csv.gz");
+  ASSERT_FALSE(tosses.empty());
+  const Toss& toss = tosses.front();
+  std::vector<std::pair<std::string, TossRun>> runs;
+  for (const char* name : {"custom", "bullet"})
+    runs.emplace_back(name, simulate_toss(find_backend(name)->dynamics, toss, kPublishedParams));
+  const nlohmann::json d = toss_replay_data(toss, runs, "toss");
+  ASSERT_EQ(d["ghost"]["time"].size(), toss.samples.size());
+  for (const auto& [name, b] : d["backends"].items())
+    EXPECT_EQ(b["time"].size(), toss.samples.size()) << name;  // a pose at every measured sample
+  std::ofstream(dir / "toss.html") << view_page(d, three_js());
+  const std::vector<std::string> bad = check_page(dir / "toss.html", d);
+  for (const std::string& b : bad) ADD_FAILURE() << b;
+  nlohmann::json cut = d;
+  cut["ghost"]["time"].erase(cut["ghost"]["time"].begin());
+  std::ofstream(dir / "cut.html") << view_page(cut, three_js());
+  const std::vector<std::string> bad_cut = check_page(dir / "cut.html", d);
+  ASSERT_FALSE(bad_cut.empty());
+  EXPECT_EQ(bad_cut.front().rfind("ghost:", 0), 0u) << bad_cut.front();
   fs::remove_all(dir);
 }
 
