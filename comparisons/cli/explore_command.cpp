@@ -47,6 +47,8 @@ struct BackendTally {
   std::map<std::string, uint64_t> first_index;  // lowest sample index of each signature
   std::map<std::string, BackendOutcome> first_outcome;
   std::map<std::string, std::vector<double>> values;  // metric -> measured values
+  // Impact kind: samples and disagreements by the quarter of its step the contact falls in.
+  long phase_samples[4] = {0, 0, 0, 0}, phase_disagreements[4] = {0, 0, 0, 0};
 };
 
 std::vector<std::string> subject_backends(const std::string& list, const std::string& kind) {
@@ -288,6 +290,17 @@ std::string markdown_impact(const Json& j) {
            three("velocity_err_ke"), three("momentum_err_ke")});
   }
   o << t.markdown();
+  o << "\n## Disagreement rate by the phase of the contact within its step\n\nThe first contact "
+       "falls at this fraction of the step that detects it (0 %: at the step's start, so the "
+       "bodies overlap by a whole step of approach when it is seen).\n\n";
+  Table ph({"backend", "0-25 %", "25-50 %", "50-75 %", "75-100 %"});
+  for (const auto& [name, b] : j["backends"].items()) {
+    std::vector<std::string> row = {name};
+    for (const Json& q : b["by_phase_quarter"])
+      row.push_back(fmt_num(q["rate"], 3) + " (" + std::to_string(q["samples"].get<long>()) + ")");
+    ph.add(row);
+  }
+  o << ph.markdown();
   o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B (static: B "
        "is static), the contact's features, the kind of error. Each group's first sample was "
        "shrunk to the scene named; `reproduced` says whether `rbx compare` shows the velocity "
@@ -416,6 +429,11 @@ int explore_command(const ExploreOptions& opt) {
       for (const BackendOutcome& b : s.backends) {
         BackendTally& t = tally[b.backend];
         ++t.samples;
+        if (impact && s.phase >= 0) {
+          const int q = std::min(3, static_cast<int>(s.phase * 4));
+          ++t.phase_samples[q];
+          t.phase_disagreements[q] += b.error.empty() ? 0 : 1;
+        }
         if (b.measured && impact) {
           t.values["velocity_err_ke"].push_back(b.velocity_err_ke);
           t.values["momentum_err_ke"].push_back(b.momentum_err_ke);
@@ -491,6 +509,17 @@ int explore_command(const ExploreOptions& opt) {
                         {"p99", percentile(v, 99)},
                         {"max", percentile(v, 100)},
                         {"quantiles_every_5", q}};
+    }
+    if (impact) {
+      b["by_phase_quarter"] = Json::array();
+      for (int q = 0; q < 4; ++q)
+        b["by_phase_quarter"].push_back(
+            {{"phase", std::to_string(q * 25) + "-" + std::to_string(q * 25 + 25) + " %"},
+             {"samples", t.phase_samples[q]},
+             {"disagreements", t.phase_disagreements[q]},
+             {"rate", t.phase_samples[q]
+                          ? static_cast<double>(t.phase_disagreements[q]) / t.phase_samples[q]
+                          : 0.0}});
     }
     b["groups"] = Json::array();
     std::vector<std::pair<long, std::string>> order;

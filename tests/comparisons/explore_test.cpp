@@ -279,8 +279,9 @@ TEST(ExploreImpact, ShrunkSceneReproducesThroughTheHarness) {
     BackendOutcome seed = r.outcome.backends[0];
     seed.backend = "custom-seed";
     const SampleOutcome seed_on_shrunk = evaluate_impact_sample(r.sample, {"custom-seed"});
-    if (seed_on_shrunk.backends[0].error.empty())
+    if (seed_on_shrunk.backends[0].error.empty()) {
       EXPECT_FALSE(harness_reproduces(r.sample.text, "shrunk.toml", seed, &detail)) << detail;
+    }
     return;
   }
   FAIL() << "no sample among the first 20 where mujoco misses the impulse and custom-seed not";
@@ -301,9 +302,10 @@ TEST(ExploreCommand, ImpactSameJsonWithOneAndThreeThreads) {
     o.out = (base / std::to_string(k)).string();
     ASSERT_EQ(explore_command(o), 0);
     json[k] = without_timing(base / std::to_string(k) / "explore.json");
-    if (k == 1)
+    if (k == 1) {
       for (const auto& f : fs::directory_iterator(base / "0" / "scenes"))
         EXPECT_EQ(read(f.path()), read(base / "1" / "scenes" / f.path().filename()));
+    }
   }
   EXPECT_EQ(json[0], json[1]);
   const Json j = Json::parse(json[0]);
