@@ -49,6 +49,7 @@ struct ReportOptions {
   const std::vector<Backend>* registry = nullptr;
   std::string backends;  // --backends LIST
   bool quiet = false;    // no progress line
+  int threads = 0;       // report: threads per rank (0: the cores of the node, divided among ranks)
 };
 
 /// `rbx report`: accuracy report over a scene library.

@@ -23,7 +23,14 @@ namespace rbx {
 
 namespace {
 
-const char* const kMetrics[] = {"normal_err_deg", "depth_err_rel", "point_err_rel"};
+const char* const kMetrics[] = {"normal_err_deg", "depth_err_rel", "point_err_rel",
+                                "velocity_err_ke", "momentum_err_ke"};
+
+// The metrics of one kind of sample.
+std::vector<std::string> metrics_of(const std::string& kind) {
+  if (kind == "impact") return {"velocity_err_ke", "momentum_err_ke"};
+  return {"normal_err_deg", "depth_err_rel", "point_err_rel"};
+}
 
 // Nearest-rank percentile of sorted values (p in [0, 100]).
 double percentile(const std::vector<double>& sorted, double p) {
@@ -40,14 +47,19 @@ struct BackendTally {
   std::map<std::string, uint64_t> first_index;  // lowest sample index of each signature
   std::map<std::string, BackendOutcome> first_outcome;
   std::map<std::string, std::vector<double>> values;  // metric -> measured values
+  // Impact kind: samples and disagreements by the quarter of its step the contact falls in.
+  long phase_samples[4] = {0, 0, 0, 0}, phase_disagreements[4] = {0, 0, 0, 0};
 };
 
-std::vector<std::string> contact_backends(const std::string& list) {
+std::vector<std::string> subject_backends(const std::string& list, const std::string& kind) {
   std::vector<std::string> names;
   if (list.empty()) {
-    // Every backend with a contact query; `exact` is the truth, not a subject.
+    // Every backend with a contact query (contact kind) or a dynamics run (impact kind);
+    // `exact` is the truth, not a subject.
     for (const Backend& b : backends())
-      if (b.contact && b.name != "exact") names.push_back(b.name);
+      if ((kind == "impact" ? static_cast<bool>(b.dynamics) : static_cast<bool>(b.contact)) &&
+          b.name != "exact")
+        names.push_back(b.name);
     return names;
   }
   std::stringstream ss(list);
@@ -105,6 +117,13 @@ std::string describe(const BackendOutcome& b) {
   }
   if (b.error == "misses") return "misses a contact";
   if (b.error == "false_contact") return "reports a contact where there is none";
+  if (b.error == "missed") return "the body flew on untouched (no impulse)";
+  if (b.error == "impulse" || b.error == "spin")
+    return "velocity error " + fmt_num(b.velocity_err_ke, 3) + ", momentum error " +
+           fmt_num(b.momentum_err_ke, 3) + " (energy norm; " +
+           (b.error == "impulse" ? "the impulse is wrong"
+                                 : "the impulse is right, the spin after it is not") +
+           ")";
   o << "normal off by " << fmt_num(b.normal_err_deg, 3) << " deg, depth off by "
     << fmt_num(b.depth_err_rel, 3) << " and point off by " << fmt_num(b.point_err_rel, 3)
     << " of the smaller body";
@@ -153,6 +172,43 @@ std::string shrink_group(const Json& g, uint64_t seed, long count, int budget) {
               {"normal_err_deg", found.normal_err_deg},
               {"depth_err_rel", found.depth_err_rel},
               {"point_err_rel", found.point_err_rel},
+              {"message", found.message}}
+      .dump();
+}
+
+// One impact group's shrink: the scene carries its closed form ([expect]) already.
+std::string shrink_impact_group(const Json& g, uint64_t seed, long count, int budget) {
+  const ImpactSample start = make_impact_sample(seed, g["first_sample"].get<uint64_t>());
+  const std::string backend = g["backend"], sig = g["signature"];
+  const ImpactShrinkResult r = shrink_impact(start, backend, sig, budget);
+  BackendOutcome found;
+  for (const BackendOutcome& b : r.outcome.backends)
+    if (b.backend == backend) found = b;
+  if (found.error.empty()) return Json{{"ok", false}}.dump();
+  std::ostringstream h;
+  h << "# Found by `rbx explore --kind impact --seed " << seed << " --count " << count
+    << "`: sample " << start.index << ", group '" << sig << ",\n# " << g["count"].get<long>()
+    << " samples. " << backend << " against the closed form: " << describe(found) << ".\n"
+    << "# Shrunk from " << r.vertices_before << " to " << r.vertices_after << " points ("
+    << r.steps_accepted << " simplifications kept, " << r.evaluations
+    << " tried), while the disagreement stayed.\n# Reproduce: rbx compare THIS_FILE --backends "
+    << backend << "\n";
+  const std::string text = h.str() + r.sample.text;
+  std::string detail;
+  bool reproduced = false;
+  if (!AbortGuard::run(
+          [&] { reproduced = harness_reproduces(text, "explore.toml", found, &detail); }))
+    detail = "the harness aborted inside the library (rbx compare aborts on this scene too)";
+  return Json{{"ok", true},
+              {"text", text},
+              {"points_before", r.vertices_before},
+              {"points_after", r.vertices_after},
+              {"evaluations", r.evaluations},
+              {"reproduced", reproduced},
+              {"harness", detail},
+              {"phase", r.sample.phase},
+              {"velocity_err_ke", found.velocity_err_ke},
+              {"momentum_err_ke", found.momentum_err_ke},
               {"message", found.message}}
       .dump();
 }
@@ -210,7 +266,59 @@ int compare_baseline(const Json& now, const std::string& path) {
   return worse ? 1 : 0;
 }
 
+std::string markdown_impact(const Json& j) {
+  std::ostringstream o;
+  o << "# rbx explore: " << j["count"] << " random single-point impacts, seed " << j["seed"]
+    << "\n\n"
+    << "Every sample is one body (a box or a hull of 4 to 60 points) hitting a box, free or "
+       "static, at one vertex on a face, with restitution e in [0.2, 1], no friction, no "
+       "gravity, first contact 2 to 5 steps ahead at a random phase of its step. The closed form "
+       "(single-point impulse at the exact oracle's point and normal, then torque-free flight) "
+       "is the truth. A disagreement: a status error, no impulse at all (missed), a momentum "
+       "error above 0.1 % in the energy norm (impulse), or a velocity error above it with the "
+       "momenta right (spin: the free rotation after the impact).\n\n## Backends\n\n";
+  Table t({"backend", "samples", "disagreements", "rate", "velocity err p50/p90/p99",
+           "momentum err p50/p90/p99"});
+  for (const auto& [name, b] : j["backends"].items()) {
+    const Json& e = b["errors"];
+    auto three = [&](const char* m) {
+      return fmt_num(e[m]["p50"], 2) + " / " + fmt_num(e[m]["p90"], 2) + " / " +
+             fmt_num(e[m]["p99"], 2);
+    };
+    t.add({name, std::to_string(b["samples"].get<long>()),
+           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
+           three("velocity_err_ke"), three("momentum_err_ke")});
+  }
+  o << t.markdown();
+  o << "\n## Disagreement rate by the phase of the contact within its step\n\nThe first contact "
+       "falls at this fraction of the step that detects it (0 %: at the step's start, so the "
+       "bodies overlap by a whole step of approach when it is seen).\n\n";
+  Table ph({"backend", "0-25 %", "25-50 %", "50-75 %", "75-100 %"});
+  for (const auto& [name, b] : j["backends"].items()) {
+    std::vector<std::string> row = {name};
+    for (const Json& q : b["by_phase_quarter"])
+      row.push_back(fmt_num(q["rate"], 3) + " (" + std::to_string(q["samples"].get<long>()) + ")");
+    ph.add(row);
+  }
+  o << ph.markdown();
+  o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B (static: B "
+       "is static), the contact's features, the kind of error. Each group's first sample was "
+       "shrunk to the scene named; `reproduced` says whether `rbx compare` shows the velocity "
+       "error on it.\n\n";
+  Table g({"backend", "signature", "count", "rate", "scene", "points", "reproduced"});
+  for (const auto& [name, b] : j["backends"].items())
+    for (const Json& x : b["groups"])
+      g.add({name, x["signature"], std::to_string(x["count"].get<long>()), fmt_num(x["rate"], 3),
+             x["scene"].is_string() ? x["scene"].get<std::string>() : std::string("-"),
+             std::to_string(x.value("points_before", 0)) + " -> " +
+                 std::to_string(x.value("points_after", 0)),
+             x.value("reproduced", false) ? "yes" : "no"});
+  o << g.markdown();
+  return o.str();
+}
+
 std::string markdown(const Json& j, bool have_figure) {
+  if (j["kind"] == "impact") return markdown_impact(j);
   std::ostringstream o;
   o << "# rbx explore: " << j["count"] << " random contact pairs, seed " << j["seed"] << "\n\n"
     << "Every sample is a random convex pair (boxes, hulls of 4 to 2,000 points, slivers; size "
@@ -256,11 +364,10 @@ int explore_command(const ExploreOptions& opt) {
   const AbortGuard guard;
   if (opt.count <= 0)
     throw InputError("rbx explore: --count: must be > 0, got " + std::to_string(opt.count));
-  if (opt.kind == "impact")
-    throw InputError("rbx explore: --kind impact: not implemented in this version (use contact)");
-  if (opt.kind != "contact")
+  if (opt.kind != "contact" && opt.kind != "impact")
     throw InputError("rbx explore: --kind: must be contact or impact, got '" + opt.kind + "'");
-  const std::vector<std::string> names = contact_backends(opt.backends);
+  const bool impact = opt.kind == "impact";
+  const std::vector<std::string> names = subject_backends(opt.backends, opt.kind);
   const uint64_t seed = opt.seed;
   const size_t count = static_cast<size_t>(opt.count);
 
@@ -271,6 +378,7 @@ int explore_command(const ExploreOptions& opt) {
     SampleOutcome o;
     o.index = i;
     try {
+      if (impact) return encode(evaluate_impact_sample(make_impact_sample(seed, i), names));
       const ContactSample s = make_contact_sample(seed, i);
       if (opt.bench) {
         // Throughput is stated on hulls under 100 points: larger ones are left out here.
@@ -321,7 +429,15 @@ int explore_command(const ExploreOptions& opt) {
       for (const BackendOutcome& b : s.backends) {
         BackendTally& t = tally[b.backend];
         ++t.samples;
-        if (b.measured) {
+        if (impact && s.phase >= 0) {
+          const int q = std::min(3, static_cast<int>(s.phase * 4));
+          ++t.phase_samples[q];
+          t.phase_disagreements[q] += b.error.empty() ? 0 : 1;
+        }
+        if (b.measured && impact) {
+          t.values["velocity_err_ke"].push_back(b.velocity_err_ke);
+          t.values["momentum_err_ke"].push_back(b.momentum_err_ke);
+        } else if (b.measured) {
           t.values["normal_err_deg"].push_back(b.normal_err_deg);
           t.values["depth_err_rel"].push_back(b.depth_err_rel);
           t.values["point_err_rel"].push_back(b.point_err_rel);
@@ -348,6 +464,9 @@ int explore_command(const ExploreOptions& opt) {
   const Json all_groups = Json::parse(par.broadcast(groups.dump()));
   const std::vector<std::string> shrunk = par.map(all_groups.size(), [&](size_t k) {
     try {
+      if (impact)
+        return shrink_impact_group(all_groups[k], seed, opt.count,
+                                   std::min(opt.shrink_budget, 120));
       return shrink_group(all_groups[k], seed, opt.count, opt.shrink_budget);
     } catch (const std::exception& e) {
       return Json{{"ok", false}, {"message", e.what()}}.dump();
@@ -379,7 +498,7 @@ int explore_command(const ExploreOptions& opt) {
     b["disagreements"] = t.disagreements;
     b["rate"] = t.samples ? static_cast<double>(t.disagreements) / t.samples : 0.0;
     b["errors"] = Json::object();
-    for (const char* m : kMetrics) {
+    for (const std::string& m : metrics_of(opt.kind)) {
       std::vector<double>& v = t.values[m];
       std::sort(v.begin(), v.end());
       Json q = Json::array();
@@ -390,6 +509,17 @@ int explore_command(const ExploreOptions& opt) {
                         {"p99", percentile(v, 99)},
                         {"max", percentile(v, 100)},
                         {"quantiles_every_5", q}};
+    }
+    if (impact) {
+      b["by_phase_quarter"] = Json::array();
+      for (int q = 0; q < 4; ++q)
+        b["by_phase_quarter"].push_back(
+            {{"phase", std::to_string(q * 25) + "-" + std::to_string(q * 25 + 25) + " %"},
+             {"samples", t.phase_samples[q]},
+             {"disagreements", t.phase_disagreements[q]},
+             {"rate", t.phase_samples[q]
+                          ? static_cast<double>(t.phase_disagreements[q]) / t.phase_samples[q]
+                          : 0.0}});
     }
     b["groups"] = Json::array();
     std::vector<std::pair<long, std::string>> order;
@@ -411,9 +541,15 @@ int explore_command(const ExploreOptions& opt) {
         for (const char* k :
              {"points_before", "points_after", "evaluations", "reproduced", "harness"})
           g[k] = r[k];
-        g["shrunk_error"] = {{"normal_err_deg", r["normal_err_deg"]},
-                             {"depth_err_rel", r["depth_err_rel"]},
-                             {"point_err_rel", r["point_err_rel"]}};
+        if (impact) {
+          g["shrunk_error"] = {{"velocity_err_ke", r["velocity_err_ke"]},
+                               {"momentum_err_ke", r["momentum_err_ke"]},
+                               {"phase", r["phase"]}};
+        } else {
+          g["shrunk_error"] = {{"normal_err_deg", r["normal_err_deg"]},
+                               {"depth_err_rel", r["depth_err_rel"]},
+                               {"point_err_rel", r["point_err_rel"]}};
+        }
         if (r["reproduced"].get<bool>()) ++reproduced;
       } else {
         g["scene"] = nullptr;

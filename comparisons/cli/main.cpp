@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
   report->add_option("inputs", report_opt.inputs, "scene files or folders");
   report->add_option("--out", report_opt.out, "output folder");
   report->add_option("--backends", report_opt.backends, "comma-separated backend names");
+  report->add_option("--threads", report_opt.threads, "threads per rank (default: every core)");
   std::vector<std::string> scenes_inputs;
   app.add_subcommand("scenes", "the scene library as a markdown table (scenes/README.md)")
       ->add_option("inputs", scenes_inputs, "scene files or folders (default: scenes/)");

@@ -8,12 +8,14 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 
 #include "comparisons/cli/commands.h"
 #include "comparisons/cli/view.h"
 #include "comparisons/eval/harness.h"
+#include "comparisons/eval/parallel.h"
 #include "comparisons/eval/tosses.h"
 #include "comparisons/eval/trajectory.h"
 #include "comparisons/output/scorecard.h"
@@ -45,6 +47,45 @@ class Progress {
  private:
   bool on_;
 };
+
+// A scene's evaluation as text for the ranks' exchange (ParallelRun::map) and back; doubles go
+// through JSON's shortest round-trip form, so rank 0 rebuilds the very same numbers.
+std::string encode_evaluation(const SceneEvaluation& ev) {
+  Json j;
+  j["family"] = ev.family;
+  j["json"] = ev.json;
+  j["metrics"] = Json::array();
+  for (const Metric& m : ev.metrics)
+    j["metrics"].push_back({m.check, m.backend, m.pair, m.name, m.value, m.against});
+  j["sweep"] = Json::array();
+  for (const SweepPoint& p : ev.sweep)
+    j["sweep"].push_back({p.backend, p.kind, p.dt, p.runtime_s, p.error, p.against});
+  j["skipped"] = ev.skipped;
+  j["expect_failures"] = ev.expect_failures;
+  j["expect_checked"] = ev.expect_checked;
+  j["expect_unchecked"] = ev.expect_unchecked;
+  j["expect_known"] = ev.expect_known;
+  j["disagreements"] = ev.disagreements;
+  j["deviations"] = ev.deviations;
+  return j.dump();
+}
+
+SceneEvaluation decode_evaluation(const std::string& text) {
+  const Json j = Json::parse(text);
+  SceneEvaluation ev;
+  ev.family = j["family"];
+  ev.json = j["json"];
+  for (const Json& m : j["metrics"]) ev.metrics.push_back({m[0], m[1], m[2], m[3], m[4], m[5]});
+  for (const Json& p : j["sweep"]) ev.sweep.push_back({p[0], p[1], p[2], p[3], p[4], p[5]});
+  ev.skipped = j["skipped"].get<std::vector<std::string>>();
+  ev.expect_failures = j["expect_failures"].get<std::vector<std::string>>();
+  ev.expect_checked = j["expect_checked"];
+  ev.expect_unchecked = j["expect_unchecked"].get<std::vector<std::string>>();
+  ev.expect_known = j["expect_known"];
+  ev.disagreements = j["disagreements"].get<std::vector<std::string>>();
+  ev.deviations = j["deviations"].get<std::vector<std::string>>();
+  return ev;
+}
 
 // True when one of the lines is about backend `name`.
 bool mentions(const std::vector<std::string>& lines, const std::string& name) {
@@ -429,16 +470,26 @@ int report_command(const ReportOptions& opt) {
 
   HarnessOptions hopt;
   hopt.backends = opt.backends;
-  Progress progress(opt.quiet);
+  // Scenes spread over MPI ranks (under mpirun) and threads, results back in scene order on
+  // rank 0 (eval/parallel.h): the report is the same for any number of ranks and threads.
+  ParallelRun par(opt.threads);
+  Progress progress(opt.quiet || !par.root());
+  std::mutex progress_mutex;
+  size_t finished = 0;
   Stopwatch clock;
-  std::vector<SceneEvaluation> evs;
-  for (size_t i = 0; i < scenes.size(); ++i) {
-    progress.show(i + 1, scenes.size(), scenes[i].file, clock.seconds());
-    evs.push_back(evaluate_scene(scenes[i], hopt));
-    if (scenes[i].has_check(CheckKind::Contact))
-      evs.back().json["geometry"] = geometry_json(scenes[i]);
-  }
+  const std::vector<std::string> raw = par.map(scenes.size(), [&](size_t i) {
+    SceneEvaluation ev = evaluate_scene(scenes[i], hopt);
+    if (scenes[i].has_check(CheckKind::Contact)) ev.json["geometry"] = geometry_json(scenes[i]);
+    {
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      progress.show(++finished, scenes.size(), scenes[i].file, clock.seconds());
+    }
+    return encode_evaluation(ev);
+  });
   progress.done();
+  if (!par.root()) return 0;  // rank 0 writes everything
+  std::vector<SceneEvaluation> evs;
+  for (const std::string& r : raw) evs.push_back(decode_evaluation(r));
 
   // Everything goes into a temporary folder beside the target, renamed into place at the end.
   const fs::path target(out);
@@ -542,7 +593,8 @@ int report_command(const ReportOptions& opt) {
   }
   std::cout << "report: " << (target / "report.md").string() << " (" << scenes.size() << " scenes, "
             << fmt_num(clock.seconds(), 3) << " s; " << disagreeing
-            << " scenes with a disagreeing backend; " << failed << " [expect] failures)\n";
+            << " scenes with a disagreeing backend; " << failed << " [expect] failures; "
+            << par.ranks() << " rank(s) x " << par.threads() << " thread(s))\n";
   return 0;
 }
 

@@ -443,7 +443,8 @@ std::string encode(const SampleOutcome& s) {
             {"t", s.touching}, {"d", s.depth_rel},  {"b", Json::array()}};
   for (const BackendOutcome& b : s.backends)
     j["b"].push_back({b.backend, b.error, b.measured, b.normal_err_deg, b.depth_err_rel,
-                      b.point_err_rel, b.message});
+                      b.point_err_rel, b.message, b.velocity_err_ke, b.momentum_err_ke});
+  if (s.phase >= 0) j["ph"] = s.phase;
   return j.dump();
 }
 
@@ -456,7 +457,9 @@ SampleOutcome decode(const std::string& text) {
   s.feature = j["f"];
   s.touching = j["t"];
   s.depth_rel = j["d"];
-  for (const Json& b : j["b"]) s.backends.push_back({b[0], b[1], b[2], b[3], b[4], b[5], b[6]});
+  for (const Json& b : j["b"])
+    s.backends.push_back({b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8]});
+  s.phase = j.value("ph", -1.0);
   return s;
 }
 
@@ -643,9 +646,460 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
   } else if (b.error == "point") {
     ok = metric("point_err_rel") > kMarkDepthRel;
     d << "point_err_rel " << metric("point_err_rel");
+  } else if (b.error == "impulse" || b.error == "spin" || b.error == "missed") {
+    // Impact kind: the harness's velocity error against the scene's [expect] closed form.
+    ok = metric("velocity_err_ke") > kMarkVelocityErr;
+    d << "velocity_err_ke " << metric("velocity_err_ke");
   }
   if (detail) *detail = d.str();
   return ok;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Impact kind
+
+namespace {
+
+// Torque-free rotation: from orientation q, angular momentum L (world, constant) over time t;
+// omega = R I^-1 R^T L, RK4 on the quaternion with steps of 1e-5 s (|omega h| < 1e-3 here, so
+// the error is below 1e-12 per step; the closed form is the exact flight, not a library's).
+Quat free_rotation(const Mat3& inverse_inertia_body, Quat q, const Vec3& L, double t) {
+  if (t <= 0 || L.norm() == 0) return q;
+  const int n = std::max(1, static_cast<int>(std::ceil(t / 1e-5)));
+  const double h = t / n;
+  auto deriv = [&](const Eigen::Vector4d& c) {
+    const Quat qq = Quat(c[3], c[0], c[1], c[2]).normalized();
+    const Mat3 R = qq.toRotationMatrix();
+    const Vec3 w = R * inverse_inertia_body * R.transpose() * L;
+    const Quat d = Quat(0.0, w.x(), w.y(), w.z()) * qq;
+    return Eigen::Vector4d(0.5 * d.x(), 0.5 * d.y(), 0.5 * d.z(), 0.5 * d.w());
+  };
+  Eigen::Vector4d c = q.coeffs();
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector4d k1 = deriv(c), k2 = deriv(c + 0.5 * h * k1), k3 = deriv(c + 0.5 * h * k2),
+                          k4 = deriv(c + h * k3);
+    c += h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4);
+    c.normalize();
+  }
+  return Quat(c[3], c[0], c[1], c[2]).normalized();
+}
+
+std::string impact_body_text(const ExploreBody& e, const std::string& name, double mass,
+                             const Vec3& velocity, bool is_static) {
+  std::string t = body_text(e, name);
+  std::ostringstream o;
+  o << "mass = " << num(mass) << "\n";
+  if (is_static)
+    o << "static = true\n";
+  else
+    o << "velocity = " << vec(velocity) << "\n";
+  return t + o.str();
+}
+
+std::string impact_text(const ImpactSample& s, const std::string& header, const std::string& tail) {
+  std::ostringstream o;
+  o << header;
+  o << "description = \"rbx explore impact seed " << s.seed << " sample " << s.index << " ("
+    << (s.b_static ? "on a static box" : "two free bodies") << ", e = " << num(s.restitution)
+    << ")\"\n";
+  o << "checks = [\"impulse\"]\n\n[sim]\ndt = " << num(s.dt) << "\nduration = " << num(s.duration)
+    << "\nrestitution = " << num(s.restitution)
+    << "\nfriction = 0.0\ngravity = [0.0, 0.0, 0.0]\n\n";
+  o << impact_body_text(s.a, "A", s.mass_a, s.velocity_a, false) << "\n"
+    << impact_body_text(s.b, "B", s.mass_b, s.velocity_b, s.b_static);
+  if (!tail.empty()) o << "\n" << tail;
+  return o.str();
+}
+
+// Scene bodies moved along their velocities by t (translation only: no spin before the impact).
+std::vector<RigidBody> at_time(std::vector<RigidBody> bodies, double t) {
+  for (RigidBody& b : bodies)
+    if (!b.is_static) b.position += b.velocity * t;
+  return bodies;
+}
+
+int impact_points(const ImpactSample& s) {
+  return (s.a.shape_class == "box" ? 8 : static_cast<int>(s.a.points.size())) + 8;
+}
+
+}  // namespace
+
+bool realize_impact(ImpactSample& s) {
+  s.text.clear();
+  if (s.b_static) s.velocity_b = Vec3::Zero();
+  // 1. Poses at the contact time: B's box centre at the origin, A's lowest vertex along B's face
+  //    normal put on the chosen point of that face.
+  ImpactSample c = s;
+  c.a.position = Vec3::Zero();
+  c.b.position = Vec3::Zero();
+  std::vector<RigidBody> bodies;
+  try {
+    bodies = make_bodies(parse_scene(impact_text(c, "", ""), "explore.toml"));
+  } catch (const std::exception&) {
+    return false;
+  }
+  const RigidBody& A0 = bodies[0];
+  const RigidBody& B0 = bodies[1];
+  const int axis = s.face % 3;
+  const double sign = s.face < 3 ? 1.0 : -1.0;
+  Vec3 local_n = Vec3::Zero();
+  local_n[axis] = sign;
+  const Vec3 n = B0.orientation * local_n;  // from B toward A
+  Vec3 local_c = Vec3::Zero();
+  local_c[axis] = 0.5 * sign * s.b.box_size[axis];
+  local_c[(axis + 1) % 3] = s.face_u * s.b.box_size[(axis + 1) % 3];
+  local_c[(axis + 2) % 3] = s.face_v * s.b.box_size[(axis + 2) % 3];
+  const Vec3 point = B0.pose().apply(local_c);
+  const double size_a = extent(*A0.shape);
+  const double size = std::min(size_a, extent(*B0.shape));
+  int lowest = -1;
+  double low = 1e300, second = 1e300;
+  for (int i = 0; i < static_cast<int>(A0.shape->vertices().size()); ++i) {
+    const double d = A0.world_vertex(i).dot(n);
+    if (d < low) {
+      second = low;
+      low = d;
+      lowest = i;
+    } else if (d < second) {
+      second = d;
+    }
+  }
+  // One vertex clearly lowest (3 % of A's size below the next): a single contact point that
+  // stays single over the step a backend takes to see it.
+  if (lowest < 0 || second - low < 0.03 * size_a) return false;
+  // The point inside the face by a margin (fractions below 0.4 of the face).
+  if (std::abs(s.face_u) > 0.4 || std::abs(s.face_v) > 0.4) return false;
+  const Vec3 shift = point - A0.world_vertex(lowest);
+  // Approaching along the normal, by at least a tenth of the relative speed.
+  const Vec3 v_rel = s.velocity_a - s.velocity_b;
+  if (!(v_rel.dot(n) < -0.1 * v_rel.norm())) return false;
+  // 2. Back along the velocities by the contact time.
+  s.a.position = shift - s.velocity_a * s.contact_time;
+  s.b.position = -s.velocity_b * s.contact_time;
+  s.phase = s.contact_time / s.dt - std::floor(s.contact_time / s.dt);
+  const std::string body_text0 = impact_text(s, "", "");
+  try {
+    bodies = make_bodies(parse_scene(body_text0, "explore.toml"));
+  } catch (const std::exception&) {
+    return false;
+  }
+  const RigidBody& A = bodies[0];
+  const RigidBody& B = bodies[1];
+  // 3. The exact oracle: separated just before the contact time, one point just after it.
+  const double approach = -v_rel.dot(n);
+  {
+    const auto before = at_time(bodies, s.contact_time - 1e-3 * s.dt);
+    const SatResult sb =
+        sat_query(*before[0].shape, before[0].pose(), *before[1].shape, before[1].pose());
+    if (sb.touching && sb.depth >= 0) return false;
+  }
+  const auto after = at_time(bodies, s.contact_time + 1e-7 * size / approach);
+  const SatResult sat =
+      sat_query(*after[0].shape, after[0].pose(), *after[1].shape, after[1].pose());
+  if (!sat.touching || sat.manifold.empty() || sat.normal.dot(n) < 1.0 - 1e-9) return false;
+  Vec3 p = Vec3::Zero();
+  for (const Vec3& m : sat.manifold) p += m;
+  p /= static_cast<double>(sat.manifold.size());
+  for (const Vec3& m : sat.manifold)
+    if ((m - p).norm() > 1e-6 * size) return false;  // not a single point
+  const Vec3 normal = sat.normal;
+  // 4. The closed form: single-point impulse with restitution e at exact's point and normal
+  //    (seed corrections: world-frame inverse inertia, velocity of the point).
+  const Vec3 ra = p - after[0].position, rb = p - after[1].position;
+  const Mat3 ia = A.inverse_inertia_world();
+  const Mat3 ib = B.is_static ? Mat3::Zero() : B.inverse_inertia_world();
+  const double inv_mb = B.is_static ? 0.0 : 1.0 / B.mass;
+  const double k = 1.0 / A.mass + inv_mb + normal.dot((ia * ra.cross(normal)).cross(ra)) +
+                   normal.dot((ib * rb.cross(normal)).cross(rb));
+  const double vn = (A.velocity - B.velocity).dot(normal);
+  const double j = -(1.0 + s.restitution) * vn / k;
+  const Vec3 va = A.velocity + j / A.mass * normal, wa = ia * ra.cross(j * normal);
+  const Vec3 vb = B.velocity - j * inv_mb * normal, wb = -(ib * rb.cross(j * normal));
+  const Vec3 La = A.inertia_world() * wa,
+             Lb = B.is_static ? Vec3::Zero() : Vec3(B.inertia_world() * wb);
+  // 5. Free flight to the end: no second contact (checked at 20 times), final spin from L.
+  const double flight = s.duration - s.contact_time;
+  Quat qa = A.orientation, qb = B.orientation;
+  for (int step = 1; step <= 20; ++step) {
+    const double t = flight * step / 20.0;
+    RigidBody a2 = after[0], b2 = after[1];
+    a2.position += va * t;
+    a2.orientation = free_rotation(A.inverse_inertia_body, A.orientation, La, t);
+    if (!B.is_static) {
+      b2.position += vb * t;
+      b2.orientation = free_rotation(B.inverse_inertia_body, B.orientation, Lb, t);
+    }
+    const SatResult r = sat_query(*a2.shape, a2.pose(), *b2.shape, b2.pose());
+    if (r.touching || r.depth > -1e-6 * size) return false;
+    qa = a2.orientation;
+    qb = b2.orientation;
+  }
+  auto spin = [](const RigidBody& b, const Quat& q, const Vec3& L) {
+    const Mat3 R = q.toRotationMatrix();
+    return Vec3(R * b.inverse_inertia_body * R.transpose() * L);
+  };
+  s.expect_velocity[0] = va;
+  s.expect_angular_velocity[0] = spin(A, qa, La);
+  s.expect_angular_momentum[0] = La;
+  s.expect_velocity[1] = vb;
+  s.expect_angular_velocity[1] = B.is_static ? Vec3::Zero() : spin(B, qb, Lb);
+  s.expect_angular_momentum[1] = Lb;
+  // 6. The scene with its derivation and [expect].
+  std::ostringstream d;
+  d << "# Closed form (rbx explore, impact kind): no spin before the impact, so the contact\n"
+       "# pose is the start pose moved along the velocities: first contact at t = "
+    << num(s.contact_time) << " s,\n# phase " << num(s.phase)
+    << " of its step. The exact oracle's contact, one point (vertex of A on a face of B):\n"
+    << "#   p = " << vec(p) << ", n = " << vec(normal) << " (from B toward A)\n"
+    << "# j = -(1 + e) (v_rel . n) / (1/mA + 1/mB + n.((IA^-1 (rA x n)) x rA) + same for B)\n"
+    << "#   = " << num(j) << " N s (v_rel . n = " << num(vn) << " m/s)\n"
+    << "# v' = v + j n / m, w' = I^-1 (r x j n) (B: minus); after it, torque-free flight to t = "
+    << num(s.duration)
+    << " s\n# (angular momentum kept, w = R I^-1 R^T L, integrated by RK4 at "
+       "1e-5 s); no second contact\n# (the exact oracle at 20 times of the flight).\n";
+  std::ostringstream x;
+  char buf[200];
+  x << "[expect]\n# The closed form is exact to round-off; 1e-3 of the speed is the harness's mark "
+       "of a\n# clear velocity disagreement (0.1 % in the energy norm): below it, a "
+       "deviation.\n";
+  std::snprintf(buf, sizeof buf, "tolerance = %.3g\n", 1e-3 * std::max(1e-9, v_rel.norm()));
+  x << buf;
+  x << "[expect.body.A]\nvelocity = " << vec(va)
+    << "\nangular_velocity = " << vec(s.expect_angular_velocity[0]) << "\n";
+  if (!B.is_static)
+    x << "[expect.body.B]\nvelocity = " << vec(vb)
+      << "\nangular_velocity = " << vec(s.expect_angular_velocity[1]) << "\n";
+  s.derivation = d.str();
+  s.text = impact_text(s, "", s.derivation + x.str());
+  return true;
+}
+
+ImpactSample make_impact_sample(uint64_t seed, uint64_t index) {
+  SampleRng r(seed, index);
+  for (int attempt = 0; attempt < 30; ++attempt) {
+    ImpactSample s;
+    s.seed = seed;
+    s.index = index;
+    s.b_static = r.uniform() < 0.4;
+    const double scale = std::pow(10.0, r.uniform(-0.3, 0.3));
+    // A: a box or a hull of 4 to 60 points (a sliver's lowest vertex is rarely unique).
+    do {
+      s.a = random_body(r, scale);
+    } while (s.a.shape_class == "sliver" || s.a.points.size() > 60);
+    s.a.orientation = r.rotation();
+    // B: a box, a slab under A when static, else up to 3 times A's size.
+    s.b.shape_class = "box";
+    if (s.b_static)
+      s.b.box_size = Vec3(4 * scale, 4 * scale, scale);
+    else
+      for (int k = 0; k < 3; ++k) s.b.box_size[k] = scale * r.uniform(1.0, 3.0);
+    s.b.orientation = r.rotation();
+    s.mass_a = std::pow(10.0, r.uniform(-0.5, 0.5));
+    s.mass_b = s.b_static ? 1.0 : std::pow(10.0, r.uniform(-0.5, 0.5));
+    s.restitution = r.uniform(0.2, 1.0);
+    s.dt = 1e-3;
+    s.face = s.b_static ? 2 : r.integer(0, 5);
+    s.face_u = r.uniform(-0.3, 0.3);
+    s.face_v = r.uniform(-0.3, 0.3);
+    // Relative velocity: against the face normal, tilted up to 30 degrees; 0.5 to 3 m/s.
+    Vec3 local_n = Vec3::Zero();
+    local_n[s.face % 3] = s.face < 3 ? 1.0 : -1.0;
+    const Vec3 n = s.b.orientation.normalized() * local_n;
+    const Vec3 t = n.cross(r.direction()).normalized();
+    const double tilt = r.uniform(0.0, 30.0) * M_PI / 180.0;
+    const Vec3 v_rel = r.uniform(0.5, 3.0) * (-std::cos(tilt) * n + std::sin(tilt) * t);
+    if (s.b_static) {
+      s.velocity_a = v_rel;
+    } else {
+      // Centre-of-mass velocity up to 1 m/s, split by the masses.
+      const Vec3 vcm = r.uniform(0.0, 1.0) * r.direction();
+      const double m = s.mass_a + s.mass_b;
+      s.velocity_a = vcm + v_rel * (s.mass_b / m);
+      s.velocity_b = vcm - v_rel * (s.mass_a / m);
+    }
+    // First contact 2 to 5 steps ahead, at a random phase of its step; 50 ms of flight after.
+    s.contact_time = (r.integer(2, 5) + r.uniform(0.02, 0.98)) * s.dt;
+    s.duration = s.contact_time + 0.05;
+    if (realize_impact(s)) return s;
+  }
+  throw std::runtime_error("no single-point impact found in 30 attempts");
+}
+
+SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<std::string>& names) {
+  SampleOutcome out;
+  out.index = s.index;
+  out.pose_class = s.b_static ? "static" : "free";
+  out.shapes = s.a.shape_class + "-" + (s.b_static ? "static" : "box");
+  out.feature = "vertex_face";
+  out.touching = true;
+  out.phase = s.phase;
+  const Scene scene = parse_scene(s.text, "explore.toml");
+  const std::vector<RigidBody> inputs = make_bodies(scene);
+  double e0 = 0.0;
+  for (const RigidBody& b : inputs)
+    if (!b.is_static) e0 += 0.5 * b.mass * b.velocity.squaredNorm();
+  std::vector<std::optional<RefState>> ref(2);
+  double e_ref = 0.0;
+  for (int i = 0; i < 2; ++i) {
+    if (inputs[i].is_static) continue;
+    ref[i] = RefState{s.expect_velocity[i], s.expect_angular_velocity[i]};
+    e_ref += 0.5 * inputs[i].mass * s.expect_velocity[i].squaredNorm() +
+             0.5 * s.expect_angular_velocity[i].dot(s.expect_angular_momentum[i]);
+  }
+  if (e_ref < 1e-12 * e0) e_ref = e0;
+  for (const std::string& name : names) {
+    const Backend* be = find_backend(name);
+    if (!be || !be->dynamics) continue;
+    DynamicsResult run;
+    const bool finished = AbortGuard::run([&] {
+      try {
+        run = be->dynamics(scene, DynamicsOptions{0.0, 0});
+      } catch (const std::exception& e) {
+        run.status = Status::Error;
+        run.message = e.what();
+      }
+    });
+    if (!finished) {
+      run = DynamicsResult{};
+      run.status = Status::Error;
+      run.message = name + " aborted inside the library (SIGABRT, a failed assertion)";
+    }
+    if (run.status == Status::Unsupported) continue;
+    BackendOutcome o;
+    o.backend = name;
+    if (run.status == Status::Ok && run.finals.size() != inputs.size()) {
+      run.status = Status::Error;
+      run.message = "returned " + std::to_string(run.finals.size()) + " final states";
+    }
+    if (run.status == Status::Error) {
+      o.error = "error";
+      o.message = run.message;
+      out.backends.push_back(o);
+      continue;
+    }
+    o.measured = true;
+    o.velocity_err_ke = ke_norm_error(inputs, run.finals, ref, e0);
+    // The same norm on momenta: p and L about the COM are what the impulse sets and the flight
+    // keeps, so this error is the impulse's alone, whatever the library's free rotation does.
+    double num_p = 0.0;
+    for (int i = 0; i < 2; ++i) {
+      if (inputs[i].is_static) continue;
+      const BodyFinal& f = run.finals[i];
+      const Mat3 R = f.orientation.toRotationMatrix();
+      const Mat3 inv_i = R * inputs[i].inverse_inertia_body * R.transpose();
+      const Mat3 inertia = R * inputs[i].inertia_body * R.transpose();
+      const Vec3 dp = inputs[i].mass * (f.velocity - s.expect_velocity[i]);
+      const Vec3 dl = inertia * f.angular_velocity - s.expect_angular_momentum[i];
+      num_p += dp.squaredNorm() / inputs[i].mass + dl.dot(inv_i * dl);
+    }
+    o.momentum_err_ke = std::sqrt(num_p / (2.0 * e_ref));
+    const double v0 = s.velocity_a.norm();
+    if ((run.finals[0].velocity - s.velocity_a).norm() <= 1e-9 * v0 &&
+        run.finals[0].angular_velocity.norm() <= 1e-9 * v0 / extent(*inputs[0].shape))
+      o.error = "missed";  // A flew on untouched
+    else if (!(o.momentum_err_ke <= kMarkVelocityErr))
+      o.error = "impulse";
+    else if (!(o.velocity_err_ke <= kMarkVelocityErr))
+      o.error = "spin";  // the impulse is right; the free rotation after it is not
+    out.backends.push_back(o);
+  }
+  return out;
+}
+
+ImpactShrinkResult shrink_impact(const ImpactSample& start, const std::string& backend,
+                                 const std::string& sig, int max_evaluations) {
+  ImpactShrinkResult r;
+  r.sample = start;
+  r.vertices_before = impact_points(start);
+  const std::vector<std::string> names = {backend};
+  auto keeps = [&](ImpactSample c, SampleOutcome* out = nullptr) {
+    if (r.evaluations >= max_evaluations) return false;
+    ++r.evaluations;
+    try {
+      if (!realize_impact(c)) return false;
+      const SampleOutcome o = evaluate_impact_sample(c, names);
+      for (const BackendOutcome& b : o.backends)
+        if (!b.error.empty() && signature(o, b) == sig) {
+          if (out) *out = o;
+          r.sample = c;
+          return true;
+        }
+    } catch (const std::exception&) {
+    }
+    return false;
+  };
+  auto accept = [&](const ImpactSample& c) {
+    const ImpactSample keep = r.sample;
+    if (!keeps(c)) {
+      r.sample = keep;
+      return false;
+    }
+    ++r.steps_accepted;
+    return true;
+  };
+  // 1. Fewer points of A: its hull's own vertices, then chunks (halves first).
+  if (r.sample.a.shape_class != "box") {
+    ImpactSample c = r.sample;
+    try {
+      c.a.points = convex_hull(c.a.points).vertices();
+      if (c.a.points.size() < r.sample.a.points.size()) accept(c);
+    } catch (const std::exception&) {
+    }
+    for (size_t chunk = r.sample.a.points.size() / 2; chunk >= 1; chunk /= 2) {
+      for (size_t at = 0; at < r.sample.a.points.size() && r.sample.a.points.size() > 4;) {
+        ImpactSample d = r.sample;
+        auto& p = d.a.points;
+        const size_t end = std::min(at + chunk, p.size());
+        if (p.size() - (end - at) < 4) break;
+        p.erase(p.begin() + at, p.begin() + end);
+        if (!accept(d)) at += chunk;
+      }
+      if (r.evaluations >= max_evaluations) break;
+    }
+  }
+  // 2. Round numbers: e, masses, the point on the face, velocities.
+  for (double e : {1.0, 0.5}) {
+    ImpactSample c = r.sample;
+    c.restitution = e;
+    if (accept(c)) break;
+  }
+  {
+    ImpactSample c = r.sample;
+    c.mass_a = 1.0;
+    c.mass_b = 1.0;
+    accept(c);
+  }
+  {
+    ImpactSample c = r.sample;
+    c.face_u = c.face_v = 0.0;
+    if (!accept(c)) {
+      c.face_u = std::round(r.sample.face_u * 10) / 10;
+      c.face_v = std::round(r.sample.face_v * 10) / 10;
+      accept(c);
+    }
+  }
+  for (double g : {0.5, 0.1, 0.01}) {
+    ImpactSample c = r.sample;
+    c.velocity_a = round_to(c.velocity_a, g);
+    c.velocity_b = round_to(c.velocity_b, g);
+    if (accept(c)) break;
+  }
+  // 3. Rotations toward axis-aligned, coarsest grid first.
+  const double grids_deg[] = {90, 45, 15, 5, 1, 0.1};
+  for (ExploreBody ImpactSample::*body : {&ImpactSample::a, &ImpactSample::b}) {
+    const Vec3 deg = euler_deg(build_orientation(r.sample.*body));
+    for (double g : grids_deg) {
+      ImpactSample d = r.sample;
+      (d.*body).use_degrees = true;
+      (d.*body).rotation_deg = round_to(deg, g);
+      if (accept(d)) break;
+    }
+  }
+  r.vertices_after = impact_points(r.sample);
+  ++max_evaluations;
+  ImpactSample last = r.sample;
+  keeps(last, &r.outcome);
+  return r;
 }
 
 }  // namespace rbx

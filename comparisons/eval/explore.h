@@ -94,6 +94,9 @@ struct BackendOutcome {
   double depth_err_rel = 0.0;   // |depth - exact depth| / smaller body size
   double point_err_rel = 0.0;   // distance of the point from the intersection / size
   std::string message;          // the backend's message when status is error
+  // Impact kind (measured = the run finished):
+  double velocity_err_ke = 0.0;  // final velocities against the closed form, KE norm (harness)
+  double momentum_err_ke = 0.0;  // final momenta (p, L about the COM) against it, same norm
 };
 
 /// Everything measured on one sample.
@@ -105,6 +108,7 @@ struct SampleOutcome {
   bool touching = false;
   double depth_rel = 0.0;                // exact depth / smaller body size (negative: separated)
   std::vector<BackendOutcome> backends;  // in the order asked for; unsupported ones left out
+  double phase = -1.0;  // impact kind: where in its step the first contact falls, [0, 1)
 };
 
 /// Runs the sample through `exact` and each named backend and classifies each answer.
@@ -147,5 +151,55 @@ ShrinkResult shrink(const ContactSample& s, const std::string& backend, const st
 /// off by more than the same fraction. `detail` says what it saw.
 bool harness_reproduces(const std::string& scene_text, const std::string& path,
                         const BackendOutcome& b, std::string* detail = nullptr);
+
+// ---------------------------------------------------------------------------------------------
+// Impact kind: one body hits another (free or static) at one vertex on a face; the closed form
+// is the single-point impulse with restitution e (seed corrections: world-frame inverse inertia,
+// relative velocity at the point), computed here from the masses, the inertia tensors and the
+// exact oracle's contact point and normal, not by the custom engine.
+
+/// One random single-point impact, as it is written to a scene.
+struct ImpactSample {
+  uint64_t seed = 0;
+  uint64_t index = 0;
+  bool b_static = false;              // B static (a slab) or free
+  ExploreBody a, b;                   // B is a box; positions are those at t = 0
+  double mass_a = 1.0, mass_b = 1.0;  // kg
+  Vec3 velocity_a = Vec3::Zero(), velocity_b = Vec3::Zero();  // m/s, no spin before the impact
+  double restitution = 1.0;
+  double dt = 1e-3;                   // s
+  double contact_time = 0.0;          // s, first contact (exact, translation only before it)
+  double phase = 0.0;                 // contact_time / dt - floor(contact_time / dt)
+  double duration = 0.0;              // s
+  int face = 0;                       // B's face hit: axis 0..2, + 3 for the negative side
+  double face_u = 0.0, face_v = 0.0;  // the point hit on it, fractions of the face in (-0.5, 0.5)
+  // The closed form (index 0: A, 1: B), at t = duration:
+  Vec3 expect_velocity[2], expect_angular_velocity[2];  // m/s, rad/s (world)
+  Vec3 expect_angular_momentum[2];                      // kg m^2/s about the COM (world)
+  std::string text;        // the scene with its [expect] block (empty: no valid sample)
+  std::string derivation;  // comment lines: point, normal, impulse
+};
+
+/// Sample `index` of `seed` (impact kind). Poses are drawn until one gives a single contact
+/// point (a unique lowest vertex over the inside of a face) and no second contact afterwards;
+/// throws std::runtime_error when none of the attempts does.
+ImpactSample make_impact_sample(uint64_t seed, uint64_t index);
+
+/// Builds the sample's scene and closed form from its design (shapes, orientations, masses,
+/// velocities, e, dt, contact time): false when it has no single-point contact or a second one.
+bool realize_impact(ImpactSample& s);
+
+/// Runs the sample's scene through each named dynamics backend against its closed form.
+SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<std::string>& names);
+
+/// Impact groups shrunk like the contact ones: fewer hull points, rotations toward whole
+/// degrees, rounder speeds, masses and e, as long as `backend` keeps signature `sig`.
+struct ImpactShrinkResult {
+  ImpactSample sample;
+  SampleOutcome outcome;
+  int vertices_before = 0, vertices_after = 0, steps_accepted = 0, evaluations = 0;
+};
+ImpactShrinkResult shrink_impact(const ImpactSample& s, const std::string& backend,
+                                 const std::string& sig, int max_evaluations = 120);
 
 }  // namespace rbx
