@@ -368,6 +368,12 @@ DynamicsResult ode_hull_dynamics(const Scene& scene, const DynamicsOptions& opt)
 
 DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
                                  const OdeSettings& settings) {
+  // One ODE world steps at a time in the process: ODE 0.16's worlds share its default
+  // self-threaded stepping implementation, and two dWorldStep calls on two threads (rbx report
+  // runs scenes on every core) fail its assertion in WaitWakeup (threading_fake_sync.h:83),
+  // measured on analytic/headon_e0. Contact queries (dCollide) need no lock.
+  static std::mutex world_step_lock;
+  const std::lock_guard<std::mutex> lock(world_step_lock);
   init_ode();
   DynamicsResult r;
   const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
