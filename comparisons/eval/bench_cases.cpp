@@ -27,6 +27,7 @@
 #include <memory>
 #include <utility>
 
+#include "comparisons/eval/explore.h"
 #include "comparisons/scene/mesh_io.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/world.h"
@@ -474,6 +475,44 @@ CaseSet step_cases(const BenchPlan& plan, std::mt19937_64&) {
   return set;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Explore throughput: `rbx explore`'s contact samples of the default seed whose shapes have
+// fewer than 100 points, each through exact (the truth), custom and fcl, on one thread.
+
+CaseSet explore_cases(const BenchPlan& plan, std::mt19937_64&) {
+  struct State {
+    std::vector<ContactSample> samples;
+    std::size_t next = 0;
+  };
+  auto c = std::make_shared<State>();
+  const std::size_t wanted = plan.quick ? 200 : 1000;
+  auto small = [](const ExploreBody& b) { return b.shape_class == "box" || b.points.size() < 100; };
+  for (uint64_t i = 0; c->samples.size() < wanted && i < 100000; ++i) {
+    ContactSample s = make_contact_sample(1, i);
+    if (small(s.a) && small(s.b)) c->samples.push_back(std::move(s));
+  }
+  const std::vector<std::string> names = {"custom", "fcl"};
+  const std::string name = "explore/contact/exact+custom+fcl";
+  CaseSet set;
+  BenchCase bc;
+  bc.name = name;
+  bc.warm_up = [c, names] { evaluate_contact_sample(c->samples.front(), names); };
+  // Samples in turn; the time per iteration is the mean over them once every one has run.
+  bc.body = [c, names] {
+    evaluate_contact_sample(c->samples[c->next++ % c->samples.size()], names);
+  };
+  bc.min_time_s = plan.quick ? 1.0 : 3.0;
+  bc.repetitions = kBenchRepetitions;
+  set.cases.push_back(bc);
+  const int count = static_cast<int>(c->samples.size());
+  set.collect = [name, count](Collector& collector, BenchResults& out) {
+    ExploreRow r{"exact, custom, fcl", count, NAN};
+    if (collector.seconds.count(name)) r.samples_per_minute = 60.0 / collector.seconds[name];
+    out.explore.push_back(r);
+  };
+  return set;
+}
+
 // The bench table: every family of cases and its builder, in the order they run and are written.
 struct Family {
   const char* name;
@@ -483,6 +522,7 @@ const Family kFamilies[] = {
     {"narrowphase", narrowphase_cases},
     {"broadphase", broadphase_cases},
     {"step", step_cases},
+    {"explore", explore_cases},
 };
 
 }  // namespace

@@ -127,6 +127,13 @@ struct StepRow {
   std::string status;
 };
 
+/// An explore-throughput row: contact samples of `rbx explore` per minute on one core.
+struct ExploreRow {
+  std::string backends;  // what each sample runs through
+  int samples = 0;       // distinct samples cycled through
+  double samples_per_minute = NAN;
+};
+
 /// Everything a run measured.
 struct BenchResults {
   int cpus = 0;  // as Google Benchmark saw the machine
@@ -135,6 +142,7 @@ struct BenchResults {
   std::vector<NarrowRow> narrow;
   std::vector<BroadRow> broad;
   std::vector<StepRow> step;
+  std::vector<ExploreRow> explore;
 };
 
 /// Builds every family's cases, times them with Google Benchmark and returns the rows.

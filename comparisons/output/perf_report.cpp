@@ -94,6 +94,46 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
     }
   }
 
+  // Issue 11: the accelerated detector no slower than FCL with prebuilt shapes at every hull
+  // size timed, touching; the whole custom step within 2x of Bullet per body-step.
+  {
+    std::string measured;
+    bool met = true;
+    int compared = 0;
+    for (int n : plan.hull_sizes) {
+      const double c = find_time(results.narrow, "custom", "fast", "touching", n);
+      const double f = find_time(results.narrow, "fcl", "prebuilt", "touching", n);
+      if (!std::isfinite(c) || !std::isfinite(f)) continue;
+      ++compared;
+      met = met && c <= f;
+      measured += (measured.empty() ? "" : ", ") + ("N = " + std::to_string(n) + ": ") +
+                  bench_num(c / f, 2) + "x";
+    }
+    goals.push_back(
+        {"custom (fast) no slower than fcl (shapes prebuilt) at every hull size timed, "
+         "touching (issue 11)",
+         measured.empty() ? "not measured" : measured, met && compared > 0});
+  }
+  for (const char* scene : {"many_100", "many_1000"}) {
+    double custom = NAN, bullet = NAN;
+    for (const StepRow& r : results.step)
+      if (r.scene == scene && r.variant != "seed") {
+        if (r.backend == "custom") custom = r.us_per_body_step;
+        if (r.backend == "bullet") bullet = r.us_per_body_step;
+      }
+    goals.push_back({std::string("whole custom step within 2x of Bullet per body-step on ") +
+                         scene + " (issue 11)",
+                     bench_num(custom, 3) + " µs vs " + bench_num(bullet, 3) + " µs: ratio " +
+                         bench_num(custom / bullet, 3),
+                     custom <= 2.0 * bullet});
+  }
+  // Issue 17: explore's contact samples per minute per core.
+  for (const ExploreRow& r : results.explore)
+    goals.push_back({"rbx explore: at least 50,000 contact samples per minute per core through " +
+                         r.backends + " on hulls under 100 points (issue 17)",
+                     bench_num(r.samples_per_minute, 3) + " per minute (one thread, " +
+                         std::to_string(r.samples) + " samples of seed 1 in turn)",
+                     r.samples_per_minute >= 50000.0});
   return goals;
 }
 
@@ -182,7 +222,7 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
      << kBenchRepetitions
      << " times and keep the fastest (the machine is shared). Wall time of the timing: "
      << bench_num(timing_s, 3) << " s.\n\n";
-  md << "## Goals (issue 6)\n\n| goal | measured | met |\n|---|---|---|\n";
+  md << "## Goals\n\n| goal | measured | met |\n|---|---|---|\n";
   for (const PerfGoal& g : goals)
     md << "| " << g.goal << " | " << g.measured << " | " << (g.met ? "yes" : "**no**") << " |\n";
   md << "\n## Narrow phase\n\n"
