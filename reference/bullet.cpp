@@ -41,6 +41,8 @@
 #include <string>
 #include <vector>
 
+#include "reference/prebuilt_cache.h"
+
 namespace rbx {
 
 namespace {
@@ -162,15 +164,32 @@ struct QueryContext {
   btCollisionWorld world{&dispatcher, &broadphase, &configuration};
 };
 
-ContactResult pair_query(const RigidBody& a, const RigidBody& b, const BulletSettings& settings) {
+/// Shapes of one settings variant kept across queries (the "prebuilt" variants); null: built in
+/// each query, as the plain backends do.
+using ShapeCache = PrebuiltCache<std::unique_ptr<btConvexShape>>;
+
+ContactResult pair_query(const RigidBody& a, const RigidBody& b, const BulletSettings& settings,
+                         ShapeCache* prebuilt = nullptr) {
   try {
     thread_local QueryContext ctx;
     const Mat3 identity = Mat3::Identity();
-    auto hull_a = make_shape(a, identity, settings);
-    auto hull_b = make_shape(b, identity, settings);
+    std::unique_ptr<btConvexShape> hull_a, hull_b;
+    btConvexShape *shape_a = nullptr, *shape_b = nullptr;
+    if (prebuilt) {
+      // A box body and a hull body never share a shape pointer: the shape alone is the key.
+      shape_a =
+          prebuilt->get(a.shape, nullptr, [&] { return make_shape(a, identity, settings); }).get();
+      shape_b =
+          prebuilt->get(b.shape, nullptr, [&] { return make_shape(b, identity, settings); }).get();
+    } else {
+      hull_a = make_shape(a, identity, settings);
+      hull_b = make_shape(b, identity, settings);
+      shape_a = hull_a.get();
+      shape_b = hull_b.get();
+    }
     btCollisionObject obj_a, obj_b;
-    obj_a.setCollisionShape(hull_a.get());
-    obj_b.setCollisionShape(hull_b.get());
+    obj_a.setCollisionShape(shape_a);
+    obj_b.setCollisionShape(shape_b);
     obj_a.setWorldTransform(body_transform(a, identity));
     obj_b.setWorldTransform(body_transform(b, identity));
     // With polyhedral features the algorithm takes its axis from SAT when m_enableSatConvex is
@@ -448,11 +467,34 @@ ContactResult bullet_hull_contact(const RigidBody& a, const RigidBody& b) {
   return pair_query(a, b, bullet_hull_settings());
 }
 
-ContactResult bullet_sat_contact(const RigidBody& a, const RigidBody& b) {
+namespace {
+
+BulletSettings bullet_sat_settings() {
   BulletSettings s;
   s.native_boxes = false;
   s.sat_convex = true;
-  return pair_query(a, b, s);
+  return s;
+}
+
+}  // namespace
+
+ContactResult bullet_sat_contact(const RigidBody& a, const RigidBody& b) {
+  return pair_query(a, b, bullet_sat_settings());
+}
+
+ContactResult bullet_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local ShapeCache cache;
+  return pair_query(a, b, bullet_native_settings(), &cache);
+}
+
+ContactResult bullet_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local ShapeCache cache;
+  return pair_query(a, b, bullet_hull_settings(), &cache);
+}
+
+ContactResult bullet_sat_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local ShapeCache cache;
+  return pair_query(a, b, bullet_sat_settings(), &cache);
 }
 
 DynamicsResult bullet_dynamics_with(const Scene& scene, const DynamicsOptions& opt,

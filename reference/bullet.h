@@ -34,6 +34,12 @@ ContactResult bullet_contact(const RigidBody& a, const RigidBody& b);
 ContactResult bullet_hull_contact(const RigidBody& a, const RigidBody& b);
 /// `bullet-sat`: every body a polyhedral hull (boxes too), SAT + clipping.
 ContactResult bullet_sat_contact(const RigidBody& a, const RigidBody& b);
+/// `bullet`, `bullet-hull` and `bullet-sat` with each shape built once and kept (reference/
+/// prebuilt_cache.h; polyhedral features included): variant "prebuilt", the same query without
+/// the cost of building the shape (the report shows that cost apart).
+ContactResult bullet_contact_prebuilt(const RigidBody& a, const RigidBody& b);
+ContactResult bullet_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b);
+ContactResult bullet_sat_contact_prebuilt(const RigidBody& a, const RigidBody& b);
 /// The contact query with explicit settings.
 ContactResult bullet_contact_with(const RigidBody& a, const RigidBody& b,
                                   const BulletSettings& settings);

@@ -32,6 +32,8 @@
 #include <string>
 #include <vector>
 
+#include "reference/prebuilt_cache.h"
+
 namespace rbx {
 namespace {
 
@@ -132,12 +134,21 @@ std::shared_ptr<fcl::CollisionGeometryd> convex_geometry(const RigidBody& body) 
 /// The body as FCL's users would give it: an fcl::Box for a box body (axes the body axes), its
 /// Convex hull otherwise. `tf` receives the geometry's world pose.
 std::shared_ptr<fcl::CollisionGeometryd> native_geometry(const RigidBody& body,
-                                                         fcl::Transform3d& tf) {
+                                                         fcl::Transform3d& tf);
+
+/// The world pose of native_geometry's geometry for `body`.
+void native_placement(const RigidBody& body, fcl::Transform3d& tf) {
   tf = to_fcl(body.pose());
-  if (!is_native_box(body)) return convex_geometry(body);
   // The box centre is taken from the hull's bounds (zero up to round-off for both mass models),
   // so that round-off in the centre-of-mass shift cannot move it.
-  tf.translation() += body.pose().rotation() * body.shape->bounds().center();
+  if (is_native_box(body))
+    tf.translation() += body.pose().rotation() * body.shape->bounds().center();
+}
+
+std::shared_ptr<fcl::CollisionGeometryd> native_geometry(const RigidBody& body,
+                                                         fcl::Transform3d& tf) {
+  native_placement(body, tf);
+  if (!is_native_box(body)) return convex_geometry(body);
   return std::make_shared<fcl::Boxd>(body.box_size);
 }
 
@@ -172,25 +183,42 @@ ContactResult fcl_hull_contact(const RigidBody& a, const RigidBody& b) {
 }
 
 ContactResult fcl_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
-  // A small cache of (shape, its fcl::Convex). Keyed by the shared_ptr itself, which keeps the
-  // shape alive, so an address reused by a later shape can never hit a stale entry.
-  using Entry =
-      std::pair<std::shared_ptr<const ConvexPolyhedron>, std::shared_ptr<fcl::CollisionGeometryd>>;
-  thread_local std::vector<Entry> cache;
-  auto geometry = [](const std::shared_ptr<const ConvexPolyhedron>& shape) {
-    for (const Entry& e : cache)
-      if (e.first == shape) return e.second;
-    if (cache.size() >= 4) cache.erase(cache.begin());
-    cache.emplace_back(shape, make_convex(*shape));
-    return cache.back().second;
+  // fcl_contact with each shape's geometry (Box or Convex) built once per thread.
+  // One cache for fcl::Box bodies, one for Convex ones: the key is the shape alone.
+  thread_local PrebuiltCache<std::shared_ptr<fcl::CollisionGeometryd>> box_cache, convex_cache;
+  auto cache_of = [&](const RigidBody& body) -> auto& {
+    return is_native_box(body) ? box_cache : convex_cache;
   };
-  return reject_undefined_normals(guarded("fcl::collide (GST_LIBCCD)",
-                                          [&] {
-                                            return collide(geometry(a.shape), to_fcl(a.pose()),
-                                                           geometry(b.shape), to_fcl(b.pose()),
-                                                           fcl::GST_LIBCCD, "mpr");
-                                          }),
-                                  "fcl::collide (GST_LIBCCD, libccd MPR)");
+  const bool boxes = is_native_box(a) && is_native_box(b);
+  return reject_undefined_normals(
+      guarded(boxes ? "fcl::collide (Box-Box)" : "fcl::collide (GST_LIBCCD)",
+              [&] {
+                fcl::Transform3d tf_a, tf_b;
+                auto geom_a =
+                    cache_of(a).get(a.shape, nullptr, [&] { return native_geometry(a, tf_a); });
+                auto geom_b =
+                    cache_of(b).get(b.shape, nullptr, [&] { return native_geometry(b, tf_b); });
+                // The placement, as native_geometry gives it (the cached geometry skips it).
+                native_placement(a, tf_a);
+                native_placement(b, tf_b);
+                return collide(geom_a, tf_a, geom_b, tf_b, fcl::GST_LIBCCD,
+                               boxes ? "box-box" : "mpr");
+              }),
+      "fcl::collide (GST_LIBCCD)");
+}
+
+ContactResult fcl_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  // fcl_hull_contact with each shape's fcl::Convex built once per thread.
+  thread_local PrebuiltCache<std::shared_ptr<fcl::CollisionGeometryd>> cache;
+  return reject_undefined_normals(
+      guarded("fcl::collide (GST_LIBCCD)",
+              [&] {
+                auto geom_a = cache.get(a.shape, nullptr, [&] { return convex_geometry(a); });
+                auto geom_b = cache.get(b.shape, nullptr, [&] { return convex_geometry(b); });
+                return collide(geom_a, to_fcl(a.pose()), geom_b, to_fcl(b.pose()), fcl::GST_LIBCCD,
+                               "mpr");
+              }),
+      "fcl::collide (GST_LIBCCD, libccd MPR)");
 }
 
 ContactResult fcl_epa_contact(const RigidBody& a, const RigidBody& b) {

@@ -11,10 +11,13 @@ namespace rbx {
 ContactResult fcl_contact(const RigidBody& a, const RigidBody& b);
 /// `fcl-hull`: fcl::collide on Convex shapes with GST_LIBCCD (libccd MPR), boxes included.
 ContactResult fcl_hull_contact(const RigidBody& a, const RigidBody& b);
-/// `fcl-hull` with each shape's fcl::Convex built once and kept (the last few shapes, held by their
-/// shared_ptr) instead of on every call: the same query, for timing FCL without its set-up, as
-/// a user holding FCL objects across steps runs it. Used by `rbx bench` (variant "prebuilt").
+/// `fcl` with each shape's geometry (Box or Convex) built once and kept (reference/
+/// prebuilt_cache.h) instead of on every call: the same query, for timing FCL without its
+/// set-up, as a user holding FCL objects across steps runs it. Variant "prebuilt" of `fcl`
+/// (`rbx bench` on hulls, the report's query times).
 ContactResult fcl_contact_prebuilt(const RigidBody& a, const RigidBody& b);
+/// `fcl-hull` with each shape's fcl::Convex built once and kept: variant "prebuilt".
+ContactResult fcl_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b);
 /// `fcl-epa`: fcl::distance with signed distance (GJK + EPA).
 ContactResult fcl_epa_contact(const RigidBody& a, const RigidBody& b);
 /// `fcl-indep`: fcl::collide on Convex shapes with GST_INDEP, defects shown as they are.

@@ -35,10 +35,12 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include "engine/format.h"
 #include "reference/c_error_trap.h"
+#include "reference/prebuilt_cache.h"
 
 namespace {
 
@@ -474,6 +476,14 @@ MassResult mass_of_geom(const RigidBody& body, bool box) {
   return r;
 }
 
+/// The settings of `mujoco` contact queries: meshes with multiccd, boxes included (see
+/// mujoco_contact).
+MujocoSettings mujoco_query_settings() {
+  MujocoSettings s;
+  s.box_geoms = false;
+  return s;
+}
+
 }  // namespace
 
 MujocoSettings mujoco_hull_settings() {
@@ -487,9 +497,7 @@ ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b) {
   // Contact queries take meshes with multiccd even for boxes: box geoms report half the depth
   // (0.05 for a true 0.1), the meshes the full depth to float precision. Only the dynamics,
   // whose stiffness can make up for the halving, use box geoms.
-  MujocoSettings s;
-  s.box_geoms = false;
-  return mujoco_contact_with(a, b, s);
+  return mujoco_contact_with(a, b, mujoco_query_settings());
 }
 
 ContactResult mujoco_hull_contact(const RigidBody& a, const RigidBody& b) {
@@ -504,36 +512,75 @@ DynamicsResult mujoco_hull_dynamics(const Scene& scene, const DynamicsOptions& o
   return mujoco_dynamics_with(scene, opt, mujoco_hull_settings());
 }
 
-ContactResult mujoco_contact_with(const RigidBody& a, const RigidBody& b,
-                                  const MujocoSettings& settings) {
-  ContactResult r;
-  const std::vector<RigidBody> bodies{a, b};
+namespace {
+
+/// A compiled two-body model for contact queries (`error` set when it failed to build).
+struct QueryModel {
+  ModelPtr m;
+  DataPtr d;
   ModelOptions opt;
-  opt.box_geoms = use_box_geoms(bodies, settings);
-  opt.multiccd = settings.multiccd;
   std::string error;
-  auto [m, d] = make_simulation(bodies, /*all_free=*/true, opt, &error);
-  if (!m) return {Status::Error, error, {}};
-  set_state(m.get(), d.get(), bodies);
-  const mjModel* mc = m.get();
-  mjData* dd = d.get();
+};
+
+QueryModel make_query_model(const RigidBody& a, const RigidBody& b,
+                            const MujocoSettings& settings) {
+  QueryModel q;
+  const std::vector<RigidBody> bodies{a, b};
+  q.opt.box_geoms = use_box_geoms(bodies, settings);
+  q.opt.multiccd = settings.multiccd;
+  std::tie(q.m, q.d) = make_simulation(bodies, /*all_free=*/true, q.opt, &q.error);
+  return q;
+}
+
+/// mj_forward on the model at the bodies' poses; every contact, converted.
+ContactResult query_model(QueryModel& q, const RigidBody& a, const RigidBody& b) {
+  if (!q.m) return {Status::Error, q.error, {}};
+  ContactResult r;
+  set_state(q.m.get(), q.d.get(), {a, b});
+  const mjModel* mc = q.m.get();
+  mjData* dd = q.d.get();
   t_trap.clear_warning();
   if (!guarded([&] { mj_forward(mc, dd); }))
     return {Status::Error, std::string("MuJoCo mj_forward: ") + t_trap.error, {}};
   if (t_trap.has_warning())
     return {Status::Error, std::string("MuJoCo warning: ") + t_trap.warning, {}};
-  const int body_a = m->geom_bodyid[geom_of(mc, 0)];
-  for (int i = 0; i < d->ncon; ++i) {
-    const mjContact& c = d->contact[i];
+  const int body_a = mc->geom_bodyid[geom_of(mc, 0)];
+  for (int i = 0; i < dd->ncon; ++i) {
+    const mjContact& c = dd->contact[i];
     if (c.dist > 0.0) continue;  // inside the margin only (margin is 0: does not happen)
-    r.contacts.push_back(convert_contact(c, m->geom_bodyid[c.geom1] == body_a));
-    r.contacts.back().feature = opt.box_geoms ? "box-box" : "mesh";
+    r.contacts.push_back(convert_contact(c, mc->geom_bodyid[c.geom1] == body_a));
+    r.contacts.back().feature = q.opt.box_geoms ? "box-box" : "mesh";
   }
   // 2.2.2's box-box collider reports half the depth (pinned in tests/reference/mujoco_test.cpp):
   // passed on, labelled.
-  if (opt.box_geoms && !r.contacts.empty())
+  if (q.opt.box_geoms && !r.contacts.empty())
     r.message = "MuJoCo 2.2.2 box-box: depth reported at half its true value (known defect)";
   return r;
+}
+
+/// The contact query with the pair's model compiled once per thread (variant "prebuilt").
+ContactResult prebuilt_query(const RigidBody& a, const RigidBody& b, const MujocoSettings& settings,
+                             PrebuiltCache<QueryModel>& cache) {
+  QueryModel& q = cache.get(a.shape, b.shape, [&] { return make_query_model(a, b, settings); });
+  return query_model(q, a, b);
+}
+
+}  // namespace
+
+ContactResult mujoco_contact_with(const RigidBody& a, const RigidBody& b,
+                                  const MujocoSettings& settings) {
+  QueryModel q = make_query_model(a, b, settings);
+  return query_model(q, a, b);
+}
+
+ContactResult mujoco_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local PrebuiltCache<QueryModel> cache;
+  return prebuilt_query(a, b, mujoco_query_settings(), cache);
+}
+
+ContactResult mujoco_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local PrebuiltCache<QueryModel> cache;
+  return prebuilt_query(a, b, mujoco_hull_settings(), cache);
 }
 
 DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& opt,

@@ -23,6 +23,10 @@ MujocoSettings mujoco_hull_settings();
 ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b);
 /// `mujoco-hull`: contacts of mesh geoms from mj_forward.
 ContactResult mujoco_hull_contact(const RigidBody& a, const RigidBody& b);
+/// `mujoco` and `mujoco-hull` with the pair's model compiled once and kept (reference/
+/// prebuilt_cache.h), each query setting the poses and running mj_forward: variant "prebuilt".
+ContactResult mujoco_contact_prebuilt(const RigidBody& a, const RigidBody& b);
+ContactResult mujoco_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b);
 /// The contact query with explicit settings.
 ContactResult mujoco_contact_with(const RigidBody& a, const RigidBody& b,
                                   const MujocoSettings& settings);

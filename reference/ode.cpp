@@ -31,6 +31,7 @@
 #include <utility>
 
 #include "reference/c_error_trap.h"
+#include "reference/prebuilt_cache.h"
 
 namespace {
 
@@ -318,22 +319,35 @@ BodyFinal read_state(const RigidBody& b, dBodyID body) {
 
 namespace {
 
-ContactResult contact_query(const RigidBody& a, const RigidBody& b, bool native) {
+/// A geom kept across queries (the "prebuilt" variants), destroyed with its data.
+using KeptGeom = std::shared_ptr<ConvexGeom>;
+
+KeptGeom keep_geom(const RigidBody& b, bool native) {
+  return KeptGeom(new ConvexGeom(make_geom(nullptr, b, native)), [](ConvexGeom* g) {
+    dGeomDestroy(g->geom);
+    delete g;
+  });
+}
+
+/// dCollide of the two bodies; geoms built in the query, or kept in `prebuilt` (one cache per
+/// variant: the shape alone is the key).
+ContactResult contact_query(const RigidBody& a, const RigidBody& b, bool native,
+                            PrebuiltCache<KeptGeom>* prebuilt = nullptr) {
   init_ode();
   ContactResult r;
-  ConvexGeom ga = make_geom(nullptr, a, native);
-  ConvexGeom gb = make_geom(nullptr, b, native);
-  const char* feature = pair_feature(ga.geom, gb.geom);
-  place_geom(ga.geom, a);
-  place_geom(gb.geom, b);
+  KeptGeom ga = prebuilt ? prebuilt->get(a.shape, nullptr, [&] { return keep_geom(a, native); })
+                         : keep_geom(a, native);
+  KeptGeom gb = prebuilt ? prebuilt->get(b.shape, nullptr, [&] { return keep_geom(b, native); })
+                         : keep_geom(b, native);
+  const char* feature = pair_feature(ga->geom, gb->geom);
+  place_geom(ga->geom, a);
+  place_geom(gb->geom, b);
   dContactGeom contacts[kMaxContacts];
   int n = 0;
   t_trap.clear_warning();
-  const dGeomID g1 = ga.geom, g2 = gb.geom;
+  const dGeomID g1 = ga->geom, g2 = gb->geom;
   const bool ok =
       guarded([&] { n = dCollide(g1, g2, kMaxContacts, contacts, sizeof(dContactGeom)); });
-  dGeomDestroy(ga.geom);
-  dGeomDestroy(gb.geom);
   if (!ok) return {Status::Error, t_trap.error, {}};
   if (t_trap.has_warning()) r.message = t_trap.warning;
   for (int i = 0; i < n; ++i) r.contacts.push_back(convert_contact(contacts[i], feature));
@@ -356,6 +370,16 @@ ContactResult ode_contact(const RigidBody& a, const RigidBody& b) {
 
 ContactResult ode_hull_contact(const RigidBody& a, const RigidBody& b) {
   return contact_query(a, b, false);
+}
+
+ContactResult ode_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local PrebuiltCache<KeptGeom> cache;
+  return contact_query(a, b, true, &cache);
+}
+
+ContactResult ode_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local PrebuiltCache<KeptGeom> cache;
+  return contact_query(a, b, false, &cache);
 }
 
 DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {

@@ -21,6 +21,10 @@ OdeSettings ode_hull_settings();
 ContactResult ode_contact(const RigidBody& a, const RigidBody& b);
 /// `ode-hull`: dCollide on dCreateConvex geoms (libccd MPR in Debian's build, one point).
 ContactResult ode_hull_contact(const RigidBody& a, const RigidBody& b);
+/// `ode` and `ode-hull` with each shape's geom built once and kept (reference/prebuilt_cache.h),
+/// placed at each query: variant "prebuilt".
+ContactResult ode_contact_prebuilt(const RigidBody& a, const RigidBody& b);
+ContactResult ode_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b);
 /// `ode` dynamics: dWorldStep with dContactBounce on the native geoms.
 DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt);
 /// `ode-hull` dynamics: the same world on convex geoms.

@@ -71,8 +71,23 @@ const std::vector<QueryVariant>& query_variants() {
   static const std::vector<QueryVariant> table = {
       {"custom", "seed", "the seed's faithful loops (the fast detector's oracle)",
        custom_seed_contact},
-      {"fcl", "prebuilt", "each fcl::Convex built once and kept, as a user holding FCL objects",
+      {"fcl", "prebuilt",
+       "each fcl::Box or Convex built once and kept, as a user holding FCL "
+       "objects",
        fcl_contact_prebuilt},
+      {"fcl-hull", "prebuilt", "each fcl::Convex built once and kept", fcl_hull_contact_prebuilt},
+      {"bullet", "prebuilt", "each btBoxShape or polyhedral hull built once and kept",
+       bullet_contact_prebuilt},
+      {"bullet-hull", "prebuilt", "each btConvexHullShape built once and kept",
+       bullet_hull_contact_prebuilt},
+      {"bullet-sat", "prebuilt", "each polyhedral hull built once and kept",
+       bullet_sat_contact_prebuilt},
+      {"ode", "prebuilt", "each dBox or dConvex geom built once and kept", ode_contact_prebuilt},
+      {"ode-hull", "prebuilt", "each dConvex geom built once and kept", ode_hull_contact_prebuilt},
+      {"mujoco", "prebuilt", "the pair's model compiled once and kept (poses set, mj_forward)",
+       mujoco_contact_prebuilt},
+      {"mujoco-hull", "prebuilt", "the pair's model compiled once and kept",
+       mujoco_hull_contact_prebuilt},
   };
   return table;
 }

@@ -372,9 +372,11 @@ std::string write_markdown(const std::vector<Scene>& scenes,
         "marker is the coarsest step; the same scenes stand behind every point of a curve "
         "(self-consistency errors are in `sweep.csv` only). Contacts: one point per backend, "
         "normal angle error and depth error in two panels, median over the scenes with the 25-75 "
-        "% band on both axes and the worst scene as a small hollow marker; query times include "
-        "building the library's shape on each call, while the custom engine reuses its hulls "
-        "(prebuilt timings: `rbx bench`). Errors under 1e-13 are round-off and are drawn at 1e-15 "
+        "% band on both axes and the worst scene as a small hollow marker; filled markers time "
+        "the backend as it runs (the library's shape built in each query), the larger hollow "
+        "marker on the same row, joined by a dotted line, the same query with its shapes "
+        "prebuilt (the table below the figures). Errors under 1e-13 are round-off and are drawn at "
+        "1e-15 "
         "in the grey band. The dashed line is the Pareto front over backends. Numbers: "
         "`sweep.csv`, `metrics.csv`.\n\n";
   std::set<std::string> families;
@@ -384,6 +386,7 @@ std::string write_markdown(const std::vector<Scene>& scenes,
   if (!figures_ok) md << "_Figures were not drawn: " << figures_msg << "_\n\n";
   for (const std::string& f : families)
     md << "![error against run time, " << f << "](figures/error_vs_runtime_" << f << ".png)\n\n";
+  md << query_time_markdown(evs, cols);
 
   // Stability.
   md << "## Stability\n\n";

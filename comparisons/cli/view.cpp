@@ -226,6 +226,20 @@ constexpr const char* kScript = R"JS(
   function frameAt(times, t) {  // last frame at or before t
     var k = 0; while (k + 1 < times.length && times[k + 1] <= t + 1e-12) ++k; return k;
   }
+  // The pose at time t between key frames k and k + 1 (results keep key frames only): positions
+  // linearly, quaternions by normalised lerp on the short arc, as the frames were thinned.
+  function pose(f, times, k, t) {
+    var a = f[Math.min(k, f.length - 1)];
+    if (k + 1 >= f.length || k + 1 >= times.length || times[k + 1] <= times[k]) return a;
+    var b = f[k + 1], u = Math.min(Math.max((t - times[k]) / (times[k + 1] - times[k]), 0), 1);
+    var dot = a[3] * b[3] + a[4] * b[4] + a[5] * b[5] + a[6] * b[6], sg = dot < 0 ? -1 : 1;
+    var out = [], n = 0, j;
+    for (j = 0; j < 3; ++j) out.push(a[j] + (b[j] - a[j]) * u);
+    for (j = 3; j < 7; ++j) { out.push(a[j] + (sg * b[j] - a[j]) * u); n += out[j] * out[j]; }
+    n = Math.sqrt(n) || 1;
+    for (j = 3; j < 7; ++j) out[j] /= n;
+    return out;
+  }
   function setTime(t) {
     state.time = Math.min(Math.max(t, 0), duration);
     slider.value = duration > 0 ? Math.round(1000 * state.time / duration) : 0;
@@ -238,7 +252,7 @@ constexpr const char* kScript = R"JS(
       data.bodies.forEach(function (body, i) {
         var f = b.frames && b.frames[body.name];
         if (!f || !f.length) return;
-        var s = f[Math.min(k, f.length - 1)];
+        var s = pose(f, times, k, state.time);
         p.bodies[i].position.set(s[0], s[1], s[2]);
         p.bodies[i].quaternion.set(s[4], s[5], s[6], s[3]);
       });
@@ -525,8 +539,8 @@ std::string view_page(const Json& data, const std::string& three_js, const std::
   if (data.contains("ghost"))
     h << ". Grey ghost in every panel: " << html_escape(data["ghost"].value("label", ""))
       << " (shown with the reference)";
-  h << ". Trajectories are sampled (at most " << kMaxFrames << " frames); at most "
-    << kViewMaxEvents
+  h << ". Trajectories are sampled (at most " << kMaxFrames
+    << " frames, thinned to key frames and interpolated between them); at most " << kViewMaxEvents
     << " events per backend are drawn.</p>\n<div id=\"controls\"><button id=\"play\">play</button> "
        "<input id=\"slider\" type=\"range\" min=\"0\" max=\"1000\" value=\"0\"> <span "
        "id=\"clock\"></span> "

@@ -26,6 +26,12 @@ namespace rbx {
 
 namespace {
 
+/// True when two answers to one query are the same contact (bit for bit: a prebuilt shape is
+/// the same shape).
+bool same_answer(const ContactPoint& x, const ContactPoint& y) {
+  return x.normal == y.normal && x.point == y.point && x.depth == y.depth;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Small helpers
 
@@ -393,6 +399,20 @@ class Evaluator {
         metric("contact", name, pair, "point_err_rel",
                contact_point_error(c->point, a, b, sat.manifold) / size, "exact");
       out_.sweep.push_back({name, "contact", 0.0, run.runtime_s, angle, normal_src});
+      // The same query with the library's shapes built once (its "prebuilt" variant): the
+      // figures time both, so that the cost of building a shape shows apart from the query.
+      if (const QueryVariant* v = find_query_variant(name, "prebuilt")) {
+        Backend pre = be;
+        pre.name = name + "+prebuilt";
+        pre.contact = v->contact;
+        const ContactRun pr = timed_contact(pre, a, b);
+        const ContactPoint* pc = deepest(pr.result);
+        if (pr.result.status != Status::Ok || !pc || !same_answer(*c, *pc))
+          out_.disagreements.push_back(name + " on " + pair +
+                                       ": the prebuilt variant answers differently");
+        else
+          out_.sweep.push_back({name, "contact-prebuilt", 0.0, pr.runtime_s, angle, normal_src});
+      }
       // Disagreement marks: beyond round-off-level tolerance of the truth (1e-6 rad ~ 6e-5 deg;
       // depth within the scene's tolerance or 1e-6 of the body size).
       const double depth_tol = std::max(tol, 1e-6 * size);

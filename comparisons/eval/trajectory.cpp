@@ -1,6 +1,7 @@
 #include "comparisons/eval/trajectory.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace rbx {
@@ -16,6 +17,58 @@ double round_sig5(double x) {
   return std::round(x * scale) / scale;
 }
 
+namespace {
+
+/// One moving body's pose in a frame: x, y, z, qw, qx, qy, qz.
+using FramePose = std::array<double, 7>;
+
+/// Poses of frame `b` interpolated at the time of frame `i` between frames `a` and `b`, as the
+/// replay page draws them: positions linearly, quaternions by normalised lerp on the short arc.
+FramePose interpolate(const FramePose& pa, const FramePose& pb, double s) {
+  FramePose out;
+  for (int k = 0; k < 3; ++k) out[k] = pa[k] + (pb[k] - pa[k]) * s;
+  double dot = 0.0;
+  for (int k = 3; k < 7; ++k) dot += pa[k] * pb[k];
+  const double sign = dot < 0.0 ? -1.0 : 1.0;
+  double norm = 0.0;
+  for (int k = 3; k < 7; ++k) {
+    out[k] = pa[k] + (sign * pb[k] - pa[k]) * s;
+    norm += out[k] * out[k];
+  }
+  norm = std::sqrt(norm);
+  for (int k = 3; k < 7; ++k) out[k] /= norm > 0.0 ? norm : 1.0;
+  return out;
+}
+
+/// True when every frame strictly between `a` and `b` is reproduced by interpolating a and b
+/// within `pos_tol` (m) and kKeyFrameTolerance per quaternion component (either sign).
+bool interpolable(const std::vector<double>& time, const std::vector<std::vector<FramePose>>& poses,
+                  size_t a, size_t b, double pos_tol) {
+  for (size_t i = a + 1; i < b; ++i) {
+    const double s = (time[i] - time[a]) / (time[b] - time[a]);
+    for (const std::vector<FramePose>& body : poses) {
+      const FramePose p = interpolate(body[a], body[b], s);
+      double same = 0.0, flipped = 0.0, dp = 0.0;
+      for (int k = 0; k < 3; ++k) dp = std::max(dp, std::abs(p[k] - body[i][k]));
+      for (int k = 3; k < 7; ++k) {
+        same = std::max(same, std::abs(p[k] - body[i][k]));
+        flipped = std::max(flipped, std::abs(p[k] + body[i][k]));
+      }
+      if (dp > pos_tol || std::min(same, flipped) > kKeyFrameTolerance) return false;
+    }
+  }
+  return true;
+}
+
+/// `x` on the decimal grid of step 1 / `per_unit` (a power of ten, so that the shortest
+/// decimal form of the result is the grid value; no negative zero).
+double on_grid(double x, double per_unit) {
+  const double r = std::round(x * per_unit) / per_unit;
+  return r == 0.0 ? 0.0 : r;
+}
+
+}  // namespace
+
 Json trajectory_json(const std::vector<StateSample>& samples, const std::vector<RigidBody>& inputs,
                      size_t max_frames) {
   if (samples.empty()) return Json::object();
@@ -29,21 +82,54 @@ Json trajectory_json(const std::vector<StateSample>& samples, const std::vector<
             : static_cast<size_t>(std::llround(static_cast<double>(k) * (n - 1) / (frames - 1)));
     if (picks.empty() || picks.back() != i) picks.push_back(i);
   }
-  Json time = Json::array();
-  Json bodies = Json::object();
+  // The moving bodies' poses at the picks (names in the first sample's order).
+  std::vector<std::string> names;
+  for (const BodyFinal& s : samples.front().bodies) {
+    const auto in = std::find_if(inputs.begin(), inputs.end(),
+                                 [&](const RigidBody& b) { return b.name == s.name; });
+    if (in == inputs.end() || !in->is_static) names.push_back(s.name);
+  }
+  std::vector<double> time;
+  std::vector<std::vector<FramePose>> poses(names.size());
+  double extent = 0.0;
   for (size_t i : picks) {
-    time.push_back(round_sig5(samples[i].time));
-    for (const BodyFinal& s : samples[i].bodies) {
-      const auto in = std::find_if(inputs.begin(), inputs.end(),
-                                   [&](const RigidBody& b) { return b.name == s.name; });
-      if (in != inputs.end() && in->is_static) continue;
-      const Quat q = s.orientation.normalized();
-      bodies[s.name].push_back({round_sig5(s.position.x()), round_sig5(s.position.y()),
-                                round_sig5(s.position.z()), round_sig5(q.w()), round_sig5(q.x()),
-                                round_sig5(q.y()), round_sig5(q.z())});
+    time.push_back(samples[i].time);
+    for (size_t j = 0; j < names.size(); ++j) {
+      const auto s = std::find_if(samples[i].bodies.begin(), samples[i].bodies.end(),
+                                  [&](const BodyFinal& f) { return f.name == names[j]; });
+      FramePose p{};
+      if (s != samples[i].bodies.end()) {
+        const Quat q = s->orientation.normalized();
+        p = {s->position.x(), s->position.y(), s->position.z(), q.w(), q.x(), q.y(), q.z()};
+      } else if (!poses[j].empty()) {
+        p = poses[j].back();
+      }
+      for (int k = 0; k < 3; ++k) extent = std::max(extent, std::abs(p[k]));
+      poses[j].push_back(p);
     }
   }
-  return {{"time", time}, {"bodies", bodies}};
+  // Key frames: from each kept frame, reach as far as interpolation holds (greedy).
+  const double pos_tol = kKeyFrameTolerance * std::max(extent, 1e-9);
+  std::vector<size_t> keys = {0};
+  for (size_t i = 1; i + 1 < time.size(); ++i)
+    if (!interpolable(time, poses, keys.back(), i + 1, pos_tol)) keys.push_back(i);
+  if (time.size() > 1) keys.push_back(time.size() - 1);
+  // Rounded output: positions on a decimal grid of 1e-4..1e-5 of the extent.
+  const double per_unit = std::pow(10.0, 4.0 - std::floor(std::log10(std::max(extent, 1e-9))));
+  Json jt = Json::array();
+  Json bodies = Json::object();
+  for (size_t k : keys) jt.push_back(round_sig5(time[k]));
+  for (size_t j = 0; j < names.size(); ++j) {
+    Json frames_json = Json::array();
+    for (size_t k : keys) {
+      const FramePose& p = poses[j][k];
+      frames_json.push_back({on_grid(p[0], per_unit), on_grid(p[1], per_unit),
+                             on_grid(p[2], per_unit), on_grid(p[3], 1e5), on_grid(p[4], 1e5),
+                             on_grid(p[5], 1e5), on_grid(p[6], 1e5)});
+    }
+    bodies[names[j]] = frames_json;
+  }
+  return {{"time", jt}, {"bodies", bodies}};
 }
 
 Json results_scene_json(const Json& scene_result) {

@@ -22,16 +22,25 @@ size_t frame_budget(size_t moving_bodies);
 /// Rounds to 5 significant digits (a replay needs no more; it keeps the JSON short).
 double round_sig5(double x);
 
+/// Key-frame tolerance: a frame is dropped when interpolating its neighbours (positions linearly,
+/// quaternions by normalised lerp, as the replay page does) reproduces every moving body within
+/// kKeyFrameTolerance of the trajectory's extent (largest |coordinate|) and within
+/// kKeyFrameTolerance in each quaternion component: 0.1 pixel of a 1000-pixel view.
+constexpr double kKeyFrameTolerance = 1e-4;
+
 /// A run's samples thinned to at most `max_frames` evenly spaced frames, the first and the last
-/// kept: {"time": [s...], "bodies": {NAME: [[x, y, z, qw, qx, qy, qz] per frame]}}. Positions
-/// are the centres of mass (m, world); quaternions body to world. Static bodies are left out
-/// (their pose is the scene's). Empty object when there are no samples.
+/// kept, then to the key frames (see kKeyFrameTolerance): free flight between two events needs
+/// two frames, not a hundred. {"time": [s...], "bodies": {NAME: [[x, y, z, qw, qx, qy, qz] per
+/// frame]}}. Positions are the centres of mass (m, world), on a decimal grid of 1e-4..1e-5 of the
+/// extent; quaternions body to world, on a grid of 1e-5. Static bodies are left out (their pose
+/// is the scene's). Empty object when there are no samples.
 Json trajectory_json(const std::vector<StateSample>& samples, const std::vector<RigidBody>& inputs,
                      size_t max_frames);
 
 /// Events kept per backend in results.json: a resting stack reports a contact every step
 /// (16 000 for Bullet), which made results.json 27.8 MB; the count is kept as `contacts_total`.
-constexpr size_t kResultsMaxEvents = 100;
+/// 50 keeps the library's results under 5 MB; `rbx run SCENE --json` writes every event.
+constexpr size_t kResultsMaxEvents = 50;
 
 /// A scene's result object for results.json: each backend's `contacts` cut to the first
 /// kResultsMaxEvents (with `contacts_total`, and `contacts_truncated` when cut).

@@ -100,6 +100,7 @@ def error_vs_runtime(report, out):
     metrics = list(csv.DictReader(open(os.path.join(report, "metrics.csv"))))
     sweeps = defaultdict(list)  # (family, scene, backend) -> [(dt, runtime, error)]
     qtime = defaultdict(lambda: defaultdict(list))  # family, backend -> query times (s)
+    ptime = defaultdict(lambda: defaultdict(list))  # the same with the shapes prebuilt
     for r in rows:
         if r["kind"] == "dynamics":
             # Only closed-form references are comparable across time steps and scenes (a
@@ -108,6 +109,8 @@ def error_vs_runtime(report, out):
                 continue
             sweeps[(r["family"], r["scene"], r["backend"])].append(
                 (float(r["dt"]), float(r["runtime_s"]), float(r["error"])))
+        elif r["kind"] == "contact-prebuilt":
+            ptime[r["family"]][r["backend"]].append(float(r["runtime_s"]))
         else:
             qtime[r["family"]][r["backend"]].append(float(r["runtime_s"]))
     # Scenes differ in dt (and some set their own sweep_dt), so the points of a curve are the
@@ -186,6 +189,16 @@ def error_vs_runtime(report, out):
                 ax.scatter([t2], [floored(worst)], marker=marker, s=18, facecolors="none",
                            edgecolors=colour)
                 pts.append((t2, floored(q2)))
+                # The same query with the library's shapes built once: a hollow marker at the
+                # prebuilt median time, joined to the per-call one; the gap is the median
+                # cost of building the shapes in a query.
+                pre = ptime[family].get(backend)
+                if pre:
+                    p2 = quartiles([t * 1e6 for t in pre])[1]
+                    ax.plot([p2, t2], [floored(q2), floored(q2)], color=colour, lw=0.8, ls=":")
+                    ax.scatter([p2], [floored(q2)], marker=marker, s=55, facecolors="white",
+                               edgecolors=colour, linewidths=1.5, zorder=3)
+                    pts.append((p2, floored(q2)))
             front = pareto(pts)
             if len(front) > 1:
                 ax.step([p[0] for p in front], [p[1] for p in front], where="post",
@@ -193,7 +206,7 @@ def error_vs_runtime(report, out):
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_xlabel("time per contact query (µs), median over scenes, bar 25-75 %\n"
-                          "(libraries build their shape in each query; custom reuses its hulls)")
+                          "filled: shapes built in each query; hollow, dotted: shapes prebuilt")
             ax.set_ylabel(f"{label}: median over scenes,\nbar 25-75 %; small hollow: worst scene")
             ax.grid(True, which="both", alpha=0.3)
             # Between the round-off band and the worst scenes, where no point lies.

@@ -23,4 +23,11 @@ std::string scorecard_markdown(const std::vector<Scene>& scenes,
                                const std::vector<SceneEvaluation>& evs,
                                const std::vector<std::string>& backends, bool views);
 
+/// The contact query times in Markdown: per backend, the median over the scenes' queries of the
+/// time per query with the library's shapes built in the query (as the backend runs), with them
+/// prebuilt (its "prebuilt" variant, where it has one), and the difference, the cost of
+/// building them. Empty when no contact query ran.
+std::string query_time_markdown(const std::vector<SceneEvaluation>& evs,
+                                const std::vector<std::string>& backends);
+
 }  // namespace rbx
