@@ -399,6 +399,8 @@ const StepRunner kStepRunners[] = {
        const RunResult r = w.run();
        return r.ok ? std::string() : r.message;
      }},
+    {"custom-seed", "default",
+     [](const Scene& s) { return run_registry_backend("custom-seed", s); }},
     {"bullet", "default", [](const Scene& s) { return run_registry_backend("bullet", s); }},
 };
 

@@ -1,10 +1,10 @@
 // Sampled trajectories for results.json and the replay pages: key frames reproduce every sample
 // they drop within the stated tolerance, events are capped with their total kept.
+#include "comparisons/eval/trajectory.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "comparisons/eval/trajectory.h"
 
 namespace rbx {
 namespace {
@@ -39,7 +39,8 @@ Vec3 position_at(const Json& traj, double t) {
   while (k + 1 < time.size() && time[k + 1].get<double>() <= t) ++k;
   auto at = [&](size_t i) { return Vec3(f[i][0], f[i][1], f[i][2]); };
   if (k + 1 >= time.size()) return at(k);
-  const double u = (t - time[k].get<double>()) / (time[k + 1].get<double>() - time[k].get<double>());
+  const double u =
+      (t - time[k].get<double>()) / (time[k + 1].get<double>() - time[k].get<double>());
   return at(k) + (at(k + 1) - at(k)) * u;
 }
 
@@ -70,8 +71,7 @@ TEST(Trajectory, KeyFramesReproduceTheDroppedSamples) {
   EXPECT_GT(keys, 3u);
   EXPECT_LT(keys, kMaxFrames);
   double extent = 0.0;
-  for (const auto& smp : s)
-    extent = std::max(extent, smp.bodies[0].position.cwiseAbs().maxCoeff());
+  for (const auto& smp : s) extent = std::max(extent, smp.bodies[0].position.cwiseAbs().maxCoeff());
   // The budget's frames: every 10th sample (1001 samples, 100 frames).
   double worst = 0.0;
   for (size_t k = 0; k < kMaxFrames; ++k) {
@@ -103,7 +103,9 @@ TEST(Trajectory, StaticBodiesAreLeftOut) {
 TEST(Trajectory, ResultsKeepTheFirstEventsAndTheirCount) {
   Json events = Json::array();
   for (size_t i = 0; i < kResultsMaxEvents + 7; ++i) events.push_back({{"step", i}});
-  const Json scene = {{"backends", {{"custom", {{"contacts", events}}}, {"few", {{"contacts", Json::array({{{"step", 0}}})}}}}}};
+  const Json scene = {{"backends",
+                       {{"custom", {{"contacts", events}}},
+                        {"few", {{"contacts", Json::array({{{"step", 0}}})}}}}}};
   const Json out = results_scene_json(scene);
   EXPECT_EQ(out["backends"]["custom"]["contacts"].size(), kResultsMaxEvents);
   EXPECT_EQ(out["backends"]["custom"]["contacts_total"], kResultsMaxEvents + 7);

@@ -37,7 +37,7 @@ std::vector<std::pair<RigidBody, RigidBody>> pairs() {
   out.push_back({cube, pyramid});
   out.push_back({pyramid, at(slab, Vec3(0.4, 0.8, 0.4), Quat::Identity())});
   out.push_back({cube, at(slab, Vec3(5.0, 0.0, 0.0), Quat::Identity())});  // separated
-  out.push_back({cube, slab});                                              // back to the first
+  out.push_back({cube, slab});                                             // back to the first
   return out;
 }
 
