@@ -91,6 +91,9 @@ class World {
   std::string failure_;
   double energy0_ = 0.0;       // J, total energy at t = 0
   double energy_scale_ = 0.0;  // J, the energy budget the guard compares growth with
+  // Per body, fixed by its shape: thickness (shape_thickness) and the bounding radius about
+  // the centre of mass, for the time-of-impact search (filled on its first step).
+  std::vector<double> thickness_, radius_;
 };
 
 /// Builds every body of the scene and runs it with the custom engine.

@@ -97,13 +97,22 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
   const size_t n = bodies_.size();
   std::vector<bool> moved(n, false);
   if (sim_.integrator != Integrator::Symplectic) return moved;  // the seed's Euler: no TOI
-  // Per body: thickness, sweep over the step, bounding radius about the centre of mass.
-  std::vector<double> thick(n), sweep(n), radius(n, 0.0);
+  // Per body: thickness and bounding radius about the centre of mass (once: shapes do not
+  // change), sweep over the step.
+  if (thickness_.size() != n) {
+    thickness_.assign(n, 0.0);
+    radius_.assign(n, 0.0);
+    for (size_t i = 0; i < n; ++i) {
+      thickness_[i] = shape_thickness(*bodies_[i].shape);
+      for (const Vec3& v : bodies_[i].shape->vertices())
+        radius_[i] = std::max(radius_[i], v.norm());
+    }
+  }
+  const std::vector<double>&thick = thickness_, &radius = radius_;
+  std::vector<double> sweep(n);
   double thinnest = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < n; ++i) {
-    thick[i] = shape_thickness(*bodies_[i].shape);
     sweep[i] = sweep_length(bodies_[i], dt);
-    for (const Vec3& v : bodies_[i].shape->vertices()) radius[i] = std::max(radius[i], v.norm());
     thinnest = std::min(thinnest, thick[i]);
   }
   std::set<std::pair<int, int>> touching;
