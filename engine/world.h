@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "engine/body.h"
@@ -10,6 +11,7 @@
 #include "engine/contact_solver.h"
 #include "engine/detect.h"
 #include "engine/scene.h"
+#include "engine/separation.h"
 
 namespace rbx {
 
@@ -94,6 +96,12 @@ class World {
   // Per body, fixed by its shape: thickness (shape_thickness) and the bounding radius about
   // the centre of mass, for the time-of-impact search (filled on its first step).
   std::vector<double> thickness_, radius_;
+  // Per pair (key i * bodies + j) that passed the bounding check but was found apart: the
+  // triangles that proved it (engine/separation.h), tried first at the next step.
+  std::unordered_map<long long, SeparationWitness> witnesses_;
+  // True when the pair (i, j) is proved apart (the detector would find nothing): by its kept
+  // witness, else by a new one, which is then kept.
+  bool separated(int i, int j);
 };
 
 /// Builds every body of the scene and runs it with the custom engine.

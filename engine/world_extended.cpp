@@ -24,6 +24,7 @@ void World::step_extended() {
   for (const BodyPair& pair : broad_phase_.find_pairs(bodies_)) {
     const RigidBody &a = bodies_[pair.first], &b = bodies_[pair.second];
     if (a.is_static && b.is_static) continue;
+    if (separated(pair.first, pair.second)) continue;  // the detector would find nothing
     auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant_);
     if (m) manifolds.push_back({pair.first, pair.second, std::move(*m), a.pose(), b.pose()});
   }
@@ -89,6 +90,26 @@ void World::step_extended() {
   for (size_t m = 0; m < manifolds.size(); ++m)
     if (impulse[m] > 0.0) pressed.push_back(std::move(manifolds[m]));
   project_contact_positions(bodies_, pressed);
+}
+
+bool World::separated(int i, int j) {
+  const RigidBody &a = bodies_[i], &b = bodies_[j];
+  const double margin = separation_margin(*a.shape, *b.shape);
+  const long long key = static_cast<long long>(i) * static_cast<long long>(bodies_.size()) + j;
+  const auto kept = witnesses_.find(key);
+  if (kept != witnesses_.end() &&
+      still_separated(kept->second, *a.shape, a.pose(), *b.shape, b.pose(), margin))
+    return true;
+  SeparationWitness w;
+  w.face_of_b = find_face_beyond(*a.shape, a.pose(), *b.shape, b.pose(), margin);
+  if (w.face_of_b >= 0)
+    w.face_of_a = find_face_beyond(*b.shape, b.pose(), *a.shape, a.pose(), margin);
+  if (w.face_of_a >= 0) {
+    witnesses_[key] = w;
+    return true;
+  }
+  if (kept != witnesses_.end()) witnesses_.erase(kept);
+  return false;
 }
 
 std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& manifolds,
