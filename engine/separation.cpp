@@ -1,63 +1,86 @@
 #include "engine/separation.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
-
-#include "engine/detect.h"
+#include <vector>
 
 namespace rbx {
 
-double separation_margin(const ConvexPolyhedron& a, const ConvexPolyhedron& b) {
-  return 2.0 * point_in_mesh_tolerance(a, b);
+double tolerance_reach(const ConvexPolyhedron& shape) {
+  const auto& tris = shape.triangles();
+  const auto& planes = shape.planes();
+  // Each vertex's triangle normals.
+  std::vector<std::vector<int>> around(shape.vertices().size());
+  for (size_t f = 0; f < tris.size(); ++f)
+    for (int v : tris[f]) around[v].push_back(static_cast<int>(f));
+  double reach = 1.0;
+  for (const std::vector<int>& faces : around) {
+    // Distinct normals only: a box corner is in one or two triangles of each face.
+    std::vector<Vec3> normals;
+    for (int f : faces)
+      if (std::none_of(normals.begin(), normals.end(),
+                       [&](const Vec3& n) { return (n - planes[f].normal).norm() <= 1e-12; }))
+        normals.push_back(planes[f].normal);
+    Vec3 w = Vec3::Zero();
+    for (const Vec3& n : normals) w += n;
+    if (!(w.norm() > 0.0)) return std::numeric_limits<double>::infinity();
+    w.normalize();
+    double least = std::numeric_limits<double>::infinity();
+    for (int f : faces) least = std::min(least, planes[f].normal.dot(w));
+    if (!(least > 0.0)) return std::numeric_limits<double>::infinity();
+    reach = std::max(reach, 1.0 / least);
+  }
+  return reach;
+}
+
+double separation_margin(double tol, double reach_a, double reach_b) {
+  return (std::max(reach_a, reach_b) + 1.0) * tol;
+}
+
+double gap_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                 const Pose& pb, const Vec3& u) {
+  // Each body's extreme along u in its own frame: one rotation, then a dot per vertex.
+  const Vec3 ua = pa.orientation.conjugate() * u, ub = pb.orientation.conjugate() * u;
+  double low_a = std::numeric_limits<double>::infinity();
+  double high_b = -std::numeric_limits<double>::infinity();
+  for (const Vec3& v : a.vertices()) low_a = std::min(low_a, v.dot(ua));
+  for (const Vec3& v : b.vertices()) high_b = std::max(high_b, v.dot(ub));
+  return (low_a + pa.position.dot(u)) - (high_b + pb.position.dot(u));
 }
 
 namespace {
 
-// The least signed distance of a's vertices beyond the plane of b's triangle `face`: the plane
-// taken into a's frame once, then one dot product per vertex.
-double least_beyond(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                    const Pose& pb, int face) {
-  const Vec3 n = pb.orientation * b.planes()[face].normal;  // world, unit
-  const Vec3 q = pb.apply(b.vertices()[b.triangles()[face][0]]);
-  const Vec3 n_a = pa.orientation.conjugate() * n;  // in a's frame
-  const double offset = (pa.position - q).dot(n);
-  double least = std::numeric_limits<double>::infinity();
-  for (const Vec3& v : a.vertices()) least = std::min(least, v.dot(n_a));
-  return least + offset;
-}
-
-}  // namespace
-
-bool beyond_face(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                 const Pose& pb, int face, double margin) {
-  return least_beyond(a, pa, b, pb, face) > margin;
-}
-
-int find_face_beyond(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                     const Pose& pb, double margin) {
-  const long work =
-      static_cast<long>(b.triangles().size()) + static_cast<long>(a.vertices().size());
-  if (work > kMaxSeparationWork) return -1;
-  // The one triangle most likely to separate: its normal nearest the direction from b's centre
-  // of mass toward a's (in b's frame). Trying every triangle cost more, on the pairs where
-  // none separates, than it saved (many_1000).
-  const Vec3 d = pb.inverse_apply(pa.position);
-  int best = -1;
+// The world normal of `shape`'s triangle whose normal is nearest the world direction d.
+Vec3 nearest_normal(const ConvexPolyhedron& shape, const Pose& pose, const Vec3& d) {
+  const Vec3 local = pose.orientation.conjugate() * d;
+  int best = 0;
   double best_dot = -std::numeric_limits<double>::infinity();
-  for (size_t f = 0; f < b.triangles().size(); ++f) {
-    const double x = b.planes()[f].normal.dot(d);
+  for (size_t f = 0; f < shape.planes().size(); ++f) {
+    const double x = shape.planes()[f].normal.dot(local);
     if (x > best_dot) {
       best_dot = x;
       best = static_cast<int>(f);
     }
   }
-  return best >= 0 && beyond_face(a, pa, b, pb, best, margin) ? best : -1;
+  return pose.orientation * shape.planes()[best].normal;
 }
 
-bool still_separated(const SeparationWitness& w, const ConvexPolyhedron& a, const Pose& pa,
-                     const ConvexPolyhedron& b, const Pose& pb, double margin) {
-  return w.face_of_b >= 0 && w.face_of_a >= 0 && beyond_face(a, pa, b, pb, w.face_of_b, margin) &&
-         beyond_face(b, pb, a, pa, w.face_of_a, margin);
+}  // namespace
+
+Vec3 find_separating_axis(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                          const Pose& pb, double margin) {
+  const long work = static_cast<long>(a.vertices().size() + b.vertices().size() +
+                                      a.triangles().size() + b.triangles().size());
+  if (work > kMaxSeparationWork || !std::isfinite(margin)) return Vec3::Zero();
+  const Vec3 d = pa.position - pb.position;
+  if (!(d.norm() > 0.0)) return Vec3::Zero();
+  const Vec3 centres = d.normalized();
+  // b's face toward a, the line of centres, a's face toward b (negated: from b toward a).
+  for (const Vec3& u :
+       {nearest_normal(b, pb, centres), centres, Vec3(-nearest_normal(a, pa, -centres))})
+    if (gap_along(a, pa, b, pb, u) > margin) return u;
+  return Vec3::Zero();
 }
 
 }  // namespace rbx

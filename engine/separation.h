@@ -1,6 +1,7 @@
 // Proof that the detector finds no contact, cheaper than running it: the extended world keeps,
-// per pair, a triangle of each body whose plane has the other body wholly beyond it, and skips
-// detection while both still hold (most pairs that pass the bounding check in a crowd).
+// per pair, an axis along which the two bodies are apart by more than the detector's tolerance
+// can bridge, and skips detection while it holds (most pairs that pass the bounding check in a
+// crowd, and every body against a far wall).
 #pragma once
 
 #include "engine/math.h"
@@ -8,38 +9,36 @@
 
 namespace rbx {
 
-/// Two triangles that separate a pair: every vertex of A beyond the plane of B's triangle
-/// `face_of_b`, every vertex of B beyond the plane of A's triangle `face_of_a` (-1: none).
-struct SeparationWitness {
-  int face_of_b = -1;
-  int face_of_a = -1;
-};
+/// How far the detector's tolerant inside test reaches beyond a shape, per unit tolerance: the
+/// test accepts p when (p - q_f) . n_f <= tol for every triangle f, a region that extends past
+/// the shape along a unit direction u by at most tol * c (c >= 1). Bound used: at the support
+/// vertex v of u, u = sum of lambda_f n_f over v's triangles with lambda >= 0, and for any unit
+/// w with n_f . w > 0 on all of them, sum lambda_f <= 1 / min_f n_f . w; w is the normalised
+/// sum of v's distinct triangle normals; c is the largest such bound over the vertices (sqrt 3 for
+/// a box). Infinite when a vertex's normals admit no such w (no witness is then ever given).
+double tolerance_reach(const ConvexPolyhedron& shape);
 
-/// The margin a witness must clear (m): twice the detector's point-in-mesh tolerance of the pair.
-/// Every point the Moore & Wilhelms tests try in B (triangle centroids, vertices, points on
-/// edges of A) is a convex combination of A's vertices, and B's inside test is (p - q_f) . n_f
-/// <= tol for every triangle f of B; so if one triangle of B has every vertex of A more than
-/// tol beyond its plane, no tried point of A is inside B, and likewise with A and B swapped:
-/// the detector returns nothing. The second tol covers the round-off between this test's
-/// arithmetic and the detector's (~1e-15 of the coordinates, 10^6 times smaller for poses within
-/// 10^6 sizes of the origin, see point_in_mesh_tolerance).
-double separation_margin(const ConvexPolyhedron& a, const ConvexPolyhedron& b);
+/// The margin an axis must clear (m): (max(c_a, c_b) + 1) x the pair's point-in-mesh tolerance
+/// (c from tolerance_reach). Every point the Moore & Wilhelms tests try in B (triangle
+/// centroids, vertices, points on edges of A) lies in A, and B's tolerant inside region lies
+/// within c_b tol of B; if A and B are apart along an axis by more than c_b tol, no tried point
+/// of A is inside B, and likewise with A and B swapped: the detector returns nothing. The extra
+/// tol covers the round-off between this test's arithmetic and the detector's (~1e-15 of the
+/// coordinates, 10^6 times smaller for poses within 10^6 sizes of the origin).
+double separation_margin(double tol, double reach_a, double reach_b);
 
-/// True when every vertex of `a` at `pa` is more than `margin` beyond the plane of triangle
-/// `face` of `b` at `pb`.
-bool beyond_face(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                 const Pose& pb, int face, double margin);
+/// The gap between `a` and `b` along the unit world axis `u` pointing from b toward a:
+/// min over a's vertices of u . v minus max over b's vertices of u . v (m; negative: overlap).
+double gap_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                 const Pose& pb, const Vec3& u);
 
-/// The triangle of `b` whose normal points most nearly toward `a`'s centre of mass, if every
-/// vertex of `a` is more than `margin` beyond its plane; else -1 (also for shapes whose
-/// triangles and vertices number more than kMaxSeparationWork: large hulls go to the
-/// detector, whose own trees are then the cheaper way).
-int find_face_beyond(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                     const Pose& pb, double margin);
+/// A unit world axis from b toward a along which the pair is apart by more than `margin`, from
+/// a few candidates (the direction between the centres of mass, b's triangle normal nearest it,
+/// a's triangle normal nearest its opposite); the zero vector when none is. Large shapes (more
+/// than kMaxSeparationWork vertices and triangles together) get none: the detector's own trees
+/// are then the cheaper way.
+Vec3 find_separating_axis(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                          const Pose& pb, double margin);
 constexpr long kMaxSeparationWork = 4096;
-
-/// True when `w` still separates the pair (both triangles set and both planes clear).
-bool still_separated(const SeparationWitness& w, const ConvexPolyhedron& a, const Pose& pa,
-                     const ConvexPolyhedron& b, const Pose& pb, double margin);
 
 }  // namespace rbx

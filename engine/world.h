@@ -96,11 +96,13 @@ class World {
   // Per body, fixed by its shape: thickness (shape_thickness) and the bounding radius about
   // the centre of mass, for the time-of-impact search (filled on its first step).
   std::vector<double> thickness_, radius_;
-  // Per pair (key i * bodies + j) that passed the bounding check but was found apart: the
-  // triangles that proved it (engine/separation.h), tried first at the next step.
-  std::unordered_map<long long, SeparationWitness> witnesses_;
+  // Per pair (key i * bodies + j) that passed the bounding check but was found apart: the axis
+  // that proved it (engine/separation.h), in b's frame, tried first at the next step.
+  std::unordered_map<long long, Vec3> witnesses_;
+  // Per body: how far the detector's tolerance reaches beyond its shape (tolerance_reach).
+  std::vector<double> reach_;
   // True when the pair (i, j) is proved apart (the detector would find nothing): by its kept
-  // witness, else by a new one, which is then kept.
+  // axis, else by a new one, which is then kept.
   bool separated(int i, int j);
 };
 

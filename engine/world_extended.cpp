@@ -94,18 +94,20 @@ void World::step_extended() {
 
 bool World::separated(int i, int j) {
   const RigidBody &a = bodies_[i], &b = bodies_[j];
-  const double margin = separation_margin(*a.shape, *b.shape);
+  if (reach_.size() != bodies_.size()) {
+    reach_.resize(bodies_.size());
+    for (size_t k = 0; k < bodies_.size(); ++k) reach_[k] = tolerance_reach(*bodies_[k].shape);
+  }
+  const double margin =
+      separation_margin(point_in_mesh_tolerance(*a.shape, *b.shape), reach_[i], reach_[j]);
   const long long key = static_cast<long long>(i) * static_cast<long long>(bodies_.size()) + j;
   const auto kept = witnesses_.find(key);
   if (kept != witnesses_.end() &&
-      still_separated(kept->second, *a.shape, a.pose(), *b.shape, b.pose(), margin))
+      gap_along(*a.shape, a.pose(), *b.shape, b.pose(), b.orientation * kept->second) > margin)
     return true;
-  SeparationWitness w;
-  w.face_of_b = find_face_beyond(*a.shape, a.pose(), *b.shape, b.pose(), margin);
-  if (w.face_of_b >= 0)
-    w.face_of_a = find_face_beyond(*b.shape, b.pose(), *a.shape, a.pose(), margin);
-  if (w.face_of_a >= 0) {
-    witnesses_[key] = w;
+  const Vec3 u = find_separating_axis(*a.shape, a.pose(), *b.shape, b.pose(), margin);
+  if (u != Vec3::Zero()) {
+    witnesses_[key] = b.orientation.conjugate() * u;
     return true;
   }
   if (kept != witnesses_.end()) witnesses_.erase(kept);
