@@ -101,6 +101,8 @@ class World {
   std::unordered_map<long long, Vec3> witnesses_;
   // Per body: how far the detector's tolerance reaches beyond its shape (tolerance_reach).
   std::vector<double> reach_;
+  // Per body: the point-in-mesh tolerance of its shape against itself (1e-9 x its size).
+  std::vector<double> own_tol_;
   // True when the pair (i, j) is proved apart (the detector would find nothing): by its kept
   // axis, else by a new one, which is then kept.
   bool separated(int i, int j);

@@ -96,10 +96,14 @@ bool World::separated(int i, int j) {
   const RigidBody &a = bodies_[i], &b = bodies_[j];
   if (reach_.size() != bodies_.size()) {
     reach_.resize(bodies_.size());
-    for (size_t k = 0; k < bodies_.size(); ++k) reach_[k] = tolerance_reach(*bodies_[k].shape);
+    own_tol_.resize(bodies_.size());
+    for (size_t k = 0; k < bodies_.size(); ++k) {
+      reach_[k] = tolerance_reach(*bodies_[k].shape);
+      own_tol_[k] = point_in_mesh_tolerance(*bodies_[k].shape, *bodies_[k].shape);
+    }
   }
-  const double margin =
-      separation_margin(point_in_mesh_tolerance(*a.shape, *b.shape), reach_[i], reach_[j]);
+  // The pair's tolerance, 1e-9 x the larger size, is the larger of the two bodies' own.
+  const double margin = separation_margin(std::max(own_tol_[i], own_tol_[j]), reach_[i], reach_[j]);
   const long long key = static_cast<long long>(i) * static_cast<long long>(bodies_.size()) + j;
   const auto kept = witnesses_.find(key);
   if (kept != witnesses_.end() &&
