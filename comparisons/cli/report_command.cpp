@@ -401,7 +401,15 @@ std::string write_markdown(const std::vector<Scene>& scenes,
             "at rest", "tunnelled", "jitter (m/s)", "why"});
   bool any_stab = false;
   for (size_t i = 0; i < evs.size(); ++i) {
+    // The verdict at the scene's step, then at the other steps of its own sweep (if it names
+    // one), each backend's rows together.
+    std::vector<std::pair<std::string, Json>> rows;
     for (const auto& [name, s] : evs[i].json["stability"].items()) {
+      rows.emplace_back(name, s);
+      if (evs[i].json.contains("stability_sweep") && evs[i].json["stability_sweep"].contains(name))
+        for (const Json& sw : evs[i].json["stability_sweep"][name]) rows.emplace_back(name, sw);
+    }
+    for (const auto& [name, s] : rows) {
       any_stab = true;
       std::string why;
       for (const auto& w : s["why"]) why += (why.empty() ? "" : "; ") + w.get<std::string>();
@@ -531,7 +539,15 @@ int report_command(const ReportOptions& opt) {
         sweep << sc << "," << fam << "," << p.backend << "," << p.kind << "," << fmt_num(p.dt, 17)
               << "," << fmt_num(p.runtime_s, 6) << "," << fmt_num(p.error, 17) << ","
               << csv_escape(p.against) << "\n";
-      for (const auto& [name, s] : evs[i].json["stability"].items())
+      std::vector<std::pair<std::string, Json>> stab_rows;  // the scene's step, then its sweep
+      for (const auto& [name, s] : evs[i].json["stability"].items()) {
+        stab_rows.emplace_back(name, s);
+        if (evs[i].json.contains("stability_sweep") &&
+            evs[i].json["stability_sweep"].contains(name))
+          for (const Json& sw : evs[i].json["stability_sweep"][name])
+            stab_rows.emplace_back(name, sw);
+      }
+      for (const auto& [name, s] : stab_rows)
         stab << sc << "," << fam << "," << name << "," << fmt_num(s["dt"].get<double>(), 17) << ","
              << fmt_num(s["restitution"].get<double>(), 17) << ","
              << s["verdict"].get<std::string>() << ","

@@ -236,6 +236,7 @@ class Evaluator {
                        {"against", s.against}});
     j["sweep"] = sweep;
     j["stability"] = stability_json_.is_null() ? Json::object() : stability_json_;
+    if (!stability_sweep_json_.is_null()) j["stability_sweep"] = stability_sweep_json_;
     j["skipped"] = out_.skipped;
     // A documented limitation excuses the engine it names only ("custom: ..." or
     // "custom-seed: ...", the text before the colon): any other subject's failure (the oracle's:
@@ -577,6 +578,8 @@ class Evaluator {
       // does not pay for the self-consistency run.
       const bool wants_velocity =
           scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory);
+      const bool stability_sweep =
+          scene_.has_check(CheckKind::Stability) && !scene_.sim.sweep_dt.empty() && wants_sweep;
       if (wants_sweep || (!have_expect && wants_velocity) ||
           scene_.has_check(CheckKind::Trajectory)) {
         // Without a sweep only the finest step is needed (the self-consistency reference).
@@ -585,8 +588,11 @@ class Evaluator {
           if (std::abs(dt - scene_.sim.dt) <= 1e-15 * dt)
             sweep_runs.push_back(main);
           else {
-            // The finest run of a trajectory check is sampled at the same times as the main run.
-            const bool sample = scene_.has_check(CheckKind::Trajectory) && dt == finest;
+            // The finest run of a trajectory check is sampled at the same times as the main run;
+            // so is every swept run of a stability scene that names its own sweep (its verdict
+            // is given at each step: the thin wall must not tunnel at any).
+            const bool sample =
+                (scene_.has_check(CheckKind::Trajectory) && dt == finest) || stability_sweep;
             const long every =
                 sample ? std::max<long>(1, std::lround(sample_every * scene_.sim.dt / dt)) : 0;
             sweep_runs.push_back(run_dynamics(be, scene_, dt, every, cache_, inputs_));
@@ -731,6 +737,11 @@ class Evaluator {
             have_expect ? ke_norm_error(inputs_, main.result.finals, expected, e0_kin) : 0.0);
       if (scene_.has_check(CheckKind::Stability))
         stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
+      // The verdict at every other swept step (report rows; not metrics of the check).
+      if (stability_sweep)
+        for (const DynRun& r : sweep_runs)
+          if (std::abs(r.dt - scene_.sim.dt) > 1e-15 * r.dt)
+            stability(name, r, e0, p0, h0, closed, p_scale, h_scale, /*swept=*/true);
     }
     if (!angular) out_.skipped.push_back("angular metrics: nothing rotates in this scene");
   }
@@ -882,8 +893,10 @@ class Evaluator {
 
   // Stability on stiff and extreme scenes: non-finite states, energy drift, momentum drift,
   // maximum penetration (whole run and at rest), tunnelling, jitter at rest, and a verdict.
+  // `swept`: a run at another step of the scene's sweep: its verdict goes to the JSON's
+  // `stability_sweep` (and the report's table), not to the metrics.
   void stability(const std::string& name, const DynRun& run, double e0, const Vec3& p0,
-                 const Vec3& h0, bool closed, double p_scale, double h_scale) {
+                 const Vec3& h0, bool closed, double p_scale, double h_scale, bool swept = false) {
     Json s;
     const auto& samples = run.result.samples;
     bool nonfinite = run.result.status == Status::Error &&
@@ -1046,6 +1059,10 @@ class Evaluator {
     const StabilityVerdict verdict = stability_verdict(facts);
     s["verdict"] = verdict.verdict;
     s["why"] = verdict.why;
+    if (swept) {
+      stability_sweep_json_[name].push_back(s);
+      return;
+    }
     stability_json_[name] = s;
     metric("stability", name, "", "energy_growth_err", std::max(growth, 0.0), "invariant");
     metric("stability", name, "", "max_penetration_rel_err", pen_max, "exact");
@@ -1143,6 +1160,7 @@ class Evaluator {
   SceneEvaluation out_;
   Json backends_json_;
   Json stability_json_;
+  Json stability_sweep_json_;  // per backend: the verdicts at the other swept steps
 };
 
 }  // namespace

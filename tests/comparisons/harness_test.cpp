@@ -135,3 +135,34 @@ TEST(HarnessExpect, AnEngineRunThatStopsFailsItsExpectationAndReferencesDoNotBin
 
 }  // namespace
 }  // namespace rbx
+
+namespace rbx {
+namespace {
+
+TEST(Harness, TheThinWallGetsAVerdictAtEverySweptStep) {
+  // stress/tunnel_thin_wall names its own sweep (1e-2 .. 5e-5 s): the stability verdict is
+  // given at each step. The custom engine's time of impact keeps the plate from passing the
+  // wall at every one; the seed's algorithm passes through at the written 1e-2 s.
+  const Scene scene =
+      load_scene(std::string(RBX_SOURCE_DIR) + "/scenes/stress/tunnel_thin_wall.toml");
+  HarnessOptions opt;
+  opt.backends = "custom,custom-seed";
+  const SceneEvaluation ev = evaluate_scene(scene, opt);
+  ASSERT_TRUE(ev.json.contains("stability_sweep"));
+  const Json& swept = ev.json["stability_sweep"]["custom"];
+  ASSERT_EQ(swept.size(), scene.sim.sweep_dt.size() - 1);  // every step but the scene's own
+  std::vector<double> dts;
+  for (const Json& s : swept) {
+    dts.push_back(s["dt"].get<double>());
+    EXPECT_EQ(s["tunnelled_pairs"].get<int>(), 0) << "custom at dt = " << s["dt"];
+  }
+  for (double dt : scene.sim.sweep_dt) {
+    if (dt == scene.sim.dt) continue;
+    EXPECT_NE(std::find(dts.begin(), dts.end(), dt), dts.end()) << dt;
+  }
+  EXPECT_EQ(ev.json["stability"]["custom"]["tunnelled_pairs"].get<int>(), 0);
+  EXPECT_EQ(ev.json["stability"]["custom-seed"]["tunnelled_pairs"].get<int>(), 1);
+}
+
+}  // namespace
+}  // namespace rbx
