@@ -293,6 +293,9 @@ void project_contact_positions(std::vector<RigidBody>& bodies,
   // ~v dt, not so fast that a deep start is thrown apart in one step. The slop, 1e-4 of the
   // smaller body's size, keeps touching contacts touching (the detector sees them next step)
   // and is 10x under the 0.1 % of a body the issue allows at rest.
+  // Moving positions with the velocities held does not keep the angular momentum about the
+  // origin (r x m v changes with r): measured on many_1000, the drift of 1.2e-7 (relative) is
+  // this projection's (without it, 1e-15); Bullet's positional correction drifts 1.1e-6 there.
   constexpr double kBaumgarte = 0.2;
   constexpr int kIterations = 4;
   const std::vector<BodyInverse> inv = inverses(bodies);
