@@ -266,6 +266,19 @@ int compare_baseline(const Json& now, const std::string& path) {
   return worse ? 1 : 0;
 }
 
+// The disagreement groups of an explore result, one row each (both kinds).
+std::string groups_table(const Json& j) {
+  Table g({"backend", "signature", "count", "rate", "scene", "points", "reproduced"});
+  for (const auto& [name, b] : j["backends"].items())
+    for (const Json& x : b["groups"])
+      g.add({name, x["signature"], std::to_string(x["count"].get<long>()), fmt_num(x["rate"], 3),
+             x["scene"].is_string() ? x["scene"].get<std::string>() : std::string("-"),
+             std::to_string(x.value("points_before", 0)) + " -> " +
+                 std::to_string(x.value("points_after", 0)),
+             x.value("reproduced", false) ? "yes" : "no"});
+  return g.markdown();
+}
+
 std::string markdown_impact(const Json& j) {
   std::ostringstream o;
   o << "# rbx explore: " << j["count"] << " random single-point impacts, seed " << j["seed"]
@@ -305,15 +318,7 @@ std::string markdown_impact(const Json& j) {
        "is static), the contact's features, the kind of error. Each group's first sample was "
        "shrunk to the scene named; `reproduced` says whether `rbx compare` shows the velocity "
        "error on it.\n\n";
-  Table g({"backend", "signature", "count", "rate", "scene", "points", "reproduced"});
-  for (const auto& [name, b] : j["backends"].items())
-    for (const Json& x : b["groups"])
-      g.add({name, x["signature"], std::to_string(x["count"].get<long>()), fmt_num(x["rate"], 3),
-             x["scene"].is_string() ? x["scene"].get<std::string>() : std::string("-"),
-             std::to_string(x.value("points_before", 0)) + " -> " +
-                 std::to_string(x.value("points_after", 0)),
-             x.value("reproduced", false) ? "yes" : "no"});
-  o << g.markdown();
+  o << groups_table(j);
   return o.str();
 }
 
@@ -345,15 +350,7 @@ std::string markdown(const Json& j, bool have_figure) {
        "oracle's axis (face_a, face_b, edge_edge, or separated), the kind of error. Each group's "
        "first sample was shrunk to the scene named; `reproduced` says whether `rbx compare` shows "
        "the same disagreement on it.\n\n";
-  Table g({"backend", "signature", "count", "rate", "scene", "points", "reproduced"});
-  for (const auto& [name, b] : j["backends"].items())
-    for (const Json& x : b["groups"])
-      g.add({name, x["signature"], std::to_string(x["count"].get<long>()), fmt_num(x["rate"], 3),
-             x["scene"].is_string() ? x["scene"].get<std::string>() : std::string("-"),
-             std::to_string(x.value("points_before", 0)) + " -> " +
-                 std::to_string(x.value("points_after", 0)),
-             x.value("reproduced", false) ? "yes" : "no"});
-  o << g.markdown();
+  o << groups_table(j);
   return o.str();
 }
 
