@@ -22,8 +22,8 @@ namespace {
 /// One moving body's pose in a frame: x, y, z, qw, qx, qy, qz.
 using FramePose = std::array<double, 7>;
 
-/// Poses of frame `b` interpolated at the time of frame `i` between frames `a` and `b`, as the
-/// replay page draws them: positions linearly, quaternions by normalised lerp on the short arc.
+/// The pose a fraction `s` of the way from `pa` to `pb`, as the replay page draws it:
+/// positions linearly, quaternions by normalised lerp on the short arc.
 FramePose interpolate(const FramePose& pa, const FramePose& pb, double s) {
   FramePose out;
   for (int k = 0; k < 3; ++k) out[k] = pa[k] + (pb[k] - pa[k]) * s;

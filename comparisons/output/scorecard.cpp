@@ -206,23 +206,19 @@ std::string scorecard_markdown(const std::vector<Scene>& scenes,
 
 std::string query_time_markdown(const std::vector<SceneEvaluation>& evs,
                                 const std::vector<std::string>& backends) {
-  // Pairs (per call, prebuilt) of one query, per backend.
+  // Pairs (per call, prebuilt) of one query, per backend: the harness writes a query's
+  // prebuilt point right after its per-call point (none when the answers differed).
   std::map<std::string, std::vector<double>> per_call, prebuilt, built;
-  for (const SceneEvaluation& ev : evs) {
-    std::map<std::string, std::vector<double>> call_here, pre_here;
-    for (const SweepPoint& p : ev.sweep) {
-      if (p.kind == "contact") call_here[p.backend].push_back(p.runtime_s);
-      if (p.kind == "contact-prebuilt") pre_here[p.backend].push_back(p.runtime_s);
+  for (const SceneEvaluation& ev : evs)
+    for (size_t k = 0; k < ev.sweep.size(); ++k) {
+      const SweepPoint& p = ev.sweep[k];
+      if (p.kind == "contact") per_call[p.backend].push_back(p.runtime_s);
+      if (p.kind != "contact-prebuilt" || k == 0) continue;
+      const SweepPoint& call = ev.sweep[k - 1];
+      if (call.kind != "contact" || call.backend != p.backend) continue;
+      prebuilt[p.backend].push_back(p.runtime_s);
+      built[p.backend].push_back(call.runtime_s - p.runtime_s);
     }
-    for (auto& [b, v] : call_here) {
-      per_call[b].insert(per_call[b].end(), v.begin(), v.end());
-      const std::vector<double>& pre = pre_here[b];
-      for (size_t k = 0; k < pre.size() && k < v.size(); ++k) {
-        prebuilt[b].push_back(pre[k]);
-        built[b].push_back(v[k] - pre[k]);
-      }
-    }
-  }
   if (per_call.empty()) return "";
   Table t({"backend", "queries", "per call (µs)", "shapes prebuilt (µs)",
            "building the shapes (µs)", "per call / prebuilt"});
