@@ -93,16 +93,17 @@ class World {
   std::string failure_;
   double energy0_ = 0.0;       // J, total energy at t = 0
   double energy_scale_ = 0.0;  // J, the energy budget the guard compares growth with
-  // Per body, fixed by its shape: thickness (shape_thickness) and the bounding radius about
-  // the centre of mass, for the time-of-impact search (filled on its first step).
-  std::vector<double> thickness_, radius_;
+  // Per body, fixed by its shape: thickness (shape_thickness), bounding radius about the
+  // centre of mass, how far the detector's tolerance reaches beyond it (tolerance_reach), and
+  // its point-in-mesh tolerance against itself (1e-9 x its size). Filled on first use.
+  struct ShapeFacts {
+    double thickness = 0.0, radius = 0.0, reach = 1.0, own_tol = 0.0;
+  };
+  std::vector<ShapeFacts> facts_;
+  const std::vector<ShapeFacts>& shape_facts();
   // Per pair (key i * bodies + j) that passed the bounding check but was found apart: the axis
   // that proved it (engine/separation.h), in b's frame, tried first at the next step.
   std::unordered_map<long long, Vec3> witnesses_;
-  // Per body: how far the detector's tolerance reaches beyond its shape (tolerance_reach).
-  std::vector<double> reach_;
-  // Per body: the point-in-mesh tolerance of its shape against itself (1e-9 x its size).
-  std::vector<double> own_tol_;
   // True when the pair (i, j) is proved apart (the detector would find nothing): by its kept
   // axis, else by a new one, which is then kept.
   bool separated(int i, int j);

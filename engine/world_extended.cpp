@@ -92,18 +92,27 @@ void World::step_extended() {
   project_contact_positions(bodies_, pressed);
 }
 
-bool World::separated(int i, int j) {
-  const RigidBody &a = bodies_[i], &b = bodies_[j];
-  if (reach_.size() != bodies_.size()) {
-    reach_.resize(bodies_.size());
-    own_tol_.resize(bodies_.size());
+const std::vector<World::ShapeFacts>& World::shape_facts() {
+  if (facts_.size() != bodies_.size()) {
+    facts_.assign(bodies_.size(), {});
     for (size_t k = 0; k < bodies_.size(); ++k) {
-      reach_[k] = tolerance_reach(*bodies_[k].shape);
-      own_tol_[k] = point_in_mesh_tolerance(*bodies_[k].shape, *bodies_[k].shape);
+      const ConvexPolyhedron& shape = *bodies_[k].shape;
+      ShapeFacts& f = facts_[k];
+      f.thickness = shape_thickness(shape);
+      for (const Vec3& v : shape.vertices()) f.radius = std::max(f.radius, v.norm());
+      f.reach = tolerance_reach(shape);
+      f.own_tol = point_in_mesh_tolerance(shape, shape);
     }
   }
+  return facts_;
+}
+
+bool World::separated(int i, int j) {
+  const RigidBody &a = bodies_[i], &b = bodies_[j];
+  const std::vector<ShapeFacts>& facts = shape_facts();
   // The pair's tolerance, 1e-9 x the larger size, is the larger of the two bodies' own.
-  const double margin = separation_margin(std::max(own_tol_[i], own_tol_[j]), reach_[i], reach_[j]);
+  const double margin = separation_margin(std::max(facts[i].own_tol, facts[j].own_tol),
+                                          facts[i].reach, facts[j].reach);
   const long long key = static_cast<long long>(i) * static_cast<long long>(bodies_.size()) + j;
   const auto kept = witnesses_.find(key);
   if (kept != witnesses_.end() &&
@@ -124,23 +133,13 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
   const size_t n = bodies_.size();
   std::vector<bool> moved(n, false);
   if (sim_.integrator != Integrator::Symplectic) return moved;  // the seed's Euler: no TOI
-  // Per body: thickness and bounding radius about the centre of mass (once: shapes do not
-  // change), sweep over the step.
-  if (thickness_.size() != n) {
-    thickness_.assign(n, 0.0);
-    radius_.assign(n, 0.0);
-    for (size_t i = 0; i < n; ++i) {
-      thickness_[i] = shape_thickness(*bodies_[i].shape);
-      for (const Vec3& v : bodies_[i].shape->vertices())
-        radius_[i] = std::max(radius_[i], v.norm());
-    }
-  }
-  const std::vector<double>&thick = thickness_, &radius = radius_;
+  // Per body: thickness and bounding radius (fixed by the shape), sweep over the step.
+  const std::vector<ShapeFacts>& facts = shape_facts();
   std::vector<double> sweep(n);
   double thinnest = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < n; ++i) {
     sweep[i] = sweep_length(bodies_[i], dt);
-    thinnest = std::min(thinnest, thick[i]);
+    thinnest = std::min(thinnest, facts[i].thickness);
   }
   std::set<std::pair<int, int>> touching;
   for (const PairManifold& pm : manifolds) touching.insert({pm.a, pm.b});
@@ -156,7 +155,8 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
       if (sweep[j] > sweep[i] || (sweep[j] == sweep[i] && j < i)) continue;  // the faster one asks
       const int lo = static_cast<int>(std::min(i, j)), hi = static_cast<int>(std::max(i, j));
       if (touching.count({lo, hi})) continue;
-      if (!(sweep[i] + sweep[j] > 0.25 * std::min(thick[i], thick[j]))) continue;
+      if (!(sweep[i] + sweep[j] > 0.25 * std::min(facts[i].thickness, facts[j].thickness)))
+        continue;
       const RigidBody &a = bodies_[lo], &b = bodies_[hi];
       // Swept spheres (the bounding check along the step): the centres' closest approach over
       // the step within the radii sum; the radius about the centre of mass bounds every
@@ -164,7 +164,7 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
       const Vec3 p = a.position - b.position, q = (a.velocity - b.velocity) * dt;
       const double s =
           q.squaredNorm() > 0.0 ? std::clamp(-p.dot(q) / q.squaredNorm(), 0.0, 1.0) : 0.0;
-      if ((p + s * q).norm() > radius[lo] + radius[hi]) continue;
+      if ((p + s * q).norm() > facts[lo].radius + facts[hi].radius) continue;
       if (const auto t = time_of_impact(a, b, dt, variant_)) hits.emplace_back(*t, lo, hi);
     }
   }
