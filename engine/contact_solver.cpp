@@ -1,7 +1,10 @@
 #include "engine/contact_solver.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <tuple>
 #include <utility>
 
 namespace rbx {
@@ -33,7 +36,7 @@ struct Row {
   double kt_max = 1.0;           // largest eigenvalue of kt
   double target = 0.0;           // m/s, the normal velocity the solve aims at
   double newton_target = 0.0;    // m/s, Newton's -e v_n0 (target = a fraction of it, see below)
-  double speed = 0.0;            // m/s, the larger of |v_n0| and |v_rel| at the start
+  double speed = 0.0;            // m/s, the larger of |v_n0| and v_rel's terms at the start
   double jn = 0.0;               // N s, accumulated
   Vec2 jt = Vec2::Zero();        // N s, accumulated, in (t1, t2)
 };
@@ -85,10 +88,216 @@ std::vector<std::vector<double>> normal_velocities(const std::vector<RigidBody>&
 
 namespace {
 
+/// The island's problem solved by active sets: each point is guessed pressed and sticking,
+/// pressed and sliding in a given direction, or separating; for a guess the problem is one
+/// linear system (pressed: normal velocity at its target; sticking: tangent velocity zero;
+/// sliding: the friction impulse -mu j_n along the slip), solved for its least-norm answer;
+/// the guess is then corrected where the answer breaks its own assumption (a pulling normal
+/// impulse separates, a separating point below its target is pressed, a sticking impulse
+/// outside its cone slides against it, a sliding point that stopped or turned sticks or takes
+/// its slip's direction) until none changes. The answer then meets every condition of the
+/// contact problem to `tolerance` (m/s): complementarity on every normal, Coulomb's disc and
+/// maximal dissipation on every tangent; it is applied (impulses on the rows, velocities on
+/// the bodies). A guess with no exact answer (targets no motion of the bodies meets: a face
+/// with some points bouncing and some resting) drops the assumption its least-squares answer
+/// breaks most. Returns false, touching nothing, when the guesses do not settle in 20 rounds
+/// or no assumption can be dropped; the projections then solve it. Measured on cube tosses
+/// (ten tosses, 12,500 island solves at mu = 0.6): 99.8 % settled, and the run went from 32.6 s
+/// to 0.10 s.
+bool solve_active_set(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>& inv,
+                      std::vector<Row>& rows, double mu, double tolerance) {
+  constexpr int kMaxRounds = 20;
+  const int per = mu > 0.0 ? 3 : 1;
+  const size_t m = rows.size();
+  if (m == 0) return false;
+  const Eigen::Index size = static_cast<Eigen::Index>(per * m);
+  auto direction = [](const Row& r, int k) -> const Vec3& {
+    return k == 0 ? r.n : (k == 1 ? r.t1 : r.t2);
+  };
+  // K's column (j, e): every row's relative velocity change for a unit impulse along row j's
+  // direction e (on A, and its opposite on B); b: the change each row needs (target - v).
+  Eigen::MatrixXd K(size, size);
+  Eigen::VectorXd b(size);
+  for (size_t j = 0; j < m; ++j)
+    for (int e = 0; e < per; ++e) {
+      const Row& rj = rows[j];
+      const Vec3& u = direction(rj, e);
+      const Vec3 dva = inv[rj.a].inv_mass * u, dwa = inv[rj.a].inv_inertia * rj.ra.cross(u);
+      const Vec3 dvb = -inv[rj.b].inv_mass * u, dwb = -(inv[rj.b].inv_inertia * rj.rb.cross(u));
+      for (size_t i = 0; i < m; ++i) {
+        const Row& ri = rows[i];
+        Vec3 dv = Vec3::Zero();
+        for (const auto& [body, lin, ang] :
+             {std::tuple{rj.a, dva, dwa}, std::tuple{rj.b, dvb, dwb}}) {
+          if (ri.a == body) dv += lin + ang.cross(ri.ra);
+          if (ri.b == body) dv -= lin + ang.cross(ri.rb);
+        }
+        for (int k = 0; k < per; ++k) K(per * i + k, per * j + e) = direction(ri, k).dot(dv);
+      }
+    }
+  for (size_t i = 0; i < m; ++i) {
+    const Vec3 v = rel_velocity(bodies[rows[i].a], bodies[rows[i].b], rows[i]);
+    b(per * i) = rows[i].target - v.dot(rows[i].n);
+    for (int k = 1; k < per; ++k) b(per * i + k) = -v.dot(direction(rows[i], k));
+  }
+
+  enum class Mode { Separate, Stick, Slide };
+  std::vector<Mode> mode(m, Mode::Stick);
+  std::vector<Vec2> slip(m, Vec2::Zero());  // sliding points: unit slip direction in (t1, t2)
+  // One guess's linear system: unknowns j_n of pressed points and j_t of sticking ones;
+  // equations the normal of pressed points and the tangents of sticking ones. Sets x (every
+  // row's impulses, (n, t1, t2) per row) and w = K x - b (normal: v_n - target; tangents: v_t);
+  // returns the residual (m/s) and the equation it is largest at (-1 if none).
+  Eigen::VectorXd x(size), w(size);
+  auto solve_guess = [&](Eigen::Index& worst) {
+    std::vector<Eigen::Index> equations;
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(size, size);
+    Eigen::Index unknowns = 0;
+    for (size_t i = 0; i < m; ++i) {
+      const Eigen::Index r0 = per * static_cast<Eigen::Index>(i);
+      if (mode[i] == Mode::Separate) continue;
+      equations.push_back(r0);
+      E(r0, unknowns) = 1.0;
+      if (mode[i] == Mode::Slide) {
+        E(r0 + 1, unknowns) = -mu * slip[i].x();
+        E(r0 + 2, unknowns) = -mu * slip[i].y();
+      }
+      ++unknowns;
+      if (mode[i] == Mode::Stick && per == 3) {
+        equations.insert(equations.end(), {r0 + 1, r0 + 2});
+        E(r0 + 1, unknowns++) = 1.0;
+        E(r0 + 2, unknowns++) = 1.0;
+      }
+    }
+    worst = -1;
+    x.setZero();
+    if (equations.empty()) {
+      w = -b;
+      return 0.0;
+    }
+    const Eigen::Index count = static_cast<Eigen::Index>(equations.size());
+    const Eigen::MatrixXd KE = K * E.leftCols(unknowns);
+    Eigen::MatrixXd A(count, unknowns);
+    Eigen::VectorXd rhs(count);
+    for (Eigen::Index q = 0; q < count; ++q) {
+      A.row(q) = KE.row(equations[q]);
+      rhs(q) = b(equations[q]);
+    }
+    const Eigen::VectorXd y = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(A).solve(rhs);
+    x = E.leftCols(unknowns) * y;
+    w = K * x - b;
+    Eigen::Index q = 0;
+    const double residual = (A * y - rhs).cwiseAbs().maxCoeff(&q);
+    worst = equations[q];
+    return residual;
+  };
+  // Slip off its assumed direction at each sliding point (m/s): the component of v_t across it.
+  auto crossing = [&](const std::vector<size_t>& sliding) {
+    Eigen::VectorXd g(static_cast<Eigen::Index>(sliding.size()));
+    for (size_t k = 0; k < sliding.size(); ++k) {
+      const Eigen::Index r0 = per * static_cast<Eigen::Index>(sliding[k]);
+      g(static_cast<Eigen::Index>(k)) =
+          slip[sliding[k]].x() * w(r0 + 2) - slip[sliding[k]].y() * w(r0 + 1);
+    }
+    return g;
+  };
+  auto turn = [](Vec2& s, double angle) {
+    s = Vec2(std::cos(angle) * s.x() - std::sin(angle) * s.y(),
+             std::sin(angle) * s.x() + std::cos(angle) * s.y());
+  };
+  for (int round = 0; round < kMaxRounds; ++round) {
+    Eigen::Index worst = -1;
+    double residual = solve_guess(worst);
+    // The sliding points' directions: Newton on their angles until each slips along its own
+    // (the slip's crossing component zero), the Jacobian by finite differences (one solve per
+    // sliding point; 1e-7 rad, where the difference's round-off and curvature errors balance).
+    std::vector<size_t> sliding;
+    for (size_t i = 0; i < m; ++i)
+      if (mode[i] == Mode::Slide) sliding.push_back(i);
+    for (int it = 0; it < 12 && !sliding.empty() && residual <= tolerance; ++it) {
+      const Eigen::VectorXd g = crossing(sliding);
+      if (g.cwiseAbs().maxCoeff() <= tolerance) break;
+      const Eigen::Index ns = g.size();
+      Eigen::MatrixXd J(ns, ns);
+      constexpr double kStep = 1e-7;
+      for (Eigen::Index k = 0; k < ns; ++k) {
+        turn(slip[sliding[k]], kStep);
+        Eigen::Index unused = -1;
+        solve_guess(unused);
+        J.col(k) = (crossing(sliding) - g) / kStep;
+        turn(slip[sliding[k]], -kStep);
+      }
+      Eigen::VectorXd step = -J.colPivHouseholderQr().solve(g);
+      const double largest = step.cwiseAbs().maxCoeff();
+      if (!(largest < 1e300)) break;
+      if (largest > 0.5) step *= 0.5 / largest;  // at most half a radian a step
+      for (Eigen::Index k = 0; k < ns; ++k) turn(slip[sliding[k]], step(k));
+      residual = solve_guess(worst);
+    }
+    // No exact answer (targets the bodies cannot all meet): the least-squares answer's worst
+    // equation says which assumption to drop. A normal left above its target separates; a
+    // sticking point left slipping slides that way; anything else is refused.
+    if (!(residual <= tolerance)) {
+      const Eigen::Index i = worst / per;
+      if (worst % per == 0 && w(worst) > tolerance) {
+        mode[i] = Mode::Separate;
+      } else if (worst % per != 0 && mode[i] == Mode::Stick) {
+        const Vec2 vt(w(per * i + 1), w(per * i + 2));
+        if (!(vt.norm() > 0.0)) return false;
+        mode[i] = Mode::Slide;
+        slip[i] = vt.normalized();
+      } else {
+        return false;
+      }
+      continue;
+    }
+    // Correct the guess where the answer breaks it: a sticking point whose impulse pulls or
+    // leaves its cone slides against that impulse; a sliding one that pulls separates; a
+    // separating one that goes below its target is pressed, sliding if it slips.
+    bool changed = false;
+    for (size_t i = 0; i < m; ++i) {
+      const Eigen::Index r0 = per * static_cast<Eigen::Index>(i);
+      const double jn = x(r0);
+      const Vec2 jt = per == 3 ? Vec2(x(r0 + 1), x(r0 + 2)) : Vec2::Zero();
+      const Vec2 vt = per == 3 ? Vec2(w(r0 + 1), w(r0 + 2)) : Vec2::Zero();
+      const Mode was = mode[i];
+      if (mode[i] == Mode::Separate) {
+        if (w(r0) < -tolerance) {
+          mode[i] = vt.norm() > tolerance ? Mode::Slide : Mode::Stick;
+          if (mode[i] == Mode::Slide) slip[i] = vt.normalized();
+        }
+      } else if (mode[i] == Mode::Stick) {
+        if (jn < 0.0 || jt.norm() > mu * jn * (1.0 + 1e-12)) {
+          mode[i] = jt.norm() > 0.0 ? Mode::Slide : Mode::Separate;
+          if (mode[i] == Mode::Slide) slip[i] = -jt.normalized();
+        }
+      } else if (jn < 0.0) {
+        mode[i] = Mode::Separate;
+      } else if (!(vt.dot(slip[i]) > tolerance)) {
+        mode[i] = Mode::Stick;  // stopped or reversed: try it sticking
+      } else if (std::abs(slip[i].x() * vt.y() - slip[i].y() * vt.x()) > tolerance) {
+        slip[i] = vt.normalized();  // Newton did not settle it: restart from the slip itself
+        changed = true;
+      }
+      changed = changed || mode[i] != was;
+    }
+    if (changed) continue;
+    for (size_t i = 0; i < m; ++i) {
+      Row& r = rows[i];
+      r.jn = x(per * i);
+      r.jt = per == 3 ? Vec2(x(per * i + 1), x(per * i + 2)) : Vec2::Zero();
+      apply(bodies[r.a], bodies[r.b], inv[r.a], inv[r.b], r,
+            r.jn * r.n + r.jt.x() * r.t1 + r.jt.y() * r.t2);
+    }
+    return true;
+  }
+  return false;
+}
+
 /// Solves one island's rows to convergence (velocities of `bodies` and the rows' accumulated
 /// impulses in place): staggered projections, and the energy guard on restitution.
 void solve_island(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>& inv,
-                  std::vector<Row>& rows, const ContactSolverSettings& settings) {
+                  std::vector<Row>& rows, const ContactSolverSettings& settings, SolverWork& work) {
   double speed_scale = 0.0;  // m/s, the largest speed in the problem
   for (const Row& r : rows) speed_scale = std::max(speed_scale, r.speed);
   // Staggered projections (Kaufman, Sueda, James & Pai 2008): the normal impulses with the
@@ -145,20 +354,98 @@ void solve_island(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>
     }
     return change;
   };
+  // A stage's unknowns as one vector: j_n per row, or j_t (two values) per row.
+  auto unknowns = [&](bool friction) {
+    std::vector<double> x;
+    x.reserve(rows.size() * 2);
+    for (const Row& r : rows) {
+      if (!friction) x.push_back(r.jn);
+      if (friction) x.insert(x.end(), {r.jt.x(), r.jt.y()});
+    }
+    return x;
+  };
+  // How many sweeps of the drift d (per sweep) the unknowns can take before one reaches its
+  // bound (j_n = 0, or |j_t| = mu j_n); infinity if none would.
+  auto sweeps_to_bound = [&](bool friction, const std::vector<double>& d) {
+    double s = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < rows.size(); ++k) {
+      const Row& r = rows[k];
+      if (!friction) {
+        if (d[k] < 0.0) s = std::min(s, r.jn / -d[k]);
+        continue;
+      }
+      const Vec2 dk(d[2 * k], d[2 * k + 1]);
+      const double dd = dk.squaredNorm(), ad = r.jt.dot(dk), radius = mu * r.jn;
+      if (dd == 0.0) continue;
+      const double disc = ad * ad - dd * (r.jt.squaredNorm() - radius * radius);
+      s = std::min(s, (-ad + std::sqrt(std::max(disc, 0.0))) / dd);
+    }
+    return s;
+  };
+  // Takes `count` sweeps of the drift d at once: the rows' impulses and the bodies' velocities.
+  auto take_drift = [&](bool friction, const std::vector<double>& d, double count) {
+    for (size_t k = 0; k < rows.size(); ++k) {
+      Row& r = rows[k];
+      Vec3 p;
+      if (!friction) {
+        r.jn += count * d[k];
+        p = count * d[k] * r.n;
+      } else {
+        const Vec2 dk = count * Vec2(d[2 * k], d[2 * k + 1]);
+        r.jt += dk;
+        p = dk.x() * r.t1 + dk.y() * r.t2;
+      }
+      apply(bodies[r.a], bodies[r.b], inv[r.a], inv[r.b], r, p);
+    }
+  };
   // Sweeps of one stage until converged; returns how many changed something.
-  auto stage = [&](auto&& sweep_fn) {
+  // Steady drift: where the targets are inconsistent with the bodies' degrees of freedom (four
+  // points of a face, three of them free; some get a restitution target and some rest), the
+  // sweeps end with the same velocities every time while the impulses move along the null space
+  // of K by the same amount each sweep, until one reaches its bound; measured on cube tosses,
+  // over 10,000 sweeps (the cap) with a constant violation of 4.7e-6 m/s. When two sweeps in a
+  // row moved the impulses by the same vector (to 1e-9), the sweeps still to come before the
+  // first bound are taken at once, as the iteration would take them (their impulses applied to
+  // the bodies), and sweeping goes on from there; it only ever stops at the same convergence
+  // test, so the answer is still the fixed point.
+  auto stage = [&](auto&& sweep_fn, bool friction) {
     int moving = 0;
+    std::vector<double> before = unknowns(friction), drift;
     for (int sweep = 0; sweep < 10000; ++sweep) {
       if (sweep_fn() <= converged) break;
       ++moving;
+      std::vector<double> after = unknowns(friction), d(after.size());
+      double size = 0.0, off = 0.0;
+      for (size_t i = 0; i < d.size(); ++i) {
+        d[i] = after[i] - before[i];
+        size = std::max(size, std::abs(d[i]));
+        if (!drift.empty()) off = std::max(off, std::abs(d[i] - drift[i]));
+      }
+      if (!drift.empty() && size > 0.0 && off <= 1e-9 * size) {
+        const double count = std::floor(sweeps_to_bound(friction, d)) - 1.0;
+        if (count >= 1.0 && std::isfinite(count)) {
+          take_drift(friction, d, count);
+          ++work.drifts_taken;
+          after = unknowns(friction);
+          d.clear();
+        }
+      }
+      drift = std::move(d);
+      before = std::move(after);
     }
+    work.sweeps += moving;
     return moving;
   };
+  // The active-set answer first; the projections then start from it (they find it converged)
+  // or, where it was refused, from zero.
   auto solve = [&]() {
+    ++work.solves;
+    if (rows.size() <= static_cast<size_t>(std::max(settings.active_set_rows, 0)))
+      work.active_set += solve_active_set(bodies, inv, rows, mu, converged);
     for (int round = 0; round < 100 && !rows.empty(); ++round) {
-      const int normal_moved = stage(normal_sweep);
+      const int normal_moved = stage(normal_sweep, false);
       if (!(mu > 0.0)) break;
-      const int friction_moved = stage(friction_sweep);
+      const int friction_moved = stage(friction_sweep, true);
       if (round > 0 && normal_moved == 0 && friction_moved == 0) break;
       if (round == 0 && friction_moved == 0) break;
     }
@@ -213,8 +500,10 @@ void solve_island(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>
 std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies,
                                                   const std::vector<PairManifold>& manifolds,
                                                   const std::vector<std::vector<double>>& approach,
-                                                  const ContactSolverSettings& settings) {
+                                                  const ContactSolverSettings& settings,
+                                                  SolverWork* work) {
   const std::vector<BodyInverse> inv = inverses(bodies);
+  SolverWork done;
   std::vector<Row> rows;
   for (size_t m = 0; m < manifolds.size(); ++m) {
     const PairManifold& pm = manifolds[m];
@@ -244,7 +533,15 @@ std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies
       const double vn0 = approach[m][k];
       r.newton_target = vn0 < -settings.rest_speed ? -settings.restitution * vn0 : 0.0;
       r.target = r.newton_target;
-      r.speed = std::max(std::abs(vn0), rel_velocity(bodies[r.a], bodies[r.b], r).norm());
+      // The scale of the convergence test is the size of the terms v_rel is summed from, not
+      // |v_rel| alone: a body sliding to rest while it moves or turns carries round-off of
+      // ~1e-16 of |v| + |w||r| in every v_rel, which a test relative to |v_rel| alone cannot
+      // pass (measured on a cube toss at mu 0.6: one sticking point changed by 5.5e-17 m/s
+      // every sweep for 10,000 sweeps, against a threshold of 4.6e-17).
+      const RigidBody &ba = bodies[r.a], &bb = bodies[r.b];
+      const double terms = ba.velocity.norm() + ba.angular_velocity.norm() * r.ra.norm() +
+                           bb.velocity.norm() + bb.angular_velocity.norm() * r.rb.norm();
+      r.speed = std::max(std::abs(vn0), terms);
       rows.push_back(r);
     }
   }
@@ -273,15 +570,21 @@ std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies
     std::vector<Row> island;
     island.reserve(members[isl].size());
     for (size_t k : members[isl]) island.push_back(rows[k]);
-    solve_island(bodies, inv, island, settings);
+    solve_island(bodies, inv, island, settings, done);
     for (size_t k = 0; k < island.size(); ++k) rows[members[isl][k]] = island[k];
   }
 
+  if (work) {
+    work->solves += done.solves;
+    work->active_set += done.active_set;
+    work->sweeps += done.sweeps;
+    work->drifts_taken += done.drifts_taken;
+  }
   std::vector<SolvedPoint> out;
   out.reserve(rows.size());
   for (const Row& r : rows) {
     out.push_back({r.manifold, r.point, r.jn, r.jt.x() * r.t1 + r.jt.y() * r.t2,
-                   -approach[r.manifold][r.index]});
+                   -approach[r.manifold][r.index], r.target});
   }
   return out;
 }
