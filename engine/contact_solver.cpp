@@ -20,10 +20,18 @@ struct BodyInverse {
   Mat3 inv_inertia = Mat3::Zero();  // world frame
 };
 
-std::vector<BodyInverse> inverses(const std::vector<RigidBody>& bodies) {
+// Filled for the bodies the manifolds name (the others are never read): one world-frame
+// inertia per body in contact, not per body in the world.
+std::vector<BodyInverse> inverses(const std::vector<RigidBody>& bodies,
+                                  const std::vector<PairManifold>& manifolds) {
   std::vector<BodyInverse> out(bodies.size());
-  for (size_t i = 0; i < bodies.size(); ++i)
-    if (!bodies[i].is_static) out[i] = {bodies[i].inverse_mass, bodies[i].inverse_inertia_world()};
+  std::vector<bool> done(bodies.size(), false);
+  for (const PairManifold& pm : manifolds)
+    for (int i : {pm.a, pm.b}) {
+      if (done[i] || bodies[i].is_static) continue;
+      done[i] = true;
+      out[i] = {bodies[i].inverse_mass, bodies[i].inverse_inertia_world()};
+    }
   return out;
 }
 
@@ -502,7 +510,7 @@ std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies
                                                   const std::vector<std::vector<double>>& approach,
                                                   const ContactSolverSettings& settings,
                                                   SolverWork* work) {
-  const std::vector<BodyInverse> inv = inverses(bodies);
+  const std::vector<BodyInverse> inv = inverses(bodies, manifolds);
   SolverWork done;
   std::vector<Row> rows;
   for (size_t m = 0; m < manifolds.size(); ++m) {
@@ -601,7 +609,7 @@ void project_contact_positions(std::vector<RigidBody>& bodies,
   // this projection's (without it, 1e-15); Bullet's positional correction drifts 1.1e-6 there.
   constexpr double kBaumgarte = 0.2;
   constexpr int kIterations = 4;
-  const std::vector<BodyInverse> inv = inverses(bodies);
+  const std::vector<BodyInverse> inv = inverses(bodies, manifolds);
   for (int it = 0; it < kIterations; ++it)
     for (const PairManifold& pm : manifolds) {
       RigidBody &a = bodies[pm.a], &b = bodies[pm.b];

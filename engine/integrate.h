@@ -10,20 +10,39 @@ namespace rbx {
 /// w * dt with the seed's matrices; move the centre by v * dt; then add gravity to v.
 void integrate_euler(RigidBody& body, const Vec3& gravity, double dt);
 
+/// A body-frame inertia's principal moments (kg m^2, ascending) and axes (columns, body
+/// frame): what rotate_free_body needs of it. Constant for a body; a world computes it once.
+struct PrincipalFrame {
+  Vec3 moments = Vec3::Ones();
+  Mat3 axes = Mat3::Identity();
+};
+
+/// The principal frame of a symmetric positive definite inertia (Eigen's direct 3x3 solver).
+PrincipalFrame principal_frame(const Mat3& inertia_body);
+
 /// Semi-implicit (symplectic) Euler: v += g dt first, then x += v dt; the rotation is the
 /// torque-free motion with gyroscopic precession (rotate_free_body), carrying the world angular
 /// momentum L exactly; then w = I_w^-1 L. Departs from the seed (seed correction 11 (the seed's
-/// per-axis Euler kept; symplectic added)), which holds w fixed in the world.
-void integrate_symplectic(RigidBody& body, const Vec3& gravity, double dt);
+/// per-axis Euler kept; symplectic added)), which holds w fixed in the world. `frame`, when
+/// given, is principal_frame(body.inertia_body), kept by the caller (the same numbers as
+/// computing it here, without the decomposition every step).
+void integrate_symplectic(RigidBody& body, const Vec3& gravity, double dt,
+                          const PrincipalFrame* frame = nullptr);
 
-/// Orientation after dt of a torque-free body with body-frame inertia `inertia_body` (kg m^2)
-/// and world angular momentum `momentum` (kg m^2/s): Strang splitting into a symmetric top and
-/// a middle-axis remainder, each by unit quaternions (exponential map), renormalised. Second
+/// Orientation after dt of a torque-free body with the principal frame `frame` and world
+/// angular momentum `momentum` (kg m^2/s): Strang splitting into a symmetric top and a
+/// middle-axis remainder, each by unit quaternions (exponential map), renormalised. Second
 /// order; L exact; energy error bounded (no drift); exact for axisymmetric bodies.
+Quat rotate_free_body(const Quat& orientation, const PrincipalFrame& frame, const Vec3& momentum,
+                      double dt);
+
+/// rotate_free_body with the principal frame of `inertia_body` (kg m^2, body frame).
 Quat rotate_free_body(const Quat& orientation, const Mat3& inertia_body, const Vec3& momentum,
                       double dt);
 
-/// Dispatches on the scene's integrator. Static bodies never move.
-void integrate(RigidBody& body, const SimSettings& sim, double dt);
+/// Dispatches on the scene's integrator. Static bodies never move. `frame` as for
+/// integrate_symplectic.
+void integrate(RigidBody& body, const SimSettings& sim, double dt,
+               const PrincipalFrame* frame = nullptr);
 
 }  // namespace rbx

@@ -126,8 +126,11 @@ bool World::step() {
     for (const BodyPair& pair : broad_phase_.find_pairs(bodies_))
       collide_pair(pair.first, pair.second, true);
   }
-  if (contact_model_ == ContactModel::Seed)
-    for (RigidBody& b : bodies_) integrate(b, sim_, sim_.dt);
+  if (contact_model_ == ContactModel::Seed) {
+    const std::vector<ShapeFacts>& facts = shape_facts();
+    for (size_t i = 0; i < bodies_.size(); ++i)
+      integrate(bodies_[i], sim_, sim_.dt, &facts[i].principal);
+  }
   ++step_;
   time_ = step_ * sim_.dt;
   return check_state();

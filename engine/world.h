@@ -10,6 +10,7 @@
 #include "engine/contact.h"
 #include "engine/contact_solver.h"
 #include "engine/detect.h"
+#include "engine/integrate.h"
 #include "engine/scene.h"
 #include "engine/separation.h"
 
@@ -93,11 +94,13 @@ class World {
   std::string failure_;
   double energy0_ = 0.0;       // J, total energy at t = 0
   double energy_scale_ = 0.0;  // J, the energy budget the guard compares growth with
-  // Per body, fixed by its shape: thickness (shape_thickness), bounding radius about the
-  // centre of mass, how far the detector's tolerance reaches beyond it (tolerance_reach), and
-  // its point-in-mesh tolerance against itself (1e-9 x its size). Filled on first use.
+  // Per body, fixed by its shape and mass: thickness (shape_thickness), bounding radius about
+  // the centre of mass, how far the detector's tolerance reaches beyond it (tolerance_reach),
+  // its point-in-mesh tolerance against itself (1e-9 x its size), and its inertia's principal
+  // frame (the free rotation's). Filled on first use.
   struct ShapeFacts {
     double thickness = 0.0, radius = 0.0, reach = 1.0, own_tol = 0.0;
+    PrincipalFrame principal;
   };
   std::vector<ShapeFacts> facts_;
   const std::vector<ShapeFacts>& shape_facts();

@@ -75,13 +75,14 @@ void World::step_extended() {
 
   // Integration (gravity already in the velocities for the symplectic scheme), then the
   // position projection on the moved poses.
+  const std::vector<ShapeFacts>& facts = shape_facts();
   for (size_t i = 0; i < bodies_.size(); ++i) {
     RigidBody& b = bodies_[i];
     if (moved[i]) continue;  // already carried through the step by its time of impact
     if (symplectic)
-      integrate_symplectic(b, Vec3::Zero(), dt);
+      integrate_symplectic(b, Vec3::Zero(), dt, &facts[i].principal);
     else
-      integrate(b, sim_, dt);
+      integrate(b, sim_, dt, &facts[i].principal);
   }
   // Only pairs that pressed together (a normal impulse) are projected apart: a penetration
   // that no approach caused, such as two overlapping bodies moving together
@@ -102,6 +103,7 @@ const std::vector<World::ShapeFacts>& World::shape_facts() {
       for (const Vec3& v : shape.vertices()) f.radius = std::max(f.radius, v.norm());
       f.reach = tolerance_reach(shape);
       f.own_tol = point_in_mesh_tolerance(shape, shape);
+      f.principal = principal_frame(bodies_[k].inertia_body);
     }
   }
   return facts_;
