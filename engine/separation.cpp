@@ -80,6 +80,28 @@ Vec3 find_separating_axis(const ConvexPolyhedron& a, const Pose& pa, const Conve
   for (const Vec3& u :
        {nearest_normal(b, pb, centres), centres, Vec3(-nearest_normal(a, pa, -centres))})
     if (gap_along(a, pa, b, pb, u) > margin) return u;
+  // Beside a long or wide body (a wall, a floor) the line of centres is oblique and proves
+  // nothing: the direction from the nearest point of one body's box (its own frame) to the
+  // other's centre, and that box's face normal nearest it, do. Measured on many_100: 60 of the
+  // 500 pairs a step reached the detector, which found a contact in 0.2 of them.
+  auto from_box = [](const ConvexPolyhedron& s, const Pose& ps, const Vec3& other) {
+    const Vec3 local = ps.inverse_apply(other);
+    const Vec3 d = local - local.cwiseMax(s.bounds().min).cwiseMin(s.bounds().max);
+    return d.norm() > 0.0 ? Vec3(ps.orientation * d.normalized()) : Vec3::Zero();
+  };
+  const Vec3 from_b = from_box(b, pb, pa.position), from_a = from_box(a, pa, pb.position);
+  for (const Vec3& u : {from_b, Vec3(-from_a)}) {
+    if (u == Vec3::Zero()) continue;
+    if (gap_along(a, pa, b, pb, u) > margin) return u;
+  }
+  if (from_b != Vec3::Zero()) {
+    const Vec3 u = nearest_normal(b, pb, from_b);
+    if (gap_along(a, pa, b, pb, u) > margin) return u;
+  }
+  if (from_a != Vec3::Zero()) {
+    const Vec3 u = -nearest_normal(a, pa, from_a);
+    if (gap_along(a, pa, b, pb, u) > margin) return u;
+  }
   return Vec3::Zero();
 }
 

@@ -34,7 +34,9 @@ double gap_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedr
 
 /// A unit world axis from b toward a along which the pair is apart by more than `margin`, from
 /// a few candidates (the direction between the centres of mass, b's triangle normal nearest it,
-/// a's triangle normal nearest its opposite); the zero vector when none is. Large shapes (more
+/// a's triangle normal nearest its opposite; then the direction from each body's box, in its
+/// own frame, to the other's centre, and the triangle normals nearest those); the zero vector
+/// when none is. Large shapes (more
 /// than kMaxSeparationWork vertices and triangles together) get none: the detector's own trees
 /// are then the cheaper way.
 Vec3 find_separating_axis(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,

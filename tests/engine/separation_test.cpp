@@ -87,5 +87,28 @@ TEST(Separation, NoWitnessWithinTheMargin) {
   EXPECT_NE(find_separating_axis(cube, pa, cube, pb, margin), Vec3::Zero());
 }
 
+TEST(Separation, BesideAWallTheNearestPointOfItsBoxProvesIt) {
+  // A unit cube (turned 0.05 rad) 1.6 cm beside a 10 m wall, near its end: the line of centres
+  // is 8 degrees off the wall's axis, so along it, along the wall's face normal nearest it (the
+  // end face's) and along the cube's the two overlap; the direction from the wall's box to the
+  // cube's centre (+y) proves the gap. Without that candidate this pair went to the detector at
+  // every step.
+  const ConvexPolyhedron wall = make_box(Vec3(10.0, 0.2, 3.0)), cube = make_box(Vec3::Ones());
+  Pose pa, pb;
+  pa.position = Vec3(4.5, 0.64, 0.0);  // lowest corner at y = 0.64 - 0.524
+  pa.orientation = Quat(Eigen::AngleAxisd(0.05, Vec3::UnitZ()));
+  const double tol = point_in_mesh_tolerance(cube, wall);
+  const double margin = separation_margin(tol, tolerance_reach(cube), tolerance_reach(wall));
+  const Vec3 w = find_separating_axis(cube, pa, wall, pb, margin);
+  ASSERT_NE(w, Vec3::Zero());
+  EXPECT_GT(gap_along(cube, pa, wall, pb, w), margin);
+  EXPECT_NEAR(w.y(), 1.0, 1e-12);
+  EXPECT_FALSE(detect(cube, pa, wall, pb, DetectorVariant::Accelerated));
+  // The same pair with the roles swapped (the wall as a): the cube's box sees it from -y.
+  const Vec3 v = find_separating_axis(wall, pb, cube, pa, margin);
+  ASSERT_NE(v, Vec3::Zero());
+  EXPECT_GT(gap_along(wall, pb, cube, pa, v), margin);
+}
+
 }  // namespace
 }  // namespace rbx
