@@ -11,8 +11,10 @@
 //   - sweep-and-prune: boxes sorted along the axis of largest spread (kept from call to call, so
 //     a small motion costs an insertion sort), then swept; O(N log N + pairs overlapping on that
 //     axis), which for bodies spread through a volume grows like N^(5/3).
-//   - tree: a bounding volume hierarchy of the boxes, rebuilt on every call (median splits), and
-//     traversed against itself; O(N log N + pairs), whatever the mix of body sizes.
+//   - tree: a bounding volume hierarchy of the moving bodies' boxes, rebuilt on every call
+//     (median splits) and traversed against itself, each static body's box queried against it;
+//     O(N log N + pairs), whatever the mix of body sizes. For many moving bodies of like size
+//     it takes a hashed uniform grid instead (O(N + pairs)).
 #pragma once
 
 #include <utility>
@@ -45,16 +47,23 @@ class BroadPhase {
   /// The method this broad phase runs.
   BroadPhaseMethod method() const { return method_; }
 
+  /// Whether the last tree call took the hashed grid (many moving bodies of like size) instead
+  /// of the hierarchy; the pairs are the same either way.
+  bool used_grid() const { return used_grid_; }
+
  private:
   void all_pairs();
   void sweep_and_prune();
   void tree();
+  // The tree's alternative for many moving bodies of like size; false when not suitable.
+  bool grid();
   // The seed's test (bounding_check) on the cached spheres: |c_i - c_j| <= r_i + r_j.
   bool spheres_touch(int i, int j) const;
   // Records (min(i, j), max(i, j)) when the spheres touch.
   void test_pair(int i, int j);
 
   BroadPhaseMethod method_;
+  bool used_grid_ = false;
   std::vector<BoundingSphere> spheres_;          // this call's bounding spheres (bounding_sphere())
   std::vector<Vec3> box_min_, box_max_;          // m, padded boxes around them
   std::vector<int> order_;                       // sweep and prune: sorted along sap_axis_
@@ -63,6 +72,14 @@ class BroadPhase {
   std::vector<std::pair<int, int>> node_pairs_;  // tree: traversal stack
   std::vector<Vec3> leaf_min_, leaf_max_;        // tree: boxes in tree order
   std::vector<BoundingSphere> leaf_spheres_;     // tree: spheres in tree order
+  std::vector<bool> static_;                     // this call's bodies: static or not
+  std::vector<int> moving_, statics_;            // tree: body indices of each kind
+  std::vector<int> tree_order_;                  // tree: body at each tree position
+  std::vector<int> bucket_start_, bucket_fill_;  // the pairs' counting sort on i
+  std::vector<BodyPair> sorted_;                 // the pairs' counting sort: output
+  std::vector<double> extent_;                   // grid: each moving box's largest side
+  std::vector<std::pair<long long, int>> cells_;  // grid: (cell key, body), sorted
+  std::vector<std::pair<int, int>> slots_;        // grid: hash slot -> run [begin, end) of cells_
   std::vector<BodyPair> pairs_;
 };
 

@@ -71,6 +71,43 @@ TEST(BroadPhase, EveryMethodFindsTheOraclePairs) {
   }
 }
 
+TEST(BroadPhase, TheGridFindsTheOraclePairs) {
+  // 800 moving boxes of like size (0.3 to 0.5 m: within 2x of the median, so the tree takes
+  // its hashed grid), centred on the origin so that cells have negative coordinates too, two
+  // static slabs among them; then moved and stretched as above. The grid's pairs are the
+  // oracle's, in order; moving boxes of widely mixed sizes take the hierarchy.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<RigidBody> bodies;
+  for (int i = 0; i < 800; ++i) {
+    const bool slab = i == 100 || i == 600;
+    const Vec3 size = slab ? Vec3(20.0, 0.2, 20.0) : Vec3::Constant(0.3 + 0.2 * unit(rng));
+    bodies.push_back(test::box_body(
+        "b" + std::to_string(i), size, 1.0,
+        8.0 * Vec3(unit(rng), unit(rng), unit(rng)) - Vec3::Constant(4.0),
+        Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), Vec3::Zero(), Vec3::Zero(), slab));
+  }
+  BroadPhase tree(BroadPhaseMethod::Tree);
+  for (int round = 0; round < 6; ++round) {
+    const std::vector<BodyPair> expected = oracle_pairs(bodies);
+    EXPECT_GT(expected.size(), bodies.size()) << "round " << round;
+    EXPECT_EQ(tree.find_pairs(bodies), expected) << "round " << round;
+    EXPECT_TRUE(tree.used_grid()) << "round " << round;
+    for (RigidBody& b : bodies) {
+      b.position += 0.05 * Vec3(g(rng), g(rng), g(rng));
+      if (round % 3 == 2) b.position[round % 3] *= 2.0;
+    }
+  }
+  // 290 moving boxes of 0.3 m and 10 of 2 m: beyond 2x of the median, the hierarchy.
+  std::vector<RigidBody> mixed;
+  for (int i = 0; i < 300; ++i)
+    mixed.push_back(test::box_body("m" + std::to_string(i), Vec3::Constant(i % 30 ? 0.3 : 2.0), 1.0,
+                                   6.0 * Vec3(unit(rng), unit(rng), unit(rng))));
+  EXPECT_EQ(tree.find_pairs(mixed), oracle_pairs(mixed));
+  EXPECT_FALSE(tree.used_grid());
+}
+
 TEST(BroadPhase, ExactlyTouchingSpheresArePairs) {
   // A (6, 4, 12) box has half extents (3, 2, 6), so its bounding sphere has radius
   // sqrt(9 + 4 + 36) = 7 exactly. Centres 14 apart: |c_a - c_b| = 14 = 7 + 7, touching
