@@ -14,7 +14,7 @@
 //   - tree: a bounding volume hierarchy of the moving bodies' boxes, rebuilt on every call
 //     (median splits) and traversed against itself, each static body's box queried against it;
 //     O(N log N + pairs), whatever the mix of body sizes. For many moving bodies of like size
-//     it takes a hashed uniform grid instead (O(N + pairs)).
+//     it takes a uniform grid instead (O(N + cells + pairs)).
 #pragma once
 
 #include <utility>
@@ -47,8 +47,8 @@ class BroadPhase {
   /// The method this broad phase runs.
   BroadPhaseMethod method() const { return method_; }
 
-  /// Whether the last tree call took the hashed grid (many moving bodies of like size) instead
-  /// of the hierarchy; the pairs are the same either way.
+  /// Whether the last tree call took the uniform grid (many moving bodies of like size, packed)
+  /// instead of the hierarchy; the pairs are the same either way.
   bool used_grid() const { return used_grid_; }
 
  private:
@@ -78,8 +78,9 @@ class BroadPhase {
   std::vector<int> bucket_start_, bucket_fill_;  // the pairs' counting sort on i
   std::vector<BodyPair> sorted_;                 // the pairs' counting sort: output
   std::vector<double> extent_;                   // grid: each moving box's largest side
-  std::vector<std::pair<long long, int>> cells_;  // grid: (cell key, body), sorted
-  std::vector<std::pair<int, int>> slots_;        // grid: hash slot -> run [begin, end) of cells_
+  std::vector<int> cell_of_;                     // grid: each moving body's cell
+  std::vector<int> cell_start_;                  // grid: first position of each cell
+  std::vector<int> in_cells_;                    // grid: bodies in cell order
   std::vector<BodyPair> pairs_;
 };
 
