@@ -303,7 +303,9 @@ bool solve_active_set(std::vector<RigidBody>& bodies, const std::vector<BodyInve
 }
 
 /// Solves one island's rows to convergence (velocities of `bodies` and the rows' accumulated
-/// impulses in place): staggered projections, and the energy guard on restitution.
+/// impulses in place): active sets first (solve_active_set, islands of up to active_set_rows
+/// points), then staggered projections from their answer or from zero, and the energy guard on
+/// restitution. Adds what it did to `work`.
 void solve_island(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>& inv,
                   std::vector<Row>& rows, const ContactSolverSettings& settings, SolverWork& work) {
   double speed_scale = 0.0;  // m/s, the largest speed in the problem
