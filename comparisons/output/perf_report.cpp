@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -56,6 +57,13 @@ double find_time(const std::vector<NarrowRow>& rows, const std::string& backend,
 
 }  // namespace
 
+// The profile behind the detector goals (perf, 2026-11-24, hulls of 32 vertices, touching).
+constexpr const char* kDetectorProfile =
+    "the accelerated detector's per-query culling is its floor at small N (perf at N = 32, "
+    "touching: AcceleratedView::candidates 38 %, primitive_culled 16 %, segment_outside 13 %, "
+    "the facing-face search 8.5 %, cull_planes 6.6 %); the faithful loops, which try every "
+    "vertex against every face, take 6.8 µs there against FCL's 2.15 µs (prebuilt).";
+
 std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& results) {
   std::vector<PerfGoal> goals;
   const double fast_exp = series_exponent(results.narrow, "custom", "fast", "touching");
@@ -71,7 +79,7 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
   goals.push_back({"custom (fast) no slower than fcl (shapes prebuilt) at N = 2048, touching",
                    fmt_duration_ns(fast_2048) + " vs " + fmt_duration_ns(fcl_2048) + ": ratio " +
                        bench_num(fast_2048 / fcl_2048),
-                   fast_2048 <= fcl_2048});
+                   fast_2048 <= fcl_2048, kDetectorProfile});
   const double fast_box = find_time(results.narrow, "custom", "fast", "touching", 8);
   const double fclbox = find_time(results.narrow, "fcl-box", "default", "touching", 8);
   goals.push_back({"custom (fast) within 1.5x of fcl-box on two boxes, touching",
@@ -112,7 +120,7 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
     goals.push_back(
         {"custom (fast) no slower than fcl (shapes prebuilt) at every hull size timed, "
          "touching (issue 11)",
-         measured.empty() ? "not measured" : measured, met && compared > 0});
+         measured.empty() ? "not measured" : measured, met && compared > 0, kDetectorProfile});
   }
   for (const char* scene : {"many_100", "many_1000"}) {
     double custom = NAN, bullet = NAN;
@@ -239,6 +247,13 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
   md << "## Goals\n\n| goal | measured | met |\n|---|---|---|\n";
   for (const PerfGoal& g : goals)
     md << "| " << g.goal << " | " << g.measured << " | " << (g.met ? "yes" : "**no**") << " |\n";
+  // Behind each goal not met: its profile, as last measured.
+  std::vector<std::string> behind;
+  for (const PerfGoal& g : goals)
+    if (!g.met && !g.behind.empty() &&
+        std::find(behind.begin(), behind.end(), g.behind) == behind.end())
+      behind.push_back(g.behind);
+  for (const std::string& b : behind) md << "\nWhy not met: " << b << "\n";
   md << "\n## Narrow phase\n\n"
      << "Every contact backend through the registry's `ContactFn` on the same pairs: two unit "
         "boxes (N = 8), and two hulls of N random points on a sphere of diameter 1 m (every "

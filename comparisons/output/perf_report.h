@@ -13,6 +13,7 @@ namespace rbx {
 struct PerfGoal {
   std::string goal, measured;
   bool met = false;
+  std::string behind;  // the profile last measured behind the goal, printed when it is not met
 };
 
 /// The goals of issue 6, judged on the rows of a run.
