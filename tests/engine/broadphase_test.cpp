@@ -108,6 +108,25 @@ TEST(BroadPhase, TheGridFindsTheOraclePairs) {
   EXPECT_FALSE(tree.used_grid());
 }
 
+TEST(BroadPhase, ManyStaticBodiesGoIntoTheTree) {
+  // 60 static boxes (beyond the 32 kept apart) among 240 moving ones, sizes mixed: every pair,
+  // static against static included, is the oracle's, in order.
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<RigidBody> bodies;
+  for (int i = 0; i < 300; ++i)
+    bodies.push_back(test::box_body("b" + std::to_string(i), Vec3::Constant(0.2 + unit(rng)), 1.0,
+                                    5.0 * Vec3(unit(rng), unit(rng), unit(rng)), Quat::Identity(),
+                                    Vec3::Zero(), Vec3::Zero(), i % 5 == 0));
+  const std::vector<BodyPair> expected = oracle_pairs(bodies);
+  int static_pairs = 0;
+  for (const BodyPair& p : expected)
+    static_pairs += bodies[p.first].is_static && bodies[p.second].is_static;
+  EXPECT_GT(static_pairs, 10);
+  BroadPhase tree(BroadPhaseMethod::Tree);
+  EXPECT_EQ(tree.find_pairs(bodies), expected);
+}
+
 TEST(BroadPhase, ExactlyTouchingSpheresArePairs) {
   // A (6, 4, 12) box has half extents (3, 2, 6), so its bounding sphere has radius
   // sqrt(9 + 4 + 36) = 7 exactly. Centres 14 apart: |c_a - c_b| = 14 = 7 + 7, touching
