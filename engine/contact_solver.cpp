@@ -365,14 +365,12 @@ void solve_island(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>
     return change;
   };
   // A stage's unknowns as one vector: j_n per row, or j_t (two values) per row.
-  auto unknowns = [&](bool friction) {
-    std::vector<double> x;
-    x.reserve(rows.size() * 2);
+  auto unknowns = [&](bool friction, std::vector<double>& x) {
+    x.clear();
     for (const Row& r : rows) {
       if (!friction) x.push_back(r.jn);
       if (friction) x.insert(x.end(), {r.jt.x(), r.jt.y()});
     }
-    return x;
   };
   // How many sweeps of the drift d (per sweep) the unknowns can take before one reaches its
   // bound (j_n = 0, or |j_t| = mu j_n); infinity if none would.
@@ -418,13 +416,16 @@ void solve_island(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>
   // first bound are taken at once, as the iteration would take them (their impulses applied to
   // the bodies), and sweeping goes on from there; it only ever stops at the same convergence
   // test, so the answer is still the fixed point.
+  std::vector<double> before, after, d, drift;  // the stages' buffers, kept across sweeps
   auto stage = [&](auto&& sweep_fn, bool friction) {
     int moving = 0;
-    std::vector<double> before = unknowns(friction), drift;
+    unknowns(friction, before);
+    drift.clear();
     for (int sweep = 0; sweep < 10000; ++sweep) {
       if (sweep_fn() <= converged) break;
       ++moving;
-      std::vector<double> after = unknowns(friction), d(after.size());
+      unknowns(friction, after);
+      d.resize(after.size());
       double size = 0.0, off = 0.0;
       for (size_t i = 0; i < d.size(); ++i) {
         d[i] = after[i] - before[i];
@@ -436,12 +437,12 @@ void solve_island(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>
         if (count >= 1.0 && std::isfinite(count)) {
           take_drift(friction, d, count);
           ++work.drifts_taken;
-          after = unknowns(friction);
+          unknowns(friction, after);
           d.clear();
         }
       }
-      drift = std::move(d);
-      before = std::move(after);
+      drift.swap(d);
+      before.swap(after);
     }
     work.sweeps += moving;
     return moving;
