@@ -42,10 +42,20 @@ struct Bvh {
   /// ended the search.
   template <typename Key, typename Skip, typename Visit>
   bool search(Key key, Skip skip, Visit visit, bool larger_first = true) const;
+  /// The same search, with `visit(slot)` given the position of the primitive in `order` (so
+  /// that data stored in leaf order can be read in place).
+  template <typename Key, typename Skip, typename Visit>
+  bool search_slots(Key key, Skip skip, Visit visit, bool larger_first = true) const;
 };
 
 template <typename Key, typename Skip, typename Visit>
 bool Bvh::search(Key key, Skip skip, Visit visit, bool larger_first) const {
+  return search_slots(
+      key, skip, [&](int slot) { return visit(order[slot]); }, larger_first);
+}
+
+template <typename Key, typename Skip, typename Visit>
+bool Bvh::search_slots(Key key, Skip skip, Visit visit, bool larger_first) const {
   if (nodes.empty()) return false;
   // A fixed stack: a median-split tree over 2^31 primitives is < 64 deep and a level pushes two.
   std::pair<int, double> stack[256];
@@ -57,7 +67,7 @@ bool Bvh::search(Key key, Skip skip, Visit visit, bool larger_first) const {
     const BvhNode& node = nodes[k];
     if (node.child < 0) {
       for (int i = node.begin; i < node.end; ++i)
-        if (visit(order[i])) return true;
+        if (visit(i)) return true;
       continue;
     }
     // The preferred child goes on top of the stack.

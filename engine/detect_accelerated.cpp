@@ -46,6 +46,7 @@ AcceleratedView place(const ConvexPolyhedron& shape, const Pose& pose, const Lim
   AcceleratedView p;
   p.shape = &shape;
   p.accel = shape.hierarchy();
+  p.linear = p.accel && static_cast<int>(shape.vertices().size()) <= kLinearVertices;
   p.r = pose.rotation();
   p.rt = p.r.transpose();
   p.position = pose.position;
@@ -86,19 +87,6 @@ bool beyond_facing(const AcceleratedView& x, const AcceleratedView& y, const Lim
   return true;
 }
 
-// A face plane of y used to cull x's primitives: every point p of a hit must have
-// s(p) = (p - q) . n <= tol for it (the seed's inside() checks every face). Precomputed for x's
-// body frame: s(x.r c + x.position) = c . m + c0, with m = x.rt n and c0 = (x.position - q) . n.
-struct CullPlane {
-  Vec3 m = Vec3::Zero();
-  Vec3 m_abs = Vec3::Zero();
-  double c0 = 0.0;
-  Vec3 normal = Vec3::Zero();  // world, the seed's n_f
-  Vec3 point = Vec3::Zero();   // m, world, the seed's q_f
-  // The seed's plane distance (p - q_f) . n_f of a world point.
-  double distance(const Vec3& p) const { return (p - point).dot(normal); }
-};
-
 // The face of y whose outward normal is most along the direction from y's centre (of its
 // bounding box) to x's: for shapes in contact, the face plane most likely to have x's points
 // outside it. -1 when the centres coincide.
@@ -124,23 +112,27 @@ int facing_face(const AcceleratedView& y, const AcceleratedView& x) {
     return best;
   }
   const ShapeHierarchy& acc = *y.accel;
-  // Branch and bound on the cone bounds: the exact best face, ties to the first found.
-  auto reach = [&](int k) {
-    const FaceCone& c = acc.cones[k];
-    const double along = c.axis.dot(dl), across = c.axis.cross(dl).norm();
-    return along >= c.cos_half ? 1.0 : along * c.cos_half + across * c.sin_half;
-  };
-  int best = acc.triangles.order[0];
-  double best_dot = -2.0;
-  acc.triangles.search(
-      reach, [&](double r) { return r <= best_dot; },
-      [&](int f) {
-        if (pl[f].normal.dot(dl) > best_dot) {
-          best_dot = pl[f].normal.dot(dl);
-          best = f;
-        }
-        return false;
-      });
+  // Hill climbing over adjacent triangles, from the axis face nearest dl: a face none of whose
+  // neighbours is more along dl. Deterministic, and any face would give the same answers (the
+  // facing face only decides how much is culled and which face inside() tries first), so a
+  // local best is enough; on a convex shape it is nearly always the global one.
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(dl[k]) > std::abs(dl[axis])) axis = k;
+  int best = acc.axis_faces[2 * axis + (dl[axis] < 0.0 ? 1 : 0)];
+  double best_dot = pl[best].normal.dot(dl);
+  for (int step = 0; step < y.num_triangles(); ++step) {
+    int next = -1;
+    for (int g : acc.triangle_neighbors[best]) {
+      const double dot = pl[g].normal.dot(dl);
+      if (dot > best_dot) {
+        best_dot = dot;
+        next = g;
+      }
+    }
+    if (next < 0) break;
+    best = next;
+  }
   return best;
 }
 
@@ -222,8 +214,8 @@ void fill_plane_table(AcceleratedView& x, const AcceleratedView& y, const Limits
     if (separated[k]) x.enters = false;
 }
 
-// The cull planes of y against x: y's facing face, and the faces most along y's body axes (for
-// a box, its faces).
+// The cull planes of y against x: y's facing face (first), and the faces most along y's body
+// axes (for a box, its faces).
 int cull_planes(const AcceleratedView& x, const AcceleratedView& y, CullPlane* planes) {
   const auto& tris = y.shape->triangles();
   int faces[7];
@@ -325,13 +317,135 @@ void table_candidates(const AcceleratedView& x, Primitive kind, int n, std::vect
   }
 }
 
+// x's cap against y's facing face plane (the first cull plane), for x with a hierarchy: every
+// vertex whose plane distance may be within tol + margin, found without visiting the rest.
+// The vertices of a convex polyhedron on one side of a plane are connected by its edges (from
+// each, an edge path of non-increasing distance leads to the lowest vertex, as in the simplex
+// method), so a search from one cap vertex over edges, through vertices below a slightly larger
+// limit (tol + 4 margin: the body-frame distances carry round-off far below the margin),
+// reaches them all. The first cap vertex comes from the vertex tree. Returns false when the cap
+// is empty: then no point of x can be inside y.
+bool find_cap(AcceleratedView& x, const Limits& lim, AcceleratedWorkspace& ws, int slot) {
+  const CullPlane& plane = x.cull[0];
+  const auto& verts = x.shape->vertices();
+  const ShapeHierarchy& h = *x.accel;
+  const double start_limit = lim.tol + 2.0 * lim.margin;
+  const double limit = lim.tol + 4.0 * lim.margin;
+  std::vector<int>& cap = ws.cap[slot];
+  cap.clear();
+  x.cap = &cap;
+  if (x.linear) {
+    // Few vertices: every one below the limit, by a scan.
+    const int nv = static_cast<int>(verts.size());
+    for (int i = 0; i < nv; ++i)
+      if (plane.local_distance(verts[i]) <= limit) cap.push_back(i);
+    return !cap.empty();
+  }
+  // A first vertex below start_limit: depth first, lower boxes first.
+  int first = -1;
+  const Bvh& tree = h.vertices;
+  tree.search(
+      [&](int k) {
+        const BvhNode& node = tree.nodes[k];
+        return plane.local_distance(node.center) - node.half.dot(plane.m_abs);
+      },
+      [&](double low) { return low > start_limit; },
+      [&](int i) {
+        if (plane.local_distance(verts[i]) > start_limit) return false;
+        first = i;
+        return true;
+      },
+      false);
+  if (first < 0) return false;
+  // Breadth first over edges; `seen` marks every vertex whose distance was computed.
+  std::vector<unsigned>& seen = ws.seen[slot];
+  if (seen.size() < verts.size() || ++ws.stamp[slot] == 0) {
+    seen.assign(std::max(seen.size(), verts.size()), 0);
+    ws.stamp[slot] = 1;
+  }
+  const unsigned stamp = ws.stamp[slot];
+  seen[first] = stamp;
+  cap.push_back(first);
+  for (std::size_t k = 0; k < cap.size(); ++k) {
+    const int v = cap[k];
+    for (int j = h.edge_start[v]; j < h.edge_start[v + 1]; ++j) {
+      const Edge& e = x.shape->edges()[h.vertex_edges[j]];
+      const int w = e.a == v ? e.b : e.a;
+      if (seen[w] == stamp) continue;
+      seen[w] = stamp;
+      if (plane.local_distance(verts[w]) <= limit) cap.push_back(w);
+    }
+  }
+  std::sort(cap.begin(), cap.end());
+  return true;
+}
+
+// True when a body-frame point of x is beyond one cull plane by more than `limit`.
+bool local_culled(const AcceleratedView& x, const Vec3& c, double limit) {
+  for (int k = 0; k < x.cull_count; ++k)
+    if (x.cull[k].local_distance(c) > limit) return true;
+  return false;
+}
+
+// Candidates from x's cap: its vertices, and the triangles and edges that have one, less those
+// beyond a cull plane. Body-frame distances decide with the margin (a point beyond a plane by
+// more than tol + margin in the body frame is beyond it by more than tol for the seed's
+// expression); an edge needs both ends beyond one plane by tol + 2 margin.
+void cap_candidates(const AcceleratedView& x, Primitive kind, std::vector<int>& out) {
+  const ShapeHierarchy& h = *x.accel;
+  const auto& verts = x.shape->vertices();
+  const double limit = x.tol + x.margin;
+  const std::vector<int>& cap = *x.cap;
+  if (kind == Primitive::Vertices) {
+    for (int v : cap)
+      if (!local_culled(x, verts[v], limit)) out.push_back(v);
+    return;
+  }
+  const bool triangles = kind == Primitive::Triangles;
+  const std::vector<int>& start = triangles ? h.triangle_start : h.edge_start;
+  const std::vector<int>& list = triangles ? h.vertex_triangles : h.vertex_edges;
+  for (int v : cap) out.insert(out.end(), list.begin() + start[v], list.begin() + start[v + 1]);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  std::size_t kept = 0;
+  for (int i : out) {
+    bool culled_out;
+    if (triangles) {
+      const auto& t = x.shape->triangles()[i];
+      culled_out = local_culled(x, (verts[t[0]] + verts[t[1]] + verts[t[2]]) / 3.0, limit);
+    } else {
+      const Edge& e = x.shape->edges()[i];
+      culled_out = false;
+      for (int k = 0; k < x.cull_count && !culled_out; ++k)
+        culled_out = x.cull[k].local_distance(verts[e.a]) > limit + x.margin &&
+                     x.cull[k].local_distance(verts[e.b]) > limit + x.margin;
+    }
+    if (!culled_out) out[kept++] = i;
+  }
+  out.resize(kept);
+}
+
+// Whether x may enter y (pairs with a hierarchy; x's cull planes set): a small x by
+// may_enter(); an x with a hierarchy when its root box is not beyond a cull plane and its cap
+// against y's facing face is not empty (find_cap, which also sets x.cap).
+bool may_enter_with_cap(AcceleratedView& x, const AcceleratedView& y, const Limits& lim,
+                        AcceleratedWorkspace& ws, int slot) {
+  if (!x.accel) return may_enter(x, y, lim);
+  const BvhNode& root = x.accel->vertices.nodes[0];
+  if (culled(x.cull, x.cull_count, root.center, root.half, lim.tol + lim.margin)) return false;
+  if (y.facing < 0) return true;  // no facing face: no cap, the trees cull
+  return find_cap(x, lim, ws, slot);
+}
+
 }  // namespace
 
-// Indices of x's primitives of `kind` that may lie (in part) inside y, in increasing order.
-// Every point a test derives from a primitive (a centroid, a vertex, a point on an edge) lies
-// in the primitive's box, so a box outside one of y's face planes holds no hit; the primitives
-// of the remaining leaves are then culled one by one (primitive_culled).
-void AcceleratedView::candidates(Primitive kind, const AcceleratedView& y,
+// Indices of x's primitives of `kind` that may lie (in part) inside y, in increasing order:
+// from the plane table (two small shapes), by a loop (a small x), from the cap (cap_candidates),
+// or, without a cap, from x's tree: every point a test derives from a primitive (a centroid, a
+// vertex, a point on an edge) lies in the primitive's box, so a box outside one of y's cull
+// planes holds no hit; the primitives of the remaining leaves are culled one by one
+// (primitive_culled).
+void AcceleratedView::candidates(Primitive kind, const AcceleratedView& /*y*/,
                                  std::vector<int>& out) const {
   const AcceleratedView& x = *this;
   out.clear();
@@ -347,14 +461,13 @@ void AcceleratedView::candidates(Primitive kind, const AcceleratedView& y,
     // centroid beyond one plane by tol + margin, or an edge whose interval is empty, holds no
     // point inside y.
     if (x.plane_table) return table_candidates(x, kind, n, out);
-    CullPlane planes[7];
-    const int count = cull_planes(x, y, planes);
     for (int i = 0; i < n; ++i)
-      if (!primitive_culled(x, kind, i, planes, count)) out.push_back(i);
+      if (!primitive_culled(x, kind, i, x.cull, x.cull_count)) out.push_back(i);
     return;
   }
-  CullPlane planes[7];
-  const int count = cull_planes(x, y, planes);
+  if (x.cap) return cap_candidates(x, kind, out);
+  const CullPlane* planes = x.cull;
+  const int count = x.cull_count;
   const double limit = tol + margin;
   const Bvh& tree = kind == Primitive::Triangles  ? x.accel->triangles
                     : kind == Primitive::Vertices ? x.accel->vertices
@@ -373,10 +486,10 @@ void AcceleratedView::candidates(Primitive kind, const AcceleratedView& y,
 }
 
 // seed correction 1 (point in mesh uses p - q_f) point in mesh, the seed's predicate exactly: (p -
-// q_f) . n_f <= tol for every face. Small shapes: the seed's loop. Others: clusters of faces whose
-// bound is at most tol - margin are certified without evaluating them; the rest are evaluated
-// exactly, and the first face found outside ends the search (the answer is an AND, so order does
-// not matter).
+// q_f) . n_f <= tol for every face. Small shapes: the seed's loop. Others: faces (or, in the tree,
+// clusters of faces) whose body-frame bound is at most tol - margin are certified, those beyond
+// tol + margin are outside, and only the rest take the seed's expression; the first face found
+// outside ends the search (the answer is an AND, so order does not matter).
 bool AcceleratedView::inside(const Vec3& p) const {
   // The face toward the other shape first: most points of the other shape are outside it.
   if (facing >= 0 && plane_distance(*this, facing, p) > tol) return false;
@@ -391,17 +504,41 @@ bool AcceleratedView::inside(const Vec3& p) const {
     return true;
   }
   const Vec3 pl = to_local(p);
-  const double certified = tol - margin;
-  // Visit first the cluster more likely to hold an outside face (the larger bound).
-  const bool outside = accel->triangles.search(
-      [&](int k) {
-        double lo, hi;
-        accel->plane_bounds(k, pl, lo, hi);
-        return hi;
-      },
-      [&](double hi) { return hi <= certified; },
-      [&](int f) { return plane_distance(*this, f, p) > tol; });
-  return !outside;
+  const double certified = tol - margin, outside = tol + margin;
+  const Bvh& tree = accel->triangles;
+  if (linear) {
+    const int n = num_triangles();
+    for (int i = 0; i < n; ++i) {
+      const LocalPlane& lp = accel->planes[i];
+      const double s = dot3(pl, lp.n) - lp.d;
+      if (s > certified && (s > outside || plane_distance(*this, tree.order[i], p) > tol))
+        return false;
+    }
+    return true;
+  }
+  // Depth first over the triangle tree; a node whose bound is certified is skipped. In a leaf,
+  // the body-frame plane distance decides whenever it is further than the margin from tol (it
+  // is within round-off of the seed's value); only the rest take the seed's expression.
+  int stack[128];
+  int size = 0;
+  stack[size++] = 0;
+  while (size > 0) {
+    const int k = stack[--size];
+    if (accel->plane_upper(k, pl) <= certified) continue;
+    const BvhNode& node = tree.nodes[k];
+    if (node.child >= 0) {
+      stack[size++] = node.child + 1;
+      stack[size++] = node.child;
+      continue;
+    }
+    for (int i = node.begin; i < node.end; ++i) {
+      const LocalPlane& lp = accel->planes[i];
+      const double s = dot3(pl, lp.n) - lp.d;
+      if (s <= certified) continue;
+      if (s > outside || plane_distance(*this, tree.order[i], p) > tol) return false;
+    }
+  }
+  return true;
 }
 
 // max over the world vertices of v . n, the seed's expression. Branch and bound: a node's
@@ -416,6 +553,15 @@ double AcceleratedView::support_max(const Vec3& n) const {
   const Bvh& tree = accel->vertices;
   const Vec3 nl = rt * n;
   const double offset = position.dot(n);
+  if (linear) {
+    // The largest body-frame value, then the seed's value of every vertex that may reach it.
+    const auto& verts = shape->vertices();
+    double top = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < nv; ++i) top = std::max(top, dot3(verts[i], nl));
+    for (int i = 0; i < nv; ++i)
+      if (dot3(verts[i], nl) + 2.0 * margin >= top) best = std::max(best, vertex(i).dot(n));
+    return best;
+  }
   tree.search(
       [&](int k) {
         const BvhNode& node = tree.nodes[k];
@@ -423,6 +569,8 @@ double AcceleratedView::support_max(const Vec3& n) const {
       },
       [&](double b) { return b + margin < best; },
       [&](int i) {
+        // The body-frame value decides when it is below the best by more than the margin.
+        if (dot3(shape->vertices()[i], nl) + offset + margin < best) return false;
         best = std::max(best, vertex(i).dot(n));
         return false;
       });
@@ -450,15 +598,28 @@ int AcceleratedView::closest_face(const Vec3& v) const {
     return closest;
   }
   const Vec3 vl = to_local(v);
-  // Lower bound of |s_f| over a node from the bounds on s_f; nearer clusters first.
-  accel->triangles.search(
+  if (linear) {
+    for (int i = 0; i < num_triangles(); ++i) {
+      const LocalPlane& lp = accel->planes[i];
+      if (std::abs(dot3(vl, lp.n) - lp.d) - margin <= best) consider(accel->triangles.order[i]);
+    }
+    return closest;
+  }
+  // Lower bound of |s_f| over a node from the bounds on s_f; nearer clusters first. In a leaf,
+  // the body-frame distance skips a face that is further than the best by the margin.
+  accel->triangles.search_slots(
       [&](int k) {
         double lo, hi;
         accel->plane_bounds(k, vl, lo, hi);
         return lo > 0.0 ? lo : (hi < 0.0 ? -hi : 0.0);
       },
       [&](double b) { return b - margin > best; },  // cannot reach (or tie) the best
-      consider, false);
+      [&](int slot) {
+        const LocalPlane& lp = accel->planes[slot];
+        if (std::abs(dot3(vl, lp.n) - lp.d) - margin > best) return false;
+        return consider(accel->triangles.order[slot]);
+      },
+      false);
   return closest;
 }
 
@@ -472,21 +633,32 @@ void AcceleratedView::crossings(const Vec3& v_i, const Vec3& v_j,
     return;
   }
   const Vec3 pi = to_local(v_i), pj = to_local(v_j);
-  accel->triangles.search(
-      [&](int k) {
-        double lo_i, hi_i, lo_j, hi_j;
-        accel->plane_bounds(k, pi, lo_i, hi_i);
-        accel->plane_bounds(k, pj, lo_j, hi_j);
-        // Both ends strictly inside every plane of the cluster, or both strictly outside.
-        const bool same_side = (hi_i + margin < 0.0 && hi_j + margin < 0.0) ||
-                               (lo_i - margin > 0.0 && lo_j - margin > 0.0);
-        return same_side ? 1.0 : 0.0;
-      },
-      [](double same_side) { return same_side > 0.0; },
-      [&](int f) {
-        crossing_of(*this, f, v_i, v_j, out);
-        return false;
-      });
+  // Both ends on one side by more than the margin in the body frame: no crossing.
+  auto may_cross = [&](int slot) {
+    const LocalPlane& lp = accel->planes[slot];
+    const double s_i = dot3(pi, lp.n) - lp.d, s_j = dot3(pj, lp.n) - lp.d;
+    return !((s_i > margin && s_j > margin) || (s_i < -margin && s_j < -margin));
+  };
+  if (linear) {
+    for (int i = 0; i < num_triangles(); ++i)
+      if (may_cross(i)) crossing_of(*this, accel->triangles.order[i], v_i, v_j, out);
+  } else {
+    accel->triangles.search_slots(
+        [&](int k) {
+          double lo_i, hi_i, lo_j, hi_j;
+          accel->plane_bounds(k, pi, lo_i, hi_i);
+          accel->plane_bounds(k, pj, lo_j, hi_j);
+          // Both ends strictly inside every plane of the cluster, or both strictly outside.
+          const bool same_side = (hi_i + margin < 0.0 && hi_j + margin < 0.0) ||
+                                 (lo_i - margin > 0.0 && lo_j - margin > 0.0);
+          return same_side ? 1.0 : 0.0;
+        },
+        [](double same_side) { return same_side > 0.0; },
+        [&](int slot) {
+          if (may_cross(slot)) crossing_of(*this, accel->triangles.order[slot], v_i, v_j, out);
+          return false;
+        });
+  }
   std::sort(out.begin(), out.end(),
             [](const Crossing& x, const Crossing& z) { return x.face < z.face; });
 }
@@ -537,18 +709,30 @@ bool AcceleratedView::segment_outside(const AcceleratedView& x, const Vec3& v_i,
     return false;
   }
   const Vec3 pi = to_local(v_i), pj = to_local(v_j);
+  // Both ends beyond one face plane by more than the limit; the body-frame distances decide
+  // unless one is within the margin of the limit.
+  auto beyond = [&](int slot) {
+    const LocalPlane& lp = accel->planes[slot];
+    const double s_i = dot3(pi, lp.n) - lp.d, s_j = dot3(pj, lp.n) - lp.d;
+    if (s_i <= limit - margin || s_j <= limit - margin) return false;
+    if (s_i > limit + margin && s_j > limit + margin) return true;
+    const int f = accel->triangles.order[slot];
+    return plane_distance(*this, f, v_i) > limit && plane_distance(*this, f, v_j) > limit;
+  };
+  if (linear) {
+    for (int i = 0; i < num_triangles(); ++i)
+      if (beyond(i)) return true;
+    return false;
+  }
   // Upper bound on min(s_f(v_i), s_f(v_j)) over a cluster; clusters far outside first.
-  return accel->triangles.search(
+  return accel->triangles.search_slots(
       [&](int k) {
         double lo, hi_i, hi_j;
         accel->plane_bounds(k, pi, lo, hi_i);
         accel->plane_bounds(k, pj, lo, hi_j);
         return std::min(hi_i, hi_j);
       },
-      [&](double b) { return b <= limit; },
-      [&](int f) {
-        return plane_distance(*this, f, v_i) > limit && plane_distance(*this, f, v_j) > limit;
-      });
+      [&](double b) { return b <= limit; }, beyond);
 }
 
 void AcceleratedPair::prepare(const ConvexPolyhedron& sa, const Pose& pa,
@@ -579,8 +763,14 @@ void AcceleratedPair::prepare(const ConvexPolyhedron& sa, const Pose& pa,
     fill_plane_table(b, a, lim, ws.tables[1]);
     return;
   }
-  a.enters = may_enter(a, b, lim);
-  b.enters = may_enter(b, a, lim);
+  // Each shape's cull planes against the other, once for the three tests; then whether its
+  // points can enter the other, and its cap.
+  a.cull_count = cull_planes(a, b, ws.cull[0]);
+  a.cull = ws.cull[0];
+  b.cull_count = cull_planes(b, a, ws.cull[1]);
+  b.cull = ws.cull[1];
+  a.enters = may_enter_with_cap(a, b, lim, ws, 0);
+  b.enters = may_enter_with_cap(b, a, lim, ws, 1);
 }
 
 std::optional<ContactPoint> AcceleratedPair::test(Feature feature, FeatureScratch& scratch) const {

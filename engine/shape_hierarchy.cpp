@@ -21,35 +21,30 @@ ShapeHierarchy ShapeHierarchy::build(const ConvexPolyhedron& s) {
   const auto& tris = s.triangles();
   const auto& planes = s.planes();
   std::vector<Vec3> lo, hi;
-  // Triangles, with their normal cones and plane offsets per node.
+  // Triangles, with the bounds of their face planes per node, and the planes in leaf order.
   for (const auto& t : tris) {
     lo.push_back(v[t[0]].cwiseMin(v[t[1]]).cwiseMin(v[t[2]]));
     hi.push_back(v[t[0]].cwiseMax(v[t[1]]).cwiseMax(v[t[2]]));
   }
   h.triangles = Bvh::build(lo, hi, kLeafSize);
-  h.cones.resize(h.triangles.nodes.size());
+  h.boxes.resize(h.triangles.nodes.size());
+  for (int f : h.triangles.order)
+    h.planes.push_back({planes[f].normal, planes[f].normal.dot(v[tris[f][0]])});
   for (std::size_t k = 0; k < h.triangles.nodes.size(); ++k) {
     const BvhNode& node = h.triangles.nodes[k];
-    FaceCone& cone = h.cones[k];
-    Vec3 sum = Vec3::Zero();
-    for (int i = node.begin; i < node.end; ++i) sum += planes[h.triangles.order[i]].normal;
-    cone.axis =
-        sum.norm() > 1e-6 ? Vec3(sum.normalized()) : planes[h.triangles.order[node.begin]].normal;
-    double c = 1.0;
-    cone.e_min = std::numeric_limits<double>::infinity();
-    cone.e_max = -cone.e_min;
+    NormalBox& box = h.boxes[k];
+    box.center = node.center;
+    box.nlo = box.nhi = planes[h.triangles.order[node.begin]].normal;
+    box.e_min = std::numeric_limits<double>::infinity();
+    box.e_max = -box.e_min;
     for (int i = node.begin; i < node.end; ++i) {
       const int f = h.triangles.order[i];
-      c = std::min(c, cone.axis.dot(planes[f].normal));
+      box.nlo = box.nlo.cwiseMin(planes[f].normal);
+      box.nhi = box.nhi.cwiseMax(planes[f].normal);
       const double e = planes[f].normal.dot(v[tris[f][0]] - node.center);
-      cone.e_min = std::min(cone.e_min, e);
-      cone.e_max = std::max(cone.e_max, e);
+      box.e_min = std::min(box.e_min, e);
+      box.e_max = std::max(box.e_max, e);
     }
-    // Widen the cone by more than the round-off of the dot products (a cosine of exactly 1 would
-    // otherwise hide an angle of up to ~1e-8 rad).
-    cone.cos_half = std::max(-1.0, c - 1e-15);
-    cone.sin_half =
-        std::min(1.0, std::sqrt(std::max(0.0, 1.0 - cone.cos_half * cone.cos_half)) + 1e-12);
   }
   // Vertices.
   h.vertices = Bvh::build(v, v, kLeafSize);
@@ -61,6 +56,38 @@ ShapeHierarchy ShapeHierarchy::build(const ConvexPolyhedron& s) {
     hi.push_back(v[e.a].cwiseMax(v[e.b]));
   }
   h.edges = Bvh::build(lo, hi, kLeafSize);
+  // Incidence by vertex (counting sort: each list in increasing index order).
+  auto incidence = [&](int count, auto ends_of, std::vector<int>& start, std::vector<int>& list) {
+    start.assign(v.size() + 1, 0);
+    for (int i = 0; i < count; ++i)
+      for (int end : ends_of(i)) ++start[end + 1];
+    for (std::size_t k = 0; k < v.size(); ++k) start[k + 1] += start[k];
+    list.resize(start.back());
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (int i = 0; i < count; ++i)
+      for (int end : ends_of(i)) list[fill[end]++] = i;
+  };
+  incidence(
+      static_cast<int>(s.edges().size()),
+      [&](int i) {
+        return std::array<int, 2>{s.edges()[i].a, s.edges()[i].b};
+      },
+      h.edge_start, h.vertex_edges);
+  incidence(
+      static_cast<int>(tris.size()), [&](int i) { return tris[i]; }, h.triangle_start,
+      h.vertex_triangles);
+  // Triangle adjacency: the other triangle holding each directed edge reversed.
+  h.triangle_neighbors.assign(tris.size(), {-1, -1, -1});
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int from = tris[t][k], to = tris[t][(k + 1) % 3];
+      for (int j = h.triangle_start[to]; j < h.triangle_start[to + 1]; ++j) {
+        const auto& u = tris[h.vertex_triangles[j]];
+        if ((u[0] == to && u[1] == from) || (u[1] == to && u[2] == from) ||
+            (u[2] == to && u[0] == from))
+          h.triangle_neighbors[t][k] = h.vertex_triangles[j];
+      }
+    }
   // The faces most along each axis direction: cull planes that approximate the bounding box.
   for (int k = 0; k < 6; ++k) {
     const Vec3 dir = (k % 2 == 0 ? 1.0 : -1.0) * Vec3::Unit(k / 2);

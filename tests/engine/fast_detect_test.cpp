@@ -4,6 +4,7 @@
 // the seed path, for the full detector and for each feature test alone (the world calls those).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "engine/detect.h"
+#include "engine/detect_accelerated.h"
 
 namespace rbx {
 namespace {
@@ -191,6 +193,62 @@ TEST(FastDetect, IcospheresMatchSeed) {
   random_poses(i3, s1, 60, 8, "ico642-sheared42", t);
   grid_poses(i2, i2, "ico162-ico162", t);
   expect_representative(t, "icospheres");
+}
+
+// Hulls above kLinearVertices search their trees (caps grown over edges, bounded clusters of
+// face planes); the smaller ones above scan. Both sizes against each other and a box.
+TEST(FastDetect, HullsThatSearchTheirTreesMatchSeed) {
+  const ConvexPolyhedron s3 = sheared_icosphere(3), i3 = make_icosphere(0.5, 3);
+  const ConvexPolyhedron s2 = sheared_icosphere(2), box = make_box(Vec3(1, 1, 1));
+  ASSERT_GT(static_cast<int>(s3.vertices().size()), detail::kLinearVertices);
+  ASSERT_LE(static_cast<int>(s2.vertices().size()), detail::kLinearVertices);
+  Tally t;
+  // Counts kept so that the seed oracle (~16 N^2 primitive tests a pose) runs in seconds.
+  random_poses(s3, i3, 90, 10, "sheared642-ico642", t);
+  random_poses(s3, s2, 90, 11, "sheared642-sheared162", t);
+  random_poses(box, s3, 90, 12, "box-sheared642", t);
+  expect_representative(t, "large hulls");
+}
+
+// The cap of a shape with a hierarchy (engine/detect_accelerated.h) must hold every vertex
+// whose plane distance from the other shape's facing face is within the tolerance: a vertex
+// missing from it would be a hit never tested. Checked against the seed's expression on every
+// vertex, at touching poses, for a scanned and a searched hull; the cap must also leave most
+// vertices out (otherwise it culls nothing and the check proves little).
+TEST(FastDetect, TheCapHoldsEveryVertexNearTheFacingPlane) {
+  for (int subdivisions : {2, 3}) {
+    const ConvexPolyhedron a = sheared_icosphere(subdivisions), b = make_icosphere(0.5, 3);
+    std::mt19937_64 rng(20 + subdivisions);
+    int caps = 0, small_caps = 0;
+    for (int i = 0; i < 200; ++i) {
+      Pose pa, pb;
+      pa.orientation = random_rotation(rng);
+      pb.orientation = random_rotation(rng);
+      const Vec3 d = random_direction(rng);
+      // Touching along d: the support planes meet, then B pushed in by up to 1 % of its size.
+      const double reach = support(a, pa, d) + support(b, pb, -d);
+      pb.position = (reach - 0.01 * std::uniform_real_distribution<double>(0.0, 1.0)(rng)) * d;
+      detail::AcceleratedWorkspace ws;
+      detail::AcceleratedPair pair;
+      pair.prepare(a, pa, b, pb, ws);
+      if (!pair.a.cap || pair.b.facing < 0) continue;
+      ++caps;
+      const auto& tri = b.triangles()[pair.b.facing];
+      const Vec3 q = pb.apply(b.vertices()[tri[0]]);
+      const Vec3 n = pb.rotation() * b.planes()[pair.b.facing].normal;
+      const std::vector<int>& cap = *pair.a.cap;
+      for (int v = 0; v < static_cast<int>(a.vertices().size()); ++v) {
+        const double s = (pa.apply(a.vertices()[v]) - q).dot(n);
+        if (s <= pair.a.tol) {
+          EXPECT_TRUE(std::binary_search(cap.begin(), cap.end(), v))
+              << "subdivisions " << subdivisions << " pose " << i << " vertex " << v << " at " << s;
+        }
+      }
+      small_caps += 4 * static_cast<int>(cap.size()) < static_cast<int>(a.vertices().size());
+    }
+    EXPECT_GT(caps, 150) << "subdivisions " << subdivisions;
+    EXPECT_GT(small_caps, caps / 2) << "subdivisions " << subdivisions;
+  }
 }
 
 // Shapes destroyed and rebuilt, likely at reused addresses: the hierarchies each shape carries
