@@ -9,8 +9,12 @@ namespace rbx {
 namespace {
 
 ContactResult contact_with(const RigidBody& a, const RigidBody& b, DetectorVariant variant) {
+  // One detection cache per thread, reused by every query as the World reuses one per pair:
+  // its scratch lists are allocated once instead of on every call (measured: ~0.3 us of a
+  // 2 us query on hulls of 32 vertices). Answers do not depend on it.
+  thread_local DetectionCache cache;
   ContactResult r;
-  const auto c = detect(*a.shape, a.pose(), *b.shape, b.pose(), variant);
+  const auto c = detect(*a.shape, a.pose(), *b.shape, b.pose(), variant, cache);
   if (c) r.contacts.push_back(*c);
   return r;
 }
