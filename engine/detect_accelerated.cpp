@@ -554,12 +554,16 @@ double AcceleratedView::support_max(const Vec3& n) const {
   const Vec3 nl = rt * n;
   const double offset = position.dot(n);
   if (linear) {
-    // The largest body-frame value, then the seed's value of every vertex that may reach it.
+    // The seed's value of every vertex whose body-frame value comes within 2 margins of the
+    // largest so far: a superset of those that may reach the maximum.
     const auto& verts = shape->vertices();
     double top = -std::numeric_limits<double>::infinity();
-    for (int i = 0; i < nv; ++i) top = std::max(top, dot3(verts[i], nl));
-    for (int i = 0; i < nv; ++i)
-      if (dot3(verts[i], nl) + 2.0 * margin >= top) best = std::max(best, vertex(i).dot(n));
+    for (int i = 0; i < nv; ++i) {
+      const double value = dot3(verts[i], nl);
+      if (value + 2.0 * margin < top) continue;
+      top = std::max(top, value);
+      best = std::max(best, vertex(i).dot(n));
+    }
     return best;
   }
   tree.search(

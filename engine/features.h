@@ -161,11 +161,18 @@ std::optional<ContactPoint> vertex_one(const View& a, const View& b, FeatureScra
   return cp;
 }
 
+/// The contact normal of an edge hit, and the overlap along it when it was computed on the way
+/// (NaN otherwise).
+struct EdgeNormal {
+  Vec3 normal = Vec3::Zero();
+  double overlap = std::numeric_limits<double>::quiet_NaN();
+};
+
 /// seed correction 10 (edge normal e_a x e_b): the contact normal of an edge hit at p on A's edge
 /// v_i + t e_a, given the planes of B the edge crosses.
 template <typename View>
-Vec3 edge_normal(const View& a, const View& b, const Vec3& v_i, const Vec3& e_a, const Vec3& p,
-                 const std::vector<Crossing>& crossings) {
+EdgeNormal edge_normal(const View& a, const View& b, const Vec3& v_i, const Vec3& e_a,
+                       const Vec3& p, const std::vector<Crossing>& crossings) {
   const double tol = a.tol;
   // B's crossed triangle: a triangle whose plane the edge crosses at a point on the triangle
   // itself (the seed's sign test only proves the plane is crossed). The one nearest p wins;
@@ -201,21 +208,23 @@ Vec3 edge_normal(const View& a, const View& b, const Vec3& v_i, const Vec3& e_a,
   Vec3 n = e_a.cross(e_b);
   // Parallel edges (sin of their angle below 1e-9, far above the ~1e-16 round-off of the
   // world directions) define no plane: fall back to the crossed triangle's outward normal.
-  if (n.norm() <= 1e-9 * e_a.norm() * e_b.norm()) return n_face;
+  if (n.norm() <= 1e-9 * e_a.norm() * e_b.norm()) return {n_face};
   n.normalize();
   // Orientation from B toward A: of +n and -n, the one along which A overlaps B less is the
   // way out (the other sign measures nearly the sum of the extents). Ties: agree with the
   // crossed triangle's outward normal.
   const double plus = overlap(a, b, n), minus = overlap(a, b, Vec3(-n));
-  if (minus < plus - tol || (std::abs(minus - plus) <= tol && n.dot(n_face) < 0.0)) n = -n;
+  const bool flip = minus < plus - tol || (std::abs(minus - plus) <= tol && n.dot(n_face) < 0.0);
+  if (flip) n = -n;
   // Departure: e_a x e_b is the normal of an edge-EDGE contact. When A's edge pierces the
   // interior of B's face (an edge-face contact, e.g. a box edge crossing a wall after a face
   // hit), e_a x e_b lies in the wall and is no way out; e_b may even be the diagonal that
   // splits a square face in two, which is no edge of the solid. Of the two candidates, the one
   // that separates the bodies with the smaller translation is the contact normal (the rule a
   // separating-axis test applies to all axes, here to the two the seed's test produces).
-  if (overlap(a, b, n_face) < std::min(plus, minus) - tol) return n_face;
-  return n;
+  const double along_face = overlap(a, b, n_face);
+  if (along_face < std::min(plus, minus) - tol) return {n_face, along_face};
+  return {n, flip ? minus : plus};
 }
 
 /// The crossing parameters of an edge of length `length` (m), sorted with 0 and 1. Coplanar
@@ -257,8 +266,11 @@ std::optional<ContactPoint> edge_one(const View& a, const View& b, FeatureScratc
       if (!b.inside(p)) continue;
       ContactPoint cp;
       cp.point = p;
-      cp.normal = edge_normal(a, b, v_i, e_a, p, s.crossings);
-      cp.depth = overlap(a, b, cp.normal);  // the seed defines no depth
+      const EdgeNormal en = edge_normal(a, b, v_i, e_a, p, s.crossings);
+      cp.normal = en.normal;
+      // The seed defines no depth: the overlap along the normal (edge_normal's when it has it,
+      // the same expression on the same normal).
+      cp.depth = std::isnan(en.overlap) ? overlap(a, b, cp.normal) : en.overlap;
       cp.feature = to_string(Feature::Edge);
       return cp;
     }
