@@ -124,6 +124,7 @@ int facing_face(const AcceleratedView& y, const AcceleratedView& x) {
   for (int step = 0; step < y.num_triangles(); ++step) {
     int next = -1;
     for (int g : acc.triangle_neighbors[best]) {
+      if (g < 0) continue;  // (a validated closed mesh has all three)
       const double dot = pl[g].normal.dot(dl);
       if (dot > best_dot) {
         best_dot = dot;
