@@ -265,7 +265,8 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
      << "% gap (*separated*); " << plan.poses
      << " poses per kind, the time is the mean per query. Times include what each adapter "
         "does per call (the references build their library's shape from the hull on every "
-        "query, as the adapters are written; `custom` caches its hierarchies per shape; "
+        "query, as the adapters are written; `custom` caches its hierarchies per shape "
+        "and reuses one detection cache per thread, as the world reuses one per pair; "
         "`fcl (prebuilt)` is the same FCL query with each fcl::Convex built once, the fair "
         "comparison for custom, and the difference between the two fcl rows is FCL's set-up). The "
         "exponent is the least-squares slope of log(time) against log(N) over the hull sizes "
