@@ -23,9 +23,11 @@
 //     it is within a safety margin of the tolerance; only those faces take the seed's
 //     expression.
 //   - Depth, closest face, plane crossings and the nearest triangle: branch and bound over the
-//     same trees, with exact evaluation at the leaves.
+//     same trees, with the same body-frame rule at the leaves and the seed's expression
+//     wherever a comparison is within the margin.
 //   - Whole orders. Before the tests, each shape's facing face (its face most along the line to
-//     the other's centre) is found; a shape lying wholly outside one face plane of the other
+//     the other's centre; for a shape with a hierarchy, found by climbing over adjacent faces)
+//     is found; a shape lying wholly outside one face plane of the other, or with an empty cap,
 //     skips that order, and every point-in-mesh test tries the facing face first.
 // Every bound is computed in a body frame and carries a safety margin (kMarginScale times the
 // coordinate scale of the query, ~10^5 times the round-off of either computation), so a bound
