@@ -19,10 +19,11 @@
 
 namespace rbx {
 
-/// Outcome of a backend call.
-enum class Status { Ok, Error, Unsupported };
+/// Outcome of a backend call. Timeout: a library call past its deadline, abandoned
+/// (reference/isolate.h); reported apart from Error so a slow library is not called wrong.
+enum class Status { Ok, Error, Unsupported, Timeout };
 
-/// "ok" | "error" | "unsupported".
+/// "ok" | "error" | "unsupported" | "timeout".
 const char* to_string(Status s);
 
 /// Contact query result at given poses. Empty `contacts` with status Ok means "not touching".
@@ -176,6 +177,7 @@ struct Backend {
   ContactFn contact;        // empty: no contact queries
   DynamicsFn dynamics;      // empty: no dynamics
   MassFn mass = nullptr;    // empty: the library computes no mass properties of a hull
+  bool library = true;      // an outside library's code: isolated with a deadline per call
 };
 
 /// Every backend, in report order.

@@ -1,146 +1,669 @@
 #include "reference/isolate.h"
 
 #include <poll.h>
+#include <pthread.h>
 #include <signal.h>
+#include <sys/mman.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
+#include <iostream>
+#include <map>
+#include <new>
+#include <stdexcept>
 #include <string>
+#include <utility>
+
+#include "engine/format.h"
 
 namespace rbx {
 
 namespace {
 
-// Wire format child -> parent: status, message, then per contact 7 doubles and a feature string.
-void put(std::string& out, const void* p, size_t n) { out.append(static_cast<const char*>(p), n); }
-void put_string(std::string& out, const std::string& s) {
-  const uint64_t n = s.size();
-  put(out, &n, sizeof n);
-  out += s;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
 }
+
+// -- bytes: plain values in host order, strings and vectors length-prefixed ---------------------
+
+struct Writer {
+  std::string out;
+  template <class T>
+  void pod(const T& v) {
+    out.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  void str(const std::string& s) {
+    pod<uint64_t>(s.size());
+    out += s;
+  }
+  void vec(const Vec3& v) {
+    for (int k = 0; k < 3; ++k) pod(v[k]);
+  }
+  void quat(const Quat& q) {
+    const double c[4] = {q.w(), q.x(), q.y(), q.z()};
+    pod(c);
+  }
+};
 
 struct Reader {
   const std::string& in;
   size_t pos = 0;
-  bool get(void* p, size_t n) {
-    if (pos + n > in.size()) return false;
-    std::memcpy(p, in.data() + pos, n);
-    pos += n;
-    return true;
+  bool ok = true;
+  template <class T>
+  T pod() {
+    T v{};
+    if (pos + sizeof v > in.size()) {
+      ok = false;
+      return v;
+    }
+    std::memcpy(&v, in.data() + pos, sizeof v);
+    pos += sizeof v;
+    return v;
   }
-  bool get_string(std::string& s) {
-    uint64_t n = 0;
-    if (!get(&n, sizeof n) || pos + n > in.size()) return false;
-    s.assign(in, pos, n);
+  std::string str() {
+    const uint64_t n = pod<uint64_t>();
+    if (!ok || pos + n > in.size()) {
+      ok = false;
+      return {};
+    }
+    std::string s = in.substr(pos, n);
     pos += n;
-    return true;
+    return s;
+  }
+  Vec3 vec() {
+    Vec3 v;
+    for (int k = 0; k < 3; ++k) v[k] = pod<double>();
+    return v;
+  }
+  Quat quat() {
+    const double w = pod<double>(), x = pod<double>(), y = pod<double>(), z = pod<double>();
+    return Quat(w, x, y, z);
+  }
+  // A count read from the stream, refused when it claims more items than bytes are left.
+  uint64_t count() {
+    const uint64_t n = pod<uint64_t>();
+    if (n > in.size()) ok = false;
+    return ok ? n : 0;
   }
 };
 
-std::string encode(const ContactResult& r) {
-  std::string out;
-  const int32_t status = static_cast<int32_t>(r.status);
-  put(out, &status, sizeof status);
-  put_string(out, r.message);
-  const uint64_t n = r.contacts.size();
-  put(out, &n, sizeof n);
-  for (const ContactPoint& c : r.contacts) {
-    const double d[7] = {c.point.x(),  c.point.y(),  c.point.z(), c.normal.x(),
-                         c.normal.y(), c.normal.z(), c.depth};
-    put(out, d, sizeof d);
-    put_string(out, c.feature);
-  }
-  return out;
+void put(Writer& w, const ContactPoint& c) {
+  w.vec(c.point);
+  w.vec(c.normal);
+  w.pod(c.depth);
+  w.str(c.feature);
+}
+ContactPoint get_contact(Reader& r) {
+  ContactPoint c;
+  c.point = r.vec();
+  c.normal = r.vec();
+  c.depth = r.pod<double>();
+  c.feature = r.str();
+  return c;
 }
 
-bool decode(const std::string& in, ContactResult& r) {
-  Reader rd{in};
-  int32_t status = 0;
-  uint64_t n = 0;
-  if (!rd.get(&status, sizeof status) || !rd.get_string(r.message) || !rd.get(&n, sizeof n))
-    return false;
-  r.status = static_cast<Status>(status);
-  for (uint64_t i = 0; i < n; ++i) {
-    double d[7];
-    ContactPoint c;
-    if (!rd.get(d, sizeof d) || !rd.get_string(c.feature)) return false;
-    c.point = Vec3(d[0], d[1], d[2]);
-    c.normal = Vec3(d[3], d[4], d[5]);
-    c.depth = d[6];
-    r.contacts.push_back(c);
+void put(Writer& w, const BodyFinal& b) {
+  w.str(b.name);
+  w.vec(b.position);
+  w.quat(b.orientation);
+  w.vec(b.velocity);
+  w.vec(b.angular_velocity);
+}
+BodyFinal get_final(Reader& r) {
+  BodyFinal b;
+  b.name = r.str();
+  b.position = r.vec();
+  b.orientation = r.quat();
+  b.velocity = r.vec();
+  b.angular_velocity = r.vec();
+  return b;
+}
+
+std::string encode(const TimedContact& t) {
+  Writer w;
+  w.pod(static_cast<int32_t>(t.result.status));
+  w.str(t.result.message);
+  w.pod(t.runtime_s);
+  w.pod<uint64_t>(t.result.contacts.size());
+  for (const ContactPoint& c : t.result.contacts) put(w, c);
+  return w.out;
+}
+bool decode(const std::string& bytes, TimedContact& t) {
+  Reader r{bytes};
+  t.result.status = static_cast<Status>(r.pod<int32_t>());
+  t.result.message = r.str();
+  t.runtime_s = r.pod<double>();
+  const uint64_t n = r.count();
+  for (uint64_t i = 0; i < n && r.ok; ++i) t.result.contacts.push_back(get_contact(r));
+  return r.ok && r.pos == bytes.size();
+}
+
+std::string encode(const TimedDynamics& t) {
+  const DynamicsResult& d = t.result;
+  Writer w;
+  w.pod(static_cast<int32_t>(d.status));
+  w.str(d.message);
+  w.pod(t.runtime_s);
+  w.pod<uint64_t>(d.events.size());
+  for (const CollisionEvent& e : d.events) {
+    w.pod(e.time);
+    w.pod(e.step);
+    w.str(e.body_a);
+    w.str(e.body_b);
+    put(w, e.contact);
+    w.pod(e.impulse);
   }
-  return true;
+  w.pod<uint64_t>(d.finals.size());
+  for (const BodyFinal& b : d.finals) put(w, b);
+  w.pod<uint64_t>(d.samples.size());
+  for (const StateSample& s : d.samples) {
+    w.pod(s.time);
+    w.pod<uint64_t>(s.bodies.size());
+    for (const BodyFinal& b : s.bodies) put(w, b);
+  }
+  const FirstImpulse& f = d.first_impulse;
+  w.pod<uint8_t>(f.seen);
+  w.str(f.body_a);
+  w.str(f.body_b);
+  w.pod(f.step);
+  w.pod(f.contact_points);
+  w.vec(f.normal);
+  w.vec(f.point);
+  w.pod(f.depth);
+  w.pod(f.impulse);
+  w.pod(f.approach_speed);
+  w.pod(f.entry_phase);
+  return w.out;
+}
+bool decode(const std::string& bytes, TimedDynamics& t) {
+  DynamicsResult& d = t.result;
+  Reader r{bytes};
+  d.status = static_cast<Status>(r.pod<int32_t>());
+  d.message = r.str();
+  t.runtime_s = r.pod<double>();
+  for (uint64_t i = 0, n = r.count(); i < n && r.ok; ++i) {
+    CollisionEvent e;
+    e.time = r.pod<double>();
+    e.step = r.pod<long>();
+    e.body_a = r.str();
+    e.body_b = r.str();
+    e.contact = get_contact(r);
+    e.impulse = r.pod<double>();
+    d.events.push_back(std::move(e));
+  }
+  for (uint64_t i = 0, n = r.count(); i < n && r.ok; ++i) d.finals.push_back(get_final(r));
+  for (uint64_t i = 0, n = r.count(); i < n && r.ok; ++i) {
+    StateSample s;
+    s.time = r.pod<double>();
+    for (uint64_t k = 0, m = r.count(); k < m && r.ok; ++k) s.bodies.push_back(get_final(r));
+    d.samples.push_back(std::move(s));
+  }
+  FirstImpulse& f = d.first_impulse;
+  f.seen = r.pod<uint8_t>() != 0;
+  f.body_a = r.str();
+  f.body_b = r.str();
+  f.step = r.pod<long>();
+  f.contact_points = r.pod<int>();
+  f.normal = r.vec();
+  f.point = r.vec();
+  f.depth = r.pod<double>();
+  f.impulse = r.pod<double>();
+  f.approach_speed = r.pod<double>();
+  f.entry_phase = r.pod<double>();
+  return r.ok && r.pos == bytes.size();
+}
+
+std::string encode(const MassResult& m) {
+  Writer w;
+  w.pod(static_cast<int32_t>(m.status));
+  w.str(m.message);
+  w.pod(m.mass);
+  w.pod(m.volume);
+  w.vec(m.center_of_mass);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) w.pod(m.inertia(i, j));
+  return w.out;
+}
+bool decode(const std::string& bytes, MassResult& m) {
+  Reader r{bytes};
+  m.status = static_cast<Status>(r.pod<int32_t>());
+  m.message = r.str();
+  m.mass = r.pod<double>();
+  m.volume = r.pod<double>();
+  m.center_of_mass = r.vec();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m.inertia(i, j) = r.pod<double>();
+  return r.ok && r.pos == bytes.size();
+}
+
+// -- frames, child -> parent, and the call state the child shares with its parent -------------
+// Frames: 'R' item bytes: an item's result.  'X' message: an item threw.  'C' bytes: the answer
+// of a lone isolated call. A call's beginning and end are not frames but writes to a page
+// shared with the parent (CallState): no system call per library call, so a block of 20,000
+// queries costs what it costs in process.
+
+void write_all(int fd, const std::string& s) {
+  size_t off = 0;
+  while (off < s.size()) {
+    const ssize_t w = write(fd, s.data() + off, s.size() - off);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) _exit(3);  // the parent is gone: nobody to answer
+    off += static_cast<size_t>(w);
+  }
+}
+
+void send(int fd, char type, const std::string& payload) {
+  Writer w;
+  w.pod(type);
+  w.str(payload);
+  write_all(fd, w.out);
+}
+
+// The call a child is in, written by the child, read by its parent (a sequence lock: `seq` is
+// odd while a call runs, and the parent trusts the other fields only if `seq` read the same
+// before and after them).
+struct CallState {
+  std::atomic<uint64_t> seq{0};
+  std::atomic<int64_t> start_ns{0};  // steady clock (shared by both processes)
+  std::atomic<double> deadline_s{0.0};
+  char backend[96] = {};
+};
+
+int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
+      .count();
+}
+
+// The context of a supervised child process (set in the child only, right after the fork).
+using FailureTable = std::map<std::pair<size_t, std::string>, CallOutcome>;
+struct ChildContext {
+  int fd = -1;                             // frames to the parent
+  CallState* state = nullptr;              // shared with the parent
+  pthread_t thread{};                      // the child's first thread: the one supervised
+  size_t item = 0;                         // the item being run
+  const FailureTable* failures = nullptr;  // calls already known to fail, answered at once
+};
+ChildContext* g_child = nullptr;
+
+// Marks the start and the end of one supervised call.
+void begin_call(CallState& st, const std::string& backend, double deadline_s) {
+  const size_t n = std::min(backend.size(), sizeof st.backend - 1);
+  std::memcpy(st.backend, backend.data(), n);
+  st.backend[n] = '\0';
+  st.deadline_s.store(deadline_s, std::memory_order_relaxed);
+  st.start_ns.store(now_ns(), std::memory_order_relaxed);
+  st.seq.fetch_add(1, std::memory_order_release);
+}
+void end_call(CallState& st) { st.seq.fetch_add(1, std::memory_order_release); }
+
+// What a child process was, once it is over.
+struct ChildEnd {
+  bool timed_out = false;        // a call overran its deadline; the child was killed
+  int wait_status = 0;           // from waitpid
+  bool in_call = false;          // a call had begun and not ended
+  std::string backend;           // that call's backend
+  double call_deadline_s = 0.0;  // and its deadline
+  double call_elapsed_s = 0.0;   // how long it had run
+  std::string call_stderr;       // what the child wrote on stderr during that call
+  std::string threw;             // an item's exception message ('X')
+  bool has_answer = false;       // a lone call's answer ('C') arrived
+  std::string answer;
+};
+
+// The signal or exit status of a child, in words.
+std::string describe(int wait_status) {
+  if (WIFSIGNALED(wait_status))
+    return std::string("died with signal ") + strsignal(WTERMSIG(wait_status));
+  if (WIFEXITED(wait_status))
+    return "exited with status " + std::to_string(WEXITSTATUS(wait_status));
+  return "ended";
+}
+
+// The last non-empty line of a text, shortened to a readable length.
+std::string last_line(const std::string& text) {
+  const size_t end = text.find_last_not_of("\r\n \t");
+  if (end == std::string::npos) return "";
+  const size_t nl = text.rfind('\n', end);
+  const size_t start = nl == std::string::npos ? 0 : nl + 1;
+  std::string line = text.substr(start, end + 1 - start);
+  if (line.size() > 300) line = line.substr(0, 297) + "...";
+  return line;
+}
+
+// A snapshot of the shared call state, consistent or not taken.
+struct CallSnapshot {
+  bool in_call = false;
+  uint64_t seq = 0;
+  double elapsed_s = 0.0, deadline_s = 0.0;
+  std::string backend;
+};
+CallSnapshot snapshot(const CallState& st) {
+  CallSnapshot s;
+  for (int tries = 0; tries < 100; ++tries) {
+    const uint64_t before = st.seq.load(std::memory_order_acquire);
+    s.elapsed_s = 1e-9 * static_cast<double>(now_ns() - st.start_ns.load());
+    s.deadline_s = st.deadline_s.load();
+    s.backend.assign(st.backend, strnlen(st.backend, sizeof st.backend));
+    if (st.seq.load(std::memory_order_acquire) != before) continue;
+    s.seq = before;
+    s.in_call = before % 2 == 1;
+    return s;
+  }
+  return s;
+}
+
+// Forks a child that runs `body(frame_fd, state)` with its stderr captured, then supervises
+// it: frames go to `on_frame`; the shared call state is read at every frame and every 50 ms,
+// and a call past its deadline gets the child killed. The child's stderr is passed on, except
+// what arrives while a call runs, held until the call ends (it names a failure).
+template <class Body, class OnFrame>
+ChildEnd supervise(const Body& body, const OnFrame& on_frame) {
+  ChildEnd end;
+  void* page =
+      mmap(nullptr, sizeof(CallState), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+  if (page == MAP_FAILED) throw std::runtime_error(std::string("mmap: ") + strerror(errno));
+  CallState* state = new (page) CallState();
+  int frames[2], errs[2];
+  if (pipe(frames) != 0 || pipe(errs) != 0)
+    throw std::runtime_error(std::string("pipe: ") + strerror(errno));
+  // Buffered output written before the fork would otherwise be written twice.
+  std::fflush(nullptr);
+  std::cout.flush();
+  std::cerr.flush();
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error(std::string("fork: ") + strerror(errno));
+  if (pid == 0) {
+    close(frames[0]);
+    close(errs[0]);
+    dup2(errs[1], STDERR_FILENO);
+    close(errs[1]);
+    body(frames[1], *state);
+    std::fflush(nullptr);
+    _exit(0);  // not exit(): the parent's atexit hooks and static destructors are not ours
+  }
+  close(frames[1]);
+  close(errs[1]);
+  std::string inbox;  // frame bytes not yet parsed
+  std::string held;   // stderr held while a call runs
+  uint64_t held_seq = 0;
+  pollfd fds[2] = {{frames[0], POLLIN, 0}, {errs[0], POLLIN, 0}};
+  int open_fds = 2;
+  char buf[65536];
+  CallSnapshot last;
+  bool exited = false;
+  while (open_fds > 0) {
+    // The deadline of the call in progress, if any.
+    last = snapshot(*state);
+    if (!exited && last.in_call && last.elapsed_s > last.deadline_s) {
+      end.timed_out = true;
+      break;
+    }
+    if (!held.empty() && (!last.in_call || last.seq != held_seq)) {
+      std::cerr.write(held.data(), static_cast<std::streamsize>(held.size())).flush();
+      held.clear();
+    }
+    // Another thread's child, forked meanwhile, may hold copies of these pipes: the end of
+    // this child is seen by waitpid, not by the pipes' end of file.
+    const int ready = poll(fds, 2, exited ? 0 : 50);
+    if (ready <= 0) {
+      if (exited) break;
+      if (waitpid(pid, &end.wait_status, WNOHANG) == pid) exited = true;
+      continue;
+    }
+    for (int k = 0; k < 2; ++k) {
+      if (fds[k].fd < 0 || !(fds[k].revents & (POLLIN | POLLHUP | POLLERR))) continue;
+      const ssize_t n = read(fds[k].fd, buf, sizeof buf);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        close(fds[k].fd);
+        fds[k].fd = -1;
+        --open_fds;
+        continue;
+      }
+      if (k == 1) {
+        const CallSnapshot now = snapshot(*state);
+        if (now.in_call) {
+          if (!held.empty() && now.seq != held_seq) {
+            std::cerr.write(held.data(), static_cast<std::streamsize>(held.size())).flush();
+            held.clear();
+          }
+          held.append(buf, static_cast<size_t>(n));
+          held_seq = now.seq;
+        } else {
+          std::cerr.write(buf, n).flush();
+        }
+        continue;
+      }
+      inbox.append(buf, static_cast<size_t>(n));
+      // Every complete frame: a type, then a length-prefixed payload.
+      for (;;) {
+        Reader r{inbox};
+        const char type = r.pod<char>();
+        const std::string payload = r.str();
+        if (!r.ok) break;
+        inbox.erase(0, r.pos);
+        if (type == 'X') {
+          end.threw = payload;
+        } else if (type == 'C') {
+          end.has_answer = true;
+          end.answer = payload;
+        } else {
+          on_frame(type, payload);
+        }
+      }
+    }
+  }
+  if (end.timed_out) kill(pid, SIGKILL);
+  for (pollfd& p : fds)
+    if (p.fd >= 0) close(p.fd);
+  while (!exited && waitpid(pid, &end.wait_status, 0) < 0 && errno == EINTR) {
+  }
+  // The state the child left: a call begun and never ended is the one that failed.
+  last = snapshot(*state);
+  end.in_call = last.in_call;
+  end.backend = last.backend;
+  end.call_deadline_s = last.deadline_s;
+  end.call_elapsed_s = last.elapsed_s;
+  if (last.in_call)
+    end.call_stderr = held;
+  else if (!held.empty())
+    std::cerr.write(held.data(), static_cast<std::streamsize>(held.size())).flush();
+  state->~CallState();
+  munmap(page, sizeof(CallState));
+  return end;
+}
+
+// The failed outcome of the call a child was in when it ended.
+CallOutcome failure_of(const ChildEnd& end) {
+  CallOutcome out;
+  out.elapsed_s = end.call_elapsed_s;
+  if (end.timed_out) {
+    out.status = Status::Timeout;
+    out.message = "no answer within the deadline of " + fmt_num(end.call_deadline_s, 3) +
+                  " s (timed out; the library call was abandoned and the run went on)";
+    return out;
+  }
+  out.status = Status::Error;
+  out.message = WIFEXITED(end.wait_status)
+                    ? "the library call ended the process (" + describe(end.wait_status) +
+                          ") without an answer (no result)"
+                    : "the library call " + describe(end.wait_status) +
+                          " (isolated process; e.g. a failed assertion)";
+  const std::string said = last_line(end.call_stderr);
+  if (!said.empty()) out.message += ": " + said;
+  return out;
 }
 
 }  // namespace
 
-ContactResult run_isolated(const std::function<ContactResult()>& query, double timeout_s) {
-  int fds[2];
-  if (pipe(fds) != 0) return {Status::Error, std::string("pipe failed: ") + strerror(errno), {}};
-  const pid_t pid = fork();
-  if (pid < 0) {
-    close(fds[0]);
-    close(fds[1]);
-    return {Status::Error, std::string("fork failed: ") + strerror(errno), {}};
+bool in_isolated_child() { return g_child != nullptr; }
+
+CallOutcome isolated(const std::string& backend, double deadline_s,
+                     const std::function<std::string()>& call) {
+  // In a supervised child, on its supervised thread: run here, unless known to fail.
+  if (g_child && pthread_equal(pthread_self(), g_child->thread)) {
+    auto known = g_child->failures->find({g_child->item, backend});
+    if (known != g_child->failures->end()) return known->second;
+    begin_call(*g_child->state, backend, deadline_s);
+    const Clock::time_point start = Clock::now();
+    CallOutcome out{Status::Ok, "", call(), 0.0};
+    out.elapsed_s = seconds_since(start);
+    end_call(*g_child->state);
+    return out;
   }
-  if (pid == 0) {
-    // Child: run the query, send the result, leave without running the parent's atexit hooks.
-    close(fds[0]);
-    ContactResult r;
+  // Otherwise one child for this call.
+  const Clock::time_point start = Clock::now();
+  const ChildEnd end = supervise(
+      [&](int fd, CallState& state) {
+        begin_call(state, backend, deadline_s);
+        const std::string answer = call();
+        end_call(state);
+        send(fd, 'C', answer);
+      },
+      [](char, const std::string&) {});
+  if (end.has_answer) return {Status::Ok, "", end.answer, seconds_since(start)};
+  return failure_of(end);
+}
+
+std::vector<std::string> run_items_isolated(size_t lo, size_t hi,
+                                            const std::function<std::string(size_t)>& item,
+                                            const std::function<void(size_t)>& done) {
+  std::vector<std::string> results(hi - lo);
+  FailureTable failures;
+  size_t next = lo;
+  while (next < hi) {
+    const ChildEnd end = supervise(
+        [&](int fd, CallState& state) {
+          ChildContext ctx{fd, &state, pthread_self(), next, &failures};
+          g_child = &ctx;
+          for (size_t i = next; i < hi; ++i) {
+            ctx.item = i;
+            std::string bytes;
+            try {
+              bytes = item(i);
+            } catch (const std::exception& e) {
+              send(fd, 'X', e.what());
+              return;
+            } catch (...) {
+              send(fd, 'X', "a non-standard exception");
+              return;
+            }
+            Writer w;
+            w.pod<uint64_t>(i);
+            w.out += bytes;
+            send(fd, 'R', w.out);
+          }
+        },
+        [&](char type, const std::string& payload) {
+          if (type != 'R') return;
+          Reader r{payload};
+          const uint64_t i = r.pod<uint64_t>();
+          if (!r.ok || i != next) throw std::runtime_error("isolated items: result out of order");
+          results[i - lo] = payload.substr(sizeof(uint64_t));
+          ++next;
+          if (done) done(i);
+        });
+    if (!end.threw.empty()) throw std::runtime_error(end.threw);
+    if (next >= hi) break;
+    if (!end.in_call && !end.timed_out)
+      throw std::runtime_error(
+          "item " + std::to_string(next) + " " + describe(end.wait_status) +
+          " outside any library call (a fault of rbx itself)" +
+          (last_line(end.call_stderr).empty() ? std::string() : ": " + last_line(end.call_stderr)));
+    // The failed call is answered at once from now on; the item starts again in a new child.
+    if (!failures.emplace(std::make_pair(next, end.backend), failure_of(end)).second)
+      throw std::runtime_error("isolated items: a recorded failure of " + end.backend +
+                               " came back on item " + std::to_string(next));
+  }
+  return results;
+}
+
+TimedContact isolated_contact(const std::string& backend, double deadline_s,
+                              const std::function<TimedContact()>& call) {
+  const CallOutcome out = isolated(backend, deadline_s, [&] {
+    TimedContact t;
     try {
-      r = query();
+      t = call();
     } catch (const std::exception& e) {
-      r = {Status::Error, e.what(), {}};
-    } catch (...) {  // anything else must not escape: the child would run on as a second rbx
-      r = {Status::Error, "library call threw a non-standard exception", {}};
+      t.result = {Status::Error, e.what(), {}};
+    } catch (...) {
+      t.result = {Status::Error, "library call threw a non-standard exception", {}};
     }
-    const std::string bytes = encode(r);
-    size_t off = 0;
-    while (off < bytes.size()) {
-      const ssize_t w = write(fds[1], bytes.data() + off, bytes.size() - off);
-      if (w <= 0) break;
-      off += static_cast<size_t>(w);
+    return encode(t);
+  });
+  TimedContact t;
+  if (out.status == Status::Ok && decode(out.bytes, t)) return t;
+  t = TimedContact{};
+  t.result.status = out.status == Status::Ok ? Status::Error : out.status;
+  t.result.message =
+      out.status == Status::Ok ? backend + ": isolated call returned no result" : out.message;
+  t.runtime_s = out.elapsed_s;
+  return t;
+}
+
+TimedDynamics isolated_dynamics(const std::string& backend, double deadline_s,
+                                const std::function<TimedDynamics()>& call) {
+  const CallOutcome out = isolated(backend, deadline_s, [&] {
+    TimedDynamics t;
+    try {
+      t = call();
+    } catch (const std::exception& e) {
+      t = TimedDynamics{};
+      t.result.status = Status::Error;
+      t.result.message = e.what();
     }
-    close(fds[1]);
-    _exit(0);
-  }
-  // Parent: read until EOF or the deadline.
-  close(fds[1]);
-  std::string bytes;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  bool timed_out = false;
-  char buf[4096];
-  for (;;) {
-    // Rounded up: truncating would time out up to 1 ms before the deadline.
-    const auto left =
-        std::chrono::ceil<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-    if (left.count() <= 0) {
-      timed_out = true;
-      break;
+    return encode(t);
+  });
+  TimedDynamics t;
+  if (out.status == Status::Ok && decode(out.bytes, t)) return t;
+  t = TimedDynamics{};
+  t.result.status = out.status == Status::Ok ? Status::Error : out.status;
+  t.result.message =
+      out.status == Status::Ok ? backend + ": isolated call returned no result" : out.message;
+  t.runtime_s = out.elapsed_s;
+  return t;
+}
+
+MassResult isolated_mass(const std::string& backend, double deadline_s,
+                         const std::function<MassResult()>& call) {
+  const CallOutcome out = isolated(backend, deadline_s, [&] {
+    MassResult m;
+    try {
+      m = call();
+    } catch (const std::exception& e) {
+      m = MassResult{};
+      m.status = Status::Error;
+      m.message = e.what();
     }
-    pollfd p{fds[0], POLLIN, 0};
-    const int ready = poll(&p, 1, static_cast<int>(left.count()));
-    if (ready == 0) continue;
-    if (ready < 0 && errno == EINTR) continue;
-    const ssize_t n = read(fds[0], buf, sizeof buf);
-    if (n <= 0) break;
-    bytes.append(buf, static_cast<size_t>(n));
-  }
-  close(fds[0]);
-  if (timed_out) kill(pid, SIGKILL);
-  int wstatus = 0;
-  waitpid(pid, &wstatus, 0);
-  if (timed_out) return {Status::Error, "library call timed out (isolated process killed)", {}};
-  if (WIFSIGNALED(wstatus))
-    return {Status::Error,
-            std::string("library call died with signal ") + strsignal(WTERMSIG(wstatus)) +
-                " (isolated process; e.g. a failed assertion)",
-            {}};
-  ContactResult r;
-  if (!decode(bytes, r)) return {Status::Error, "isolated library call returned no result", {}};
-  return r;
+    return encode(m);
+  });
+  MassResult m;
+  if (out.status == Status::Ok && decode(out.bytes, m)) return m;
+  m = MassResult{};
+  m.status = out.status == Status::Ok ? Status::Error : out.status;
+  m.message =
+      out.status == Status::Ok ? backend + ": isolated call returned no result" : out.message;
+  return m;
+}
+
+ContactResult run_isolated(const std::function<ContactResult()>& query, double timeout_s) {
+  // Always a child of its own, even inside a supervised child: the caller isolates this one
+  // call because it is known to abort, and its caller's own call must go on.
+  ChildContext* const outer = g_child;
+  g_child = nullptr;
+  const TimedContact t = isolated_contact("library", timeout_s, [&] {
+    return TimedContact{query(), 0.0};
+  });
+  g_child = outer;
+  return t.result;
 }
 
 }  // namespace rbx

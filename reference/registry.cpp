@@ -18,23 +18,25 @@ const char* to_string(Status s) {
       return "error";
     case Status::Unsupported:
       return "unsupported";
+    case Status::Timeout:
+      return "timeout";
   }
   return "error";
 }
 
 const std::vector<Backend>& backends() {
-  // name, description, contact query, dynamics run.
+  // name, description, contact query, dynamics run, mass properties, library (isolated).
   // Plain names: the library as its experts use it (native primitives where a body is one);
   // `-hull`: every body the same convex hull the custom engine gets. The former `fcl-box`
   // (Box-Box only) is what `fcl` runs on two boxes, so it is gone as a duplicate.
   static const std::vector<Backend> table = {
       {"custom", "rbx engine: Moore & Wilhelms face/vertex/edge tests, single-point impulse",
-       custom_contact, custom_dynamics},
+       custom_contact, custom_dynamics, nullptr, false},
       {"custom-seed",
        "rbx engine, the seed's algorithm: first hit, single-point frictionless impulse", nullptr,
-       custom_seed_dynamics},
+       custom_seed_dynamics, nullptr, false},
       {"exact", "rbx oracle: separating-axis test over faces and edge pairs, clipped manifold",
-       exact_contact, nullptr},
+       exact_contact, nullptr, nullptr, false},
       {"fcl", "FCL 0.7: Box (boxBoxIntersect) or Convex (libccd MPR)", fcl_contact, nullptr,
        fcl_mass},
       {"fcl-hull", "FCL 0.7 Convex, GST_LIBCCD (libccd MPR)", fcl_hull_contact, nullptr,

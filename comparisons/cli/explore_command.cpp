@@ -108,12 +108,12 @@ std::string expect_block(const std::string& text) {
 
 std::string describe(const BackendOutcome& b) {
   std::ostringstream o;
-  if (b.error == "error") {
+  if (b.error == "error" || b.error == "timeout") {
     // One line: the message goes into a scene file's comment.
     std::string m = b.message;
     std::replace(m.begin(), m.end(), '\n', ' ');
     std::replace(m.begin(), m.end(), '\r', ' ');
-    return "status error: " + m;
+    return "status " + b.error + ": " + m;
   }
   if (b.error == "misses") return "misses a contact";
   if (b.error == "false_contact") return "reports a contact where there is none";
@@ -157,11 +157,7 @@ std::string shrink_group(const Json& g, uint64_t seed, long count, int budget) {
   const std::string text = body + "\n" + expect_block(body);
   std::string detail;
   bool reproduced = false;
-  if (!AbortGuard::run(
-          [&] { reproduced = harness_reproduces(text, "explore.toml", found, &detail); })) {
-    // The harness does not guard against aborts: `rbx compare` ends the same way on this scene.
-    detail = "the harness aborted inside the library (rbx compare aborts on this scene too)";
-  }
+  reproduced = harness_reproduces(text, "explore.toml", found, &detail);
   return Json{{"ok", true},
               {"text", text},
               {"points_before", r.vertices_before},
@@ -196,9 +192,7 @@ std::string shrink_impact_group(const Json& g, uint64_t seed, long count, int bu
   const std::string text = h.str() + r.sample.text;
   std::string detail;
   bool reproduced = false;
-  if (!AbortGuard::run(
-          [&] { reproduced = harness_reproduces(text, "explore.toml", found, &detail); }))
-    detail = "the harness aborted inside the library (rbx compare aborts on this scene too)";
+  reproduced = harness_reproduces(text, "explore.toml", found, &detail);
   return Json{{"ok", true},
               {"text", text},
               {"points_before", r.vertices_before},
@@ -358,7 +352,6 @@ std::string markdown(const Json& j, bool have_figure) {
 
 int explore_command(const ExploreOptions& opt) {
   ParallelRun par(opt.threads);
-  const AbortGuard guard;
   if (opt.count <= 0)
     throw InputError("rbx explore: --count: must be > 0, got " + std::to_string(opt.count));
   if (opt.kind != "contact" && opt.kind != "impact")

@@ -110,7 +110,7 @@ std::string headline(const SceneEvaluation& ev, const std::string& backend, std:
   if (!bj.contains(backend)) return "";
   const std::string status = bj[backend]["status"];
   if (status == "unsupported") return "n/a";
-  if (status == "error") return "error";
+  if (status == "error" || status == "timeout") return status;
   std::string cell;
   if (const Metric* t = find_metric(ev, backend, "touching_err"); t && t->value > 0) {
     cell = "wrong touch";
@@ -491,15 +491,17 @@ int report_command(const ReportOptions& opt) {
   std::mutex progress_mutex;
   size_t finished = 0;
   Stopwatch clock;
-  const std::vector<std::string> raw = par.map(scenes.size(), [&](size_t i) {
-    SceneEvaluation ev = evaluate_scene(scenes[i], hopt);
-    if (scenes[i].has_check(CheckKind::Contact)) ev.json["geometry"] = geometry_json(scenes[i]);
-    {
-      const std::lock_guard<std::mutex> lock(progress_mutex);
-      progress.show(++finished, scenes.size(), scenes[i].file, clock.seconds());
-    }
-    return encode_evaluation(ev);
-  });
+  const std::vector<std::string> raw = par.map(
+      scenes.size(),
+      [&](size_t i) {
+        SceneEvaluation ev = evaluate_scene(scenes[i], hopt);
+        if (scenes[i].has_check(CheckKind::Contact)) ev.json["geometry"] = geometry_json(scenes[i]);
+        return encode_evaluation(ev);
+      },
+      [&](size_t i) {
+        const std::lock_guard<std::mutex> lock(progress_mutex);
+        progress.show(++finished, scenes.size(), scenes[i].file, clock.seconds());
+      });
   progress.done();
   if (!par.root()) return 0;  // rank 0 writes everything
   std::vector<SceneEvaluation> evs;

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "comparisons/cli/commands.h"
+#include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/json_io.h"
 #include "comparisons/output/table.h"
 
@@ -56,20 +57,16 @@ int run_command(const SceneCommandOptions& opt) {
   for (const std::string& name : names) {
     const Backend* b = find_backend(name);
     DynamicsResult r;
-    Stopwatch clock;
+    double runtime = 0.0;
     if (!b->dynamics) {
       r.status = Status::Unsupported;
       r.message = name + " has no dynamics (contact queries only)";
     } else {
-      try {
-        r = b->dynamics(scene, DynamicsOptions{});
-      } catch (const std::exception& e) {
-        r.status = Status::Error;
-        r.message = e.what();
-      }
+      TimedDynamics t = run_dynamics_isolated(*b, scene, DynamicsOptions{});
+      r = std::move(t.result);
+      runtime = t.runtime_s;
     }
-    const double runtime = clock.seconds();
-    if (r.status == Status::Error) ++failed;
+    if (r.status == Status::Error || r.status == Status::Timeout) ++failed;
     print_dynamics(out, name, scene, r, runtime);
     backends_json[name] = dynamics_result_json(inputs, r, runtime);
   }

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "comparisons/cli/view.h"
+#include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/tosses.h"
 #include "comparisons/eval/trajectory.h"
 #include "comparisons/output/table.h"
@@ -332,7 +333,7 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
     std::vector<std::pair<std::string, TossRun>> runs;
     for (size_t k = 0; k < chosen.size(); ++k) {
       runs.emplace_back(chosen[k]->name,
-                        simulate_toss(chosen[k]->dynamics, t, ev.stored[k].params));
+                        simulate_toss(isolated_dynamics_fn(*chosen[k]), t, ev.stored[k].params));
       const TossRun& run = runs.back().second;
       if (run.status != Status::Ok) continue;
       for (size_t i = 0; i < run.track.position.size(); ++i)

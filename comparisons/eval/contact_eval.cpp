@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "comparisons/eval/json_io.h"
+#include "reference/isolate.h"
 
 namespace rbx {
 
@@ -15,20 +16,54 @@ ContactRun run_contact(const Backend& b, const RigidBody& a, const RigidBody& bb
     run.result = {Status::Unsupported, b.name + " has no contact query (dynamics only)", {}};
     return run;
   }
-  std::vector<double> times;
-  for (int k = 0; k < std::max(repeats, 1); ++k) {
+  // The repeats, timed one by one, with the median kept.
+  auto timed = [&] {
+    TimedContact t;
+    std::vector<double> times;
+    for (int k = 0; k < std::max(repeats, 1); ++k) {
+      Stopwatch clock;
+      try {
+        t.result = b.contact(a, bb);
+      } catch (const std::exception& e) {
+        t.result = {Status::Error, e.what(), {}};
+      }
+      times.push_back(clock.seconds());
+      if (t.result.status != Status::Ok) break;
+    }
+    std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
+    t.runtime_s = times[times.size() / 2];
+    return t;
+  };
+  // A library's query runs isolated, under its deadline (reference/isolate.h); ours in process.
+  const TimedContact t =
+      b.library ? isolated_contact(b.name, CallDeadlines{}.contact_s, timed) : timed();
+  run.result = t.result;
+  run.runtime_s = t.runtime_s;
+  return run;
+}
+
+TimedDynamics run_dynamics_isolated(const Backend& b, const Scene& scene,
+                                    const DynamicsOptions& opt) {
+  auto run = [&] {
+    TimedDynamics t;
     Stopwatch clock;
     try {
-      run.result = b.contact(a, bb);
+      t.result = b.dynamics(scene, opt);
     } catch (const std::exception& e) {
-      run.result = {Status::Error, e.what(), {}};
+      t.result = DynamicsResult{};
+      t.result.status = Status::Error;
+      t.result.message = e.what();
     }
-    times.push_back(clock.seconds());
-    if (run.result.status != Status::Ok) break;
-  }
-  std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
-  run.runtime_s = times[times.size() / 2];
-  return run;
+    t.runtime_s = clock.seconds();
+    return t;
+  };
+  return b.library ? isolated_dynamics(b.name, CallDeadlines{}.dynamics_s, run) : run();
+}
+
+DynamicsFn isolated_dynamics_fn(const Backend& b) {
+  return [&b](const Scene& scene, const DynamicsOptions& opt) {
+    return run_dynamics_isolated(b, scene, opt).result;
+  };
 }
 
 const ContactPoint* deepest(const ContactResult& r) {

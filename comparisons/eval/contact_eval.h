@@ -4,6 +4,7 @@
 #include <string>
 
 #include "reference/backend.h"
+#include "reference/isolate.h"
 
 namespace rbx {
 
@@ -17,6 +18,15 @@ struct ContactRun {
 /// Runs backend `b` on (A, B) `repeats` times (median time); a thrown exception becomes status
 /// Error with its message; a backend without contact queries gives Unsupported.
 ContactRun run_contact(const Backend& b, const RigidBody& a, const RigidBody& bb, int repeats = 1);
+
+/// Runs backend `b`'s dynamics on `scene` (a thrown exception becomes status Error); a library's
+/// run is isolated under its deadline (reference/isolate.h), so an abort or an endless loop is
+/// that run's `error` or `timeout`. The run time is the run's own, measured where it ran.
+TimedDynamics run_dynamics_isolated(const Backend& b, const Scene& scene,
+                                    const DynamicsOptions& opt);
+
+/// Backend `b`'s dynamics as a function that runs it through run_dynamics_isolated.
+DynamicsFn isolated_dynamics_fn(const Backend& b);
 
 /// The deepest contact point of a result, or nullptr when there is none.
 const ContactPoint* deepest(const ContactResult& r);

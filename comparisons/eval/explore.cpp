@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <csetjmp>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -300,36 +298,6 @@ std::string sample_scene_text(const ContactSample& s, const std::string& header,
 
 namespace {
 
-// An abort inside a library call (a failed assertion: FCL 0.7's EPA asserts in
-// ComputeVisiblePatch on some random pairs) must not end a run of 20,000 samples. While a
-// query runs, SIGABRT jumps back to it and the query becomes that backend's error. The
-// library's state of that call is abandoned (leaked); glibc's abort() releases its own lock
-// before raising, so later aborts on any thread are caught the same way. Design note: a fork
-// per query (reference/isolate.h) would also do, at a fork per call.
-thread_local sigjmp_buf* t_abort_jump = nullptr;
-
-extern "C" void explore_on_abort(int) {
-  if (t_abort_jump) siglongjmp(*t_abort_jump, 1);
-  std::signal(SIGABRT, SIG_DFL);  // not inside a guarded query: abort as usual
-  std::raise(SIGABRT);
-}
-
-ContactRun guarded_contact(const Backend& be, const RigidBody& a, const RigidBody& b) {
-  sigjmp_buf here;
-  sigjmp_buf* outer = t_abort_jump;
-  ContactRun run;
-  if (sigsetjmp(here, 1) == 0) {
-    t_abort_jump = &here;
-    run = run_contact(be, a, b);
-  } else {
-    run = ContactRun{};
-    run.result = {
-        Status::Error, be.name + " aborted inside the library (SIGABRT, a failed assertion)", {}};
-  }
-  t_abort_jump = outer;
-  return run;
-}
-
 // Below this many body sizes of depth or gap, touching or not is round-off: a stated tolerance
 // of the iterative references (FCL's 1e-6 m distance tolerance is far larger; the exact oracle's
 // depth carries about 1e-15 relative error), so a touching mismatch inside it is not counted.
@@ -348,12 +316,12 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
   for (const std::string& name : names) {
     const Backend* be = find_backend(name);
     if (!be || !be->contact) continue;
-    const ContactRun run = guarded_contact(*be, a, b);
+    const ContactRun run = run_contact(*be, a, b);
     if (run.result.status == Status::Unsupported) continue;
     BackendOutcome o;
     o.backend = name;
-    if (run.result.status == Status::Error) {
-      o.error = "error";
+    if (run.result.status == Status::Error || run.result.status == Status::Timeout) {
+      o.error = to_string(run.result.status);
       o.message = run.result.message;
       out.backends.push_back(o);
       continue;
@@ -395,26 +363,6 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
 }
 
 }  // namespace
-
-AbortGuard::AbortGuard() {
-  previous_ = reinterpret_cast<void*>(std::signal(SIGABRT, explore_on_abort));
-}
-
-AbortGuard::~AbortGuard() { std::signal(SIGABRT, reinterpret_cast<void (*)(int)>(previous_)); }
-
-bool AbortGuard::run(const std::function<void()>& f) {
-  sigjmp_buf here;
-  sigjmp_buf* outer = t_abort_jump;
-  bool ok = true;
-  if (sigsetjmp(here, 1) == 0) {
-    t_abort_jump = &here;
-    f();
-  } else {
-    ok = false;
-  }
-  t_abort_jump = outer;
-  return ok;
-}
 
 SampleOutcome evaluate_contact_sample(const ContactSample& s,
                                       const std::vector<std::string>& names) {
@@ -628,8 +576,8 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
                                  : "missing";
   bool ok = false;
   std::ostringstream d;
-  if (b.error == "error") {
-    ok = status == "error";
+  if (b.error == "error" || b.error == "timeout") {
+    ok = status == b.error;
     d << "status " << status;
   } else if (b.error == "misses") {
     ok = said("misses a contact");
@@ -950,20 +898,7 @@ SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<st
   for (const std::string& name : names) {
     const Backend* be = find_backend(name);
     if (!be || !be->dynamics) continue;
-    DynamicsResult run;
-    const bool finished = AbortGuard::run([&] {
-      try {
-        run = be->dynamics(scene, DynamicsOptions{0.0, 0});
-      } catch (const std::exception& e) {
-        run.status = Status::Error;
-        run.message = e.what();
-      }
-    });
-    if (!finished) {
-      run = DynamicsResult{};
-      run.status = Status::Error;
-      run.message = name + " aborted inside the library (SIGABRT, a failed assertion)";
-    }
+    DynamicsResult run = run_dynamics_isolated(*be, scene, DynamicsOptions{0.0, 0}).result;
     if (run.status == Status::Unsupported) continue;
     BackendOutcome o;
     o.backend = name;
@@ -971,8 +906,8 @@ SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<st
       run.status = Status::Error;
       run.message = "returned " + std::to_string(run.finals.size()) + " final states";
     }
-    if (run.status == Status::Error) {
-      o.error = "error";
+    if (run.status == Status::Error || run.status == Status::Timeout) {
+      o.error = to_string(run.status);
       o.message = run.message;
       out.backends.push_back(o);
       continue;

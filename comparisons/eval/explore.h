@@ -20,22 +20,6 @@
 
 namespace rbx {
 
-/// While alive, an abort (SIGABRT) inside a library query run by explore becomes that query's
-/// error instead of ending the process; `run` does the same for any block (false: it aborted;
-/// what it left half done is abandoned). Create one per command, on the main thread.
-class AbortGuard {
- public:
-  AbortGuard();
-  ~AbortGuard();
-  AbortGuard(const AbortGuard&) = delete;
-  AbortGuard& operator=(const AbortGuard&) = delete;
-  /// Runs f; false when it aborted.
-  static bool run(const std::function<void()>& f);
-
- private:
-  void* previous_ = nullptr;
-};
-
 /// Counter-based random numbers: splitmix64 seeded from a hash of (seed, index).
 class SampleRng {
  public:

@@ -64,14 +64,9 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
       run.cached = true;
       return run;
     }
-  Stopwatch clock;
-  try {
-    run.result = b.dynamics(scene, DynamicsOptions{dt, sample_every});
-  } catch (const std::exception& e) {
-    run.result.status = Status::Error;
-    run.result.message = e.what();
-  }
-  run.runtime_s = clock.seconds();
+  const TimedDynamics t = run_dynamics_isolated(b, scene, DynamicsOptions{dt, sample_every});
+  run.result = t.result;
+  run.runtime_s = t.runtime_s;
   // A backend that returns fewer final states than bodies has failed in a way we must show.
   if (run.result.status == Status::Ok && run.result.finals.size() != scene.bodies.size()) {
     run.result.status = Status::Error;
@@ -1127,12 +1122,7 @@ class Evaluator {
           r = hit->result;
           backend_json(b->name)["cached"] = true;
         } else {
-          try {
-            r = b->mass(body);
-          } catch (const std::exception& e) {
-            r.status = Status::Error;
-            r.message = e.what();
-          }
+          r = isolated_mass(b->name, CallDeadlines{}.mass_s, [&] { return b->mass(body); });
           if (cacheable) cache_.store(key, r, 0.0);
         }
         record(b->name, r);

@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "reference/isolate.h"
+
 #ifdef RBX_WITH_MPI
 #include <mpi.h>
 #endif
@@ -89,8 +91,8 @@ ParallelRun::~ParallelRun() {
 #endif
 }
 
-std::vector<std::string> ParallelRun::map(size_t n,
-                                          const std::function<std::string(size_t)>& item) const {
+std::vector<std::string> ParallelRun::map(size_t n, const std::function<std::string(size_t)>& item,
+                                          const std::function<void(size_t)>& done) const {
   // This rank's block, cut again among the threads.
   const auto [lo, hi] = block(n, ranks_, rank_);
   std::vector<std::string> local(hi - lo);
@@ -99,7 +101,8 @@ std::vector<std::string> ParallelRun::map(size_t n,
   auto work = [&](size_t t) {
     const auto [a, b] = block(hi - lo, nthreads, t);
     try {
-      for (size_t i = a; i < b; ++i) local[i] = item(lo + i);
+      std::vector<std::string> mine = run_items_isolated(lo + a, lo + b, item, done);
+      for (size_t i = a; i < b; ++i) local[i] = std::move(mine[i - a]);
     } catch (...) {
       errors[t] = std::current_exception();
     }

@@ -13,6 +13,7 @@
 #include <map>
 #include <sstream>
 
+#include "comparisons/eval/contact_eval.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/format.h"
 
@@ -279,7 +280,7 @@ BackendTosses evaluate_backend(const Backend& backend, const std::vector<Toss>& 
   Stopwatch clock;
   int failed = 0;
   for (const Toss& t : tosses) {
-    const TossRun run = simulate_toss(backend.dynamics, t, params, model);
+    const TossRun run = simulate_toss(isolated_dynamics_fn(backend), t, params, model);
     if (run.status != Status::Ok) {
       if (failed++ == 0) out.message = run.message;
       continue;

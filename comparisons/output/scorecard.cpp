@@ -40,10 +40,10 @@ double truth_metric(const SceneEvaluation& ev, const std::string& backend,
 // Why a backend failed a scene, measured: the status, then the first clear sign in the metrics.
 std::string cause(const SceneEvaluation& ev, const std::string& backend) {
   const Json& bj = ev.json["backends"][backend];
-  if (bj["status"] == "error") {
+  if (bj["status"] == "error" || bj["status"] == "timeout") {
     std::string msg = bj["message"].get<std::string>();
     if (msg.size() > 70) msg = msg.substr(0, 67) + "...";
-    return "error: " + msg;
+    return bj["status"].get<std::string>() + ": " + msg;
   }
   if (truth_metric(ev, backend, "touching_err") > 0)
     return "misses a contact or reports a false one";
@@ -129,8 +129,8 @@ std::string scorecard_markdown(const std::vector<Scene>& scenes,
         const Json& bj = ev.json["backends"][b];
         if (bj["status"] == "unsupported") continue;
         ++run;
-        const bool bad =
-            bj["status"] == "error" || about(ev.disagreements, b) || about(ev.deviations, b);
+        const bool bad = bj["status"] == "error" || bj["status"] == "timeout" ||
+                         about(ev.disagreements, b) || about(ev.deviations, b);
         if (!bad)
           ++within;
         else {

@@ -226,6 +226,39 @@ TEST(Cli, CheckPassesOnItsOwnBaselineAndFailsOnOneClaimingSmallerErrors) {
   fs::remove_all(dir);
 }
 
+TEST(LibraryContainment, AnAssertingLibraryIsItsBackendsErrorAndEveryOtherAnswerIsKept) {
+  // FCL 0.7's EPA fails an assertion on this pose (compiled into rbx from FCL's headers, so no
+  // library error hook sees it). It used to end rbx with SIGABRT (exit 134) and print nothing.
+  const fs::path dir = temp_dir("contain");
+  const CmdResult c =
+      rbx("contacts tests/data/flat_dome_on_box.toml --json '" + (dir / "c.json").string() + "'");
+  EXPECT_TRUE(c.code == 0 || c.code == 1) << c.code << c.err;
+  std::ifstream in(dir / "c.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const auto& b = j["backends"];
+  EXPECT_EQ(b["fcl-epa"]["status"], "error");
+  EXPECT_NE(b["fcl-epa"]["message"].get<std::string>().find("signal Aborted"), std::string::npos)
+      << b["fcl-epa"]["message"];
+  EXPECT_NE(b["fcl-epa"]["message"].get<std::string>().find("gjk_libccd-inl.h:1327"),
+            std::string::npos)
+      << b["fcl-epa"]["message"];
+  // Every other backend answered, with its own status; the library's assertion line went into
+  // the message, not onto the terminal.
+  for (const char* name : {"custom", "exact", "fcl", "bullet", "mujoco", "ode", "libccd"})
+    EXPECT_TRUE(b.contains(name) && b[name].contains("status")) << name;
+  EXPECT_EQ(b["exact"]["status"], "ok");
+  EXPECT_EQ(b["bullet-hull"]["status"], "ok");
+  EXPECT_EQ(c.err.find("Assertion"), std::string::npos) << c.err;
+  // The report is written, with the backend's error in it.
+  const CmdResult r =
+      rbx("report tests/data/flat_dome_on_box.toml --out '" + (dir / "out").string() + "'");
+  EXPECT_TRUE(r.code == 0 || r.code == 1) << r.code << r.err;
+  std::stringstream md;
+  md << std::ifstream(dir / "out/report.md").rdbuf();
+  EXPECT_NE(md.str().find("fcl-epa | error"), std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST(Cli, ReportWritesEverythingIntoItsFolder) {
   const fs::path dir = temp_dir("report");
   // An earlier `rbx bench` in the same folder: kept; an old report file: replaced.

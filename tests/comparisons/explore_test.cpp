@@ -166,19 +166,6 @@ TEST(ExploreShrink, ShrunkSceneReproducesThroughTheHarness) {
   EXPECT_FALSE(harness_reproduces(text, "shrunk.toml", exact, &detail)) << detail;
 }
 
-TEST(ExploreAbortGuard, AnAbortInsideAGuardedBlockReturnsFalse) {
-  // FCL 0.7's EPA asserts on some random pairs; a run of 20,000 samples must survive that.
-  const AbortGuard guard;
-  bool after = false;
-  EXPECT_FALSE(AbortGuard::run([&] {
-    std::abort();
-    after = true;
-  }));
-  EXPECT_FALSE(after);
-  EXPECT_TRUE(AbortGuard::run([&] { after = true; }));
-  EXPECT_TRUE(after);
-}
-
 // ---------------------------------------------------------------------------------------------
 // Impact kind
 

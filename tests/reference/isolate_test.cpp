@@ -94,10 +94,10 @@ TEST(RunIsolated, HangIsKilledAfterTheTimeout) {
         },
         timeout_s);
   });
-  EXPECT_EQ(r.status, Status::Error);
+  EXPECT_EQ(r.status, Status::Timeout);
   EXPECT_NE(r.message.find("timed out"), std::string::npos) << r.message;
-  // Not before the deadline (the parent polls until then); and well before the child's own
-  // end (never): 5 s covers a fork, a SIGKILL and a reap on a loaded 2-core machine.
+  // Not before the deadline; and well before the child's own end (never): 5 s covers a fork,
+  // the 50 ms polling of the call state, a SIGKILL and a reap on a loaded 2-core machine.
   EXPECT_GE(elapsed, timeout_s);
   EXPECT_LT(elapsed, timeout_s + 5.0);
   expect_no_child_left();
@@ -112,7 +112,7 @@ TEST(RunIsolated, AnswerAfterTheDeadlineIsDiscarded) {
         return {Status::Ok, "late", {}};
       },
       0.3);
-  EXPECT_EQ(r.status, Status::Error);
+  EXPECT_EQ(r.status, Status::Timeout);
   EXPECT_NE(r.message.find("timed out"), std::string::npos) << r.message;
   expect_no_child_left();
 }
@@ -202,6 +202,170 @@ TEST(RunIsolated, ChildCannotChangeTheParentsState) {
   });
   EXPECT_EQ(r.status, Status::Ok);
   EXPECT_EQ(counter, 0);
+  expect_no_child_left();
+}
+
+// -- blocks of items (run_items_isolated, what ParallelRun::map runs) --------------------------
+
+// A contact query of backend `name` that answers at once with one contact of depth `depth`.
+std::string answer_item(const std::string& name, double depth) {
+  const TimedContact t = isolated_contact(name, 5.0, [&] {
+    return TimedContact{{Status::Ok, "", {ContactPoint{Vec3::Zero(), Vec3::UnitZ(), depth, "x"}}},
+                        0.0};
+  });
+  return std::string(to_string(t.result.status)) + "|" + t.result.message + "|" +
+         (t.result.contacts.empty() ? "" : std::to_string(t.result.contacts[0].depth));
+}
+
+TEST(RunItemsIsolated, AnEndlessQueryTimesOutAndTheOtherItemsGoOn) {
+  // Item 2's "library" never returns. Its backend becomes `timeout` for that item; the items
+  // before and after it, and another backend in the same item, answer as usual.
+  const double deadline_s = 0.5;
+  std::vector<size_t> done;
+  std::vector<std::string> out;
+  const double elapsed = seconds_of([&] {
+    out = run_items_isolated(
+        0, 5,
+        [&](size_t i) {
+          std::string s = answer_item("good", static_cast<double>(i));
+          if (i == 2) {
+            const TimedContact t = isolated_contact("endless", deadline_s, []() -> TimedContact {
+              for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+            });
+            s += "/" + std::string(to_string(t.result.status)) + "|" + t.result.message;
+          }
+          return s;
+        },
+        [&](size_t i) { done.push_back(i); });
+  });
+  ASSERT_EQ(out.size(), 5u);
+  for (size_t i = 0; i < 5; ++i)
+    EXPECT_EQ(out[i].rfind("ok||" + std::to_string(static_cast<double>(i)), 0), 0u) << out[i];
+  EXPECT_NE(out[2].find("/timeout|no answer within the deadline"), std::string::npos) << out[2];
+  EXPECT_EQ(done, (std::vector<size_t>{0, 1, 2, 3, 4}));
+  // One deadline, not two: the second child answers the known failure at once.
+  EXPECT_GE(elapsed, deadline_s);
+  EXPECT_LT(elapsed, deadline_s + 5.0);
+  expect_no_child_left();
+}
+
+TEST(RunItemsIsolated, AnAbortFailsThatBackendInThatItemOnly) {
+  // A failed assertion prints its line and aborts: the backend's error names the signal and
+  // quotes the line; every later call of that backend in the item gets the same answer without
+  // running; the next item runs it again.
+  const std::vector<std::string> out = run_items_isolated(0, 3, [](size_t i) {
+    std::string s;
+    for (int call = 0; call < 2; ++call) {
+      const TimedContact t = isolated_contact("fragile", 5.0, [i]() -> TimedContact {
+        if (i == 1) {
+          std::fprintf(stderr, "fragile.h:12: check: Assertion `ok' failed.\n");
+          std::abort();
+        }
+        return {};
+      });
+      s += std::string(to_string(t.result.status)) + "|" + t.result.message + "#";
+    }
+    return s + answer_item("sturdy", 1.0);
+  });
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_EQ(out[0], "ok|#ok|#ok||1.000000");
+  EXPECT_EQ(out[2], "ok|#ok|#ok||1.000000");
+  EXPECT_NE(
+      out[1].find(std::string("error|the library call died with signal ") + strsignal(SIGABRT)),
+      std::string::npos)
+      << out[1];
+  EXPECT_NE(out[1].find("fragile.h:12: check: Assertion `ok' failed."), std::string::npos)
+      << out[1];
+  const size_t first = out[1].find('#');
+  EXPECT_EQ(out[1].substr(0, first), out[1].substr(first + 1, first)) << out[1];
+  EXPECT_NE(out[1].find("ok||1.000000"), std::string::npos) << out[1];
+  expect_no_child_left();
+}
+
+TEST(RunItemsIsolated, AnItemsExceptionIsRethrownHere) {
+  EXPECT_THROW(
+      {
+        try {
+          run_items_isolated(0, 3, [](size_t i) -> std::string {
+            if (i == 1) throw std::runtime_error("bad sample 1");
+            return "fine";
+          });
+        } catch (const std::runtime_error& e) {
+          EXPECT_STREQ(e.what(), "bad sample 1");
+          throw;
+        }
+      },
+      std::runtime_error);
+  expect_no_child_left();
+}
+
+TEST(RunItemsIsolated, ADeathOutsideAnyLibraryCallIsRbxsOwnFault) {
+  // Not a library's: nothing to blame and no call to answer for, so the map fails loudly.
+  try {
+    run_items_isolated(0, 2, [](size_t i) -> std::string {
+      if (i == 1) raise(SIGKILL);
+      return "fine";
+    });
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("outside any library call"), std::string::npos)
+        << e.what();
+  }
+  expect_no_child_left();
+}
+
+TEST(RunItemsIsolated, ResultsAreTheItemsOwnBytesInOrder) {
+  const std::vector<std::string> out = run_items_isolated(10, 14, [](size_t i) {
+    return std::string("item ") + std::to_string(i) + std::string(1, '\0') + "end";
+  });
+  ASSERT_EQ(out.size(), 4u);
+  for (size_t i = 0; i < 4; ++i)
+    EXPECT_EQ(out[i], "item " + std::to_string(10 + i) + std::string(1, '\0') + "end");
+  expect_no_child_left();
+}
+
+TEST(IsolatedDynamics, AWholeRunComesBackIntact) {
+  // Every field of a dynamics result crosses the process boundary bit for bit.
+  DynamicsResult sent;
+  sent.message = "note";
+  CollisionEvent e;
+  e.time = 0.1 + 0.2;
+  e.step = 42;
+  e.body_a = "A";
+  e.body_b = "B";
+  e.contact = ContactPoint{Vec3(1.0 / 3, 2, 3), Vec3(0, 0, -1), 1e-310, "edge"};
+  e.impulse = 2.25;
+  sent.events = {e, e};
+  BodyFinal f;
+  f.name = "A";
+  f.position = Vec3(1, 2, 3);
+  f.orientation = Quat(0.5, 0.5, -0.5, 0.5);
+  f.velocity = Vec3(-0.0, 1e300, 7);
+  f.angular_velocity = Vec3(0.1, 0.2, 0.3);
+  sent.finals = {f};
+  sent.samples = {StateSample{0.5, {f, f}}};
+  sent.first_impulse.seen = true;
+  sent.first_impulse.body_a = "A";
+  sent.first_impulse.step = 3;
+  sent.first_impulse.contact_points = 4;
+  sent.first_impulse.entry_phase = 0.7;
+  const TimedDynamics got = isolated_dynamics("lib", 5.0, [&] { return TimedDynamics{sent, 1.5}; });
+  ASSERT_EQ(got.result.status, Status::Ok) << got.result.message;
+  EXPECT_EQ(got.runtime_s, 1.5);
+  EXPECT_EQ(got.result.message, "note");
+  ASSERT_EQ(got.result.events.size(), 2u);
+  EXPECT_TRUE(same_bits(got.result.events[1].time, e.time));
+  EXPECT_EQ(got.result.events[1].step, 42);
+  EXPECT_TRUE(same_bits(got.result.events[1].contact.depth, 1e-310));
+  EXPECT_EQ(got.result.events[1].contact.feature, "edge");
+  ASSERT_EQ(got.result.finals.size(), 1u);
+  EXPECT_TRUE(same_bits(got.result.finals[0].velocity.x(), -0.0));
+  EXPECT_EQ(got.result.finals[0].orientation.coeffs(), f.orientation.coeffs());
+  ASSERT_EQ(got.result.samples.size(), 1u);
+  EXPECT_EQ(got.result.samples[0].bodies.size(), 2u);
+  EXPECT_TRUE(got.result.first_impulse.seen);
+  EXPECT_EQ(got.result.first_impulse.contact_points, 4);
+  EXPECT_EQ(got.result.first_impulse.entry_phase, 0.7);
   expect_no_child_left();
 }
 
