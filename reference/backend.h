@@ -21,9 +21,11 @@ namespace rbx {
 
 /// Outcome of a backend call. Timeout: a library call past its deadline, abandoned
 /// (reference/isolate.h); reported apart from Error so a slow library is not called wrong.
-enum class Status { Ok, Error, Unsupported, Timeout };
+/// Touching: a contact query that finds the pair touching at zero depth and, by the library's
+/// convention, gives no normal there (libccd, FCL's signed distance): an answer, not an error.
+enum class Status { Ok, Error, Unsupported, Timeout, Touching };
 
-/// "ok" | "error" | "unsupported" | "timeout".
+/// "ok" | "error" | "unsupported" | "timeout" | "touching".
 const char* to_string(Status s);
 
 /// Contact query result at given poses. Empty `contacts` with status Ok means "not touching".
@@ -33,14 +35,24 @@ struct ContactResult {
   std::vector<ContactPoint> contacts;
 };
 
-/// A library answer of "touching" whose normal is zero or not finite (libccd's MPR sets its
-/// direction to zero below CCD_EPS of depth) defines no contact normal. Returns `r` unchanged
-/// when every normal is a unit vector, else status Error saying which query, at what depth.
-/// This labels a library's answer; it corrects nothing.
+/// Depth (m) up to which a contact without a normal is "touching": libccd's MPR zeroes its
+/// direction below its epsilon of depth, FCL's signed distance has coincident nearest points at
+/// zero distance; a nanometre is far above both and far below any depth a scene states.
+constexpr double kTouchingDepth = 1e-9;
+
+/// A library answer of "touching" whose normal is zero or not finite defines no contact
+/// normal. Returns `r` unchanged when every normal is a unit vector; status Touching when such
+/// a contact has (nearly) zero depth, the libraries' convention at exact touching; else status
+/// Error saying which query, at what depth. This labels a library's answer; it corrects nothing.
 inline ContactResult reject_undefined_normals(ContactResult r, const std::string& query) {
   for (const ContactPoint& c : r.contacts) {
     const double n = c.normal.norm();
     if (std::isfinite(n) && n > 0.5) continue;
+    if (std::abs(c.depth) <= kTouchingDepth)
+      return {Status::Touching,
+              query + " reports the pair touching (depth " + std::to_string(c.depth) +
+                  ") with no normal, its convention at zero depth",
+              {}};
     return {Status::Error,
             query + " reported a contact (depth " + std::to_string(c.depth) +
                 ") with a zero or undefined normal",

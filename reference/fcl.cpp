@@ -244,7 +244,9 @@ ContactResult fcl_epa_contact(const RigidBody& a, const RigidBody& b) {
     const Vec3 p1 = result.nearest_points[1];
     const Vec3 d = p1 - p0;
     if (!(d.norm() > kCoincidentPoints)) {
-      return {Status::Error,
+      // At zero distance FCL 0.7 gives coincident nearest points: touching, with no normal.
+      const bool touching = std::abs(result.min_distance) <= kTouchingDepth;
+      return {touching ? Status::Touching : Status::Error,
               "signed distance " + std::to_string(result.min_distance) +
                   " with coincident nearest points: FCL 0.7 returns no normal at zero depth",
               {}};

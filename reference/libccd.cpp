@@ -24,10 +24,23 @@ namespace {
 static_assert(std::is_same<ccd_real_t, double>::value,
               "libccd must be built with CCD_DOUBLE: the adapter passes doubles through");
 
-// Iteration cap for MPR refinement, GJK and EPA. libccd's default is unlimited
-// ((unsigned long)-1), so a case that does not converge would hang the report; polytopes of a
-// few hundred vertices converge in far fewer.
+// Iteration cap for GJK and MPR's last refinement, the only loops of libccd 2.1 that read it.
+// libccd's default is unlimited ((unsigned long)-1); polytopes of a few hundred vertices
+// converge in far fewer.
 constexpr unsigned long kMaxIterations = 1000;
+
+// Support-call budget of one libccd query, the cap libccd 2.1 lacks: EPA (ccd.c, __ccdGJKEPA)
+// and MPR's portal refinement (mpr.c, refinePortal) loop on `while (1)`. EPA does loop forever
+// where the Minkowski difference has a large flat face (boxes face on face, as in MuJoCo's
+// BoxBoxLarge): libccd takes an inner diagonal of that face for the nearest feature (its
+// distance ties the face's within libccd's absolute epsilon), the support along the edge's
+// tilted witness is a vertex the polytope already has, yet the gap passes the tolerance test
+// with the face's long lever; adding the vertex again swaps to the other diagonal, without end.
+// Past the budget both bodies return the same point, so the Minkowski support is the origin
+// and every libccd loop stops; the query is then reported as not converged. Converging queries
+// use a few hundred calls (2 per GJK iteration and per EPA expansion). Even, so a pair's two
+// calls (support1 then support2) fall on the same side of it.
+constexpr long kMaxSupportCalls = 4 * static_cast<long>(kMaxIterations) + 16;
 
 // MPR, EPA and GJK-distance tolerance (m). libccd's defaults (1e-4 MPR/EPA) are a tenth of a
 // millimetre, coarse next to the 0.1-1 mm depths of our scenes; 1e-10 is tight enough not to
@@ -37,14 +50,24 @@ constexpr ccd_real_t kTolerance = 1e-10;
 /// A posed hull as libccd sees it: the body-frame polyhedron and the body-to-world transform.
 struct CcdBody {
   const ConvexPolyhedron* hull;
-  Mat3 rotation;  // body to world
-  Vec3 position;  // m, world position of the body origin (the centre of mass)
+  Mat3 rotation;        // body to world
+  Vec3 position;        // m, world position of the body origin (the centre of mass)
+  long* support_calls;  // calls so far in the current query, shared by the pair
 };
 
-/// libccd support function: the world-frame vertex of the posed hull furthest along `dir`,
-/// R * support_local(R^T dir) + p.
+/// libccd support function, the one rbx gives every library that takes one: the world-frame
+/// vertex of the posed hull furthest along `dir`, R * support_local(R^T dir) + p, where
+/// support_local is the body-frame hull's support_index (among vertices tied on the dot
+/// product, the first in the hull's vertex order). A box's vertex order puts -x before +x (and
+/// likewise y, z), so at a zero component of `dir` it returns the corner on the minus side,
+/// where libccd's test-suite box support returns the face centre (sign 0): both are support
+/// points, and only tie-sensitive algorithms (MPR) can tell them apart.
 void support(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* vec) {
   const auto* body = static_cast<const CcdBody*>(obj);
+  if (++*body->support_calls > kMaxSupportCalls) {  // over budget: see kMaxSupportCalls
+    ccdVec3Set(vec, 0.0, 0.0, 0.0);
+    return;
+  }
   const Vec3 dir_world(ccdVec3X(dir), ccdVec3Y(dir), ccdVec3Z(dir));
   const Vec3 dir_local = body->rotation.transpose() * dir_world;
   const Vec3& v_local = body->hull->vertices()[body->hull->support_index(dir_local)];
@@ -83,14 +106,9 @@ Penetration convert(int code, ccd_real_t depth, const ccd_vec3_t& dir, const ccd
   return p;
 }
 
-}  // namespace
-
-ContactResult libccd_contact(const RigidBody& a, const RigidBody& b) {
-  const CcdBody body_a{a.shape.get(), a.pose().rotation(), a.position};
-  const CcdBody body_b{b.shape.get(), b.pose().rotation(), b.position};
-
-  // Default first direction (ccdFirstDirDefault, +x); our support and centre functions; the
-  // cap and tolerances above.
+/// The libccd set-up shared by both queries: default first direction (ccdFirstDirDefault,
+/// +x), our support and centre functions, the cap and the tolerances above.
+ccd_t make_ccd() {
   ccd_t ccd;
   CCD_INIT(&ccd);
   ccd.support1 = support;
@@ -101,43 +119,47 @@ ContactResult libccd_contact(const RigidBody& a, const RigidBody& b) {
   ccd.mpr_tolerance = kTolerance;
   ccd.epa_tolerance = kTolerance;
   ccd.dist_tolerance = kTolerance;
+  return ccd;
+}
 
-  // Both algorithms on the same pair.
+/// One libccd penetration query (`run` calls ccdMPRPenetration or ccdGJKPenetration) on the
+/// pair, converted to our convention.
+template <class Query>
+ContactResult penetration(const RigidBody& a, const RigidBody& b, const char* name,
+                          const char* feature, Query&& run) {
+  long support_calls = 0;
+  const CcdBody body_a{a.shape.get(), a.pose().rotation(), a.position, &support_calls};
+  const CcdBody body_b{b.shape.get(), b.pose().rotation(), b.position, &support_calls};
+  const ccd_t ccd = make_ccd();
   ccd_real_t depth = 0.0;
   ccd_vec3_t dir, pos;
   ccdVec3Set(&dir, 0.0, 0.0, 0.0);
   ccdVec3Set(&pos, 0.0, 0.0, 0.0);
-  const int mpr_code = ccdMPRPenetration(&body_a, &body_b, &ccd, &depth, &dir, &pos);
-  const Penetration mpr = convert(mpr_code, depth, dir, pos, "mpr");
-  depth = 0.0;
-  ccdVec3Set(&dir, 0.0, 0.0, 0.0);
-  ccdVec3Set(&pos, 0.0, 0.0, 0.0);
-  const int gjk_code = ccdGJKPenetration(&body_a, &body_b, &ccd, &depth, &dir, &pos);
-  if (gjk_code == -2) return {Status::Error, "ccdGJKPenetration: memory allocation failed", {}};
-  const Penetration epa = convert(gjk_code, depth, dir, pos, "gjk-epa");
+  const int code = run(&body_a, &body_b, &ccd, &depth, &dir, &pos);
+  if (support_calls > kMaxSupportCalls)
+    return {Status::Error,
+            std::string(name) + " did not converge within " + std::to_string(kMaxSupportCalls) +
+                " support calls (libccd 2.1 caps no iteration there; see reference/libccd.cpp)",
+            {}};
+  if (code == -2) return {Status::Error, std::string(name) + ": memory allocation failed", {}};
+  const Penetration p = convert(code, depth, dir, pos, feature);
+  if (!p.intersecting) return {};
+  // A contact without a direction cannot be reported in our convention (libccd 2.1 at exact
+  // touching: MPR zeroes its direction, GJK + EPA returns depth 0 and dir NaN).
+  if (!p.direction_defined) return reject_undefined_normals({Status::Ok, "", {p.contact}}, name);
+  return {Status::Ok, "", {p.contact}};
+}
 
-  // A contact without a direction cannot be reported in our convention: say so instead of
-  // dropping it silently (libccd 2.1 GJK + EPA at exactly touching returns depth 0, dir NaN).
-  for (const Penetration* p : {&mpr, &epa}) {
-    if (p->intersecting && !p->direction_defined) {
-      return {Status::Error,
-              std::string(p == &mpr ? "ccdMPRPenetration" : "ccdGJKPenetration") +
-                  " reported contact (depth " + std::to_string(p->contact.depth) +
-                  ") with an undefined direction",
-              {}};
-    }
-  }
+}  // namespace
 
-  // contacts[0] = MPR, contacts[1] = GJK + EPA when both see contact; if only one does, its
-  // contact alone (told apart by `feature`) and a note of the disagreement.
-  ContactResult out;
-  if (mpr.intersecting) out.contacts.push_back(mpr.contact);
-  if (epa.intersecting) out.contacts.push_back(epa.contact);
-  if (mpr.intersecting != epa.intersecting) {
-    out.message = mpr.intersecting ? "MPR reports contact, GJK reports none"
-                                   : "GJK + EPA reports contact, MPR reports none";
-  }
-  return out;
+ContactResult libccd_mpr_contact(const RigidBody& a, const RigidBody& b) {
+  return penetration(a, b, "ccdMPRPenetration", "mpr",
+                     [](auto... args) { return ccdMPRPenetration(args...); });
+}
+
+ContactResult libccd_epa_contact(const RigidBody& a, const RigidBody& b) {
+  return penetration(a, b, "ccdGJKPenetration", "gjk-epa",
+                     [](auto... args) { return ccdGJKPenetration(args...); });
 }
 
 }  // namespace rbx

@@ -20,6 +20,8 @@ const char* to_string(Status s) {
       return "unsupported";
     case Status::Timeout:
       return "timeout";
+    case Status::Touching:
+      return "touching";
   }
   return "error";
 }
@@ -43,7 +45,10 @@ const std::vector<Backend>& backends() {
        fcl_hull_mass},
       {"fcl-epa", "FCL 0.7 signed distance (GJK + EPA)", fcl_epa_contact, nullptr},
       {"fcl-indep", "FCL 0.7 Convex, GST_INDEP (known defects shown)", fcl_indep_contact, nullptr},
-      {"libccd", "libccd 2.1 on our support function: MPR and GJK + EPA", libccd_contact, nullptr},
+      {"libccd-mpr", "libccd 2.1 MPR (ccdMPRPenetration) on our support function",
+       libccd_mpr_contact, nullptr},
+      {"libccd-epa", "libccd 2.1 GJK + EPA (ccdGJKPenetration) on our support function",
+       libccd_epa_contact, nullptr},
       {"bullet", "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
        bullet_contact, bullet_dynamics, bullet_mass},
       {"bullet-hull", "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",

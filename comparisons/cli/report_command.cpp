@@ -111,6 +111,7 @@ std::string headline(const SceneEvaluation& ev, const std::string& backend, std:
   const std::string status = bj[backend]["status"];
   if (status == "unsupported") return "n/a";
   if (status == "error" || status == "timeout") return status;
+  if (status == "touching") return "touching, no normal";
   std::string cell;
   if (const Metric* t = find_metric(ev, backend, "touching_err"); t && t->value > 0) {
     cell = "wrong touch";
@@ -183,17 +184,20 @@ const std::vector<PinnedCause>& pinned_causes() {
        "**fcl-indep**: FCL 0.7's GST_INDEP leaves the EPA normal in A's local frame and returns "
        "the depth negated (`FclIndep.*`); its signed distance on Box-Convex aborts on an "
        "assertion (`FclIndepDistance.*`, run in a forked process)."},
-      {{"fcl-hull", "libccd", "ode-hull", "mujoco-hull"},
+      {{"fcl-hull", "libccd-mpr", "ode-hull", "mujoco-hull"},
        {"small_on_diagonal"},
-       "**fcl-hull, libccd, ode-hull, mujoco-hull on `small_on_diagonal`**: MPR follows the ray "
+       "**fcl-hull, libccd-mpr, ode-hull, mujoco-hull on `small_on_diagonal`**: MPR follows the "
+       "ray "
        "between the centres, not the minimum-translation axis (FCL issue 545): n = (1, 1, "
        "1)/sqrt(3), depth 0.26 for a true 0.15 (`FclMpr.*`, `Libccd.DiagonalCubeMprWrongEpaRight`, "
        "`MujocoKnownWrongAnswer.*`). Debian's ODE runs convex-convex through libccd MPR too, so it "
        "shares FCL's answers bit for bit."},
-      {{"fcl-hull", "libccd", "ode-hull"},
+      {{"fcl-hull", "libccd-mpr", "libccd-epa", "ode-hull", "fcl-epa"},
        {},
-       "**fcl-hull, libccd, ode-hull at exact touching**: libccd's MPR zeroes its direction below "
-       "CCD_EPS of depth; the adapters report that as `error` (no normal), not as a 180 deg miss."},
+       "**fcl-hull, libccd-mpr, libccd-epa, ode-hull, fcl-epa at exact touching**: libccd's MPR "
+       "zeroes its direction below CCD_EPS of depth, its EPA and FCL's signed distance return no "
+       "direction at zero distance; the adapters report that as `touching` (no normal), a "
+       "convention, apart from errors."},
       {{"bullet-sat"},
        {},
        "**bullet-sat**: the SAT + clipping path measures each point's depth to the first body's "

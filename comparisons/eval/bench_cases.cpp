@@ -77,7 +77,7 @@ std::vector<NarrowBackend> narrow_backends() {
       {"fcl", "default", registry("fcl"), 8192, 2048},
       {"fcl", "prebuilt", variant("fcl", "prebuilt"), 8192, 2048},
       {"fcl-epa", "default", registry("fcl-epa"), 8192, 2048},
-      {"libccd", "default", registry("libccd"), 8192, 2048},
+      {"libccd-mpr", "default", registry("libccd-mpr"), 8192, 2048},
       {"bullet", "default", registry("bullet"), 8192, 2048},
       {"bullet-sat", "default", registry("bullet-sat"), 512, 128},
       {"mujoco", "default", registry("mujoco"), 8192, 512},
@@ -121,7 +121,7 @@ Quat random_rotation(std::mt19937_64& rng) {
 PosedPair make_poses(const ConvexPolyhedron& shape, bool box, const PoseKind& kind, int count,
                      std::mt19937_64& rng) {
   PosedPair p{body_of("A", shape, box), body_of("B", shape, box), {}, {}};
-  const ContactFn ccd = find_backend("libccd")->contact;
+  const ContactFn ccd = find_backend("libccd-mpr")->contact;
   for (int k = 0; k < count; ++k) {
     p.a.position = Vec3::Zero();
     p.a.orientation = random_rotation(rng);

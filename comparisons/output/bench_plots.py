@@ -16,10 +16,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 # One colour and marker per backend, stable across figures (the order of the registry).
-BACKENDS = ["custom", "exact", "fcl", "fcl-epa", "fcl-indep", "fcl-box", "libccd", "bullet",
-            "bullet-sat", "mujoco", "ode"]
+BACKENDS = ["custom", "exact", "fcl", "fcl-epa", "fcl-indep", "fcl-box", "libccd-mpr", "bullet",
+            "bullet-sat", "mujoco", "ode", "libccd"]
 COLOURS = dict(zip(BACKENDS, plt.cm.tab20.colors[::2] + plt.cm.tab20.colors[1::2]))
-MARKERS = dict(zip(BACKENDS, "os^vD<>pPX*"))
+MARKERS = dict(zip(BACKENDS, "os^vD<>pPX*h"))
 METHOD_STYLE = {"all-pairs": ("tab:red", "o"), "sweep-and-prune": ("tab:orange", "s"),
                 "tree": ("tab:blue", "^")}
 

@@ -25,7 +25,7 @@ OKABE_ITO = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#56B4E9", "#D55E00", "
              "#000000"]
 MARKER_CYCLE = "os^DvP<X>*ph"
 PREFERRED = ["custom", "custom-seed", "exact", "fcl", "fcl-hull", "fcl-epa", "fcl-indep",
-             "fcl-box", "libccd", "bullet", "bullet-hull", "bullet-sat", "mujoco", "mujoco-hull",
+             "fcl-box", "libccd-mpr", "libccd-epa", "bullet", "bullet-hull", "bullet-sat", "mujoco", "mujoco-hull",
              "ode", "ode-hull"]
 _STYLE = {}
 

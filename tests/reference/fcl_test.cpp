@@ -121,15 +121,17 @@ TEST(FclMpr, FacePairConventionBothOrdersAndRotated) {
   check_face_pair(fcl_hull_contact, kRoundOff);
 }
 
-TEST(FclMpr, ExactTouchingOffCentreHasNoNormalAndIsAnError) {
+TEST(FclMpr, ExactTouchingOffCentreHasNoNormalAndIsTouching) {
   // scenes/contact/touching_zero_depth.toml: A exactly on top of B, shifted (0.3, 0.2). Unlike
   // the centred touching pair below, MPR here reports contact at a round-off depth with its
   // direction zeroed (mpr.c findPenetr, below CCD_EPS), which FCL copies as the normal.
-  // Pinned: the adapter labels that as no normal (status Error), not a 180 deg miss.
+  // Pinned: the adapter labels that as touching with no normal (status Touching, the library's
+  // convention at zero depth), not a 180 deg miss and not an error.
   const ContactResult r =
       fcl_hull_contact(unit_cube("A", Vec3(0.3, 0.2, 1)), unit_cube("B", Vec3::Zero()));
-  EXPECT_EQ(r.status, Status::Error);
-  EXPECT_NE(r.message.find("zero or undefined normal"), std::string::npos) << r.message;
+  EXPECT_EQ(r.status, Status::Touching);
+  EXPECT_NE(r.message.find("touching"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("no normal"), std::string::npos) << r.message;
 }
 
 TEST(FclMpr, OneContactLabelledMpr) {
@@ -185,11 +187,12 @@ TEST(FclEpa, SeparatedIsNoContact) {
   EXPECT_TRUE(r.contacts.empty());
 }
 
-TEST(FclEpa, TouchingHasNoNormalAndIsReportedAsError) {
+TEST(FclEpa, TouchingHasNoNormalAndIsReportedAsTouching) {
   // Pinned: at gap 0 FCL returns min_distance 0 and two coincident nearest points, and 0.7's
-  // DistanceResult carries no normal; the adapter says so instead of inventing a direction.
+  // DistanceResult carries no normal; the adapter says so (status Touching) instead of
+  // inventing a direction.
   const ContactResult r = fcl_epa_contact(unit_cube("A", Vec3::Zero()), touching_b());
-  EXPECT_EQ(r.status, Status::Error);
+  EXPECT_EQ(r.status, Status::Touching);
   EXPECT_NE(r.message.find("no normal"), std::string::npos) << r.message;
   EXPECT_TRUE(r.contacts.empty());
 }

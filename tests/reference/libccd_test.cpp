@@ -1,5 +1,5 @@
-// Tests of the libccd adapter: ccdMPRPenetration (contacts[0], "mpr") and ccdGJKPenetration
-// (contacts[1], "gjk-epa") on our own support function.
+// Tests of the libccd adapters: ccdMPRPenetration (`libccd-mpr`, feature "mpr") and
+// ccdGJKPenetration (`libccd-epa`, feature "gjk-epa") on our own support function, each alone.
 //
 // Expected values are derived by hand (comments), plus a fixed-seed cross-check against a
 // separating-axis computation written here (15 axes of two boxes: the exact minimum
@@ -31,6 +31,14 @@ using test::unit_cube;
 // EPA face is an exact hull face): unit-scale coordinates give ~1e-15; 1e-12 leaves margin.
 constexpr double kRoundOff = 1e-12;
 
+// Both algorithms on one pair: {MPR's answer, GJK + EPA's answer}.
+struct Both {
+  ContactResult mpr, epa;
+};
+Both both(const RigidBody& a, const RigidBody& b) {
+  return {libccd_mpr_contact(a, b), libccd_epa_contact(a, b)};
+}
+
 // ---------------------------------------------------------------------------------------------
 // Face pair: unit cubes, A at the origin, B at (0.9, 0, 0). Overlap 0.1 along x (1 along y, z),
 // B on A's +x side: ours n = (-1, 0, 0), depth 0.1. Rotated as a whole by R: n = R (-1, 0, 0).
@@ -40,13 +48,15 @@ TEST(Libccd, FacePairConventionBothOrdersAndRotated) {
     const RigidBody a = unit_cube("A", Vec3::Zero(), q);
     const RigidBody b = unit_cube("B", q * Vec3(0.9, 0, 0), q);
     for (bool swapped : {false, true}) {
-      const ContactResult r = swapped ? libccd_contact(b, a) : libccd_contact(a, b);
-      ASSERT_EQ(r.status, Status::Ok) << r.message;
-      ASSERT_EQ(r.contacts.size(), 2u);
-      EXPECT_EQ(r.contacts[0].feature, "mpr");
-      EXPECT_EQ(r.contacts[1].feature, "gjk-epa");
+      const Both r = swapped ? both(b, a) : both(a, b);
+      ASSERT_EQ(r.mpr.status, Status::Ok) << r.mpr.message;
+      ASSERT_EQ(r.epa.status, Status::Ok) << r.epa.message;
+      ASSERT_EQ(r.mpr.contacts.size(), 1u);
+      ASSERT_EQ(r.epa.contacts.size(), 1u);
+      EXPECT_EQ(r.mpr.contacts[0].feature, "mpr");
+      EXPECT_EQ(r.epa.contacts[0].feature, "gjk-epa");
       const Vec3 n = (swapped ? -1.0 : 1.0) * (q * Vec3(-1, 0, 0));
-      for (const ContactPoint& c : r.contacts) {
+      for (const ContactPoint& c : {r.mpr.contacts[0], r.epa.contacts[0]}) {
         EXPECT_NEAR((c.normal - n).norm(), 0.0, kRoundOff) << c.feature;
         EXPECT_NEAR(c.depth, 0.1, kRoundOff) << c.feature;
         // MPR's point lies in the overlap slab x in [0.4, 0.5] of A's frame. libccd's EPA point
@@ -64,21 +74,23 @@ TEST(Libccd, FacePairConventionBothOrdersAndRotated) {
 
 TEST(Libccd, SeparatedIsNoContact) {
   // Gap 0.1 along x: both algorithms report no intersection.
-  const ContactResult r =
-      libccd_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(1.1, 0, 0)));
-  EXPECT_EQ(r.status, Status::Ok);
-  EXPECT_TRUE(r.contacts.empty());
+  const Both r = both(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(1.1, 0, 0)));
+  for (const ContactResult* x : {&r.mpr, &r.epa}) {
+    EXPECT_EQ(x->status, Status::Ok);
+    EXPECT_TRUE(x->contacts.empty());
+  }
 }
 
 TEST(Libccd, TouchingGjkHasNoDirectionPinned) {
   // Pinned: at gap 0, MPR reports no intersection while ccdGJKPenetration reports one with
-  // depth 0 and a NaN direction; the adapter returns status Error naming it rather than a
-  // contact without a normal.
-  const ContactResult r =
-      libccd_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(1.0, 0, 0)));
-  EXPECT_EQ(r.status, Status::Error);
-  EXPECT_NE(r.message.find("ccdGJKPenetration"), std::string::npos) << r.message;
-  EXPECT_TRUE(r.contacts.empty());
+  // depth 0 and a NaN direction; the adapter returns status Touching (no normal, libccd's
+  // convention at zero depth), not a contact without a normal and not an error.
+  const Both r = both(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(1.0, 0, 0)));
+  EXPECT_EQ(r.mpr.status, Status::Ok);
+  EXPECT_TRUE(r.mpr.contacts.empty());
+  EXPECT_EQ(r.epa.status, Status::Touching);
+  EXPECT_NE(r.epa.message.find("ccdGJKPenetration"), std::string::npos) << r.epa.message;
+  EXPECT_TRUE(r.epa.contacts.empty());
 }
 
 TEST(Libccd, DiagonalCubeMprWrongEpaRight) {
@@ -90,13 +102,15 @@ TEST(Libccd, DiagonalCubeMprWrongEpaRight) {
   // 0.15 sqrt(3) ~ 0.2598 (pinned: a known wrong answer). EPA finds a face: an axis, 0.15.
   const RigidBody big = unit_cube("A", Vec3::Zero());
   const RigidBody small = box_at("B", Vec3::Constant(0.1), Vec3::Constant(0.4));
-  const ContactResult r = libccd_contact(big, small);
-  ASSERT_EQ(r.status, Status::Ok) << r.message;
-  ASSERT_EQ(r.contacts.size(), 2u);
-  const ContactPoint& mpr = r.contacts[0];
+  const Both r = both(big, small);
+  ASSERT_EQ(r.mpr.status, Status::Ok) << r.mpr.message;
+  ASSERT_EQ(r.epa.status, Status::Ok) << r.epa.message;
+  ASSERT_EQ(r.mpr.contacts.size(), 1u);
+  ASSERT_EQ(r.epa.contacts.size(), 1u);
+  const ContactPoint& mpr = r.mpr.contacts[0];
   EXPECT_NEAR((mpr.normal + Vec3::Ones().normalized()).norm(), 0.0, kRoundOff);
   EXPECT_NEAR(mpr.depth, 0.15 * std::sqrt(3.0), kRoundOff);
-  const ContactPoint& epa = r.contacts[1];
+  const ContactPoint& epa = r.epa.contacts[0];
   EXPECT_NEAR(epa.depth, 0.15, kRoundOff);
   EXPECT_NEAR(epa.normal.minCoeff(), -1.0, kRoundOff);  // one of -x, -y, -z ...
   EXPECT_NEAR(epa.normal.norm(), 1.0, kRoundOff);       // ... and nothing else
@@ -135,16 +149,19 @@ TEST(Libccd, RandomBoxPairsAgainstSeparatingAxes) {
     const RigidBody b = box_at("B", size_b, centre_b, q_b);
     const double truth = sat_depth(a, b);
     if (std::abs(truth) < 1e-6) continue;
-    const ContactResult r = libccd_contact(a, b);
-    ASSERT_EQ(r.status, Status::Ok) << "sample " << k << ": " << r.message;
+    const Both r = both(a, b);
+    ASSERT_EQ(r.mpr.status, Status::Ok) << "sample " << k << ": " << r.mpr.message;
+    ASSERT_EQ(r.epa.status, Status::Ok) << "sample " << k << ": " << r.epa.message;
     if (truth < 0) {
-      EXPECT_TRUE(r.contacts.empty()) << "sample " << k;
+      EXPECT_TRUE(r.mpr.contacts.empty()) << "sample " << k;
+      EXPECT_TRUE(r.epa.contacts.empty()) << "sample " << k;
       continue;
     }
     ++overlapping;
-    ASSERT_EQ(r.contacts.size(), 2u) << "sample " << k << ": " << r.message;
-    const ContactPoint& mpr = r.contacts[0];
-    const ContactPoint& epa = r.contacts[1];
+    ASSERT_EQ(r.mpr.contacts.size(), 1u) << "sample " << k;
+    ASSERT_EQ(r.epa.contacts.size(), 1u) << "sample " << k;
+    const ContactPoint& mpr = r.mpr.contacts[0];
+    const ContactPoint& epa = r.epa.contacts[0];
     EXPECT_NEAR(mpr.normal.norm(), 1.0, kRoundOff);
     EXPECT_NEAR(epa.normal.norm(), 1.0, kRoundOff);
     if (std::abs(epa.depth - truth) > kDepthTolerance) {
@@ -185,16 +202,68 @@ TEST(Libccd, EpaUnderestimatesPinned) {
       Quat(0.31812010099052296, -0.8985848754636705, 0.28341090204507841, 0.10499087358296565)
           .normalized());
   const double truth = sat_depth(a, b);  // ~0.8124 m, exact by the separating-axis theorem
-  const ContactResult r = libccd_contact(a, b);
+  const ContactResult r = libccd_epa_contact(a, b);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
-  ASSERT_EQ(r.contacts.size(), 2u);
-  const ContactPoint& epa = r.contacts[1];
+  ASSERT_EQ(r.contacts.size(), 1u);
+  const ContactPoint& epa = r.contacts[0];
   // Pinned wrong answer: 0.72789060 m (10% short); 1e-8 m is the adapter's convergence
   // tolerance plus round-off, so any change in libccd's EPA path shows.
   EXPECT_NEAR(epa.depth, 0.72789060112160253, 1e-8);
   EXPECT_LT(epa.depth, truth - 0.05);
   // Not a supporting plane: the overlap along its own normal is deeper still.
   EXPECT_GT(depth_along(a, b, epa.normal), truth);
+}
+
+TEST(Libccd, BoxBoxLargeEpaIsStoppedAndSaysSoMprAnswers) {
+  // MuJoCo's BoxBoxLarge (engine_collision_gjk_test.cc): a 100 x 100 x 0.5 m slab and a 0.2 m
+  // cube resting on it, faces parallel to ~1e-10 rad, 0.754 mm deep. libccd 2.1's EPA never
+  // returns here (it swaps between the two diagonals of the flat face of the Minkowski
+  // difference); the support-call budget stops it: libccd-epa is an error that says so, at
+  // once, and MPR answers right.
+  Mat3 r;
+  r << 1.0, -0.000000000004566, -0.000000000167641,  //
+      0.000000000004566, 1.0, -0.000000000017877,    //
+      0.000000000167641, 0.000000000017877, 1.0;
+  const RigidBody a = box_at("geom1", Vec3(100, 100, 0.5), Vec3(0, 0, 0.25));
+  const RigidBody b =
+      box_at("geom2", Vec3(0.2, 0.2, 0.2),
+             Vec3(-0.000000000043537, -0.000000000012973, 0.599245786666870), Quat(r).normalized());
+  const double truth = sat_depth(a, b);  // 0.000754213351681798 m
+  const Both res = both(a, b);
+  EXPECT_EQ(res.epa.status, Status::Error);
+  EXPECT_NE(res.epa.message.find("ccdGJKPenetration did not converge"), std::string::npos)
+      << res.epa.message;
+  ASSERT_EQ(res.mpr.status, Status::Ok) << res.mpr.message;
+  ASSERT_EQ(res.mpr.contacts.size(), 1u);
+  // MPR converges to 1e-10 m (the adapter's tolerance); its answer here is 1.8e-12 off.
+  EXPECT_NEAR(res.mpr.contacts[0].depth, truth, 1e-10);
+  EXPECT_NEAR(res.mpr.contacts[0].normal.z(), -1.0, 1e-12);
+}
+
+TEST(Libccd, OurBoxSupportIsASupportPointWhereverTheTestSuitesIs) {
+  // libccd's test suite gives boxes a support of its own (testsuites/support.c): the corner
+  // sign(d) * half size, with a zero component of d giving the face centre. Ours is the first
+  // hull vertex of maximal d . v. Along every direction (zeros included) both are support
+  // points: equal d . v; and where no component is zero, the same point.
+  const Vec3 half(0.3, 0.5, 0.7);
+  const RigidBody box = box_at("A", 2.0 * half, Vec3::Zero());
+  auto ccd_suite_support = [&](const Vec3& d) {
+    Vec3 s;
+    for (int k = 0; k < 3; ++k) s[k] = (d[k] > 0 ? 1.0 : d[k] < 0 ? -1.0 : 0.0) * half[k];
+    return s;
+  };
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> pick(-2, 2);
+  for (int k = 0; k < 500; ++k) {
+    const Vec3 d(pick(rng), pick(rng), pick(rng));
+    if (d.isZero()) continue;
+    const Vec3& ours = box.shape->vertices()[box.shape->support_index(d)];
+    const Vec3 theirs = ccd_suite_support(d);
+    EXPECT_EQ(ours.dot(d), theirs.dot(d)) << d.transpose();
+    if ((d.array() != 0.0).all()) {
+      EXPECT_EQ(ours, theirs) << d.transpose();
+    }
+  }
 }
 
 }  // namespace
