@@ -81,15 +81,9 @@ int check_command(const ReportOptions& opt) {
   std::vector<Scene> scenes;
   for (const std::string& f : collect_scene_files(opt.inputs)) scenes.push_back(load_scene(f));
   // With --backends only those backends' metrics are compared (and merged by --update).
-  const std::vector<std::string> only = split_list(opt.backends);
   const std::vector<Backend>& table = opt.registry ? *opt.registry : backends();
-  for (const std::string& name : only)
-    if (std::none_of(table.begin(), table.end(),
-                     [&](const Backend& b) { return b.name == name; })) {
-      std::string names;
-      for (const Backend& b : table) names += (names.empty() ? "" : ", ") + b.name;
-      throw InputError("--backends: unknown backend '" + name + "'; known: " + names);
-    }
+  const std::vector<std::string> only =
+      opt.backends == "all" ? std::vector<std::string>{} : parse_backend_list(opt.backends, table);
   const auto selected = [&](const std::string& backend) {
     return only.empty() || std::find(only.begin(), only.end(), backend) != only.end();
   };

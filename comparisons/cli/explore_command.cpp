@@ -12,6 +12,7 @@
 #include "comparisons/cli/commands.h"
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/parallel.h"
+#include "comparisons/eval/select_backends.h"
 #include "comparisons/output/table.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/bounding.h"
@@ -53,7 +54,7 @@ struct BackendTally {
 
 std::vector<std::string> subject_backends(const std::string& list, const std::string& kind) {
   std::vector<std::string> names;
-  if (list.empty()) {
+  if (list.empty() || list == "all") {
     // Every backend with a contact query (contact kind) or a dynamics run (impact kind);
     // `exact` is the truth, not a subject.
     for (const Backend& b : backends())
@@ -62,14 +63,7 @@ std::vector<std::string> subject_backends(const std::string& list, const std::st
         names.push_back(b.name);
     return names;
   }
-  std::stringstream ss(list);
-  std::string name;
-  while (std::getline(ss, name, ',')) {
-    if (name.empty()) continue;
-    if (!find_backend(name))
-      throw InputError("rbx explore: --backends: unknown backend '" + name + "'");
-    names.push_back(name);
-  }
+  names = parse_backend_list(list);
   if (names.empty()) throw InputError("rbx explore: --backends: no backend named");
   return names;
 }

@@ -2,6 +2,7 @@
 // (0 success, 1 a check failed, 2 bad input or usage, with one line on stderr).
 #include <CLI/CLI.hpp>
 #include <exception>
+#include <filesystem>
 #include <iostream>
 
 #include "comparisons/cli/commands.h"
@@ -105,6 +106,21 @@ int main(int argc, char** argv) {
                     "time the sampling only (hulls under 100 points)");
   explore->add_flag("--no-figure", explore_opt.no_figure, "skip the matplotlib figure");
 
+  // An unknown command is named as such (CLI11 would say only that a subcommand is required).
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+      known = known || sub->get_name() == argv[1];
+    }
+    if (!known) {
+      std::cerr << "rbx: unknown command '" << argv[1] << "'; commands: " << names
+                << " (see rbx --help)\n";
+      return 2;
+    }
+  }
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -114,6 +130,29 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::cerr << "rbx: " << e.what() << " (see rbx --help)\n";
     return 2;
+  }
+
+  // Usage that would quietly mean something else is refused before any work: an empty
+  // --backends (it would run the defaults) and a --json file in a folder that does not exist
+  // (it would fail only after the whole run).
+  for (const CLI::App* sub : app.get_subcommands()) {
+    for (const CLI::Option* o : sub->get_options()) {
+      if (o->count() == 0) continue;
+      const std::string value = o->as<std::string>();
+      if (o->get_name() == "--backends" && value.find_first_not_of(", ") == std::string::npos) {
+        std::cerr << "rbx " << sub->get_name()
+                  << ": --backends: the list is empty; name backends (e.g. custom,fcl) or all\n";
+        return 2;
+      }
+      if (o->get_name() == "--json" && value != "-") {
+        const std::filesystem::path folder = std::filesystem::path(value).parent_path();
+        if (!folder.empty() && !std::filesystem::is_directory(folder)) {
+          std::cerr << "rbx " << sub->get_name() << ": --json: folder '" << folder.string()
+                    << "' does not exist\n";
+          return 2;
+        }
+      }
+    }
   }
 
   try {

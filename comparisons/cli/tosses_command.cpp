@@ -11,6 +11,7 @@
 
 #include "comparisons/cli/view.h"
 #include "comparisons/eval/contact_eval.h"
+#include "comparisons/eval/select_backends.h"
 #include "comparisons/eval/tosses.h"
 #include "comparisons/eval/trajectory.h"
 #include "comparisons/output/table.h"
@@ -27,18 +28,12 @@ namespace {
 // kept and reported unsupported), else every backend with dynamics, in registry order.
 std::vector<const Backend*> select_toss_backends(const std::string& list) {
   std::vector<const Backend*> out;
-  if (list.empty()) {
+  if (list.empty() || list == "all") {
     for (const Backend& b : backends())
       if (b.dynamics) out.push_back(&b);
     return out;
   }
-  std::vector<std::string> names;
-  std::stringstream ss(list);
-  std::string name;
-  while (std::getline(ss, name, ','))
-    if (!name.empty()) names.push_back(name);
-  for (const std::string& n : names)
-    if (!find_backend(n)) throw InputError("--backends: unknown backend '" + n + "'");
+  const std::vector<std::string> names = parse_backend_list(list);
   for (const Backend& b : backends())
     if (std::find(names.begin(), names.end(), b.name) != names.end()) out.push_back(&b);
   if (out.empty()) throw InputError("--backends: no backend named");

@@ -326,6 +326,13 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
       out.backends.push_back(o);
       continue;
     }
+    // Touching with no normal: a false contact where the pair is clearly apart, else an answer
+    // with nothing to score (kept apart from errors).
+    if (run.result.status == Status::Touching) {
+      if (!sat.touching && sat.depth < -band) o.error = "false_contact";
+      out.backends.push_back(o);
+      continue;
+    }
     const ContactPoint* c = deepest(run.result);
     const bool touch = c != nullptr;
     if (touch != sat.touching) {

@@ -29,21 +29,33 @@ std::vector<std::string> select_backends(const Scene& scene, const std::string& 
   return select_backends(scene, list, cap, backends());
 }
 
+std::vector<std::string> parse_backend_list(const std::string& list,
+                                            const std::vector<Backend>& table) {
+  std::vector<std::string> out;
+  if (list == "all") {
+    for (const Backend& b : table) out.push_back(b.name);
+    return out;
+  }
+  for (const std::string& name : split_list(list)) {
+    if (std::none_of(table.begin(), table.end(),
+                     [&](const Backend& b) { return b.name == name; })) {
+      std::string names;
+      for (const Backend& b : table) names += (names.empty() ? "" : ", ") + b.name;
+      throw InputError("--backends: unknown backend '" + name + "'; known: all, " + names);
+    }
+    out.push_back(name);
+  }
+  return out;
+}
+
 std::vector<std::string> select_backends(const Scene& scene, const std::string& list,
                                          Capability cap, const std::vector<Backend>& table) {
-  auto known = [&](const std::string& name) {
-    return std::any_of(table.begin(), table.end(),
-                       [&](const Backend& b) { return b.name == name; });
-  };
   std::vector<std::string> wanted;
-  if (!list.empty()) {
-    wanted = split_list(list);
-    for (const std::string& name : wanted)
-      if (!known(name)) {
-        std::string names;
-        for (const Backend& b : table) names += (names.empty() ? "" : ", ") + b.name;
-        throw InputError("--backends: unknown backend '" + name + "'; known: " + names);
-      }
+  if (list == "all") {
+    for (const Backend& b : table)
+      if (serves(b, cap)) wanted.push_back(b.name);
+  } else if (!list.empty()) {
+    wanted = parse_backend_list(list, table);
   } else if (!scene.backends.empty()) {
     wanted = scene.backends;
   }

@@ -104,7 +104,7 @@ std::string scorecard_markdown(const std::vector<Scene>& scenes,
       families.push_back(ev.family);
   std::ostringstream md;
   md << "## Scorecard\n\n"
-        "Per backend and scene family: scenes run (status ok or error; `unsupported` not counted), "
+        "Per backend and scene family: scenes run (`unsupported` not counted), "
         "how many are within tolerance (no ✗ and no ~ in the full table), the error against the "
         "truth (the closed form, the `exact` oracle or the exact solid; self-consistency errors "
         "are not counted), median and worst over the scenes that have one, and the median run "
@@ -120,7 +120,7 @@ std::string scorecard_markdown(const std::vector<Scene>& scenes,
   std::map<std::string, std::vector<std::pair<std::string, std::vector<std::string>>>> causes;
   for (const std::string& b : backends) {
     for (const std::string& fam : families) {
-      int run = 0, within = 0;
+      int run = 0, within = 0, touching = 0;  // touching: answered with no normal
       std::vector<double> e1, e2, times, prebuilt;
       bool contact = false;
       for (size_t i = 0; i < evs.size(); ++i) {
@@ -143,6 +143,7 @@ std::string scorecard_markdown(const std::vector<Scene>& scenes,
           it->second.push_back(
               views ? "[" + name + "](views/" + scene_slug(fam, scenes[i].file) + ".html)" : name);
         }
+        if (bj["status"] == "touching") ++touching;
         if (bj["status"] != "ok") continue;
         if (const double a = truth_metric(ev, b, "normal_err_deg"); a >= 0) {
           contact = true;
@@ -185,7 +186,8 @@ std::string scorecard_markdown(const std::vector<Scene>& scenes,
       if (!prebuilt.empty()) time += " (" + fmt_num(median_of(prebuilt) * 1e6, 3) + " prebuilt)";
       t.add({"**" + b + "**", fam, std::to_string(run),
              std::to_string(within) +
-                 (within == run ? "" : " (" + std::to_string(run - within) + " not)"),
+                 (within == run ? "" : " (" + std::to_string(run - within) + " not)") +
+                 (touching ? ", " + std::to_string(touching) + " touching with no normal" : ""),
              med, worst, time});
     }
   }
