@@ -99,6 +99,7 @@ struct ExpectBody {
 struct ExpectContact {
   std::optional<bool> touching;
   std::optional<Vec3> normal;  // unit, from B toward A
+  bool either_sign = false;    // the normal is right with either sign (a tie by symmetry)
   std::optional<double> depth;
   std::optional<Vec3> point;
 };

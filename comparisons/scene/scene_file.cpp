@@ -73,15 +73,16 @@ const KeyInfo kKeys[] = {
     {"expect.body.angular_velocity", "[0, 0, 0]"},
     {"expect.contact.touching", "true"},
     {"expect.contact.normal", "[-1, 0, 0]"},
+    {"expect.contact.either_sign", "true"},
     {"expect.contact.depth", "0.1"},
     {"expect.contact.point", "[0, 0, 0]"},
 };
 
 const std::vector<std::string> kChecks = {"contact", "impulse", "trajectory", "stability", "mass"};
-const std::vector<std::string> kBackends = {"custom",      "custom-seed", "exact",      "fcl",
-                                            "fcl-hull",    "fcl-epa",     "fcl-indep",  "libccd",
-                                            "bullet",      "bullet-hull", "bullet-sat", "mujoco",
-                                            "mujoco-hull", "ode",         "ode-hull"};
+const std::vector<std::string> kBackends = {
+    "custom",    "custom-seed", "exact",      "fcl",     "fcl-hull",    "fcl-epa",
+    "fcl-indep", "libccd-mpr",  "libccd-epa", "bullet",  "bullet-hull", "bullet-sat",
+    "mujoco",    "mujoco-hull", "ode",        "ode-hull"};
 const std::vector<std::string> kShapes = {"box", "icosphere", "prism", "convex", "mesh"};
 
 // Shape-specific body keys and the shape that owns them.
@@ -882,6 +883,12 @@ Expect read_expect(const Reader& r, const toml::table& t, const std::vector<Body
         r.fail(line_of(v), "expect.contact.normal", "the zero vector has no direction",
                "give the unit normal from B toward A, e.g. normal = [-1, 0, 0]");
       ec.normal = normal.normalized();
+    }
+    if (const toml::node* v = c.get("either_sign")) {
+      ec.either_sign = r.boolean(*v, "expect.contact.either_sign", "expect.contact.either_sign");
+      if (!ec.normal)
+        r.fail(line_of(v), "expect.contact.either_sign", "either_sign qualifies a normal",
+               "give normal = [...] beside it, or remove either_sign");
     }
     if (const toml::node* v = c.get("depth")) {
       ec.depth = r.number(*v, "expect.contact.depth", "expect.contact.depth");
