@@ -6,6 +6,8 @@
 #include <map>
 #include <utility>
 
+#include "engine/contact_plane.h"
+
 namespace rbx {
 
 namespace {
@@ -60,8 +62,10 @@ std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const P
   if (!hit) return std::nullopt;
   ContactManifold m;
   m.detector_contact = *hit;
-  m.normal = hit->normal;
-  m.depth = overlap_along(a, pa, b, pb, m.normal);
+  // The tests decide that the shapes touch; the plane is chosen (engine/contact_plane.h).
+  const ContactPlane plane = choose_contact_plane(a, pa, b, pb);
+  m.normal = plane.normal;
+  m.depth = plane.depth;
   const Vec3& n = m.normal;
   const double tol = point_in_mesh_tolerance(a, b);
 

@@ -2,8 +2,10 @@
 //
 // Departure from the seed, which resolves the first face / vertex / edge hit (or an average of
 // one kind) as a single point (seed correction 12 (what the seed admits it lacks) names a
-// contact plane from the detector as future work): the manifold keeps the detector's normal (Moore
-// & Wilhelms, engine/detect.h) and collects, against it, every vertex of A inside B, every vertex
+// contact plane from the detector as future work): once the detector (Moore & Wilhelms,
+// engine/detect.h) finds a contact, the manifold takes the chosen plane (engine/contact_plane.h,
+// the direction of least overlap, not the first face hit) and collects, against it, every vertex
+// of A inside B, every vertex
 // of B inside A and every crossing of a real edge of A with a real edge of B (the closest points of
 // two crossing segments). A face-face landing then has its four corners, not one averaged point.
 #pragma once
@@ -34,12 +36,12 @@ struct ContactManifold {
 };
 
 /// The manifold of A and B at their poses, or nothing when the detector finds no contact.
-/// The normal is the detector's; the points are the vertices of each shape inside the other
-/// (point_in_mesh with point_in_mesh_tolerance) and the edge-edge crossings whose midpoint lies
-/// in both shapes. Edges between two coplanar triangles (a face's triangulation diagonal) are
-/// not edges of the solid and are skipped. Points closer than 1e-7 of the larger shape's size
-/// are merged. When no point qualifies (a face centroid inside, no vertex), the detector's point
-/// is the manifold.
+/// The normal is the chosen plane's (choose_contact_plane); the points are the vertices of each
+/// shape inside the other (point_in_mesh with point_in_mesh_tolerance) and the edge-edge crossings
+/// whose midpoint lies in both shapes. Edges between two coplanar triangles (a face's triangulation
+/// diagonal) are not edges of the solid and are skipped. Points closer than 1e-7 of the larger
+/// shape's size are merged. When no point qualifies (a face centroid inside, no vertex), the
+/// detector's point is the manifold.
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
                                               const ConvexPolyhedron& b, const Pose& pb,
                                               DetectorVariant variant);

@@ -82,7 +82,10 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
       throw GeometryError("mesh is open: edge " + std::to_string(e.first) + "-" +
                           std::to_string(e.second) + " of face " + std::to_string(f) +
                           " has no neighbouring face");
-    if (e.first < e.second) p.edges_.push_back({e.first, e.second});
+    if (e.first < e.second) {
+      p.edges_.push_back({e.first, e.second});
+      p.edge_faces_.push_back({f, directed[{e.second, e.first}]});
+    }
   }
 
   p.vertices_ = std::move(vertices);

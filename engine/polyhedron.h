@@ -68,6 +68,8 @@ class ConvexPolyhedron {
   const std::vector<std::array<int, 3>>& triangles() const { return triangles_; }
   /// Unique edges of the triangulation (each once, whatever its two triangles).
   const std::vector<Edge>& edges() const { return edges_; }
+  /// The two triangles of edge i (edges()[i]): the one using it from a to b, then the other.
+  const std::vector<std::array<int, 2>>& edge_faces() const { return edge_faces_; }
   /// Outward plane of triangle i.
   const std::vector<Plane>& planes() const { return planes_; }
   /// 1 where triangle i's normal differs (bit for bit) from triangle i - 1's, so a new plane
@@ -90,6 +92,7 @@ class ConvexPolyhedron {
   std::vector<Vec3> vertices_;
   std::vector<std::array<int, 3>> triangles_;
   std::vector<Edge> edges_;
+  std::vector<std::array<int, 2>> edge_faces_;
   std::vector<Plane> planes_;
   std::vector<unsigned char> new_plane_;
   Aabb bounds_;

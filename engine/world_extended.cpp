@@ -63,6 +63,7 @@ void World::step_extended() {
     if (!collision[m] || !(impulse[m] > 0.0)) continue;
     ContactPoint c = manifolds[m].manifold.detector_contact;
     c.point = moment[m] / impulse[m];
+    c.normal = manifolds[m].manifold.normal;
     c.depth = manifolds[m].manifold.depth;
     events_.push_back(
         {time_, step_, bodies_[manifolds[m].a].name, bodies_[manifolds[m].b].name, c, impulse[m]});
@@ -189,6 +190,7 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
       if (impulse > 0.0) {
         ContactPoint c = one[0].manifold.detector_contact;
         c.point = moment / impulse;
+        c.normal = one[0].manifold.normal;
         c.depth = one[0].manifold.depth;
         events_.push_back({time_ + t, step_, a.name, b.name, c, impulse});
       }

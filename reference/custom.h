@@ -5,7 +5,8 @@
 
 namespace rbx {
 
-/// Contact at the current poses by the Moore & Wilhelms detector (first hit, seed order).
+/// Contact at the current poses: the Moore & Wilhelms detector finds it and its point, the plane
+/// is the direction of least overlap (engine/contact_plane.h), from either body order alike.
 ContactResult custom_contact(const RigidBody& a, const RigidBody& b);
 /// Contact by the faithful seed loops (the oracle of the fast detector).
 ContactResult custom_seed_contact(const RigidBody& a, const RigidBody& b);

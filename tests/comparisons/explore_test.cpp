@@ -115,8 +115,9 @@ TEST(ExploreCommand, SameJsonAndScenesWithOneAndThreeThreads) {
   o.baseline = (base / "0" / "explore.json").string();
   EXPECT_EQ(explore_command(o), 0);
   Json better = Json::parse(read(base / "0" / "explore.json"));
-  ASSERT_GT(better["backends"]["custom"]["rate"].get<double>(), 0.0);
-  better["backends"]["custom"]["rate"] = 0.0;
+  // fcl (GJK/EPA on meshes) disagrees on some of these samples: a rate to claim lower.
+  ASSERT_GT(better["backends"]["fcl"]["rate"].get<double>(), 0.0);
+  better["backends"]["fcl"]["rate"] = 0.0;
   std::ofstream(base / "better.json") << better.dump();
   o.baseline = (base / "better.json").string();
   EXPECT_EQ(explore_command(o), 1);
@@ -126,17 +127,17 @@ TEST(ExploreCommand, SameJsonAndScenesWithOneAndThreeThreads) {
 TEST(ExploreShrink, KeepsTheDisagreementAndSimplifies) {
   ContactSample s;
   SampleOutcome o;
-  ASSERT_TRUE(first_disagreement("custom", "normal", &s, &o));
+  ASSERT_TRUE(first_disagreement("fcl", "normal", &s, &o));
   std::string sig;
   for (const BackendOutcome& b : o.backends)
-    if (b.error == "normal") sig = signature(o, b);
-  const ShrinkResult r = shrink(s, "custom", sig, 300);
+    if (b.backend == "fcl" && b.error == "normal") sig = signature(o, b);
+  const ShrinkResult r = shrink(s, "fcl", sig, 300);
   EXPECT_LE(r.vertices_after, r.vertices_before);
   EXPECT_GT(r.steps_accepted, 0);
   EXPECT_GT(r.evaluations, r.steps_accepted);  // some simplifications were tried and refused
   // The shrunk scene, read back as text, still shows the same signature.
   const SampleOutcome again =
-      evaluate_scene_text(sample_scene_text(r.sample), {"custom"}, r.sample.pose_class,
+      evaluate_scene_text(sample_scene_text(r.sample), {"fcl"}, r.sample.pose_class,
                           r.sample.a.shape_class + "-" + r.sample.b.shape_class);
   ASSERT_EQ(again.backends.size(), 1u);
   EXPECT_EQ(signature(again, again.backends[0]), sig);

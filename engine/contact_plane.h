@@ -1,0 +1,45 @@
+// The contact plane chosen, not first found (the extended engine, `custom`).
+//
+// Departure from the seed: Moore & Wilhelms' tests decide *whether* two shapes touch and where
+// (engine/detect.h), but the plane they return is the first face (or edge pair) the loops meet,
+// right when contact begins at zero depth and wrong beyond it: the answer then depends on the
+// depth, on the order of the bodies and on the phase of the step at which contact is first seen.
+// The seed's own closing section names a detector that furnishes the point and the plane together
+// as future work. Here, once the tests have found a contact, the plane is chosen by a stated
+// criterion: the direction of least overlap (the minimum translation that separates the shapes),
+// which for two convex polyhedra lies among the face normals of either shape and the cross
+// products of one edge of each whose Gauss-map arcs cross (docs/contact_plane.md derives it).
+//
+// Order symmetry: every candidate axis and every overlap is computed from the same numbers in
+// either order, and ties are broken by a key of the geometry (the kind of axis, then the axis
+// itself in a sign-free form), never by argument slot, so (B, A) gives the normal of (A, B)
+// negated and the same depth.
+#pragma once
+
+#include "engine/math.h"
+#include "engine/polyhedron.h"
+
+namespace rbx {
+
+/// Which kind of axis gave the contact plane.
+enum class PlaneAxis {
+  FaceOfA,  ///< a face normal of A (A is pushed against it)
+  FaceOfB,  ///< a face normal of B
+  EdgeEdge  ///< the cross product of an edge of A and an edge of B
+};
+
+/// The chosen contact plane of a pair, in the convention of engine/contact.h.
+struct ContactPlane {
+  Vec3 normal = Vec3::UnitZ();  // unit, world, from B toward A
+  double depth = 0.0;           // m, >= 0: the overlap of the shapes along the normal
+  PlaneAxis axis = PlaneAxis::FaceOfB;
+};
+
+/// The direction of least overlap of A and B at their poses: over every distinct face normal of
+/// either shape and every pair of solid edges (one of each, not a flat face's diagonal) that forms
+/// a face of the Minkowski difference, the one along which A must move least to separate.
+/// Meant for shapes the detector found in contact; for separated shapes the depth is 0.
+ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
+                                  const ConvexPolyhedron& b, const Pose& pb);
+
+}  // namespace rbx
