@@ -1118,15 +1118,20 @@ class Evaluator {
         const std::string what =
             name + " on " + body.name + ": mass properties off by " + fmt_num(worst, 3) +
             " (relative, worst of mass, centre of mass and inertia) against the exact solid" +
-            (name == "custom" ? " (the seed's point masses at the vertices)" : "");
+            (name == "custom-seed" ? " (the seed's point masses at the vertices)" : "");
         if (worst > 1e-2)
           out_.disagreements.push_back(what);
         else if (worst > 1e-6)
           out_.deviations.push_back(what);
       };
-      // The seed's model (point masses at the vertices) on the same hull.
+      // The engines' own rows: `custom` with the model it simulates this body with (the
+      // scene's mass_model, solid by default), `custom-seed` with the seed's point masses at the
+      // vertices.
+      const MassProperties own =
+          mass_properties(*body.shape, body.mass, scene_.bodies[i].mass_model);
+      record("custom", {Status::Ok, "", own.mass, -1.0, own.center_of_mass, own.inertia});
       const MassProperties seed = vertex_mass_properties(*body.shape, body.mass);
-      record("custom", {Status::Ok, "", seed.mass, -1.0, seed.center_of_mass, seed.inertia});
+      record("custom-seed", {Status::Ok, "", seed.mass, -1.0, seed.center_of_mass, seed.inertia});
       for (const Backend* b : libs) {
         MassResult r;
         const bool cacheable = cache_.enabled() && ResultCache::caches(b->name);
@@ -1147,12 +1152,14 @@ class Evaluator {
     // not dropped (the contract: named but not applicable -> unsupported).
     const bool named = !opt_.backends.empty() || !scene_.backends.empty();
     for (const std::string& name : wanted)
-      if (named && name != "custom" && !backend(name).mass)
+      if (named && name != "custom" && name != "custom-seed" && !backend(name).mass)
         set_status(name, Status::Unsupported,
                    name +
                        " computes no mass properties of its own (every backend is given the "
                        "exact solid values)");
-    out_.skipped.push_back("mass: custom is the seed's vertex model; ode has no hull mass routine");
+    out_.skipped.push_back(
+        "mass: custom is the model it simulates with, custom-seed the seed's vertex model; ode has "
+        "no hull mass routine");
   }
 
   const Scene& scene_;
