@@ -184,7 +184,8 @@ void edge_axes(Query& q) {
   for (const int i : q.edges_a) {
     const Edge& ea = a.shape->edges()[i];
     const auto& fa = a.shape->edge_faces()[i];
-    const Vec3 n0 = a.r * a.shape->planes()[fa[0]].normal, n1 = a.r * a.shape->planes()[fa[1]].normal;
+    const Vec3 n0 = a.r * a.shape->planes()[fa[0]].normal,
+               n1 = a.r * a.shape->planes()[fa[1]].normal;
     const Vec3 da = a.v[ea.b] - a.v[ea.a];
     for (const int j : q.edges_b) {
       const Edge& eb = b.shape->edges()[j];

@@ -119,6 +119,8 @@ struct Scene {
   std::string file;                   // path it was read from, as given
   std::vector<CheckKind> checks;      // in the order the scene lists them
   std::vector<std::string> backends;  // empty: every backend that serves the checks
+  // What the loader changed in what the file says, one line each (a quaternion normalised).
+  std::vector<std::string> input_notes;
   SimSettings sim;
   std::vector<BodySpec> bodies;
   std::optional<Expect> expect;

@@ -55,6 +55,7 @@ int compare_command(const SceneCommandOptions& opt) {
   for (const Scene& scene : scenes) {
     const SceneEvaluation ev = evaluate_scene(scene, hopt);
     out << "scene: " << scene.name << " (" << scene.file << ")\n";
+    for (const std::string& s : scene.input_notes) out << "  input: " << s << "\n";
     Table status({"backend", "status", "message"});
     for (const auto& [name, bj] : ev.json["backends"].items())
       status.add({name, bj["status"].get<std::string>(), bj["message"].get<std::string>()});

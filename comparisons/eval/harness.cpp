@@ -197,6 +197,7 @@ class Evaluator {
     j["file"] = scene_.file;
     j["family"] = out_.family;
     j["description"] = scene_.description;
+    if (!scene_.input_notes.empty()) j["input_notes"] = scene_.input_notes;
     j["checks"] = scene_.check_names();
     j["settings"] = settings_json(scene_);
     backends_json_ = Json::object();

@@ -95,11 +95,12 @@ const std::vector<std::pair<std::string, std::string>> kShapeKeys = {
 // More steps than this is almost surely a typo (1e8 steps of a two-body scene is minutes).
 constexpr double kMaxSteps = 1e8;
 
-// Quaternions must be unit within this: a value printed with >= 10 significant digits passes,
-// while a hand-typed [0.7071, 0.7071, 0, 0] (norm 1 - 4e-5) or a non-rotation like
-// [1, 1, 0, 0] fails instead of being silently renormalised into a rotation the author did not
-// write down.
-constexpr double kUnitQuaternionTolerance = 1e-9;
+// Quaternions must be unit within this: a value a float32 library wrote (its components rounded
+// to ~6e-8, norm off by up to ~1e-7) or one printed with >= 7 significant digits passes and is
+// normalised (the results say so), while a hand-typed [0.7071, 0.7071, 0, 0] (norm 1 - 1e-5) or
+// a non-rotation like [1, 1, 0, 0] fails instead of being silently renormalised into a rotation
+// the author did not write down.
+constexpr double kUnitQuaternionTolerance = 1e-6;
 
 // Keys of the sub-tables of one level, from the table above: prefix "sim." -> {"dt", ...}.
 std::vector<std::string> keys_under(const std::string& prefix) {
@@ -627,7 +628,8 @@ void read_sim(const Reader& r, const toml::table& sim, SimSettings& s, bool forc
 }
 
 // Builds one body from its [[body]] table; mesh paths are resolved against `folder`.
-BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder) {
+BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder,
+                   std::vector<std::string>& notes) {
   BodySpec b;
   const int table_line = line_of(&t);
 
@@ -812,10 +814,12 @@ BodySpec read_body(const Reader& r, const toml::table& t, const fs::path& folder
     const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     if (!(std::abs(norm - 1.0) <= kUnitQuaternionTolerance))
       r.fail(line_of(orientation), p + "orientation",
-             "quaternion [w, x, y, z] has norm " + fixed10(norm) + ", must be 1 within 1e-9",
-             "write it to at least 10 significant digits, or use rotation (degrees)");
-    // Renormalise the (at most 1e-9) round-off.
+             "quaternion [w, x, y, z] has norm " + fixed10(norm) + ", must be 1 within 1e-6",
+             "write its components to at least 7 significant digits, or use rotation (degrees)");
+    // Renormalise the (at most 1e-6) rounding, and say so where it is more than round-off.
     b.orientation = Quat(q[0], q[1], q[2], q[3]).normalized();
+    if (std::abs(norm - 1.0) > 1e-12)
+      notes.push_back(p + "orientation: norm " + fixed10(norm) + " normalised to 1");
   }
   if (const toml::node* n = t.get("velocity"))
     b.velocity = r.vec3(*n, p + "velocity", "body.velocity");
@@ -991,7 +995,7 @@ Scene parse_scene(const std::string& text, const std::string& path,
   // Bodies, with unique names.
   const fs::path folder = fs::path(path).parent_path();
   for (const toml::node& n : *body_array) {
-    BodySpec b = read_body(r, *n.as_table(), folder);
+    BodySpec b = read_body(r, *n.as_table(), folder, scene.input_notes);
     for (size_t k = 0; k < scene.bodies.size(); ++k)
       if (scene.bodies[k].name == b.name)
         r.fail(line_of(n.as_table()->get("name")), "body." + b.name + ".name",

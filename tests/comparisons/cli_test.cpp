@@ -151,6 +151,26 @@ TEST(Cli, RunJsonIsByteIdenticalApartFromTimings) {
   EXPECT_GE(j["backends"]["custom"]["contacts"].size(), 1u);
 }
 
+TEST(Cli, AFloat32QuaternionIsNormalisedAndTheResultsSaySo) {
+  // [0.70710677, 0.70710677, 0, 0]: sqrt(1/2) rounded to float32 and printed with 8 digits, norm
+  // 1 - 1.5e-8: accepted (within 1e-6), normalised, and the JSON and the text name the change.
+  const fs::path dir = temp_dir("float32_quaternion");
+  std::ofstream(dir / "q.toml") << "checks = [\"contact\"]\n[sim]\nduration = 0\n"
+                                << "[[body]]\nname = \"A\"\norientation = [0.70710677, "
+                                   "0.70710677, 0, 0]\n[[body]]\nname = \"B\"\n"
+                                   "position = [0, 0, 2]\n";
+  const CmdResult j = rbx("compare '" + (dir / "q.toml").string() + "' --backends exact --json -");
+  ASSERT_EQ(j.code, 0) << j.err;
+  const auto notes = nlohmann::json::parse(j.out)["scenes"][0]["input_notes"];
+  ASSERT_EQ(notes.size(), 1u) << j.out;
+  EXPECT_NE(notes[0].get<std::string>().find("body.A.orientation: norm 0.99999"), std::string::npos)
+      << notes;
+  EXPECT_NE(notes[0].get<std::string>().find("normalised"), std::string::npos) << notes;
+  const CmdResult t = rbx("compare '" + (dir / "q.toml").string() + "' --backends exact");
+  EXPECT_NE(t.out.find("input: body.A.orientation: norm"), std::string::npos) << t.out;
+  fs::remove_all(dir);
+}
+
 TEST(Cli, SetOverridesAKey) {
   const CmdResult r = rbx("run scenes/seed/face_face.toml --set sim.duration=0 --json -");
   ASSERT_EQ(r.code, 0) << r.err;

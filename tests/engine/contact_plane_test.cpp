@@ -21,7 +21,7 @@ Quat random_rotation(std::mt19937& rng) {
 // (icospheres of 80 and 320 triangles, a 24-sided prism).
 std::vector<ConvexPolyhedron> shapes() {
   return {make_box(Vec3(1.0, 0.6, 0.3)), make_box(Vec3(2.0, 2.0, 0.05)), make_prism(0.5, 0.8, 6),
-          make_prism(0.4, 1.2, 24), make_icosphere(0.6, 1), make_icosphere(0.5, 2)};
+          make_prism(0.4, 1.2, 24),      make_icosphere(0.6, 1),         make_icosphere(0.5, 2)};
 }
 
 double radius(const ConvexPolyhedron& s) {
