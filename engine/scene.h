@@ -121,6 +121,9 @@ struct Scene {
   std::vector<std::string> backends;  // empty: every backend that serves the checks
   // What the loader changed in what the file says, one line each (a quaternion normalised).
   std::vector<std::string> input_notes;
+  // The overrides ("--set KEY") that changed the physics [expect] was written for: non-empty,
+  // [expect] is set aside and reported as not checked.
+  std::vector<std::string> expect_set_aside_by;
   SimSettings sim;
   std::vector<BodySpec> bodies;
   std::optional<Expect> expect;

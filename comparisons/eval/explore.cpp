@@ -872,9 +872,10 @@ ImpactSample make_impact_sample(uint64_t seed, uint64_t index) {
       s.velocity_a = vcm + v_rel * (s.mass_b / m);
       s.velocity_b = vcm - v_rel * (s.mass_a / m);
     }
-    // First contact 2 to 5 steps ahead, at a random phase of its step; 50 ms of flight after.
+    // First contact 2 to 5 steps ahead, at a random phase of its step; then at least 50 ms of
+    // flight, to a whole number of steps (a scene's duration is one).
     s.contact_time = (r.integer(2, 5) + r.uniform(0.02, 0.98)) * s.dt;
-    s.duration = s.contact_time + 0.05;
+    s.duration = std::ceil((s.contact_time + 0.05) / s.dt) * s.dt;
     if (realize_impact(s)) return s;
   }
   throw std::runtime_error("no single-point impact found in 30 attempts");

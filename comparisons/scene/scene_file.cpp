@@ -265,6 +265,8 @@ class Reader {
   void mark_overridden(const std::string& key) { overridden_.insert(key); }
   /// True when `key` (or a table holding it) was set by --set.
   bool overridden(const std::string& key) const { return is_overridden(key); }
+  /// Every key --set changed, by its canonical dotted name.
+  const std::set<std::string>& overridden_keys() const { return overridden_; }
 
   /// Throws the one-line InputError. `line` 0 means no line; an overridden key is shown as
   /// "--set KEY" without a line, since its value is not in the file.
@@ -611,6 +613,20 @@ void read_sim(const Reader& r, const toml::table& sim, SimSettings& s, bool forc
   auto refuse = [&](double dt, const std::string& dt_key, const toml::node* dt_node) {
     const double steps = s.duration / dt;
     const bool countable = steps <= kMaxStepCount;  // false for inf and NaN too
+    // A run takes whole steps: a duration that is no whole number of them (to 1e-9 of the
+    // count, far above the round-off of the quotient) would end early or late and judge [expect]
+    // at a time the file does not name; a positive duration shorter than half a step, never run.
+    const double whole = std::round(steps);
+    if (countable &&
+        (std::abs(steps - whole) > 1e-9 * std::max(1.0, steps) || (s.duration > 0 && whole == 0))) {
+      const bool duration_key = dt_key == "sim.dt" && blame_duration;
+      r.fail(line_of(duration_key ? duration_node : dt_node),
+             duration_key ? "sim.duration" : dt_key,
+             "duration " + num(s.duration) + " s is " + num(steps) + " steps of dt = " + num(dt) +
+                 " s, not a whole number",
+             "choose dt so that duration / dt is a whole number (e.g. dt = " +
+                 num(s.duration / std::max(1.0, std::ceil(steps))) + ")");
+    }
     if (countable && (force || steps <= kMaxSteps)) return;
     const bool duration_key = dt_key == "sim.dt" && blame_duration;
     const std::string what = "duration " + num(s.duration) + " s at dt = " + num(dt) + " s is " +
@@ -839,8 +855,14 @@ Expect read_expect(const Reader& r, const toml::table& t, const std::vector<Body
   }
   // A closed form the custom engine is known to miss (a documented limitation): kept as the
   // truth, reported as known, and pinned by the tests so a fix is noticed.
-  if (const toml::node* n = t.get("known_failure"))
+  if (const toml::node* n = t.get("known_failure")) {
     e.known_failure = r.string(*n, "expect.known_failure", "expect.known_failure");
+    // It excuses the engine it names: without the name it would excuse nothing, silently.
+    if (!starts_with(e.known_failure, "custom: ") && !starts_with(e.known_failure, "custom-seed: "))
+      r.fail(line_of(n), "expect.known_failure",
+             "must start with the engine it excuses, \"custom: \" or \"custom-seed: \"",
+             "write e.g. known_failure = \"custom: why it fails here\"");
+  }
   std::vector<std::string> names;
   for (const BodySpec& b : bodies) names.push_back(b.name);
 
@@ -1007,6 +1029,18 @@ Scene parse_scene(const std::string& text, const std::string& path,
 
   if (const toml::node* n = root.get("expect"))
     scene.expect = read_expect(r, r.table(*n, "expect"), scene.bodies);
+  // [expect] is the closed form of the physics the file describes: an override of that physics
+  // (a body, gravity, restitution, friction, the duration it is judged at) sets it aside, to be
+  // reported as not checked with the key that changed it. A step size, the integrator, the
+  // checks, the backends or the expectation itself leave it standing.
+  static const std::vector<std::string> kKeepExpect = {
+      "sim.dt", "sim.sweep_dt", "sim.integrator", "sim.max_energy_ratio", "name", "description",
+      "checks", "backends",     "force"};
+  if (scene.expect)
+    for (const std::string& key : r.overridden_keys())
+      if (!starts_with(key, "expect.") &&
+          std::find(kKeepExpect.begin(), kKeepExpect.end(), key) == kKeepExpect.end())
+        scene.expect_set_aside_by.push_back("--set " + key);
   return scene;
 }
 

@@ -171,6 +171,24 @@ TEST(Cli, AFloat32QuaternionIsNormalisedAndTheResultsSaySo) {
   fs::remove_all(dir);
 }
 
+TEST(Cli, AnOverrideOfThePhysicsSetsExpectAsideAndNamesTheKey) {
+  // headon_e05's [expect] is the e = 0.5 closed form: with e = 0.2 it would fail (and judging it
+  // would be wrong); it is reported not checked, naming the key. A step size leaves it standing.
+  const std::string scene = "scenes/analytic/headon_e05.toml";
+  const CmdResult e = rbx("compare " + scene + " --set sim.restitution=0.2 --backends custom");
+  EXPECT_EQ(e.code, 0) << e.out;
+  EXPECT_NE(e.out.find("[expect]: not checked"), std::string::npos) << e.out;
+  EXPECT_NE(e.out.find("--set sim.restitution changed that"), std::string::npos) << e.out;
+  EXPECT_EQ(e.out.find("[expect] FAILED"), std::string::npos) << e.out;
+  const CmdResult j =
+      rbx("compare " + scene + " --set sim.restitution=0.2 --backends custom --json -");
+  ASSERT_EQ(j.code, 0) << j.err;
+  EXPECT_FALSE(nlohmann::json::parse(j.out)["scenes"][0]["expect"]["checked"].get<bool>());
+  const CmdResult dt = rbx("compare " + scene + " --set sim.dt=1e-4 --backends custom");
+  EXPECT_EQ(dt.code, 0) << dt.out;
+  EXPECT_NE(dt.out.find("[expect]: passed"), std::string::npos) << dt.out;
+}
+
 TEST(Cli, SetOverridesAKey) {
   const CmdResult r = rbx("run scenes/seed/face_face.toml --set sim.duration=0 --json -");
   ASSERT_EQ(r.code, 0) << r.err;
