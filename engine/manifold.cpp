@@ -108,6 +108,24 @@ std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const P
       pts.push_back({mid, std::max((cb - ca).dot(n), 0.0)});
     }
 
+  // Touching, overlapping by no more than the tests' tolerance (as at a time of impact): which
+  // vertex is inside the other shape is then decided by round-off, and the tests may see a touch
+  // where nothing overlaps. The points are instead the vertices of each shape that lie lowest
+  // toward the other along the normal and face it across the gap, placed midway across it: a
+  // face landing gets its four corners, a corner landing its corner. An edge crossing keeps the
+  // crossings found above.
+  if (hi_b - lo_a <= tol) {
+    std::vector<ManifoldPoint> facing;
+    const double gap = lo_a - hi_b;
+    for (const Vec3& p : va)
+      if (p.dot(n) <= lo_a + tol && point_in_mesh(b, pb, p - gap * n, tol))
+        facing.push_back({p - 0.5 * gap * n, 0.0});
+    for (const Vec3& p : vb)
+      if (p.dot(n) >= hi_b - tol && point_in_mesh(a, pa, p + gap * n, tol))
+        facing.push_back({p + 0.5 * gap * n, 0.0});
+    if (!facing.empty()) pts = std::move(facing);
+  }
+
   // Merge coincident points (a stacked cube's corners sit on the corners below it).
   const double merge = 1e-7 * std::max(size_of(a), size_of(b));
   for (const ManifoldPoint& p : pts) {

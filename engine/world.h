@@ -88,6 +88,9 @@ class World {
   DetectionCache detection_;  // the pair being resolved: placed once per pair per step
   ContactModel contact_model_ = ContactModel::Seed;
   BroadPhase broad_phase_;
+  // The extended step's second broad phase, on the poses at the step's end (new contacts).
+  BroadPhase ahead_broad_phase_;
+  std::vector<RigidBody> ahead_;  // scratch: the bodies moved to the step's end
   std::vector<CollisionEvent> events_;
   double time_ = 0.0;
   long step_ = 0;

@@ -12,6 +12,7 @@
 #include "engine/contact_solver.h"
 #include "engine/integrate.h"
 #include "engine/manifold.h"
+#include "engine/separation.h"
 #include "engine/time_of_impact.h"
 #include "engine/world.h"
 
@@ -170,6 +171,26 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
       if ((p + s * q).norm() > facts[lo].radius + facts[hi].radius) continue;
       if (const auto t = time_of_impact(a, b, dt, variant_)) hits.emplace_back(*t, lo, hi);
     }
+  }
+  // Every other new contact (departure from the seed, whose detection after penetration resolves
+  // a contact at whatever depth a step first sees it, along a plane and from a point that depend
+  // on that depth): a pair apart at the step's start whose poses at its end, moved with the
+  // step's velocities, touch is moved to its first touch like the fast pairs above, so an impact
+  // is resolved where it begins whatever its phase in the step.
+  ahead_.clear();
+  for (const RigidBody& b : bodies_) ahead_.push_back(b.is_static ? b : advanced(b, dt));
+  std::set<std::pair<int, int>> asked;
+  for (const auto& [t, i, j] : hits) asked.insert({i, j});
+  for (const BodyPair& pair : ahead_broad_phase_.find_pairs(ahead_)) {
+    const auto [i, j] = pair;
+    const RigidBody &a = ahead_[i], &b = ahead_[j];
+    if ((a.is_static && b.is_static) || touching.count(pair) || asked.count(pair)) continue;
+    const double margin = separation_margin(std::max(facts[i].own_tol, facts[j].own_tol),
+                                            facts[i].reach, facts[j].reach);
+    if (find_separating_axis(*a.shape, a.pose(), *b.shape, b.pose(), margin) != Vec3::Zero())
+      continue;  // still apart at the step's end
+    if (const auto t = time_of_impact(bodies_[i], bodies_[j], dt, variant_))
+      hits.emplace_back(*t, i, j);
   }
   std::sort(hits.begin(), hits.end());
   for (const auto& [t, i, j] : hits) {
