@@ -196,6 +196,8 @@ struct Backend {
 const std::vector<Backend>& backends();
 /// The backend called `name`, or nullptr.
 const Backend* find_backend(const std::string& name);
+/// The backend called `name` in `table` (null: the registry), or nullptr.
+const Backend* find_backend(const std::string& name, const std::vector<Backend>* table);
 
 /// A contact query that is the same library path as a registry backend with a different set-up,
 /// kept for timing (`rbx bench`) rather than reported as a backend of its own.

@@ -67,8 +67,10 @@ const std::vector<Backend>& backends() {
   return table;
 }
 
-const Backend* find_backend(const std::string& name) {
-  for (const Backend& b : backends())
+const Backend* find_backend(const std::string& name) { return find_backend(name, nullptr); }
+
+const Backend* find_backend(const std::string& name, const std::vector<Backend>* table) {
+  for (const Backend& b : table ? *table : backends())
     if (b.name == name) return &b;
   return nullptr;
 }

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "comparisons/cli/commands.h"
+#include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/result_cache.h"
 #include "comparisons/eval/select_backends.h"
@@ -132,6 +133,21 @@ int check_command(const ReportOptions& opt) {
         std::none_of(ev.expect_failures.begin(), ev.expect_failures.end(),
                      [&](const std::string& f) { return f.rfind(subject + ":", 0) == 0; }))
       now_passing.emplace_back(scene, std::make_pair(s.file, subject));
+  }
+  // Explore's fixed random samples: what no scene of the library shows (random poses, impacts
+  // at a random phase). Every backend of the family (--backends narrows it), the oracle aside.
+  if (opt.explore || opt.inputs.empty()) {
+    std::vector<std::string> contact, impact;
+    for (const Backend& b : table) {
+      if (b.name == "exact" || !selected(b.name)) continue;
+      if (b.contact) contact.push_back(b.name);
+      if (b.dynamics) impact.push_back(b.name);
+    }
+    for (const ExploreCheckMetric& m :
+         explore_check_metrics(contact, impact, ExploreCheckSet{}, opt.registry)) {
+      scene_in_run.insert(m.scene);
+      now[key_of(m.scene, m.metric)] = m.metric.value;
+    }
   }
   const double runtime = clock.seconds();
 

@@ -65,6 +65,9 @@ int main(int argc, char** argv) {
       ->add_flag("--accept-worse", check_opt.accept_worse,
                  "with --update: record worse metrics too")
       ->needs(update);
+  check->add_flag("--explore", check_opt.explore,
+                  "also run explore's fixed random samples (contact and impact kinds, seed 1): "
+                  "the default when no scene is named");
   check->add_flag("--no-cache", check_opt.no_cache,
                   "rerun every reference library (no build/cache)");
   rbx::BenchOptions bench_opt;

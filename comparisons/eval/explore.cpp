@@ -304,7 +304,8 @@ namespace {
 constexpr double kTouchBand = 1e-9;
 
 SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
-                              const std::vector<std::string>& names, const std::string& shapes) {
+                              const std::vector<std::string>& names, const std::string& shapes,
+                              const std::vector<Backend>* table = nullptr) {
   SampleOutcome out;
   out.shapes = shapes;
   const SatResult sat = sat_query(*a.shape, a.pose(), *b.shape, b.pose());
@@ -314,7 +315,7 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
   out.feature = sat.touching ? sat.axis_kind : "separated";
   const double band = kTouchBand * size, true_depth = std::max(sat.depth, 0.0);
   for (const std::string& name : names) {
-    const Backend* be = find_backend(name);
+    const Backend* be = find_backend(name, table);
     if (!be || !be->contact) continue;
     const ContactRun run = run_contact(*be, a, b);
     if (run.result.status == Status::Unsupported) continue;
@@ -371,10 +372,10 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
 
 }  // namespace
 
-SampleOutcome evaluate_contact_sample(const ContactSample& s,
-                                      const std::vector<std::string>& names) {
+SampleOutcome evaluate_contact_sample(const ContactSample& s, const std::vector<std::string>& names,
+                                      const std::vector<Backend>* table) {
   const RigidBody a = build_body(s.a, "A"), b = build_body(s.b, "B");
-  SampleOutcome out = evaluate_bodies(a, b, names, s.a.shape_class + "-" + s.b.shape_class);
+  SampleOutcome out = evaluate_bodies(a, b, names, s.a.shape_class + "-" + s.b.shape_class, table);
   out.index = s.index;
   out.pose_class = s.pose_class;
   return out;
@@ -881,7 +882,8 @@ ImpactSample make_impact_sample(uint64_t seed, uint64_t index) {
   throw std::runtime_error("no single-point impact found in 30 attempts");
 }
 
-SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<std::string>& names) {
+SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<std::string>& names,
+                                     const std::vector<Backend>* table) {
   SampleOutcome out;
   out.index = s.index;
   out.pose_class = s.b_static ? "static" : "free";
@@ -904,7 +906,7 @@ SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<st
   }
   if (e_ref < 1e-12 * e0) e_ref = e0;
   for (const std::string& name : names) {
-    const Backend* be = find_backend(name);
+    const Backend* be = find_backend(name, table);
     if (!be || !be->dynamics) continue;
     DynamicsResult run = run_dynamics_isolated(*be, scene, DynamicsOptions{0.0, 0}).result;
     if (run.status == Status::Unsupported) continue;

@@ -97,8 +97,9 @@ struct SampleOutcome {
 
 /// Runs the sample through `exact` and each named backend and classifies each answer.
 /// Thresholds: the harness's marks of a clear disagreement (kMarkAngleDeg, kMarkDepthRel).
-SampleOutcome evaluate_contact_sample(const ContactSample& s,
-                                      const std::vector<std::string>& names);
+/// Backends are looked up in `table` (default: the registry).
+SampleOutcome evaluate_contact_sample(const ContactSample& s, const std::vector<std::string>& names,
+                                      const std::vector<Backend>* table = nullptr);
 
 /// The same on a scene's text (as `rbx compare` would read it); `shapes` names the classes of
 /// A and B ("box-hull"), which the text does not record.
@@ -173,8 +174,10 @@ ImpactSample make_impact_sample(uint64_t seed, uint64_t index);
 /// velocities, e, dt, contact time): false when it has no single-point contact or a second one.
 bool realize_impact(ImpactSample& s);
 
-/// Runs the sample's scene through each named dynamics backend against its closed form.
-SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<std::string>& names);
+/// Runs the sample's scene through each named dynamics backend against its closed form (backends
+/// looked up in `table`, default: the registry).
+SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<std::string>& names,
+                                     const std::vector<Backend>* table = nullptr);
 
 /// Impact groups shrunk like the contact ones: fewer hull points, rotations toward whole
 /// degrees, rounder speeds, masses and e, as long as `backend` keeps signature `sig`.

@@ -185,3 +185,41 @@ TEST(Check, AKnownFailureThatPassesIsNamed) {
 
 }  // namespace
 }  // namespace rbx
+
+namespace rbx {
+namespace {
+
+TEST(Check, AChangeThatOnlyBreaksRandomPosesIsNamedByTheExploreSamples) {
+  // The broken copy answers with the seed's first hit (the plane of the first face the tests
+  // meet): right on axis_x, whose bodies are axis-aligned, wrong on many random poses. The
+  // scene alone passes; with explore's fixed samples the check names the regression.
+  std::vector<Backend> broken = backends();
+  for (Backend& b : broken)
+    if (b.name == "custom") b.contact = custom_seed_contact;
+  const fs::path dir = temp_dir("check_random_poses");
+  ReportOptions opt;
+  opt.inputs = {RBX_SOURCE_DIR "/scenes/contact/axis_x.toml"};
+  opt.backends = "custom";
+  opt.explore = true;
+  opt.baseline = (dir / "baseline.json").string();
+  opt.update = true;
+  ASSERT_EQ(run_check(opt).code, 0);
+
+  ReportOptions check = opt;
+  check.update = false;
+  check.registry = &broken;
+  check.explore = false;
+  const CheckRun scenes_only = run_check(check);
+  EXPECT_EQ(scenes_only.code, 0) << scenes_only.out;
+  check.explore = true;
+  const CheckRun r = run_check(check);
+  EXPECT_EQ(r.code, 1) << r.out;
+  const size_t at = r.out.find("explore/contact\n  custom\n");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("worse   explore disagreement_rate_err: 0 -> ", at), std::string::npos)
+      << r.out;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rbx

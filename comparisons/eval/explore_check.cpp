@@ -1,0 +1,77 @@
+#include "comparisons/eval/explore_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "comparisons/eval/explore.h"
+#include "comparisons/eval/parallel.h"
+
+namespace rbx {
+
+namespace {
+
+// Nearest-rank percentile of sorted values (p in [0, 100]), 0 for none.
+double percentile(const std::vector<double>& sorted, double p) {
+  if (sorted.empty()) return 0.0;
+  const size_t k = static_cast<size_t>(std::ceil(p / 100.0 * sorted.size()));
+  return sorted[std::min(sorted.size() - 1, k == 0 ? 0 : k - 1)];
+}
+
+// The metrics of one family from its encoded outcomes.
+void tally(const std::string& scene, const std::vector<std::string>& encoded,
+           const std::vector<std::string>& error_names, const std::string& against,
+           std::vector<ExploreCheckMetric>& out) {
+  std::map<std::string, long> samples, disagreements;
+  std::map<std::string, std::map<std::string, std::vector<double>>> values;
+  for (const std::string& text : encoded) {
+    const SampleOutcome o = decode(text);
+    for (const BackendOutcome& b : o.backends) {
+      ++samples[b.backend];
+      if (!b.error.empty()) ++disagreements[b.backend];
+      if (!b.measured) continue;
+      values[b.backend]["normal_err_deg"].push_back(b.normal_err_deg);
+      values[b.backend]["depth_err_rel"].push_back(b.depth_err_rel);
+      values[b.backend]["velocity_err_ke"].push_back(b.velocity_err_ke);
+    }
+  }
+  for (const auto& [backend, n] : samples) {
+    const double rate = static_cast<double>(disagreements[backend]) / static_cast<double>(n);
+    out.push_back({scene, {"explore", backend, "", "disagreement_rate_err", rate, against}});
+    for (const std::string& name : error_names) {
+      std::vector<double> v = values[backend][name];
+      std::sort(v.begin(), v.end());
+      out.push_back({scene, {"explore", backend, "", name + "_p50", percentile(v, 50), against}});
+      out.push_back({scene, {"explore", backend, "", name + "_p90", percentile(v, 90), against}});
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<ExploreCheckMetric> explore_check_metrics(
+    const std::vector<std::string>& contact_backends,
+    const std::vector<std::string>& impact_backends, const ExploreCheckSet& set,
+    const std::vector<Backend>* table) {
+  std::vector<ExploreCheckMetric> out;
+  const ParallelRun run;
+  if (!contact_backends.empty() && set.contact > 0)
+    tally("explore/contact",
+          run.map(static_cast<size_t>(set.contact),
+                  [&](size_t i) {
+                    return encode(evaluate_contact_sample(make_contact_sample(set.seed, i),
+                                                          contact_backends, table));
+                  }),
+          {"normal_err_deg", "depth_err_rel"}, "exact", out);
+  if (!impact_backends.empty() && set.impact > 0)
+    tally("explore/impact",
+          run.map(static_cast<size_t>(set.impact),
+                  [&](size_t i) {
+                    return encode(evaluate_impact_sample(make_impact_sample(set.seed, i),
+                                                         impact_backends, table));
+                  }),
+          {"velocity_err_ke"}, "analytic", out);
+  return out;
+}
+
+}  // namespace rbx

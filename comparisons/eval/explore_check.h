@@ -1,0 +1,36 @@
+// The fixed random samples `rbx check` runs beside the scene library: a change that breaks
+// random poses or impacts at a random phase, which no scene of the library shows, moves these
+// metrics and fails the check.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "comparisons/eval/harness.h"
+#include "reference/backend.h"
+
+namespace rbx {
+
+/// Which samples: explore's own families (contact and impact kinds), from one seed.
+struct ExploreCheckSet {
+  uint64_t seed = 1;
+  int contact = 2000;  // contact-kind samples
+  int impact = 300;    // impact-kind samples
+};
+
+/// One metric of the sample set, under a pseudo-scene name ("explore/contact",
+/// "explore/impact") so that it takes its place beside the scenes' metrics.
+struct ExploreCheckMetric {
+  std::string scene;
+  Metric metric;
+};
+
+/// Per backend: the disagreement rate and the median and 90th percentile of its errors (contact:
+/// normal_err_deg, depth_err_rel; impact: velocity_err_ke), over the samples, exactly as `rbx
+/// explore` classifies them. Backends are looked up in `table` (null: the registry).
+std::vector<ExploreCheckMetric> explore_check_metrics(
+    const std::vector<std::string>& contact_backends,
+    const std::vector<std::string>& impact_backends, const ExploreCheckSet& set,
+    const std::vector<Backend>* table = nullptr);
+
+}  // namespace rbx
