@@ -86,7 +86,7 @@ namespace rbx {
 struct ExploreOptions {
   long count = 20000;            // samples
   unsigned long long seed = 1;   // sample k of seed s depends on (s, k) only
-  std::string kind = "contact";  // contact | impact
+  std::string kind = "contact";  // contact | impact | landing
   std::string backends;          // --backends LIST ("" : every contact backend but exact)
   std::string out;               // output folder ("" : reports/explore)
   std::string baseline;          // --baseline FILE: exit 1 when a backend got worse

@@ -24,13 +24,28 @@ namespace rbx {
 
 namespace {
 
-const char* const kMetrics[] = {"normal_err_deg", "depth_err_rel", "point_err_rel",
-                                "velocity_err_ke", "momentum_err_ke"};
+const char* const kMetrics[] = {"normal_err_deg",  "depth_err_rel",   "point_err_rel",
+                                "velocity_err_ke", "momentum_err_ke", "position_err_m",
+                                "turn_rad",        "rest_time_err_s"};
 
 // The metrics of one kind of sample.
 std::vector<std::string> metrics_of(const std::string& kind) {
   if (kind == "impact") return {"velocity_err_ke", "momentum_err_ke"};
+  if (kind == "landing")
+    return {"position_err_m", "turn_rad", "velocity_err_ke", "rest_time_err_s"};
   return {"normal_err_deg", "depth_err_rel", "point_err_rel"};
+}
+
+// One metric of a backend's outcome, by its name in explore.json.
+double metric_value(const BackendOutcome& b, const std::string& m) {
+  if (m == "normal_err_deg") return b.normal_err_deg;
+  if (m == "depth_err_rel") return b.depth_err_rel;
+  if (m == "point_err_rel") return b.point_err_rel;
+  if (m == "velocity_err_ke") return b.velocity_err_ke;
+  if (m == "momentum_err_ke") return b.momentum_err_ke;
+  if (m == "position_err_m") return b.position_err_m;
+  if (m == "turn_rad") return b.turn_rad;
+  return b.rest_time_err_s;
 }
 
 // Nearest-rank percentile of sorted values (p in [0, 100]).
@@ -48,17 +63,17 @@ struct BackendTally {
   std::map<std::string, uint64_t> first_index;  // lowest sample index of each signature
   std::map<std::string, BackendOutcome> first_outcome;
   std::map<std::string, std::vector<double>> values;  // metric -> measured values
-  // Impact kind: samples and disagreements by the quarter of its step the contact falls in.
+  // Impact, landing: samples and disagreements by the quarter of its step the contact falls in.
   long phase_samples[4] = {0, 0, 0, 0}, phase_disagreements[4] = {0, 0, 0, 0};
 };
 
 std::vector<std::string> subject_backends(const std::string& list, const std::string& kind) {
   std::vector<std::string> names;
   if (list.empty() || list == "all") {
-    // Every backend with a contact query (contact kind) or a dynamics run (impact kind);
+    // Every backend with a contact query (contact kind) or a dynamics run (impact, landing);
     // `exact` is the truth, not a subject.
     for (const Backend& b : backends())
-      if ((kind == "impact" ? static_cast<bool>(b.dynamics) : static_cast<bool>(b.contact)) &&
+      if ((kind != "contact" ? static_cast<bool>(b.dynamics) : static_cast<bool>(b.contact)) &&
           b.name != "exact")
         names.push_back(b.name);
     return names;
@@ -118,6 +133,9 @@ std::string describe(const BackendOutcome& b) {
            (b.error == "impulse" ? "the impulse is wrong"
                                  : "the impulse is right, the spin after it is not") +
            ")";
+  if (b.error == "position" || b.error == "turn")
+    return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
+           fmt_num(b.turn_rad, 3) + " rad";
   o << "normal off by " << fmt_num(b.normal_err_deg, 3) << " deg, depth off by "
     << fmt_num(b.depth_err_rel, 3) << " and point off by " << fmt_num(b.point_err_rel, 3)
     << " of the smaller body";
@@ -166,6 +184,21 @@ std::string shrink_group(const Json& g, uint64_t seed, long count, int budget) {
       .dump();
 }
 
+// The leading comment of a shrunk closed-form scene (impact, landing kinds): where it was
+// found, what the backend does on it, how it was shrunk (`shrunk`), how to reproduce it.
+std::string closed_form_header(const std::string& kind, uint64_t seed, long count, uint64_t index,
+                               const Json& g, const BackendOutcome& found,
+                               const std::string& shrunk) {
+  const std::string backend = g["backend"], sig = g["signature"];
+  std::ostringstream h;
+  h << "# Found by `rbx explore --kind " << kind << " --seed " << seed << " --count " << count
+    << "`: sample " << index << ", group '" << sig << "',\n# " << g["count"].get<long>()
+    << " samples. " << backend << " against the closed form: " << describe(found) << ".\n"
+    << "# Shrunk " << shrunk << ", while the disagreement stayed.\n"
+    << "# Reproduce: rbx compare THIS_FILE --backends " << backend << "\n";
+  return h.str();
+}
+
 // One impact group's shrink: the scene carries its closed form ([expect]) already.
 std::string shrink_impact_group(const Json& g, uint64_t seed, long count, int budget) {
   const ImpactSample start = make_impact_sample(seed, g["first_sample"].get<uint64_t>());
@@ -175,15 +208,13 @@ std::string shrink_impact_group(const Json& g, uint64_t seed, long count, int bu
   for (const BackendOutcome& b : r.outcome.backends)
     if (b.backend == backend) found = b;
   if (found.error.empty()) return Json{{"ok", false}}.dump();
-  std::ostringstream h;
-  h << "# Found by `rbx explore --kind impact --seed " << seed << " --count " << count
-    << "`: sample " << start.index << ", group '" << sig << ",\n# " << g["count"].get<long>()
-    << " samples. " << backend << " against the closed form: " << describe(found) << ".\n"
-    << "# Shrunk from " << r.vertices_before << " to " << r.vertices_after << " points ("
-    << r.steps_accepted << " simplifications kept, " << r.evaluations
-    << " tried), while the disagreement stayed.\n# Reproduce: rbx compare THIS_FILE --backends "
-    << backend << "\n";
-  const std::string text = h.str() + r.sample.text;
+  const std::string text =
+      closed_form_header("impact", seed, count, start.index, g, found,
+                         "from " + std::to_string(r.vertices_before) + " to " +
+                             std::to_string(r.vertices_after) + " points (" +
+                             std::to_string(r.steps_accepted) + " simplifications kept, " +
+                             std::to_string(r.evaluations) + " tried)") +
+      r.sample.text;
   std::string detail;
   bool reproduced = false;
   reproduced = harness_reproduces(text, "explore.toml", found, &detail);
@@ -197,6 +228,36 @@ std::string shrink_impact_group(const Json& g, uint64_t seed, long count, int bu
               {"phase", r.sample.phase},
               {"velocity_err_ke", found.velocity_err_ke},
               {"momentum_err_ke", found.momentum_err_ke},
+              {"message", found.message}}
+      .dump();
+}
+
+// One landing group's shrink, as the impact kind's.
+std::string shrink_landing_group(const Json& g, uint64_t seed, long count, int budget) {
+  const LandingSample start = make_landing_sample(seed, g["first_sample"].get<uint64_t>());
+  const std::string backend = g["backend"], sig = g["signature"];
+  const LandingShrinkResult r = shrink_landing(start, backend, sig, budget);
+  BackendOutcome found;
+  for (const BackendOutcome& b : r.outcome.backends)
+    if (b.backend == backend) found = b;
+  if (found.error.empty()) return Json{{"ok", false}}.dump();
+  const std::string text =
+      closed_form_header("landing", seed, count, start.index, g, found,
+                         "toward round numbers (" + std::to_string(r.steps_accepted) +
+                             " simplifications kept, " + std::to_string(r.evaluations) +
+                             " tried)") +
+      r.sample.text;
+  std::string detail;
+  const bool reproduced = harness_reproduces(text, "explore.toml", found, &detail);
+  return Json{{"ok", true},
+              {"text", text},
+              {"evaluations", r.evaluations},
+              {"reproduced", reproduced},
+              {"harness", detail},
+              {"phase", r.sample.phase},
+              {"position_err_m", found.position_err_m},
+              {"turn_rad", found.turn_rad},
+              {"rest_time_err_s", found.rest_time_err_s},
               {"message", found.message}}
       .dump();
 }
@@ -261,10 +322,30 @@ std::string groups_table(const Json& j) {
     for (const Json& x : b["groups"])
       g.add({name, x["signature"], std::to_string(x["count"].get<long>()), fmt_num(x["rate"], 3),
              x["scene"].is_string() ? x["scene"].get<std::string>() : std::string("-"),
-             std::to_string(x.value("points_before", 0)) + " -> " +
-                 std::to_string(x.value("points_after", 0)),
+             x.contains("points_before") ? std::to_string(x["points_before"].get<int>()) + " -> " +
+                                               std::to_string(x["points_after"].get<int>())
+                                         : std::string("-"),
              x.value("reproduced", false) ? "yes" : "no"});
   return g.markdown();
+}
+
+// A metric's p50 / p90 / p99 from a backend's "errors" object, `digits` significant digits.
+std::string three(const Json& errors, const char* m, int digits = 2) {
+  const Json& e = errors[m];
+  return fmt_num(e["p50"], digits) + " / " + fmt_num(e["p90"], digits) + " / " +
+         fmt_num(e["p99"], digits);
+}
+
+// The table of disagreement rates by the quarter of its step the first contact falls in.
+std::string phase_table(const Json& j) {
+  Table ph({"backend", "0-25 %", "25-50 %", "50-75 %", "75-100 %"});
+  for (const auto& [name, b] : j["backends"].items()) {
+    std::vector<std::string> row = {name};
+    for (const Json& q : b["by_phase_quarter"])
+      row.push_back(fmt_num(q["rate"], 3) + " (" + std::to_string(q["samples"].get<long>()) + ")");
+    ph.add(row);
+  }
+  return ph.markdown();
 }
 
 std::string markdown_impact(const Json& j) {
@@ -280,28 +361,15 @@ std::string markdown_impact(const Json& j) {
        "momenta right (spin: the free rotation after the impact).\n\n## Backends\n\n";
   Table t({"backend", "samples", "disagreements", "rate", "velocity err p50/p90/p99",
            "momentum err p50/p90/p99"});
-  for (const auto& [name, b] : j["backends"].items()) {
-    const Json& e = b["errors"];
-    auto three = [&](const char* m) {
-      return fmt_num(e[m]["p50"], 2) + " / " + fmt_num(e[m]["p90"], 2) + " / " +
-             fmt_num(e[m]["p99"], 2);
-    };
+  for (const auto& [name, b] : j["backends"].items())
     t.add({name, std::to_string(b["samples"].get<long>()),
            std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
-           three("velocity_err_ke"), three("momentum_err_ke")});
-  }
+           three(b["errors"], "velocity_err_ke"), three(b["errors"], "momentum_err_ke")});
   o << t.markdown();
   o << "\n## Disagreement rate by the phase of the contact within its step\n\nThe first contact "
        "falls at this fraction of the step that detects it (0 %: at the step's start, so the "
        "bodies overlap by a whole step of approach when it is seen).\n\n";
-  Table ph({"backend", "0-25 %", "25-50 %", "50-75 %", "75-100 %"});
-  for (const auto& [name, b] : j["backends"].items()) {
-    std::vector<std::string> row = {name};
-    for (const Json& q : b["by_phase_quarter"])
-      row.push_back(fmt_num(q["rate"], 3) + " (" + std::to_string(q["samples"].get<long>()) + ")");
-    ph.add(row);
-  }
-  o << ph.markdown();
+  o << phase_table(j);
   o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B (static: B "
        "is static), the contact's features, the kind of error. Each group's first sample was "
        "shrunk to the scene named; `reproduced` says whether `rbx compare` shows the velocity "
@@ -310,8 +378,47 @@ std::string markdown_impact(const Json& j) {
   return o.str();
 }
 
+std::string markdown_landing(const Json& j) {
+  std::ostringstream o;
+  o << "# rbx explore: " << j["count"] << " random flat landings with friction, seed " << j["seed"]
+    << "\n\n"
+    << "Every sample is a box (sides 0.2 to 2 m, mass 0.1 to 10 kg, any yaw) landing flat on a "
+       "static floor, e = 0, mu in [0.1, 1], falling at 0.2 to 2 m/s and sliding at 0.05 to "
+       "1.5 m/s, under gravity, first touch 2 to 5 steps ahead at a random phase of its step; "
+       "its height is drawn so that it cannot tip (mu sz <= 0.8 min(sx, sy)). The closed form "
+       "(landing impulse J = m vn, friction impulse min(mu J, m |v_h|), a slide decelerating at "
+       "mu g to rest, no turn) is the truth at the end of the run, 0.1 s or more after the rest. "
+       "A disagreement: a status error, a turn above 1e-3 rad (turn), or a resting centre more "
+       "than 1 mm from the closed form, horizontally (position). Time to rest: when the "
+       "horizontal speed falls below 1 mm/s for good, read from every step (one step's "
+       "resolution); reported, not marked. Velocity error: the final velocities in the energy "
+       "norm against the initial kinetic energy.\n\n## Backends\n\n";
+  Table t({"backend", "samples", "disagreements", "rate", "position err p50/p90/p99 (m)",
+           "turn p50/p90/p99 (rad)", "rest time err p50/p99 (s)", "velocity err p99"});
+  for (const auto& [name, b] : j["backends"].items()) {
+    const Json& e = b["errors"];
+    t.add(
+        {name, std::to_string(b["samples"].get<long>()),
+         std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
+         three(e, "position_err_m"), three(e, "turn_rad"),
+         fmt_num(e["rest_time_err_s"]["p50"], 2) + " / " + fmt_num(e["rest_time_err_s"]["p99"], 2),
+         fmt_num(e["velocity_err_ke"]["p99"], 2)});
+  }
+  o << t.markdown();
+  o << "\n## Disagreement rate by the phase of the first touch within its step\n\nThe first "
+       "touch falls at this fraction of the step that detects it (0 %: at the step's start).\n\n";
+  o << phase_table(j);
+  o << "\n## Disagreement groups\n\nSignature: backend, box-floor, whether the base slides on "
+       "after the landing (slides) or the landing stops it (sticks), the kind of error. Each "
+       "group's first sample was shrunk to the scene named; `reproduced` says whether `rbx "
+       "compare` shows the same final position or turn on it.\n\n";
+  o << groups_table(j);
+  return o.str();
+}
+
 std::string markdown(const Json& j, bool have_figure) {
   if (j["kind"] == "impact") return markdown_impact(j);
+  if (j["kind"] == "landing") return markdown_landing(j);
   std::ostringstream o;
   o << "# rbx explore: " << j["count"] << " random contact pairs, seed " << j["seed"] << "\n\n"
     << "Every sample is a random convex pair (boxes, hulls of 4 to 2,000 points, slivers; size "
@@ -324,13 +431,10 @@ std::string markdown(const Json& j, bool have_figure) {
            "depth p50/p90/p99 (rel)", "point p99 (rel)"});
   for (const auto& [name, b] : j["backends"].items()) {
     const Json& e = b["errors"];
-    auto three = [&](const char* m) {
-      return fmt_num(e[m]["p50"], 2) + " / " + fmt_num(e[m]["p90"], 2) + " / " +
-             fmt_num(e[m]["p99"], 2);
-    };
     t.add({name, std::to_string(b["samples"].get<long>()),
            std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
-           three("normal_err_deg"), three("depth_err_rel"), fmt_num(e["point_err_rel"]["p99"], 2)});
+           three(e, "normal_err_deg"), three(e, "depth_err_rel"),
+           fmt_num(e["point_err_rel"]["p99"], 2)});
   }
   o << t.markdown();
   if (have_figure) o << "\n![error distributions per backend](explore_errors.png)\n";
@@ -348,9 +452,10 @@ int explore_command(const ExploreOptions& opt) {
   ParallelRun par(opt.threads);
   if (opt.count <= 0)
     throw InputError("rbx explore: --count: must be > 0, got " + std::to_string(opt.count));
-  if (opt.kind != "contact" && opt.kind != "impact")
-    throw InputError("rbx explore: --kind: must be contact or impact, got '" + opt.kind + "'");
-  const bool impact = opt.kind == "impact";
+  if (opt.kind != "contact" && opt.kind != "impact" && opt.kind != "landing")
+    throw InputError("rbx explore: --kind: must be contact, impact or landing, got '" + opt.kind +
+                     "'");
+  const bool impact = opt.kind == "impact", landing = opt.kind == "landing";
   const std::vector<std::string> names = subject_backends(opt.backends, opt.kind);
   const uint64_t seed = opt.seed;
   const size_t count = static_cast<size_t>(opt.count);
@@ -363,6 +468,7 @@ int explore_command(const ExploreOptions& opt) {
     o.index = i;
     try {
       if (impact) return encode(evaluate_impact_sample(make_impact_sample(seed, i), names));
+      if (landing) return encode(evaluate_landing_sample(make_landing_sample(seed, i), names));
       const ContactSample s = make_contact_sample(seed, i);
       if (opt.bench) {
         // Throughput is stated on hulls under 100 points: larger ones are left out here.
@@ -413,19 +519,14 @@ int explore_command(const ExploreOptions& opt) {
       for (const BackendOutcome& b : s.backends) {
         BackendTally& t = tally[b.backend];
         ++t.samples;
-        if (impact && s.phase >= 0) {
+        if (s.phase >= 0) {
           const int q = std::min(3, static_cast<int>(s.phase * 4));
           ++t.phase_samples[q];
           t.phase_disagreements[q] += b.error.empty() ? 0 : 1;
         }
-        if (b.measured && impact) {
-          t.values["velocity_err_ke"].push_back(b.velocity_err_ke);
-          t.values["momentum_err_ke"].push_back(b.momentum_err_ke);
-        } else if (b.measured) {
-          t.values["normal_err_deg"].push_back(b.normal_err_deg);
-          t.values["depth_err_rel"].push_back(b.depth_err_rel);
-          t.values["point_err_rel"].push_back(b.point_err_rel);
-        }
+        if (b.measured)
+          for (const std::string& m : metrics_of(opt.kind))
+            t.values[m].push_back(metric_value(b, m));
         if (b.error.empty()) continue;
         ++t.disagreements;
         const std::string sig = signature(s, b);
@@ -451,6 +552,9 @@ int explore_command(const ExploreOptions& opt) {
       if (impact)
         return shrink_impact_group(all_groups[k], seed, opt.count,
                                    std::min(opt.shrink_budget, 120));
+      if (landing)
+        return shrink_landing_group(all_groups[k], seed, opt.count,
+                                    std::min(opt.shrink_budget, 60));
       return shrink_group(all_groups[k], seed, opt.count, opt.shrink_budget);
     } catch (const std::exception& e) {
       return Json{{"ok", false}, {"message", e.what()}}.dump();
@@ -494,7 +598,7 @@ int explore_command(const ExploreOptions& opt) {
                         {"max", percentile(v, 100)},
                         {"quantiles_every_5", q}};
     }
-    if (impact) {
+    if (impact || landing) {
       b["by_phase_quarter"] = Json::array();
       for (int q = 0; q < 4; ++q)
         b["by_phase_quarter"].push_back(
@@ -524,10 +628,15 @@ int explore_command(const ExploreOptions& opt) {
         g["scene"] = file;
         for (const char* k :
              {"points_before", "points_after", "evaluations", "reproduced", "harness"})
-          g[k] = r[k];
+          if (r.contains(k)) g[k] = r[k];  // a landing's box has 8 points throughout: no count
         if (impact) {
           g["shrunk_error"] = {{"velocity_err_ke", r["velocity_err_ke"]},
                                {"momentum_err_ke", r["momentum_err_ke"]},
+                               {"phase", r["phase"]}};
+        } else if (landing) {
+          g["shrunk_error"] = {{"position_err_m", r["position_err_m"]},
+                               {"turn_rad", r["turn_rad"]},
+                               {"rest_time_err_s", r["rest_time_err_s"]},
                                {"phase", r["phase"]}};
         } else {
           g["shrunk_error"] = {{"normal_err_deg", r["normal_err_deg"]},

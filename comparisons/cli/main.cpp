@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
       "explore", "random contact pairs against the exact oracle; disagreements shrunk to scenes");
   explore->add_option("--count", explore_opt.count, "number of samples (default 20000)");
   explore->add_option("--seed", explore_opt.seed, "seed (default 1)");
-  explore->add_option("--kind", explore_opt.kind, "contact | impact");
+  explore->add_option("--kind", explore_opt.kind, "contact | impact | landing");
   explore->add_option("--backends", explore_opt.backends, "comma-separated backend names");
   explore->add_option("--out", explore_opt.out, "output folder (default reports/explore)");
   explore->add_option("--baseline", explore_opt.baseline,

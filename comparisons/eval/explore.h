@@ -78,9 +78,13 @@ struct BackendOutcome {
   double depth_err_rel = 0.0;   // |depth - exact depth| / smaller body size
   double point_err_rel = 0.0;   // distance of the point from the intersection / size
   std::string message;          // the backend's message when status is error
-  // Impact kind (measured = the run finished):
+  // Impact and landing kinds (measured = the run finished):
   double velocity_err_ke = 0.0;  // final velocities against the closed form, KE norm (harness)
   double momentum_err_ke = 0.0;  // final momenta (p, L about the COM) against it, same norm
+  // Landing kind:
+  double position_err_m = 0.0;   // horizontal distance of the final centre from the closed form
+  double turn_rad = 0.0;         // rotation angle of the final orientation from the initial one
+  double rest_time_err_s = 0.0;  // |measured - closed-form time to rest| (the run's samples)
 };
 
 /// Everything measured on one sample.
@@ -92,7 +96,7 @@ struct SampleOutcome {
   bool touching = false;
   double depth_rel = 0.0;                // exact depth / smaller body size (negative: separated)
   std::vector<BackendOutcome> backends;  // in the order asked for; unsupported ones left out
-  double phase = -1.0;  // impact kind: where in its step the first contact falls, [0, 1)
+  double phase = -1.0;  // impact, landing: where in its step the first contact falls, [0, 1)
 };
 
 /// Runs the sample through `exact` and each named backend and classifies each answer.
@@ -133,7 +137,8 @@ ShrinkResult shrink(const ContactSample& s, const std::string& backend, const st
 /// True when the harness (evaluate_scene, as `rbx compare` runs it) shows on the scene text
 /// the disagreement of `b`'s kind: status error, a touching mismatch, a normal off by more
 /// than kMarkAngleDeg, a depth off by more than kMarkDepthRel of the smaller body, a point
-/// off by more than the same fraction. `detail` says what it saw.
+/// off by more than the same fraction; impact kind: a velocity error above kMarkVelocityErr;
+/// landing kind: a final centre or turn beyond the landing marks. `detail` says what it saw.
 bool harness_reproduces(const std::string& scene_text, const std::string& path,
                         const BackendOutcome& b, std::string* detail = nullptr);
 
@@ -188,5 +193,72 @@ struct ImpactShrinkResult {
 };
 ImpactShrinkResult shrink_impact(const ImpactSample& s, const std::string& backend,
                                  const std::string& sig, int max_evaluations = 120);
+
+// ---------------------------------------------------------------------------------------------
+// Landing kind: a box lands flat on a static floor with a horizontal velocity, e = 0, friction
+// mu; the closed form is the landing impulse J = m vn, the friction impulse min(mu J, m |v_h|)
+// against the slip, then a slide decelerating at mu g to rest, without turning (the box is drawn
+// so that it cannot tip: mu sz < min(sx, sy)). The derivation is written in each scene.
+
+/// A landing's disagreement marks, for every backend alike. Position: 1 mm, above a
+/// time-stepped slide's own discretisation (a right Riemann sum of the falling speed falls short
+/// by at most v dt / 2 = 0.75 mm at the largest slide speed drawn, 1.5 m/s, and dt = 1 ms) and
+/// below what a wrong law does (a deceleration 1 % off moves the rest by 1 % of the slide,
+/// centimetres on most samples). Turn: 1e-3 rad: a box that stays flat turns by round-off only,
+/// one that tips or spins on its contact patch by far more.
+constexpr double kLandingPositionMark = 1e-3;  // m
+constexpr double kLandingTurnMark = 1e-3;      // rad
+
+/// One random landing: its design (drawn) and the closed form (derived by realize_landing).
+struct LandingSample {
+  uint64_t seed = 0;
+  uint64_t index = 0;
+  // Design.
+  Vec3 size = Vec3::Ones();  // m, full extents of the box
+  double mass = 1.0;         // kg
+  double yaw_deg = 0.0;      // the box's turn about the vertical (it still lands flat)
+  double slide_speed = 1.0;  // m/s, horizontal speed |v_h| before the landing
+  double heading_deg = 0.0;  // direction of v_h, degrees from +x toward +y
+  double fall_speed = 1.0;   // m/s, downward speed vz at t = 0 (> 0)
+  double friction = 0.5;     // Coulomb mu
+  double dt = 1e-3;          // s
+  int steps_before = 2;      // k: first touch in step k (counting from 0)
+  double phase = 0.5;        // where in that step: t_c = (k + phase) dt
+  // The closed form (realize_landing).
+  double contact_time = 0.0;      // s, t_c
+  double drop = 0.0;              // m, h0: height of the base above the floor at t = 0
+  double normal_impulse = 0.0;    // N s, J = m vn
+  double friction_impulse = 0.0;  // N s, min(mu J, m |v_h|)
+  double speed_after = 0.0;       // m/s, |v_h'| just after the landing
+  double rest_time = 0.0;         // s, t_c + |v_h'| / (mu g)
+  double duration = 0.0;          // s, a whole number of steps past the rest
+  bool slides = false;            // the base slides on after the landing (|v_h| > mu vn)
+  Vec3 start_position = Vec3::Zero(), velocity = Vec3::Zero();  // t = 0, m and m/s
+  Vec3 expect_position = Vec3::Zero();                          // m, centre at t = duration
+  std::string text;  // the scene with its derivation and [expect] block (empty: invalid design)
+};
+
+/// Sample `index` of `seed` (landing kind): a pure function of the two.
+LandingSample make_landing_sample(uint64_t seed, uint64_t index);
+
+/// The closed form and the scene of a landing design: false when the design is not a flat
+/// landing of the closed form (a box that could tip, a touch outside its step, no fall).
+bool realize_landing(LandingSample& s);
+
+/// Runs the sample's scene through each named dynamics backend against its closed form:
+/// status error, then a turn above kLandingTurnMark, then a position above
+/// kLandingPositionMark.
+SampleOutcome evaluate_landing_sample(const LandingSample& s,
+                                      const std::vector<std::string>& names);
+
+/// Landing groups shrunk toward round designs (unit mass, no yaw, a slide along x, rounder mu,
+/// sizes, speeds and phase) while `backend` keeps signature `sig`.
+struct LandingShrinkResult {
+  LandingSample sample;
+  SampleOutcome outcome;
+  int steps_accepted = 0, evaluations = 0;
+};
+LandingShrinkResult shrink_landing(const LandingSample& s, const std::string& backend,
+                                   const std::string& sig, int max_evaluations = 120);
 
 }  // namespace rbx
