@@ -1051,7 +1051,9 @@ ImpactShrinkResult shrink_impact(const ImpactSample& start, const std::string& b
   k.sig = sig;
   k.max_evaluations = max_evaluations;
   k.realize = realize_impact;
-  k.evaluate = evaluate_impact_sample;
+  k.evaluate = [](const ImpactSample& s, const std::vector<std::string>& names) {
+    return evaluate_impact_sample(s, names);
+  };
   // 1. Fewer points of A: its hull's own vertices, then chunks (halves first).
   if (k.sample.a.shape_class != "box") {
     ImpactSample c = k.sample;
