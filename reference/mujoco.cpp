@@ -6,8 +6,8 @@
 // dynamics because 2.2.2's box-box collider reports half the depth; otherwise mesh geoms with
 // multi-point convex collision (mjENBL_MULTICCD). Box geoms only when all are boxes: a box-mesh
 // pair runs MPR at the full depth, so one global stiffness factor would be wrong for it.
-// Contact queries of `mujoco` use the multiccd meshes for every body (the halved box-box depth
-// would be passed on as a wrong answer, and no stiffness makes up for it there).
+// Contact queries of `mujoco` take the same geoms as its dynamics: MuJoCo's own box-box collider
+// for two boxes (its halved depth passed on, labelled: no stiffness makes up for it in a query).
 //
 // The model is written as MJCF text into MuJoCo's virtual file system and compiled with
 // mj_loadXML. Three MuJoCo habits need care:
@@ -476,13 +476,9 @@ MassResult mass_of_geom(const RigidBody& body, bool box) {
   return r;
 }
 
-/// The settings of `mujoco` contact queries: meshes with multiccd, boxes included (see
-/// mujoco_contact).
-MujocoSettings mujoco_query_settings() {
-  MujocoSettings s;
-  s.box_geoms = false;
-  return s;
-}
+/// The settings of `mujoco` contact queries: those of its dynamics (box geoms for two boxes,
+/// multiccd meshes otherwise; see mujoco_contact).
+MujocoSettings mujoco_query_settings() { return MujocoSettings{}; }
 
 }  // namespace
 
@@ -494,9 +490,9 @@ MujocoSettings mujoco_hull_settings() {
 }
 
 ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b) {
-  // Contact queries take meshes with multiccd even for boxes: box geoms report half the depth
-  // (0.05 for a true 0.1), the meshes the full depth to float precision. Only the dynamics,
-  // whose stiffness can make up for the halving, use box geoms.
+  // Two boxes meet in MuJoCo's own box-box collider, as in its dynamics and as its own tests
+  // exercise it (its normals there are right where the meshes' MPR is not); 2.2.2 reports half
+  // the depth there, passed on and labelled (query_model). `mujoco-hull` keeps the meshes.
   return mujoco_contact_with(a, b, mujoco_query_settings());
 }
 

@@ -215,7 +215,10 @@ TEST(Cli, ContactsRunsEveryBackendInTheContractConvention) {
     const auto& c = b["contacts"][0];
     EXPECT_EQ(c["bodies"], nlohmann::json::array({"A", "B"})) << name;
     EXPECT_NEAR(c["normal"][0].get<double>(), -1.0, 1e-6) << name;  // MuJoCo: float vertices
-    EXPECT_NEAR(c["depth"].get<double>(), 0.1, 1e-6) << name;
+    // MuJoCo 2.2.2's box-box collider reports half the depth: passed on, and labelled.
+    EXPECT_NEAR(c["depth"].get<double>(), name == "mujoco" ? 0.05 : 0.1, 1e-6) << name;
+    if (name == "mujoco")
+      EXPECT_NE(b["message"].get<std::string>().find("half"), std::string::npos);
     ++answered;
   }
   EXPECT_GE(answered, 9);  // every contact backend but the INDEP one
