@@ -198,6 +198,11 @@ const std::vector<PinnedCause>& pinned_causes() {
        "zeroes its direction below CCD_EPS of depth, its EPA and FCL's signed distance return no "
        "direction at zero distance; the adapters report that as `touching` (no normal), a "
        "convention, apart from errors."},
+      {{"mujoco"},
+       {"family:contact", "family:external"},
+       "**mujoco on two boxes**: queried, like its dynamics, in MuJoCo 2.2.2's own box-box "
+       "collider, which reports half the depth (the normal is right); passed on and labelled "
+       "(`FairReferences.NativeBoxQueriesGiveTheFourCornerFaceManifold`)."},
       {{"bullet-sat"},
        {},
        "**bullet-sat**: the SAT + clipping path measures each point's depth to the first body's "
