@@ -109,9 +109,7 @@ namespace {
 /// the bodies). A guess with no exact answer (targets no motion of the bodies meets: a face
 /// with some points bouncing and some resting) drops the assumption its least-squares answer
 /// breaks most. Returns false, touching nothing, when the guesses do not settle in 20 rounds
-/// or no assumption can be dropped; the projections then solve it. Measured on cube tosses
-/// (ten tosses at mu = 0.6, then at 0.18: 12,512 island solves): 99.2 % settled; at 0.6 the run
-/// went from 32.6 s to 0.10 s.
+/// or no assumption can be dropped; the projections then solve it.
 bool solve_active_set(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>& inv,
                       std::vector<Row>& rows, double mu, double tolerance) {
   constexpr int kMaxRounds = 20;

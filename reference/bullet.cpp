@@ -21,8 +21,8 @@
 // 0.1 along x. The `bullet-hull` world meets it too, since it solves contacts only after
 // overlap; `bullet` does not (box-box detector).
 //
-// Dynamics: btDiscreteDynamicsWorld with the settings of REFERENCES.md that turn it into a fair
-// single-impulse reference; each setting carries its reason where it is made.
+// Dynamics: btDiscreteDynamicsWorld with the settings of docs/references.md that turn it into a
+// fair single-impulse reference; each setting carries its reason where it is made.
 //
 // Bullet's convention (btManifoldPoint): m_normalWorldOnB points from the callback's object 1
 // toward object 0, getDistance() < 0 when penetrating, m_positionWorldOnB lies on object 1 and
@@ -244,8 +244,8 @@ BodyFinal final_state(const std::string& name, const BulletBody& bb) {
 }
 
 /// Runs the scene in a btDiscreteDynamicsWorld. `settings.fair_world`: the single-impulse
-/// settings of REFERENCES.md; otherwise Bullet's defaults for the world, solver and bodies (the
-/// scene's shapes, masses, inertia, restitution and gravity are used either way).
+/// settings of docs/references.md; otherwise Bullet's defaults for the world, solver and bodies
+/// (the scene's shapes, masses, inertia, restitution and gravity are used either way).
 DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
                          const BulletSettings& settings) {
   const bool fair = settings.fair_world;

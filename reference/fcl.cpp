@@ -46,7 +46,7 @@ constexpr std::size_t kMaxContacts = 8;
 // unit-scale coordinates (~1e-16 m).
 constexpr double kCoincidentPoints = 1e-12;
 
-// Note attached to every fcl-indep result (REFERENCES.md, "Known wrong answers").
+// Note attached to every fcl-indep result (docs/references.md, "Known wrong answers").
 constexpr const char* kIndepDefect =
     "FCL 0.7 GST_INDEP on Convex: normal left in A's local frame (not rotated to world) and "
     "depth negative; passed on unpatched (known defects)";

@@ -32,7 +32,9 @@ const std::vector<Backend>& backends() {
   // `-hull`: every body the same convex hull the custom engine gets. The former `fcl-box`
   // (Box-Box only) is what `fcl` runs on two boxes, so it is gone as a duplicate.
   static const std::vector<Backend> table = {
-      {"custom", "rbx engine: Moore & Wilhelms face/vertex/edge tests, single-point impulse",
+      {"custom",
+       "rbx engine, extended: Moore & Wilhelms tests with the plane of least overlap, contact "
+       "manifolds, Coulomb friction, resting contact, time of impact for every new contact",
        custom_contact, custom_dynamics, nullptr, false},
       {"custom-seed",
        "rbx engine, the seed's algorithm: first hit, single-point frictionless impulse", nullptr,

@@ -61,10 +61,9 @@ BenchPlan bench_plan(bool quick) {
   return p;
 }
 
-// The caps keep the full run under ten minutes on two cores; each is named in perf.md. Measured
-// on the development machine (one touching query): the seed loops ~0.3 s at N = 2048 separated
-// (16 N^2 primitive tests), bullet-sat ~7.5 s at N = 2048 (its polyhedral features are rebuilt
-// per call), exact ~0.1 s at N = 2048, ode ~1 s and mujoco ~0.5 s at N = 8192.
+// The caps keep the full run under ten minutes on two cores; each is named, with its reason, in
+// perf.md: the seed loops' 16 N^2 primitive tests, bullet-sat's polyhedral features rebuilt on
+// every call, the exact oracle's, ODE's and MuJoCo's cost at the largest sizes.
 std::vector<NarrowBackend> narrow_backends() {
   auto registry = [](const std::string& name) { return find_backend(name)->contact; };
   auto variant = [](const std::string& name, const std::string& v) {

@@ -1,4 +1,4 @@
-// Determinism (STYLE.md, after Box2D's determinism check): the same many-body scene run twice
+// Determinism (docs/style.md, after Box2D's determinism check): the same many-body scene run twice
 // gives bit-identical final states, hashed, and byte-identical JSON apart from runtime_s.
 // Two scenes: the library's 64 cubes in a closed box (scenes/stress/many_bodies_walls.toml) and
 // a 60-body scene built here that mixes shapes, rotations, gravity, restitution < 1 and both

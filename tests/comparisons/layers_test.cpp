@@ -1,6 +1,6 @@
 // The dependency order of the source folders, checked on the includes: engine/ < reference/ <
 // comparisons/scene/ < comparisons/eval/ < comparisons/output/ < comparisons/cli/. A file may
-// include its own layer and the layers below it, never one above (STYLE.md: "nothing points
+// include its own layer and the layers below it, never one above (docs/style.md: "nothing points
 // backwards"). The CMake libraries enforce the same order for symbols (comparisons/CMakeLists.txt).
 #include <gtest/gtest.h>
 

@@ -94,7 +94,7 @@ TEST(BulletContact, SatAlignedCubes) {
 // coplanar, it returns a diagonal normal with depth 0.1/sqrt(3) instead of (-1,0,0), 0.1.
 // Property pinned (independent of the exact wrong numbers): a penetration vector must separate
 // the shapes, but moving A by depth * normal leaves an x-overlap of 0.1 - depth * |n_x| > 0.
-// If Bullet gets fixed this test fails: update REFERENCES.md and the report.
+// If Bullet gets fixed this test fails: update docs/references.md and the report.
 TEST(BulletContact, KnownDefectEpaCoplanarSides) {
   const ContactResult r =
       bullet_hull_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(0.9, 0, 0)));
@@ -112,7 +112,7 @@ TEST(BulletContact, KnownDefectEpaCoplanarSides) {
 // unit cube turned 45 deg about y pressed into a size-3 cube, B's top face at z = 0, A's lowest
 // edge at -sqrt(2)/2): the true depth is sqrt(2)/2 along +z. With A first its tilted face is
 // the reference and the deepest point comes out at depth 1; with B first, B's top face is the
-// reference and the answer is exact. Pinned; if Bullet changes, update REFERENCES.md.
+// reference and the answer is exact. Pinned; if Bullet changes, update docs/references.md.
 TEST(BulletContact, KnownDefectSatDepthMeasuredToTheFirstBodysFace) {
   const RigidBody a = unit_cube("A", Vec3::Zero(), Quat(Eigen::AngleAxisd(kPi / 4, Vec3::UnitY())));
   const RigidBody b = make_body(box_spec("B", Vec3(3, 3, 3), Vec3(0, 0, -1.5)));
@@ -364,7 +364,7 @@ TEST(BulletDynamics, CubeCornerOnStaticSlab) {
   }
 }
 
-// (3) REFERENCES.md's known defect, with B at rest: m1 = m2 = 1, v1 = 1, e = 1 (restitution 1
+// (3) docs/references.md's known defect, with B at rest: m1 = m2 = 1, v1 = 1, e = 1 (restitution 1
 // on both bodies). Bullet's default world solves the contact before the faces touch (contact
 // processing threshold BT_LARGE_FLOAT) with the target normal velocity e |v_n| - d / dt (the
 // "speculative" gap term). The gap, 0.5 m, is 500 steps of |v| dt, so at d = 0.002 the target

@@ -1,6 +1,6 @@
 // FCL 0.7 calls that can take the process down, run through run_isolated (reference/isolate.h).
 //
-// REFERENCES.md: "Distance with INDEP on Box-Convex can hit an assertion". This is what the
+// docs/references.md: "Distance with INDEP on Box-Convex can hit an assertion". This is what the
 // Debian build really does. Kept apart from fcl_test.cpp, whose executable must never abort
 // (it does not link the isolation helper); this one links the whole reference library.
 //
@@ -117,7 +117,7 @@ TEST(FclIndepDistance, PenetratingBoxConvexAbortsOnTheAssertionPinned) {
   // Pinned: the overlapping pair above through fcl::distance (signed, GST_INDEP) dies with
   // SIGABRT from the assertion at distance-inl.h:177. run_isolated turns that into status
   // Error naming the signal, and this process carries on. If FCL stops aborting here (an
-  // upgrade, or a build with NDEBUG), this test fails and REFERENCES.md must change.
+  // upgrade, or a build with NDEBUG), this test fails and docs/references.md must change.
   std::string child_stderr;
   const ContactResult r =
       run_isolated_capturing_stderr([] { return indep_box_convex_distance(0.9); }, &child_stderr);

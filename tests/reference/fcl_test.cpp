@@ -92,8 +92,8 @@ RigidBody touching_b() { return unit_cube("B", Vec3(1.0, 0, 0)); }
 RigidBody separated_b() { return unit_cube("B", Vec3(1.1, 0, 0)); }
 
 // ---------------------------------------------------------------------------------------------
-// FCL issue 545 (REFERENCES.md): a cube of side 0.1 centred at (0.4, 0.4, 0.4), on the diagonal
-// of a unit cube A at the origin. B spans [0.35, 0.45]^3, entirely inside A. The least
+// FCL issue 545 (docs/references.md): a cube of side 0.1 centred at (0.4, 0.4, 0.4), on the
+// diagonal of a unit cube A at the origin. B spans [0.35, 0.45]^3, entirely inside A. The least
 // translation of A that frees B is 0.5 - 0.35 = 0.15 along -x, -y or -z (a three-way tie; the
 // other way round each axis costs 0.45 + 0.5 = 0.95): truth normal in {-x, -y, -z}, depth 0.15.
 // MPR instead follows the ray from the Minkowski difference's interior point c_A - c_B =
@@ -225,7 +225,7 @@ TEST(FclIndep, CarriesTheDefectNote) {
 TEST(FclIndep, RotatedPairNormalInLocalFrameAndNegativeDepthPinned) {
   // Offset pair: B at (0.9, 0.2, 0.1) from A. Overlaps 0.1 (x), 0.8 (y), 0.9 (z): truth n =
   // (-1, 0, 0), depth 0.1. Rotated as a whole by R: truth n = R (-1, 0, 0), depth 0.1.
-  // REFERENCES.md: GST_INDEP leaves the normal in A's local frame and negates the depth. With
+  // docs/references.md: GST_INDEP leaves the normal in A's local frame and negates the depth. With
   // only the documented A -> B flip applied, the adapter must show n = R^T (truth) = (-1, 0, 0)
   // and depth -0.1. EPA ends on the exact hull face (x = 0.1 of the Minkowski difference), so
   // round-off only.

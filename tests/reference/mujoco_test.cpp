@@ -130,7 +130,7 @@ TEST(MujocoContact, RecentredMeshStaysOnOurPose) {
 
 // --- Known wrong answer: MPR on a small cube at a big cube's corner (FCL issue 545) ----------
 
-// REFERENCES.md and scenes/contact/small_on_diagonal.toml: a 0.1 cube B centred at (0.4, 0.4,
+// docs/references.md and scenes/contact/small_on_diagonal.toml: a 0.1 cube B centred at (0.4, 0.4,
 // 0.4) inside the unit cube A at the origin. B spans [0.35, 0.45]^3; the least translation that
 // frees it is 0.15 along an axis (0.5 - 0.35; a three-way tie), so the truth is depth 0.15 with
 // an axis normal. MuJoCo 2.2.2 runs libccd's MPR on mesh geoms with the geom centres as the
@@ -212,7 +212,7 @@ TEST(MujocoKnownDefect, BoxBoxReportsHalfTheDepth) {
   // Two unit box geoms (primitive type "box", not meshes) overlapping 0.1 along x, as in
   // OverlapAlongX. The true depth is 0.1; MuJoCo 2.2.2's box-box collider reports
   // dist = -0.05 (fixed upstream much later). This test pins the defect: if it fails, the
-  // library changed and REFERENCES.md must be updated. The adapter uses mesh geoms, which get
+  // library changed and docs/references.md must be updated. The adapter uses mesh geoms, which get
   // 0.1 (OverlapAlongXGivesNormalFromBTowardA).
   mjModel* m = load_mjcf(R"(<mujoco><worldbody>
       <body pos="0 0 0"><freejoint/><geom type="box" size="0.5 0.5 0.5"/></body>
