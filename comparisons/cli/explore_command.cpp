@@ -506,13 +506,14 @@ int explore_command(const ExploreOptions& opt) {
   std::map<std::string, BackendTally> tally;
   std::map<std::string, long> pose_classes;
   long invalid = 0;
+  std::string first_invalid;  // the first failed sample's message
   Json groups = Json::array();
   if (par.root()) {
     for (const std::string& n : names) tally[n];
     for (const std::string& text : raw) {
       const SampleOutcome s = decode(text);
       if (s.pose_class == "invalid") {
-        ++invalid;
+        if (invalid++ == 0) first_invalid = s.feature;
         continue;
       }
       ++pose_classes[s.pose_class];
@@ -676,9 +677,14 @@ int explore_command(const ExploreOptions& opt) {
             << " reproduced by the harness) in " << fmt_num(sampling_s + shrinking_s, 3) << " s on "
             << par.ranks() << " rank(s) x " << par.threads() << " thread(s) -> " << out.string()
             << "/explore.{json,md}\n";
-  int code = 0;
+  // Samples that could not be made are said, never silently left out; none made at all is a
+  // failed run.
+  if (invalid > 0)
+    std::cerr << "rbx explore: " << invalid << " of " << opt.count
+              << " samples could not be made (first: " << first_invalid << ")\n";
+  int code = invalid == static_cast<long>(opt.count) ? 1 : 0;
   try {
-    if (!opt.baseline.empty()) code = compare_baseline(j, opt.baseline);
+    if (!opt.baseline.empty()) code = std::max(code, compare_baseline(j, opt.baseline));
   } catch (const InputError&) {
     par.broadcast("2");  // the other ranks end with the same exit code
     throw;
