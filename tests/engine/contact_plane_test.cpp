@@ -30,6 +30,25 @@ double radius(const ConvexPolyhedron& s) {
   return r;
 }
 
+// Two of `all`, turned at random, A's centre a random fraction of the sum of their radii from
+// B's in a random direction: overlapping, touching or apart.
+struct RandomPair {
+  const ConvexPolyhedron* a = nullptr;
+  const ConvexPolyhedron* b = nullptr;
+  Pose pa, pb;
+};
+RandomPair random_pair(const std::vector<ConvexPolyhedron>& all, std::mt19937& rng) {
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(all.size()) - 1);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  RandomPair p;
+  p.a = &all[pick(rng)];
+  p.b = &all[pick(rng)];
+  const Vec3 dir = random_rotation(rng) * Vec3::UnitX();
+  p.pa = {dir * unit(rng) * (radius(*p.a) + radius(*p.b)), random_rotation(rng)};
+  p.pb = {Vec3::Zero(), random_rotation(rng)};
+  return p;
+}
+
 TEST(ContactPlane, AxisAlignedBoxesTakeTheAxisOfLeastOverlap) {
   // Closed form: two axis-aligned boxes overlap by (h_a + h_b) - |c_a - c_b| on each axis, and
   // the least of the three is the depth along that axis, pointing from B's centre to A's.
@@ -68,14 +87,11 @@ TEST(ContactPlane, AxisAlignedBoxesTakeTheAxisOfLeastOverlap) {
 TEST(ContactPlane, EitherBodyOrderGivesTheSameContactReversed) {
   std::mt19937 rng(11);
   const std::vector<ConvexPolyhedron> all = shapes();
-  std::uniform_int_distribution<int> pick(0, static_cast<int>(all.size()) - 1);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
   int touching = 0;
   for (int trial = 0; trial < 1000; ++trial) {
-    const ConvexPolyhedron &a = all[pick(rng)], &b = all[pick(rng)];
-    const Vec3 dir = random_rotation(rng) * Vec3::UnitX();
-    const Pose pa{dir * unit(rng) * (radius(a) + radius(b)), random_rotation(rng)};
-    const Pose pb{Vec3::Zero(), random_rotation(rng)};
+    const RandomPair r = random_pair(all, rng);
+    const ConvexPolyhedron &a = *r.a, &b = *r.b;
+    const Pose &pa = r.pa, &pb = r.pb;
     if (!detect(a, pa, b, pb)) continue;
     ++touching;
     const ContactPlane ab = choose_contact_plane(a, pa, b, pb);
@@ -93,14 +109,11 @@ TEST(ContactPlane, NoDirectionSeparatesWithASmallerMove) {
   // overlap along the chosen normal, and no other direction (sampled) has a smaller one.
   std::mt19937 rng(13);
   const std::vector<ConvexPolyhedron> all = shapes();
-  std::uniform_int_distribution<int> pick(0, static_cast<int>(all.size()) - 1);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
   int touching = 0;
   for (int trial = 0; trial < 300; ++trial) {
-    const ConvexPolyhedron &a = all[pick(rng)], &b = all[pick(rng)];
-    const Vec3 dir = random_rotation(rng) * Vec3::UnitX();
-    const Pose pa{dir * unit(rng) * (radius(a) + radius(b)), random_rotation(rng)};
-    const Pose pb{Vec3::Zero(), random_rotation(rng)};
+    const RandomPair r = random_pair(all, rng);
+    const ConvexPolyhedron &a = *r.a, &b = *r.b;
+    const Pose &pa = r.pa, &pb = r.pb;
     if (!detect(a, pa, b, pb)) continue;
     ++touching;
     const ContactPlane p = choose_contact_plane(a, pa, b, pb);
