@@ -102,3 +102,32 @@ struct ExploreOptions {
 int explore_command(const ExploreOptions& opt);
 
 }  // namespace rbx
+
+namespace rbx {
+
+/// Options of `rbx view`.
+struct ViewOptions {
+  std::string scene;     // scene file
+  std::string backends;  // --backends LIST ("" : the scene's, or every one that serves it)
+  std::string out;       // --out FILE ("" : FAMILY_STEM.html in the current folder)
+};
+
+/// `rbx view SCENE`: evaluates the scene (no time-step sweep) and writes its replay page.
+int view_command(const ViewOptions& opt);
+
+}  // namespace rbx
+
+namespace rbx {
+
+/// Options of `rbx tosses`.
+struct TossesOptions {
+  std::string data;      // DATA.csv or .csv.gz
+  std::string params;    // --params FILE ("" : params.json beside DATA)
+  bool fit = false;      // --fit: fit every selected backend on DATA and write the params file
+  std::string backends;  // --backends LIST
+  std::string json;      // --json FILE|-
+};
+/// `rbx tosses`.
+int tosses_command(const TossesOptions& opt);
+
+}  // namespace rbx

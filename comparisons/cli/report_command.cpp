@@ -13,13 +13,16 @@
 #include <sstream>
 
 #include "comparisons/cli/commands.h"
-#include "comparisons/cli/view.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/parallel.h"
+#include "comparisons/eval/scene_batch.h"
 #include "comparisons/eval/tosses.h"
 #include "comparisons/eval/trajectory.h"
+#include "comparisons/output/report_writer.h"
 #include "comparisons/output/scorecard.h"
 #include "comparisons/output/table.h"
+#include "comparisons/output/tosses_report.h"
+#include "comparisons/output/view_page.h"
 #include "comparisons/scene/repo_path.h"
 #include "comparisons/scene/scene_collection.h"
 #include "comparisons/scene/scene_file.h"
@@ -48,440 +51,6 @@ class Progress {
   bool on_;
 };
 
-// A scene's evaluation as text for the ranks' exchange (ParallelRun::map) and back; doubles go
-// through JSON's shortest round-trip form, so rank 0 rebuilds the very same numbers.
-std::string encode_evaluation(const SceneEvaluation& ev) {
-  Json j;
-  j["family"] = ev.family;
-  j["json"] = ev.json;
-  j["metrics"] = Json::array();
-  for (const Metric& m : ev.metrics)
-    j["metrics"].push_back({m.check, m.backend, m.pair, m.name, m.value, m.against});
-  j["sweep"] = Json::array();
-  for (const SweepPoint& p : ev.sweep)
-    j["sweep"].push_back({p.backend, p.kind, p.dt, p.runtime_s, p.error, p.against});
-  j["skipped"] = ev.skipped;
-  j["expect_failures"] = ev.expect_failures;
-  j["expect_checked"] = ev.expect_checked;
-  j["expect_unchecked"] = ev.expect_unchecked;
-  j["expect_known"] = ev.expect_known;
-  j["disagreements"] = ev.disagreements;
-  j["deviations"] = ev.deviations;
-  j["causes"] = Json::array();
-  for (const Cause& c : ev.causes) j["causes"].push_back({c.backend, c.scene, c.kind, c.detail});
-  return j.dump();
-}
-
-SceneEvaluation decode_evaluation(const std::string& text) {
-  const Json j = Json::parse(text);
-  SceneEvaluation ev;
-  ev.family = j["family"];
-  ev.json = j["json"];
-  for (const Json& m : j["metrics"]) ev.metrics.push_back({m[0], m[1], m[2], m[3], m[4], m[5]});
-  for (const Json& p : j["sweep"]) ev.sweep.push_back({p[0], p[1], p[2], p[3], p[4], p[5]});
-  ev.skipped = j["skipped"].get<std::vector<std::string>>();
-  ev.expect_failures = j["expect_failures"].get<std::vector<std::string>>();
-  ev.expect_checked = j["expect_checked"];
-  ev.expect_unchecked = j["expect_unchecked"].get<std::vector<std::string>>();
-  ev.expect_known = j["expect_known"];
-  ev.disagreements = j["disagreements"].get<std::vector<std::string>>();
-  ev.deviations = j["deviations"].get<std::vector<std::string>>();
-  for (const Json& c : j["causes"]) ev.causes.push_back({c[0], c[1], c[2], c[3]});
-  return ev;
-}
-
-// True when one of the lines is about backend `name`.
-bool mentions(const std::vector<std::string>& lines, const std::string& name) {
-  for (const std::string& d : lines)
-    if (d.rfind(name + " ", 0) == 0 || d.rfind(name + ":", 0) == 0) return true;
-  return false;
-}
-
-const Metric* find_metric(const SceneEvaluation& ev, const std::string& backend,
-                          const std::string& name) {
-  for (const Metric& m : ev.metrics)
-    if (m.backend == backend && m.name == name) return &m;
-  return nullptr;
-}
-
-// The headline cell of a scene for one backend, and what it was measured against.
-std::string headline(const SceneEvaluation& ev, const std::string& backend, std::string& against) {
-  const Json& bj = ev.json["backends"];
-  if (!bj.contains(backend)) return "";
-  const std::string status = bj[backend]["status"];
-  if (status == "unsupported") return "n/a";
-  if (status == "error" || status == "timeout") return status;
-  if (status == "touching") return "touching, no normal";
-  std::string cell;
-  if (const Metric* t = find_metric(ev, backend, "touching_err"); t && t->value > 0) {
-    cell = "wrong touch";
-  } else if (const Metric* a = find_metric(ev, backend, "normal_err_deg")) {
-    const Metric* d = find_metric(ev, backend, "depth_err");
-    cell = fmt_num(a->value, 2) + "° / " + fmt_num(d ? d->value : 0.0, 2);
-    against = a->against;
-  } else if (const Metric* v = find_metric(ev, backend, "velocity_err_ke")) {
-    cell = fmt_num(v->value, 2);
-    against = v->against;
-  } else if (find_metric(ev, backend, "inertia_err_rel")) {
-    // Mass scenes: the worst relative inertia error over the bodies.
-    double worst = 0.0;
-    for (const Metric& m : ev.metrics)
-      if (m.backend == backend && m.name == "inertia_err_rel") worst = std::max(worst, m.value);
-    cell = "inertia " + fmt_num(worst, 2);
-    against = "exact solid";
-  } else if (ev.json["stability"].contains(backend)) {
-    cell = ev.json["stability"][backend]["verdict"];
-  } else if (t) {
-    cell = "0 (no contact)";
-  } else {
-    cell = "ok";
-  }
-  if (mentions(ev.disagreements, backend))
-    cell += " ✗";
-  else if (mentions(ev.deviations, backend))
-    cell += " ~";
-  // The engine under test on a documented limitation: marked by the same rule, and labelled.
-  // The engine the known failure names ("custom" or "custom-seed", before its colon).
-  const std::string known = ev.json["expect"].value("known_failure", std::string());
-  if (ev.expect_known && backend == known.substr(0, known.find(':'))) cell += " (known failure)";
-  return cell;
-}
-
-std::string csv_escape(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
-
-// World geometry of the bodies at t = 0, for the contact pictures.
-Json geometry_json(const Scene& scene) {
-  Json g = Json::array();
-  for (const RigidBody& b : make_bodies(scene)) {
-    if (b.shape->vertices().size() > 2000) return Json::array();
-    Json verts = Json::array();
-    for (size_t i = 0; i < b.shape->vertices().size(); ++i)
-      verts.push_back(to_json(b.world_vertex(static_cast<int>(i))));
-    Json tris = Json::array();
-    for (const auto& t : b.shape->triangles()) tris.push_back({t[0], t[1], t[2]});
-    g.push_back({{"name", b.name}, {"vertices", verts}, {"triangles", tris}});
-  }
-  return g;
-}
-
-// Contact-query causes that no dynamics record can show: each pinned by a test under
-// tests/reference/ (a library upgrade that changes it fails there). A sentence is printed only
-// when one of its backends ran and, where it cites scenes, one of them is in the run.
-struct PinnedCause {
-  std::vector<std::string> backends;
-  std::vector<std::string> scenes;  // cited scene names or "family:F"; empty: cites none
-  const char* text;
-};
-const std::vector<PinnedCause>& pinned_causes() {
-  static const std::vector<PinnedCause> causes = {
-      {{"fcl-indep"},
-       {},
-       "**fcl-indep**: FCL 0.7's GST_INDEP leaves the EPA normal in A's local frame and returns "
-       "the depth negated (`FclIndep.*`); its signed distance on Box-Convex aborts on an "
-       "assertion (`FclIndepDistance.*`, run in a forked process)."},
-      {{"fcl-hull", "libccd-mpr", "ode-hull", "mujoco-hull"},
-       {"small_on_diagonal"},
-       "**fcl-hull, libccd-mpr, ode-hull, mujoco-hull on `small_on_diagonal`**: MPR follows the "
-       "ray "
-       "between the centres, not the minimum-translation axis (FCL issue 545): n = (1, 1, "
-       "1)/sqrt(3), depth 0.26 for a true 0.15 (`FclMpr.*`, `Libccd.DiagonalCubeMprWrongEpaRight`, "
-       "`MujocoKnownWrongAnswer.*`). Debian's ODE runs convex-convex through libccd MPR too, so it "
-       "shares FCL's answers bit for bit."},
-      {{"fcl-hull", "libccd-mpr", "libccd-epa", "ode-hull", "fcl-epa"},
-       {},
-       "**fcl-hull, libccd-mpr, libccd-epa, ode-hull, fcl-epa at exact touching**: libccd's MPR "
-       "zeroes its direction below CCD_EPS of depth, its EPA and FCL's signed distance return no "
-       "direction at zero distance; the adapters report that as `touching` (no normal), a "
-       "convention, apart from errors."},
-      {{"mujoco"},
-       {"family:contact", "family:external"},
-       "**mujoco on two boxes**: queried, like its dynamics, in MuJoCo 2.2.2's own box-box "
-       "collider, which reports half the depth (the normal is right); passed on and labelled "
-       "(`FairReferences.NativeBoxQueriesGiveTheFourCornerFaceManifold`)."},
-      {{"bullet-sat"},
-       {},
-       "**bullet-sat**: the SAT + clipping path measures each point's depth to the first body's "
-       "reference face, reported along the separating normal: too deep when A touches with an "
-       "edge or a vertex; the normal is right (`BulletContact.KnownDefectSatDepth*`)."},
-      {{"bullet-hull", "fcl-hull", "mujoco-hull"},
-       {"family:mass"},
-       "**mass (`-hull`)**: Bullet's hull inertia is its bounding box's; FCL 0.7's Convex inertia "
-       "is off on every hull here, the box included (relative 0.5 to 5); MuJoCo's mesh inertia is "
-       "exact to float round-off (`LibraryMass.*`, `scenes/mass/`)."},
-  };
-  return causes;
-}
-
-// The why-list: for impacts, what each backend's first impulse saw against the exact oracle
-// (SceneEvaluation::causes, one line per measured sign, naming the scenes and the numbers);
-// then the pinned contact-query causes that apply to this run.
-std::string why_markdown(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs,
-                         const std::vector<std::string>& cols) {
-  std::ostringstream md;
-  md << "## Why\n\n";
-  md << "Impacts: for every backend that misses a closed form (velocity error above 0.1 %, as "
-        "written or with first contact 1/3 or 2/3 of a step later), what its first impulse saw "
-        "against the `exact` oracle at the poses of the step that detected it: the number of "
-        "points, the normal's angle to the truth, the offset of a lone point from the true patch's "
-        "centre, the impulse of that step against the closed form, the depth and entry phase at "
-        "detection. Each line is the first measured sign, in that order: a wrong normal, one point "
-        "on a face patch, an error only when contact begins inside a step, a contact first seen "
-        "deep; else the contact was seen as the truth and the error is in the response (e.g. a "
-        "soft contact).\n\n";
-  std::map<std::string, std::map<std::string, std::vector<std::string>>> by;  // backend, kind
-  for (size_t i = 0; i < evs.size(); ++i)
-    for (const Cause& c : evs[i].causes)
-      by[c.backend][c.kind].push_back(md_escape(scenes[i].name) + " (" + md_escape(c.detail) + ")");
-  if (by.empty()) md << "No backend misses an impact's closed form in this run.\n";
-  for (const std::string& b : cols) {
-    if (!by.count(b)) continue;
-    md << "- **" << b << "**\n";
-    for (const auto& [kind, list] : by[b]) {
-      md << "  - " << kind << ": ";
-      for (size_t k = 0; k < list.size(); ++k) md << (k ? "; " : "") << list[k];
-      md << "\n";
-    }
-  }
-  std::set<std::string> ran(cols.begin(), cols.end()), names;
-  for (const Scene& sc : scenes) names.insert(sc.name);
-  for (const SceneEvaluation& ev : evs) names.insert("family:" + ev.family);
-  std::vector<const char*> pinned;
-  for (const PinnedCause& p : pinned_causes()) {
-    bool backend_ran = false, cited = p.scenes.empty();
-    for (const std::string& b : p.backends) backend_ran = backend_ran || ran.count(b);
-    for (const std::string& sc : p.scenes) cited = cited || names.count(sc);
-    if (backend_ran && cited) pinned.push_back(p.text);
-  }
-  if (!pinned.empty()) {
-    md << "\nContact queries (each cause pinned by a test in `tests/reference/`):\n\n";
-    for (const char* t : pinned) md << "- " << t << "\n";
-  }
-  md << "\n";
-  return md.str();
-}
-
-std::string write_markdown(const std::vector<Scene>& scenes,
-                           const std::vector<SceneEvaluation>& evs, double total_s, bool figures_ok,
-                           const std::string& figures_msg, bool views_ok) {
-  std::ostringstream md;
-  // Backends that appear anywhere, in registry order.
-  std::vector<std::string> cols;
-  for (const Backend& b : backends())
-    for (const SceneEvaluation& ev : evs)
-      if (ev.json["backends"].contains(b.name)) {
-        cols.push_back(b.name);
-        break;
-      }
-  md << "# rbx accuracy report\n\n";
-  md << scenes.size() << " scenes through " << cols.size() << " backends in " << fmt_num(total_s, 3)
-     << " s. Every number except run times is deterministic: the same scenes give the same "
-        "report.\n\n";
-  // --- scorecard and replay pages (view-report) ---
-  if (views_ok)
-    md << "Every scene has a 3-D replay of every backend's run: [index.html](index.html), or the "
-          "link on each scene below.\n\n";
-  md << scorecard_markdown(scenes, evs, cols, views_ok);
-  // --- end scorecard ---
-  md << "## Summary\n\n";
-  md << "Headline error of each backend on each scene. Contact scenes: **normal angle (deg) / "
-        "depth error (m)** of the deepest point against the closed form (`[expect]`) or the "
-        "`exact` oracle. Dynamics scenes: **post-collision velocity error in the kinetic-energy "
-        "norm** `sqrt(sum m|dv|^2 + dw.I.dw) / sqrt(2 E_ref)` against the closed form or the "
-        "same backend at its finest time step. Stability-only scenes: the verdict. **✗** marks a "
-        "backend that clearly disagrees with the closed form or `exact` (normal off by more than "
-        "1°, depth by more than 1 % of the smaller body, or velocity error above 0.1 %); **~** "
-        "one outside the scene's tolerance but within those bounds; `n/a`: the backend cannot "
-        "serve the scene; blank: not run for this scene's checks.\n\n";
-  std::vector<std::string> header = {"scene", "checks", "against"};
-  header.insert(header.end(), cols.begin(), cols.end());
-  Table summary(header);
-  int marks = 0;
-  for (size_t i = 0; i < evs.size(); ++i) {
-    std::string against;
-    std::vector<std::string> row = {md_escape(evs[i].family + "/" + scenes[i].name), "", ""};
-    if (views_ok)
-      row[0] = "[" + row[0] + "](views/" + scene_slug(evs[i].family, scenes[i].file) + ".html)";
-    std::string checks;
-    for (const std::string& c : scenes[i].check_names()) checks += (checks.empty() ? "" : ", ") + c;
-    row[1] = checks;
-    for (const std::string& c : cols) {
-      std::string a;
-      row.push_back(headline(evs[i], c, a));
-      if (row.back().find("✗") != std::string::npos) ++marks;
-      if (against.empty() || against == a)
-        against = a;
-      else if (!a.empty() && a.rfind("self", 0) == 0 && against.rfind("self", 0) == 0)
-        against = "self (finest dt)";
-    }
-    row[2] = against;
-    if (!evs[i].expect_failures.empty())
-      row[0] += evs[i].expect_known ? " [expect: known failure]" : " **[expect failed]**";
-    summary.add(row);
-  }
-  md << summary.markdown() << "\n" << marks << " cells marked ✗.\n\n";
-
-  // Contact phase: the impact scenes also run with first contact 1/3 and 2/3 of a step later.
-  {
-    Table phases({"scene", "backend", "as written", "1/3 later", "2/3 later", "worst"});
-    for (size_t i = 0; i < evs.size(); ++i)
-      for (const std::string& c : cols) {
-        const Json& bj = evs[i].json["backends"];
-        if (!bj.contains(c) || !bj[c].contains("contact_phase")) continue;
-        const Json& p = bj[c]["contact_phase"];
-        auto cell = [&](const char* k) {
-          if (!p.contains(k)) return std::string("-");
-          return p[k].is_number() ? fmt_num(p[k].get<double>(), 2)
-                                  : md_escape(p[k].get<std::string>());
-        };
-        phases.add({md_escape(evs[i].family + "/" + scenes[i].name), c, cell("written"),
-                    cell("1_3"), cell("2_3"), cell("worst")});
-      }
-    if (phases.size() > 0) {
-      md << "## Contact phase\n\n";
-      md << "Every analytic scene puts first contact exactly on a step boundary, at zero depth. "
-            "Each impact with a closed form and neither gravity nor spin is also run with every "
-            "moving body moved back along its velocity by 1/3 and 2/3 of a step (and one step "
-            "more of duration), so first contact falls inside a step and the closed form is "
-            "unchanged. Velocity error in the kinetic-energy norm; the summary's headline cell is "
-            "the scene **as written**; `worst` is the largest of the three.\n\n";
-      md << phases.markdown() << "\n";
-    }
-  }
-
-  // Disagreements, grouped by backend.
-  md << "## Who disagrees with the truth\n\n";
-  std::map<std::string, std::vector<std::string>> by_backend;
-  for (size_t i = 0; i < evs.size(); ++i)
-    for (const std::string& d : evs[i].disagreements) {
-      const std::string name = d.substr(0, d.find_first_of(" :"));
-      by_backend[name].push_back(scenes[i].name + ": " + d.substr(name.size() + 1));
-    }
-  if (by_backend.empty()) md << "No backend disagrees with a closed form or the exact oracle.\n\n";
-  for (const std::string& c : cols) {
-    if (!by_backend.count(c)) continue;
-    const auto& list = by_backend[c];
-    md << "- **" << c << "** (" << list.size() << "): ";
-    for (size_t k = 0; k < list.size() && k < 6; ++k) md << (k ? "; " : "") << list[k];
-    if (list.size() > 6) md << "; and " << list.size() - 6 << " more (see the scene details)";
-    md << "\n";
-  }
-  md << "\n" << why_markdown(scenes, evs, cols);
-
-  // Error against run time.
-  md << "## Error against run time\n\n";
-  md << "Dynamics: each backend is run at every time step of the scene's `sweep_dt` (default 4, "
-        "2, 1, 1/2 and 1/4 times `dt`). One point per (backend, time step): the **median over the "
-        "family's closed-form scenes** of the velocity error in the kinetic-energy norm, with the "
-        "25-75 % band as a bar, against the median run time of one scene run; the large open "
-        "marker is the coarsest step; the same scenes stand behind every point of a curve "
-        "(self-consistency errors are in `sweep.csv` only). Contacts: one point per backend, "
-        "normal angle error and depth error in two panels, median over the scenes with the 25-75 "
-        "% band on both axes and the worst scene as a small hollow marker; filled markers time "
-        "the backend as it runs (the library's shape built in each query), the larger hollow "
-        "marker on the same row, joined by a dotted line, the same query with its shapes "
-        "prebuilt (the table below the figures). Errors under 1e-13 are round-off and are drawn at "
-        "1e-15 "
-        "in the grey band. The dashed line is the Pareto front over backends. Numbers: "
-        "`sweep.csv`, `metrics.csv`.\n\n";
-  std::set<std::string> families;
-  for (const SceneEvaluation& ev : evs)
-    for (const SweepPoint& p : ev.sweep)
-      families.insert(ev.family + (p.kind == "contact" ? "-contact" : ""));
-  if (!figures_ok) md << "_Figures were not drawn: " << figures_msg << "_\n\n";
-  for (const std::string& f : families)
-    md << "![error against run time, " << f << "](figures/error_vs_runtime_" << f << ".png)\n\n";
-  md << query_time_markdown(evs, cols);
-
-  // Stability.
-  md << "## Stability\n\n";
-  md << "Verdicts, worst first: **unstable** (non-finite state, energy gained beyond 1 %, "
-        "tunnelling, a stopped run, momentum drift in a closed system, penetration past half a "
-        "body), **sinks** (bodies more than 1 % of the smaller body inside each other in every "
-        "sample of the last fifth of the run: \"at rest\"), **dissipative** (e = 1, no friction, "
-        "more than 1 % of the "
-        "energy lost by the end), **stable**. Energy drift: the largest |E/E0 - 1| over the run, "
-        "signed (+ gained, - lost); penetration relative to the smaller body's size.\n\n";
-  Table st({"scene", "backend", "dt (s)", "e", "verdict", "energy drift", "max penetration",
-            "at rest", "tunnelled", "jitter (m/s)", "why"});
-  bool any_stab = false;
-  for (size_t i = 0; i < evs.size(); ++i) {
-    // The verdict at the scene's step, then at the other steps of its own sweep (if it names
-    // one), each backend's rows together.
-    std::vector<std::pair<std::string, Json>> rows;
-    for (const auto& [name, s] : evs[i].json["stability"].items()) {
-      rows.emplace_back(name, s);
-      if (evs[i].json.contains("stability_sweep") && evs[i].json["stability_sweep"].contains(name))
-        for (const Json& sw : evs[i].json["stability_sweep"][name]) rows.emplace_back(name, sw);
-    }
-    for (const auto& [name, s] : rows) {
-      any_stab = true;
-      std::string why;
-      for (const auto& w : s["why"]) why += (why.empty() ? "" : "; ") + w.get<std::string>();
-      const double drift = s["energy_drift_rel"].get<double>();
-      st.add({scenes[i].name, name, fmt_num(s["dt"].get<double>(), 3),
-              fmt_num(s["restitution"].get<double>(), 3), s["verdict"],
-              (drift > 0 ? "+" : "") + fmt_num(100 * drift, 3) + " %",
-              fmt_num(100 * s["max_penetration_rel"].get<double>(), 3) + " %",
-              fmt_num(100 * s["rest_penetration_rel"].get<double>(), 3) + " %",
-              std::to_string(s["tunnelled_pairs"].get<int>()),
-              s.contains("jitter_rms_mps") ? fmt_num(s["jitter_rms_mps"].get<double>(), 3) : "-",
-              why});
-    }
-  }
-  md << (any_stab ? st.markdown() : std::string("No scene asks for the stability check.\n"))
-     << "\n";
-
-  // Per-scene detail.
-  md << "## Scenes\n\n";
-  for (size_t i = 0; i < evs.size(); ++i) {
-    const SceneEvaluation& ev = evs[i];
-    const std::string slug = ev.family + "_" + fs::path(scenes[i].file).stem().string();
-    md << "### " << md_escape(ev.family + "/" + scenes[i].name) << "\n\n";
-    if (!scenes[i].description.empty()) md << md_escape(scenes[i].description) << "\n\n";
-    md << "`" << scenes[i].file << "`";
-    if (views_ok) md << " — [3-D replay](views/" << slug << ".html)";
-    md << "\n\n";
-    Table status({"backend", "status", "run time (s)", "message"});
-    for (const auto& [name, bj] : ev.json["backends"].items())
-      status.add({name, bj["status"], fmt_num(bj["runtime_s"].get<double>(), 3), bj["message"]});
-    md << status.markdown() << "\n";
-    if (!ev.metrics.empty()) {
-      Table mt({"check", "pair", "metric", "backend", "value", "against"});
-      for (const Metric& m : ev.metrics)
-        mt.add({m.check, m.pair, m.name, m.backend, fmt_num(m.value, 4), m.against});
-      md << mt.markdown() << "\n";
-    }
-    for (const std::string& d : ev.disagreements) md << "- disagrees: " << d << "\n";
-    for (const std::string& d : ev.deviations)
-      md << "- deviates (within the ✗ bounds): " << d << "\n";
-    for (const std::string& s : ev.skipped) md << "- left out: " << s << "\n";
-    if (scenes[i].expect)
-      md << "- [expect]: "
-         << (!ev.expect_failures.empty() ? "FAILED"
-             : ev.expect_checked         ? "passed"
-                                         : "not checked")
-         << "\n";
-    for (const std::string& f : ev.expect_unchecked) md << "  - not checked: " << f << "\n";
-    for (const std::string& f : ev.expect_failures) md << "  - " << f << "\n";
-    if (scenes[i].expect && !scenes[i].expect->known_failure.empty())
-      md << "  - known failure: " << scenes[i].expect->known_failure << "\n";
-    if (figures_ok) {
-      if (scenes[i].has_check(CheckKind::Contact) && !ev.json["geometry"].empty())
-        md << "\n![contacts](figures/contact_" << slug << ".png)\n";
-      if (find_metric(ev, "custom", "velocity_err_ke") || ev.json["backends"].contains("bullet"))
-        if (scenes[i].has_check(CheckKind::Impulse))
-          md << "\n![velocities](figures/velocity_" << slug << ".png)\n";
-    }
-    md << "\n";
-  }
-  return md.str();
-}
-
 }  // namespace
 
 int report_command(const ReportOptions& opt) {
@@ -500,21 +69,15 @@ int report_command(const ReportOptions& opt) {
   std::mutex progress_mutex;
   size_t finished = 0;
   Stopwatch clock;
-  const std::vector<std::string> raw = par.map(
-      scenes.size(),
-      [&](size_t i) {
-        SceneEvaluation ev = evaluate_scene(scenes[i], hopt);
-        if (scenes[i].has_check(CheckKind::Contact)) ev.json["geometry"] = geometry_json(scenes[i]);
-        return encode_evaluation(ev);
-      },
-      [&](size_t i) {
-        const std::lock_guard<std::mutex> lock(progress_mutex);
-        progress.show(++finished, scenes.size(), scenes[i].file, clock.seconds());
-      });
+  std::vector<SceneEvaluation> evs = evaluate_scenes(par, scenes, hopt, [&](size_t i) {
+    const std::lock_guard<std::mutex> lock(progress_mutex);
+    progress.show(++finished, scenes.size(), scenes[i].file, clock.seconds());
+  });
   progress.done();
   if (!par.root()) return 0;  // rank 0 writes everything
-  std::vector<SceneEvaluation> evs;
-  for (const std::string& r : raw) evs.push_back(decode_evaluation(r));
+  // The contact pictures draw the bodies at t = 0.
+  for (size_t i = 0; i < scenes.size(); ++i)
+    if (scenes[i].has_check(CheckKind::Contact)) evs[i].json["geometry"] = geometry_json(scenes[i]);
 
   // Everything goes into a temporary folder beside the target, renamed into place at the end.
   const fs::path target(out);
@@ -523,73 +86,9 @@ int report_command(const ReportOptions& opt) {
   fs::remove_all(tmp);
   fs::create_directories(tmp / "figures");
   try {
-    Json results;
-    results["generated_by"] = "rbx report";
-    results["backends"] = Json::array();
-    for (const Backend& b : backends())
-      results["backends"].push_back({{"name", b.name},
-                                     {"description", b.description},
-                                     {"contact", static_cast<bool>(b.contact)},
-                                     {"dynamics", static_cast<bool>(b.dynamics)}});
-    results["scenes"] = Json::array();
-    for (const SceneEvaluation& ev : evs) results["scenes"].push_back(results_scene_json(ev.json));
-    // Compact: two-space indentation tripled the size (13.9 MB against 4.4 MB for the library).
-    write_text((tmp / "results.json").string(), results.dump() + "\n");
-
-    std::ostringstream metrics, sweep, stab;
-    metrics << "scene,family,check,backend,pair,metric,value,against\n";
-    sweep << "scene,family,backend,kind,dt,runtime_s,error,against\n";
-    stab << "scene,family,backend,dt,restitution,verdict,energy_growth_rel,energy_drift_rel,"
-            "max_penetration_rel,rest_penetration_rel,tunnelled_pairs,jitter_rms_mps\n";
-    for (size_t i = 0; i < evs.size(); ++i) {
-      const std::string sc = csv_escape(scenes[i].name), fam = evs[i].family;
-      for (const Metric& m : evs[i].metrics)
-        metrics << sc << "," << fam << "," << m.check << "," << m.backend << "," << m.pair << ","
-                << m.name << "," << fmt_num(m.value, 17) << "," << csv_escape(m.against) << "\n";
-      for (const SweepPoint& p : evs[i].sweep)
-        sweep << sc << "," << fam << "," << p.backend << "," << p.kind << "," << fmt_num(p.dt, 17)
-              << "," << fmt_num(p.runtime_s, 6) << "," << fmt_num(p.error, 17) << ","
-              << csv_escape(p.against) << "\n";
-      std::vector<std::pair<std::string, Json>> stab_rows;  // the scene's step, then its sweep
-      for (const auto& [name, s] : evs[i].json["stability"].items()) {
-        stab_rows.emplace_back(name, s);
-        if (evs[i].json.contains("stability_sweep") &&
-            evs[i].json["stability_sweep"].contains(name))
-          for (const Json& sw : evs[i].json["stability_sweep"][name])
-            stab_rows.emplace_back(name, sw);
-      }
-      for (const auto& [name, s] : stab_rows)
-        stab << sc << "," << fam << "," << name << "," << fmt_num(s["dt"].get<double>(), 17) << ","
-             << fmt_num(s["restitution"].get<double>(), 17) << ","
-             << s["verdict"].get<std::string>() << ","
-             << fmt_num(s["energy_growth_rel"].get<double>(), 17) << ","
-             << fmt_num(s["energy_drift_rel"].get<double>(), 17) << ","
-             << fmt_num(s["max_penetration_rel"].get<double>(), 17) << ","
-             << fmt_num(s["rest_penetration_rel"].get<double>(), 17) << ","
-             << s["tunnelled_pairs"].get<int>() << ","
-             << (s.contains("jitter_rms_mps") ? fmt_num(s["jitter_rms_mps"].get<double>(), 17) : "")
-             << "\n";
-    }
-    write_text((tmp / "metrics.csv").string(), metrics.str());
-    write_text((tmp / "sweep.csv").string(), sweep.str());
-    write_text((tmp / "stability.csv").string(), stab.str());
-
-    // Figures: matplotlib from Debian, through /usr/bin/python3.
-    const std::string script = std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/plots.py";
-    bool figures_ok = false;
+    write_report_tables(tmp.string(), scenes, evs);
     std::string figures_msg;
-    if (!fs::exists("/usr/bin/python3")) {
-      figures_msg = "/usr/bin/python3 not found";
-    } else {
-      const std::string cmd = "/usr/bin/python3 '" + script + "' '" + tmp.string() + "' > '" +
-                              (tmp / "figures.log").string() + "' 2>&1";
-      const int rc = std::system(cmd.c_str());
-      figures_ok = rc == 0;
-      if (!figures_ok)
-        figures_msg = "plots.py failed (see figures.log)";
-      else
-        fs::remove(tmp / "figures.log");
-    }
+    const bool figures_ok = draw_report_figures(tmp.string(), figures_msg);
     // --- replay pages (view-report): views/SLUG.html and index.html ---
     bool views_ok = true;
     try {
@@ -600,8 +99,8 @@ int report_command(const ReportOptions& opt) {
     }
     // --- end replay pages ---
     std::string md =
-        write_markdown(scenes, evs, clock.seconds(), figures_ok, figures_msg, views_ok);
-    // Real impacts: every tosses data set under the inputs (comparisons/cli/tosses_command.cpp).
+        report_markdown(scenes, evs, clock.seconds(), figures_ok, figures_msg, views_ok);
+    // Real impacts: every tosses data set under the inputs (comparisons/output/tosses_report.cpp).
     for (const std::string& dir : find_toss_datasets(opt.inputs))
       md += tosses_report_section(dir, tmp.string(), opt.backends);
     write_text((tmp / "report.md").string(), md);

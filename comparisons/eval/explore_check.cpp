@@ -5,18 +5,12 @@
 #include <map>
 
 #include "comparisons/eval/explore.h"
+#include "comparisons/eval/explore_campaign.h"
 #include "comparisons/eval/parallel.h"
 
 namespace rbx {
 
 namespace {
-
-// Nearest-rank percentile of sorted values (p in [0, 100]), 0 for none.
-double percentile(const std::vector<double>& sorted, double p) {
-  if (sorted.empty()) return 0.0;
-  const size_t k = static_cast<size_t>(std::ceil(p / 100.0 * sorted.size()));
-  return sorted[std::min(sorted.size() - 1, k == 0 ? 0 : k - 1)];
-}
 
 // The metrics of one family from its encoded outcomes.
 void tally(const std::string& scene, const std::vector<std::string>& encoded,
@@ -41,8 +35,12 @@ void tally(const std::string& scene, const std::vector<std::string>& encoded,
     for (const std::string& name : error_names) {
       std::vector<double> v = values[backend][name];
       std::sort(v.begin(), v.end());
-      out.push_back({scene, {"explore", backend, "", name + "_p50", percentile(v, 50), against}});
-      out.push_back({scene, {"explore", backend, "", name + "_p90", percentile(v, 90), against}});
+      out.push_back(
+          {scene,
+           {"explore", backend, "", name + "_p50", nearest_rank_percentile(v, 50), against}});
+      out.push_back(
+          {scene,
+           {"explore", backend, "", name + "_p90", nearest_rank_percentile(v, 90), against}});
     }
   }
 }

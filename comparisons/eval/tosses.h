@@ -153,27 +153,39 @@ std::vector<std::pair<std::string, ContactParams>> read_params_file(const std::s
 /// orientation_error_deg, final_position_error (median, mean, p90), runtime_s, per_toss.
 Json backend_tosses_json(const BackendTosses& r);
 
-/// Runs the tosses data set in folder `dir` (test.csv[.gz] with params.json) through every
-/// dynamics backend (or those named in `backend_list`), at the stored and at the published
-/// parameters; writes tosses.json, tosses_per_toss.csv and tosses_traj.csv into `out_dir`,
-/// the figures into out_dir/figures (through comparisons/output/tosses_plots.py when python3 is
-/// there) and returns the report's "Real impacts" markdown section.
-std::string tosses_report_section(const std::string& dir, const std::string& out_dir,
-                                  const std::string& backend_list);
+/// Backends to toss: those named in `list` (unknown names are an InputError; names without
+/// dynamics are kept and reported unsupported), else every backend with dynamics, in registry
+/// order.
+std::vector<const Backend*> select_toss_backends(const std::string& list);
+
+/// Every selected backend over the tosses, at its stored parameters and at the published ones.
+struct TossEvaluation {
+  std::vector<BackendTosses> stored, published;
+};
+
+/// Runs `chosen` over `tosses` at the parameters in `stored` (the published ones where a
+/// backend has none) and at the published parameters.
+TossEvaluation evaluate_tosses(const std::vector<const Backend*>& chosen,
+                               const std::vector<Toss>& tosses,
+                               const std::vector<std::pair<std::string, ContactParams>>& stored);
+
+/// The study's JSON (`rbx tosses --json`, the report's tosses.json): the data, the cube model,
+/// the parameter file and every backend at both parameter sets.
+Json toss_evaluation_json(const std::string& data, const std::vector<Toss>& tosses,
+                          const std::string& params_file, const TossEvaluation& ev);
+
+/// Backend indices ordered by median position error (failed-everything backends last).
+std::vector<size_t> toss_ranking(const std::vector<BackendTosses>& rs);
+
+/// params.json beside the data file.
+std::string default_toss_params_path(const std::string& data);
+
+/// The stored params file at `path` with the fitted backends replaced (others kept), as JSON.
+Json updated_params_json(const std::string& path, const std::string& data,
+                         const std::vector<std::pair<std::string, FitResult>>& fits);
 
 /// Folders under `inputs` (recursively; "" : scenes/) holding a tosses data set: a
 /// params.json beside test.csv or test.csv.gz. Sorted.
 std::vector<std::string> find_toss_datasets(const std::vector<std::string>& inputs);
-
-/// Options of `rbx tosses`.
-struct TossesOptions {
-  std::string data;      // DATA.csv or .csv.gz
-  std::string params;    // --params FILE ("" : params.json beside DATA)
-  bool fit = false;      // --fit: fit every selected backend on DATA and write the params file
-  std::string backends;  // --backends LIST
-  std::string json;      // --json FILE|-
-};
-/// `rbx tosses`.
-int tosses_command(const TossesOptions& opt);
 
 }  // namespace rbx

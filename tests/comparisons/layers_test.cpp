@@ -4,6 +4,7 @@
 // backwards"). The CMake libraries enforce the same order for symbols (comparisons/CMakeLists.txt).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -94,4 +95,28 @@ TEST(Layers, EveryComparisonsSourceIsInALayer) {
   // A file straight in comparisons/ would belong to no layer and escape the check above.
   for (const std::string& f : sources_under("comparisons"))
     EXPECT_GE(layer_of(f), 0) << f << " is outside comparisons/{scene,eval,output,cli}/";
+}
+
+// Lines of the .h and .cpp files under `folder`.
+std::size_t lines_under(const std::string& folder) {
+  std::size_t n = 0;
+  for (const std::string& f : sources_under(folder)) {
+    const std::string text = read(f);
+    n += static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+  }
+  return n;
+}
+
+TEST(Layers, CommandsParseAndCallTheLayersBelow) {
+  // A command parses its arguments, calls eval/ and output/ and sets the exit code: it never
+  // reaches into an adapter or runs the engine's world itself (docs/style.md).
+  static const std::regex reach_re(R"re(^\s*#\s*include\s*"(reference/[^"]+|engine/world\.h)")re");
+  for (const std::string& f : sources_under("comparisons/cli")) {
+    std::istringstream lines(read(f));
+    std::string line;
+    while (std::getline(lines, line))
+      if (std::regex_search(line, reach_re)) ADD_FAILURE() << f << ": " << line;
+  }
+  // What computes or writes lives below: the command layer stays the smaller one.
+  EXPECT_LT(lines_under("comparisons/cli"), lines_under("comparisons/output"));
 }

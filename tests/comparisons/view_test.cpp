@@ -1,8 +1,6 @@
 // The 3-D replay page (`rbx view`): scene text is escaped, and in headless Chromium the page
 // loads every backend with its frames, draws the bodies and moves them; a deliberately broken
 // page (no bodies, a backend missing) fails the same check.
-#include "comparisons/cli/view.h"
-
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -17,6 +15,7 @@
 
 #include "comparisons/eval/harness.h"
 #include "comparisons/output/scorecard.h"
+#include "comparisons/output/view_page.h"
 #include "comparisons/scene/scene_file.h"
 
 namespace fs = std::filesystem;

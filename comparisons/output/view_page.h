@@ -54,14 +54,4 @@ std::string html_escape(const std::string& s);
 void write_report_views(const std::string& dir, const std::vector<Scene>& scenes,
                         const std::vector<SceneEvaluation>& evs);
 
-/// Options of `rbx view`.
-struct ViewOptions {
-  std::string scene;     // scene file
-  std::string backends;  // --backends LIST ("" : the scene's, or every one that serves it)
-  std::string out;       // --out FILE ("" : FAMILY_STEM.html in the current folder)
-};
-
-/// `rbx view SCENE`: evaluates the scene (no time-step sweep) and writes its replay page.
-int view_command(const ViewOptions& opt);
-
 }  // namespace rbx

@@ -1,0 +1,170 @@
+// The tosses study: which backends run, both parameter sets over every toss, the study's JSON,
+// the ranking and the parameter file (`rbx tosses` and the report's "Real impacts" section).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "comparisons/eval/select_backends.h"
+#include "comparisons/eval/tosses.h"
+#include "comparisons/scene/repo_path.h"
+#include "comparisons/scene/scene_file.h"
+#include "engine/format.h"
+
+namespace fs = std::filesystem;
+
+namespace rbx {
+
+namespace {
+
+// The stored parameters of `name`, or the published ones (params_source says which).
+ContactParams stored_params(const std::vector<std::pair<std::string, ContactParams>>& stored,
+                            const std::string& name, std::string* source) {
+  for (const auto& [n, p] : stored)
+    if (n == name) {
+      *source = "fitted";
+      return p;
+    }
+  *source = "published (none stored)";
+  return kPublishedParams;
+}
+
+Json model_json(const CubeTossModel& m) {
+  return {{"cube_width_m", 2.0 * m.half_width},
+          {"mass_kg", m.mass},
+          {"gravity_mps2", m.gravity},
+          {"sample_rate_hz", m.sample_rate},
+          {"substeps", m.substeps},
+          {"dt_s", 1.0 / (m.sample_rate * m.substeps)},
+          {"floor", "static box " + fmt_num(m.floor_size, 3) + " x " + fmt_num(m.floor_size, 3) +
+                        " x " + fmt_num(m.floor_thickness, 3) + " m, top face z = 0"}};
+}
+
+}  // namespace
+
+std::vector<const Backend*> select_toss_backends(const std::string& list) {
+  std::vector<const Backend*> out;
+  if (list.empty() || list == "all") {
+    for (const Backend& b : backends())
+      if (b.dynamics) out.push_back(&b);
+    return out;
+  }
+  const std::vector<std::string> names = parse_backend_list(list);
+  for (const Backend& b : backends())
+    if (std::find(names.begin(), names.end(), b.name) != names.end()) out.push_back(&b);
+  if (out.empty()) throw InputError("--backends: no backend named");
+  return out;
+}
+
+TossEvaluation evaluate_tosses(const std::vector<const Backend*>& chosen, const std::vector<Toss>& tosses,
+                        const std::vector<std::pair<std::string, ContactParams>>& stored) {
+  TossEvaluation ev;
+  for (const Backend* b : chosen) {
+    std::string source;
+    const ContactParams p = stored_params(stored, b->name, &source);
+    ev.stored.push_back(evaluate_backend(*b, tosses, p));
+    ev.stored.back().params_source = source;
+    ev.published.push_back(evaluate_backend(*b, tosses, kPublishedParams));
+    ev.published.back().params_source = "published";
+  }
+  return ev;
+}
+
+Json toss_evaluation_json(const std::string& data, const std::vector<Toss>& tosses,
+                     const std::string& params_file, const TossEvaluation& ev) {
+  Json j;
+  j["data"] = data;
+  j["tosses"] = tosses.size();
+  size_t samples = 0;
+  for (const Toss& t : tosses) samples += t.samples.size();
+  j["samples"] = samples;
+  j["model"] = model_json(CubeTossModel{});
+  j["params_file"] = params_file;
+  j["errors"] =
+      "position: mean |p_sim - p_real| / cube width over the samples after t = 0; orientation: "
+      "mean rotation angle (deg) between simulated and measured orientation; final: the same at "
+      "the last (resting) sample; median, mean, p90 over tosses";
+  j["backends"] = Json::object();
+  for (const BackendTosses& r : ev.stored) j["backends"][r.name] = backend_tosses_json(r);
+  j["published_params"]["params"] = {{"restitution", kPublishedParams.restitution},
+                                     {"friction", kPublishedParams.friction}};
+  j["published_params"]["backends"] = Json::object();
+  for (const BackendTosses& r : ev.published)
+    j["published_params"]["backends"][r.name] = backend_tosses_json(r);
+  return j;
+}
+
+std::vector<size_t> toss_ranking(const std::vector<BackendTosses>& rs) {
+  std::vector<size_t> order;
+  for (size_t i = 0; i < rs.size(); ++i) order.push_back(i);
+  auto key = [&](size_t i) {
+    std::vector<double> v;
+    for (const TossErrors& e : rs[i].tosses) v.push_back(e.position);
+    const double m = spread_of(v).median;
+    return std::isfinite(m) ? m : std::numeric_limits<double>::infinity();
+  };
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return key(a) < key(b); });
+  return order;
+}
+
+std::string default_toss_params_path(const std::string& data) {
+  const fs::path dir = fs::path(data).parent_path();
+  return (dir.empty() ? fs::path("params.json") : dir / "params.json").string();
+}
+
+Json updated_params_json(const std::string& path, const std::string& data,
+                         const std::vector<std::pair<std::string, FitResult>>& fits) {
+  Json j;
+  std::error_code ec;
+  if (fs::exists(path, ec)) {
+    read_params_file(path);  // validates
+    std::ifstream in(path);
+    j = Json::parse(in);
+  }
+  j["about"] =
+      "Restitution e and Coulomb friction mu per dynamics backend, fitted on the training tosses "
+      "by `rbx tosses train.csv.gz --fit` (5 x 6 grid over e in [0, 1], mu in [0, 1.5], then "
+      "Nelder-Mead; objective: mean position error in cube widths). Backends not listed run at "
+      "the published e = 0.125, mu = 0.18.";
+  j["model"] = model_json(CubeTossModel{});
+  Json& b = j["backends"];
+  if (!b.is_object()) b = Json::object();
+  for (const auto& [name, fit] : fits)
+    b[name] = {{"restitution", fit.params.restitution},
+               {"friction", fit.params.friction},
+               {"fit_data", fs::path(data).filename().string()},
+               {"train_position_error", fit.objective},
+               {"evaluations", fit.evaluations},
+               {"fit_s", fit.seconds}};
+  // Registry order, so refitting one backend does not reorder the file.
+  Json sorted = Json::object();
+  for (const Backend& r : backends())
+    if (b.contains(r.name)) sorted[r.name] = b[r.name];
+  for (const auto& [name, v] : b.items())
+    if (!sorted.contains(name)) sorted[name] = v;
+  b = sorted;
+  return j;
+}
+
+std::vector<std::string> find_toss_datasets(const std::vector<std::string>& inputs) {
+  std::vector<std::string> roots = inputs;
+  if (roots.empty()) roots.push_back(default_repo_path("scenes"));
+  std::vector<std::string> found;
+  for (const std::string& root : roots) {
+    std::error_code ec;
+    if (!fs::is_directory(root, ec)) continue;
+    auto consider = [&](const fs::path& d) {
+      if (fs::exists(d / "params.json") &&
+          (fs::exists(d / "test.csv.gz") || fs::exists(d / "test.csv")))
+        found.push_back(d.string());
+    };
+    consider(root);  // the folder itself, then every folder below it
+    for (const auto& e : fs::recursive_directory_iterator(root, ec))
+      if (e.is_directory()) consider(e.path());
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+}  // namespace rbx

@@ -1,0 +1,162 @@
+// explore.md and the error-distribution figure of an explore campaign (comparisons/eval/
+// explore_campaign.h).
+#include "comparisons/output/explore_page.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include "comparisons/output/table.h"
+#include "comparisons/scene/repo_path.h"
+#include "engine/format.h"
+
+namespace fs = std::filesystem;
+
+namespace rbx {
+
+namespace {
+
+// The disagreement groups of an explore result, one row each (both kinds).
+std::string groups_table(const Json& j) {
+  Table g({"backend", "signature", "count", "rate", "scene", "points", "reproduced"});
+  for (const auto& [name, b] : j["backends"].items())
+    for (const Json& x : b["groups"])
+      g.add({name, x["signature"], std::to_string(x["count"].get<long>()), fmt_num(x["rate"], 3),
+             x["scene"].is_string() ? x["scene"].get<std::string>() : std::string("-"),
+             x.contains("points_before") ? std::to_string(x["points_before"].get<int>()) + " -> " +
+                                               std::to_string(x["points_after"].get<int>())
+                                         : std::string("-"),
+             x.value("reproduced", false) ? "yes" : "no"});
+  return g.markdown();
+}
+
+// A metric's p50 / p90 / p99 from a backend's "errors" object, `digits` significant digits.
+std::string three(const Json& errors, const char* m, int digits = 2) {
+  const Json& e = errors[m];
+  return fmt_num(e["p50"], digits) + " / " + fmt_num(e["p90"], digits) + " / " +
+         fmt_num(e["p99"], digits);
+}
+
+// The table of disagreement rates by the quarter of its step the first contact falls in.
+std::string phase_table(const Json& j) {
+  Table ph({"backend", "0-25 %", "25-50 %", "50-75 %", "75-100 %"});
+  for (const auto& [name, b] : j["backends"].items()) {
+    std::vector<std::string> row = {name};
+    for (const Json& q : b["by_phase_quarter"])
+      row.push_back(fmt_num(q["rate"], 3) + " (" + std::to_string(q["samples"].get<long>()) + ")");
+    ph.add(row);
+  }
+  return ph.markdown();
+}
+
+std::string markdown_impact(const Json& j) {
+  std::ostringstream o;
+  o << "# rbx explore: " << j["count"] << " random single-point impacts, seed " << j["seed"]
+    << "\n\n"
+    << "Every sample is one body (a box or a hull of 4 to 60 points) hitting a box, free or "
+       "static, at one vertex on a face, with restitution e in [0.2, 1], no friction, no "
+       "gravity, first contact 2 to 5 steps ahead at a random phase of its step. The closed form "
+       "(single-point impulse at the exact oracle's point and normal, then torque-free flight) "
+       "is the truth. A disagreement: a status error, no impulse at all (missed), a momentum "
+       "error above 0.1 % in the energy norm (impulse), or a velocity error above it with the "
+       "momenta right (spin: the free rotation after the impact).\n\n## Backends\n\n";
+  Table t({"backend", "samples", "disagreements", "rate", "velocity err p50/p90/p99",
+           "momentum err p50/p90/p99"});
+  for (const auto& [name, b] : j["backends"].items())
+    t.add({name, std::to_string(b["samples"].get<long>()),
+           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
+           three(b["errors"], "velocity_err_ke"), three(b["errors"], "momentum_err_ke")});
+  o << t.markdown();
+  o << "\n## Disagreement rate by the phase of the contact within its step\n\nThe first contact "
+       "falls at this fraction of the step that detects it (0 %: at the step's start, so the "
+       "bodies overlap by a whole step of approach when it is seen).\n\n";
+  o << phase_table(j);
+  o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B (static: B "
+       "is static), the contact's features, the kind of error. Each group's first sample was "
+       "shrunk to the scene named; `reproduced` says whether `rbx compare` shows the velocity "
+       "error on it.\n\n";
+  o << groups_table(j);
+  return o.str();
+}
+
+std::string markdown_landing(const Json& j) {
+  std::ostringstream o;
+  o << "# rbx explore: " << j["count"] << " random flat landings with friction, seed " << j["seed"]
+    << "\n\n"
+    << "Every sample is a box (sides 0.2 to 2 m, mass 0.1 to 10 kg, any yaw) landing flat on a "
+       "static floor, e = 0, mu in [0.1, 1], falling at 0.2 to 2 m/s and sliding at 0.05 to "
+       "1.5 m/s, under gravity, first touch 2 to 5 steps ahead at a random phase of its step; "
+       "its height is drawn so that it cannot tip (mu sz <= 0.8 min(sx, sy)). The closed form "
+       "(landing impulse J = m vn, friction impulse min(mu J, m |v_h|), a slide decelerating at "
+       "mu g to rest, no turn) is the truth at the end of the run, 0.1 s or more after the rest. "
+       "A disagreement: a status error, a turn above 1e-3 rad (turn), or a resting centre more "
+       "than 1 mm from the closed form, horizontally (position). Time to rest: when the "
+       "horizontal speed falls below 1 mm/s for good, read from every step (one step's "
+       "resolution); reported, not marked. Velocity error: the final velocities in the energy "
+       "norm against the initial kinetic energy.\n\n## Backends\n\n";
+  Table t({"backend", "samples", "disagreements", "rate", "position err p50/p90/p99 (m)",
+           "turn p50/p90/p99 (rad)", "rest time err p50/p99 (s)", "velocity err p99"});
+  for (const auto& [name, b] : j["backends"].items()) {
+    const Json& e = b["errors"];
+    t.add(
+        {name, std::to_string(b["samples"].get<long>()),
+         std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
+         three(e, "position_err_m"), three(e, "turn_rad"),
+         fmt_num(e["rest_time_err_s"]["p50"], 2) + " / " + fmt_num(e["rest_time_err_s"]["p99"], 2),
+         fmt_num(e["velocity_err_ke"]["p99"], 2)});
+  }
+  o << t.markdown();
+  o << "\n## Disagreement rate by the phase of the first touch within its step\n\nThe first "
+       "touch falls at this fraction of the step that detects it (0 %: at the step's start).\n\n";
+  o << phase_table(j);
+  o << "\n## Disagreement groups\n\nSignature: backend, box-floor, whether the base slides on "
+       "after the landing (slides) or the landing stops it (sticks), the kind of error. Each "
+       "group's first sample was shrunk to the scene named; `reproduced` says whether `rbx "
+       "compare` shows the same final position or turn on it.\n\n";
+  o << groups_table(j);
+  return o.str();
+}
+
+}  // namespace
+
+std::string explore_markdown(const Json& j, bool have_figure) {
+  if (j["kind"] == "impact") return markdown_impact(j);
+  if (j["kind"] == "landing") return markdown_landing(j);
+  std::ostringstream o;
+  o << "# rbx explore: " << j["count"] << " random contact pairs, seed " << j["seed"] << "\n\n"
+    << "Every sample is a random convex pair (boxes, hulls of 4 to 2,000 points, slivers; size "
+       "ratios up to 1e3) at a pose biased toward hard cases, checked against the exact oracle. A "
+       "disagreement is a status error, a touching mismatch beyond 1e-9 of the smaller body, a "
+       "normal more than 1 degree off (ties counted as right), or a depth or point more than 1 % "
+       "of the smaller body off.\n\n";
+  o << "## Backends\n\n";
+  Table t({"backend", "samples", "disagreements", "rate", "normal p50/p90/p99 (deg)",
+           "depth p50/p90/p99 (rel)", "point p99 (rel)"});
+  for (const auto& [name, b] : j["backends"].items()) {
+    const Json& e = b["errors"];
+    t.add({name, std::to_string(b["samples"].get<long>()),
+           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
+           three(e, "normal_err_deg"), three(e, "depth_err_rel"),
+           fmt_num(e["point_err_rel"]["p99"], 2)});
+  }
+  o << t.markdown();
+  if (have_figure) o << "\n![error distributions per backend](explore_errors.png)\n";
+  o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B, the exact "
+       "oracle's axis (face_a, face_b, edge_edge, or separated), the kind of error. Each group's "
+       "first sample was shrunk to the scene named; `reproduced` says whether `rbx compare` shows "
+       "the same disagreement on it.\n\n";
+  o << groups_table(j);
+  return o.str();
+}
+
+
+bool draw_explore_figure(const std::string& dir) {
+  const std::string script =
+      std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/explore_plots.py";
+  if (!fs::exists("/usr/bin/python3")) return false;
+  const std::string cmd = "/usr/bin/python3 '" + script + "' '" + dir + "' > '" +
+                          (fs::path(dir) / "figures.log").string() + "' 2>&1";
+  return std::system(cmd.c_str()) == 0;
+}
+
+}  // namespace rbx

@@ -1,0 +1,235 @@
+// The report's "Real impacts" section: the tosses study's tables, CSV files, replays and figures.
+#include "comparisons/output/tosses_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "comparisons/eval/contact_eval.h"
+#include "comparisons/eval/trajectory.h"
+#include "comparisons/output/view_page.h"
+#include "comparisons/scene/repo_path.h"
+
+namespace fs = std::filesystem;
+
+namespace rbx {
+
+Table toss_results_table(const std::vector<BackendTosses>& rs, bool markdown) {
+  Table t({"rank", "backend", "e", "mu", "params", "tosses",
+           "position err (widths) med / mean / p90", "angle err (deg) med / mean / p90",
+           "final position err med / mean / p90", "run time (s)", "status"});
+  auto triple = [](const Spread& s, int d) {
+    return fmt_num(s.median, d) + " / " + fmt_num(s.mean, d) + " / " + fmt_num(s.p90, d);
+  };
+  int rank = 0;
+  for (size_t i : toss_ranking(rs)) {
+    const BackendTosses& r = rs[i];
+    std::vector<double> pos, ang, fin;
+    for (const TossErrors& e : r.tosses) {
+      pos.push_back(e.position);
+      ang.push_back(e.orientation_deg);
+      fin.push_back(e.final_position);
+    }
+    std::string status = to_string(r.status);
+    if (!r.message.empty()) status += markdown ? ": " + r.message : "";
+    t.add({std::to_string(++rank), r.name, fmt_num(r.params.restitution, 3),
+           fmt_num(r.params.friction, 3), r.params_source, std::to_string(r.tosses.size()),
+           triple(spread_of(pos), 3), triple(spread_of(ang), 3), triple(spread_of(fin), 3),
+           fmt_num(r.runtime_s, 3), status});
+  }
+  return t;
+}
+
+std::string tosses_report_section(const std::string& dir, const std::string& out_dir,
+                                  const std::string& backend_list) {
+  const fs::path d(dir);
+  const std::string data =
+      (fs::exists(d / "test.csv.gz") ? d / "test.csv.gz" : d / "test.csv").string();
+  const std::vector<Toss> tosses = read_tosses(data);
+  const std::string params_path = (d / "params.json").string();
+  const auto stored = read_params_file(params_path);
+  // Backends without dynamics named in the report's --backends are simply not tossed.
+  std::vector<const Backend*> chosen;
+  for (const Backend* b : select_toss_backends(backend_list))
+    if (b->dynamics) chosen.push_back(b);
+  if (chosen.empty()) return "";
+
+  Stopwatch clock;
+  const TossEvaluation ev = evaluate_tosses(chosen, tosses, stored);
+  const double eval_s = clock.seconds();
+  const fs::path out(out_dir);
+  write_json((out / "tosses.json").string(), toss_evaluation_json(data, tosses, params_path, ev));
+
+  // Per-toss errors (the distribution figure).
+  std::ostringstream per;
+  per << "params,backend,toss,position_error,orientation_error_deg,final_position_error\n";
+  for (const auto* set : {&ev.stored, &ev.published})
+    for (const BackendTosses& r : *set)
+      for (const TossErrors& e : r.tosses)
+        per << (set == &ev.stored ? "stored" : "published") << "," << r.name << "," << e.toss_id
+            << "," << fmt_num(e.position, 9) << "," << fmt_num(e.orientation_deg, 9) << ","
+            << fmt_num(e.final_position, 9) << "\n";
+  write_text((out / "tosses_per_toss.csv").string(), per.str());
+
+  // Median position error over tosses at each sample time (what the error is made of).
+  const double rate = CubeTossModel{}.sample_rate;
+  std::ostringstream over;
+  over << "backend,t,median_position_error,tosses\n";
+  for (const BackendTosses& r : ev.stored) {
+    for (size_t i = 0;; ++i) {
+      std::vector<double> v;
+      for (const TossErrors& e : r.tosses)
+        if (i < e.position_by_sample.size()) v.push_back(e.position_by_sample[i]);
+      if (v.size() * 2 < r.tosses.size() || v.empty()) break;  // at least half the tosses
+      over << r.name << "," << fmt_num((i + 1) / rate, 6) << "," << fmt_num(spread_of(v).median, 6)
+           << "," << v.size() << "\n";
+    }
+  }
+  write_text((out / "tosses_error_time.csv").string(), over.str());
+
+  // Best, median and worst toss of the best backend, drawn for every backend.
+  const std::vector<size_t> order = toss_ranking(ev.stored);
+  const BackendTosses& best = ev.stored[order.front()];
+  std::vector<std::pair<std::string, long>> picks;  // label, toss id
+  if (!best.tosses.empty()) {
+    std::vector<TossErrors> sorted = best.tosses;
+    std::stable_sort(sorted.begin(), sorted.end(), [](const TossErrors& a, const TossErrors& b) {
+      return a.position < b.position;
+    });
+    picks = {{"best", sorted.front().toss_id},
+             {"median", sorted[(sorted.size() - 1) / 2].toss_id},
+             {"worst", sorted.back().toss_id}};
+  }
+  std::ostringstream traj;
+  traj << "pick,toss,source,t,z,angle_deg\n";
+  // One 3-D replay per pick: every backend's cube, the measured cube as a ghost.
+  std::vector<std::string> replays;  // page file names, in pick order ("" : not written)
+  const fs::path views = out / "views";
+  for (const auto& [label, id] : picks) {
+    const Toss& t =
+        *std::find_if(tosses.begin(), tosses.end(), [&](const Toss& x) { return x.id == id; });
+    const Quat q0 = t.samples.front().orientation;
+    for (const TossSample& s : t.samples)
+      traj << label << "," << id << ",measured," << fmt_num(s.time - t.samples.front().time, 6)
+           << "," << fmt_num(s.position.z(), 7) << ","
+           << fmt_num(rotation_angle_deg(q0, s.orientation), 6) << "\n";
+    std::vector<std::pair<std::string, TossRun>> runs;
+    for (size_t k = 0; k < chosen.size(); ++k) {
+      runs.emplace_back(chosen[k]->name,
+                        simulate_toss(isolated_dynamics_fn(*chosen[k]), t, ev.stored[k].params));
+      const TossRun& run = runs.back().second;
+      if (run.status != Status::Ok) continue;
+      for (size_t i = 0; i < run.track.position.size(); ++i)
+        traj << label << "," << id << "," << chosen[k]->name << "," << fmt_num(i / rate, 6) << ","
+             << fmt_num(run.track.position[i].z(), 7) << ","
+             << fmt_num(rotation_angle_deg(q0, run.track.orientation[i]), 6) << "\n";
+    }
+    try {
+      fs::create_directories(views);
+      if (!fs::exists(views / "three.min.js"))
+        fs::copy_file(three_js_path(), views / "three.min.js");
+      const std::string name = "toss_" + label + "_" + std::to_string(id) + ".html";
+      const std::string title =
+          "toss " + std::to_string(id) + " (" + label + " of " + best.name + ")";
+      write_text((views / name).string(),
+                 view_page(toss_replay_data(t, runs, title), "", "three.min.js"));
+      replays.push_back(name);
+    } catch (const std::exception& e) {
+      std::cerr << "rbx report: toss replay not written: " << e.what() << "\n";
+      replays.push_back("");
+    }
+  }
+  write_text((out / "tosses_traj.csv").string(), traj.str());
+
+  // Figures through matplotlib (the report's own figures need the same python3).
+  bool figures_ok = false;
+  const std::string script =
+      std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/tosses_plots.py";
+  if (fs::exists("/usr/bin/python3")) {
+    const std::string cmd = "/usr/bin/python3 '" + script + "' '" + out_dir + "' > '" +
+                            (out / "tosses_figures.log").string() + "' 2>&1";
+    figures_ok = std::system(cmd.c_str()) == 0;
+    if (figures_ok) fs::remove(out / "tosses_figures.log");
+  }
+
+  size_t samples = 0;
+  for (const Toss& t : tosses) samples += t.samples.size();
+  std::ostringstream md;
+  md << "## Real impacts: measured cube tosses\n\n";
+  md << tosses.size() << " test tosses (" << samples << " samples) of a real 10.48 cm, 0.37 kg "
+     << "cube onto a floor, tracked by motion capture at 148 Hz (ContactNets data, "
+     << "`" << data << "`; the split and the source are in the README beside it). "
+     << "Each toss is simulated from its first measured sample (pose, velocity, angular "
+     << "velocity) for its recorded duration, dt = 1/1480 s (10 substeps per sample), and "
+     << "compared at every sample: **position error** = mean |p_sim - p_real| over the toss in "
+     << "cube widths, **angle error** = mean rotation angle between simulated and measured "
+     << "orientation, **final** = the position error at the last (resting) sample. Median / "
+     << "mean / 90th percentile over tosses; ranked by the median position error. All "
+     << chosen.size() << " backends at both parameter sets took " << fmt_num(eval_s, 3)
+     << " s.\n\n";
+  md << "### At each backend's fitted parameters (`" << params_path << "`, fitted on the "
+     << "training tosses)\n\n"
+     << toss_results_table(ev.stored, true).markdown() << "\n";
+  md << "### At the dataset's published parameters (e = 0.125, mu = 0.18)\n\n"
+     << "The same parameters for every backend: the difference to the table above is what "
+        "fitting buys; what remains is the contact model.\n\n"
+     << toss_results_table(ev.published, true).markdown() << "\n";
+  // What the error is made of: the median over tosses at a few times after release.
+  {
+    const std::vector<double> marks = {0.1, 0.2, 0.3, 0.5};  // s
+    Table t({"backend", "t = 0.1 s", "0.2 s", "0.3 s", "0.5 s", "last sample",
+             "horizontal share at the last sample"});
+    for (size_t k : order) {
+      const BackendTosses& r = ev.stored[k];
+      std::vector<std::string> cells = {r.name};
+      auto median_at = [&](const std::vector<double> TossErrors::*series, long i) {
+        std::vector<double> v;
+        for (const TossErrors& e : r.tosses) {
+          const auto& s = e.*series;
+          if (s.empty()) continue;
+          v.push_back(i < 0 ? s.back() : s[std::min<size_t>(static_cast<size_t>(i), s.size() - 1)]);
+        }
+        return spread_of(v).median;
+      };
+      for (double m : marks)
+        cells.push_back(
+            fmt_num(median_at(&TossErrors::position_by_sample, std::lround(m * rate) - 1), 3));
+      const double last = median_at(&TossErrors::position_by_sample, -1);
+      cells.push_back(fmt_num(last, 3));
+      cells.push_back(fmt_num(median_at(&TossErrors::horizontal_by_sample, -1) / last, 3));
+      t.add(cells);
+    }
+    md << "Median position error (cube widths) over the tosses at times after release (a toss "
+          "already at rest counts with its last sample; the first measured impact comes at 0.115 s "
+          "(median; 0.07 to 0.18 s)) and the horizontal (x, y) part of the final error, at the "
+          "fitted parameters:\n\n"
+       << t.markdown() << "\n";
+  }
+  if (figures_ok) {
+    md << "![toss error distribution](figures/tosses_errors.png)\n\n"
+       << "Left: position error per toss, every backend (fitted and published parameters). "
+          "Right: the median position error over tosses at each time after release: the first "
+          "impact, the tumbling after it and the slide to rest show as the steps of each "
+          "curve.\n\n";
+    if (!picks.empty())
+      md << "![toss trajectories](figures/tosses_trajectories.png)\n\n"
+         << "Height of the centre and rotation angle from the release orientation, measured "
+            "(black) and simulated, for the best (toss "
+         << picks[0].second << "), median (toss " << picks[1].second << ") and worst (toss "
+         << picks[2].second << ") toss of the best backend, `" << best.name << "`.\n\n";
+    if (replays.size() == 3 && !replays[0].empty())
+      md << "3-D replays of these tosses, every backend side by side with the measured cube as "
+            "a grey ghost: [best](views/"
+         << replays[0] << "), [median](views/" << replays[1] << "), [worst](views/" << replays[2]
+         << ").\n\n";
+  } else {
+    md << "(figures not drawn: python3 with matplotlib missing or tosses_plots.py failed, see "
+          "tosses_figures.log)\n\n";
+  }
+  return md.str();
+}
+
+}  // namespace rbx
