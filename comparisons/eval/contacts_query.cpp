@@ -81,8 +81,8 @@ ContactsRow compare_row(const std::string& name, const ContactRun& run, const Co
     row.mark =
         mark_of(pair["normal_err_deg"].get<double>(), std::abs(c->depth - t->depth), size, tol);
     if (!row.mark.empty())
-      marks.push_back(row.mark + ": " + name + " on " + a.name + "-" + b.name +
-                      ": normal off by " + row.angle + " deg, depth off by " +
+      marks.push_back(row.mark + ": " + name + " on " + a.name + "-" + b.name + ": normal off by " +
+                      row.angle + " deg, depth off by " +
                       fmt_num(std::abs(c->depth - t->depth), 3) + " m (against exact)");
   } else if (run.result.status == Status::Ok) {
     pair["touching_agrees"] = (c != nullptr) == (t != nullptr);

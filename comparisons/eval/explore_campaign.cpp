@@ -175,8 +175,8 @@ std::string shrink_contact_group(const Json& g, uint64_t seed, long count, int b
     << g["count"].get<long>() << " samples. " << backend
     << " against the exact oracle: " << describe(found) << ".\n# Shrunk "
     << points_shrunk(r.vertices_before, r.vertices_after, r.steps_accepted, r.evaluations)
-    << ", while the disagreement stayed.\n# Reproduce: rbx compare THIS_FILE --backends "
-    << backend << "\n";
+    << ", while the disagreement stayed.\n# Reproduce: rbx compare THIS_FILE --backends " << backend
+    << "\n";
   const std::string body = sample_scene_text(r.sample, h.str());
   return shrunk_json(body + "\n" + expect_block(body), found,
                      {{"points_before", r.vertices_before},
@@ -228,8 +228,9 @@ std::string shrink_landing_group(const Json& g, uint64_t seed, long count, int b
 
 // Every sample, spread over ranks and threads; encoded outcomes in index order on rank 0.
 // `bench`: contact samples with a hull of 100+ points are left out (encoded as "").
-std::vector<std::string> sample_all(const ExploreSettings& set, const std::vector<std::string>& names,
-                                    const ParallelRun& par, bool bench) {
+std::vector<std::string> sample_all(const ExploreSettings& set,
+                                    const std::vector<std::string>& names, const ParallelRun& par,
+                                    bool bench) {
   return par.map(static_cast<size_t>(set.count), [&](size_t i) -> std::string {
     SampleOutcome o;
     o.index = i;
@@ -308,8 +309,10 @@ Json disagreement_groups(Tallies& t, const std::vector<std::string>& names) {
   Json groups = Json::array();
   for (const std::string& n : names)
     for (const auto& [sig, c] : t.backend[n].by_signature)
-      groups.push_back(
-          {{"backend", n}, {"signature", sig}, {"count", c}, {"first_sample", t.backend[n].first_index[sig]}});
+      groups.push_back({{"backend", n},
+                        {"signature", sig},
+                        {"count", c},
+                        {"first_sample", t.backend[n].first_index[sig]}});
   return groups;
 }
 
@@ -319,9 +322,11 @@ std::vector<std::string> shrink_groups(const Json& groups, const ExploreSettings
   return par.map(groups.size(), [&](size_t k) {
     try {
       if (set.kind == "impact")
-        return shrink_impact_group(groups[k], set.seed, set.count, std::min(set.shrink_budget, 120));
+        return shrink_impact_group(groups[k], set.seed, set.count,
+                                   std::min(set.shrink_budget, 120));
       if (set.kind == "landing")
-        return shrink_landing_group(groups[k], set.seed, set.count, std::min(set.shrink_budget, 60));
+        return shrink_landing_group(groups[k], set.seed, set.count,
+                                    std::min(set.shrink_budget, 60));
       return shrink_contact_group(groups[k], set.seed, set.count, set.shrink_budget);
     } catch (const std::exception& e) {
       return Json{{"ok", false}, {"message", e.what()}}.dump();

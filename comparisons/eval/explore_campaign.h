@@ -16,20 +16,20 @@ namespace rbx {
 
 /// What a campaign runs.
 struct ExploreSettings {
-  std::string kind = "contact";       // contact | impact | landing
-  uint64_t seed = 1;                  // sample k of seed s depends on (s, k) only
-  long count = 20000;                 // samples
-  std::string backends;               // --backends LIST ("" or "all": every subject backend)
-  int shrink_budget = 400;            // predicate evaluations per group (impact <= 120, landing <= 60)
+  std::string kind = "contact";  // contact | impact | landing
+  uint64_t seed = 1;             // sample k of seed s depends on (s, k) only
+  long count = 20000;            // samples
+  std::string backends;          // --backends LIST ("" or "all": every subject backend)
+  int shrink_budget = 400;       // predicate evaluations per group (impact <= 120, landing <= 60)
 };
 
 /// A campaign's outcome, on rank 0 (other ranks get timings only).
 struct ExploreCampaign {
-  Json result;  // explore.json
+  Json result;                                              // explore.json
   std::vector<std::pair<std::string, std::string>> scenes;  // shrunk scenes: file, text
-  long groups = 0;      // disagreement groups
-  long reproduced = 0;  // shrunk scenes on which the harness shows the disagreement
-  long invalid = 0;     // samples that could not be made
+  long groups = 0;                                          // disagreement groups
+  long reproduced = 0;        // shrunk scenes on which the harness shows the disagreement
+  long invalid = 0;           // samples that could not be made
   std::string first_invalid;  // the first one's reason
   double sampling_s = 0.0, shrinking_s = 0.0;
 };

@@ -12,6 +12,8 @@
 #include <thread>
 
 #include "comparisons/eval/contact_eval.h"
+#include "comparisons/eval/impact_cause.h"
+#include "comparisons/eval/measures.h"
 #include "comparisons/eval/metrics.h"
 #include "comparisons/eval/result_cache.h"
 #include "comparisons/eval/select_backends.h"
@@ -36,142 +38,6 @@ bool same_answer(const ContactPoint& x, const ContactPoint& y) {
 // Small helpers
 
 std::string pair_name(const RigidBody& a, const RigidBody& b) { return a.name + "-" + b.name; }
-
-// A dynamics run with its wall-clock time; library exceptions become status Error.
-struct DynRun {
-  DynamicsResult result;
-  double runtime_s = 0.0;
-  double dt = 0.0;
-  bool cached = false;    // from the reference-result cache
-  std::string cache_key;  // the run's cache key ("" : not cacheable)
-};
-
-// A reference backend's run comes from the cache when it holds this very call (the bodies as
-// built from the scene, the settings, dt and sampling); otherwise it runs and is stored.
-DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every,
-                    const ResultCache& cache, const std::vector<RigidBody>& bodies) {
-  DynRun run;
-  run.dt = dt;
-  const bool cacheable = cache.enabled() && ResultCache::caches(b.name);
-  const std::string key =
-      cacheable ? cache.dynamics_key(b.name, scene, bodies, DynamicsOptions{dt, sample_every})
-                : std::string();
-  run.cache_key = key;
-  if (cacheable)
-    if (auto hit = cache.load_dynamics(key)) {
-      run.result = std::move(hit->result);
-      run.runtime_s = hit->runtime_s;
-      run.cached = true;
-      return run;
-    }
-  const TimedDynamics t = run_dynamics_isolated(b, scene, DynamicsOptions{dt, sample_every});
-  run.result = t.result;
-  run.runtime_s = t.runtime_s;
-  // A backend that returns fewer final states than bodies has failed in a way we must show.
-  if (run.result.status == Status::Ok && run.result.finals.size() != scene.bodies.size()) {
-    run.result.status = Status::Error;
-    run.result.message = "backend returned " + std::to_string(run.result.finals.size()) +
-                         " final states for " + std::to_string(scene.bodies.size()) + " bodies";
-  }
-  if (cacheable) cache.store(key, run.result, run.runtime_s);
-  return run;
-}
-
-// Kinetic energy of the bodies at t = 0 (J).
-double initial_kinetic_energy(const std::vector<RigidBody>& inputs) {
-  double e = 0.0;
-  for (const RigidBody& b : inputs) e += b.kinetic_energy();
-  return e;
-}
-
-Vec3 linear_momentum(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& s) {
-  Vec3 p = Vec3::Zero();
-  for (size_t i = 0; i < inputs.size() && i < s.size(); ++i)
-    if (!inputs[i].is_static) p += inputs[i].mass * s[i].velocity;
-  return p;
-}
-
-Vec3 angular_momentum(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& s) {
-  Vec3 h = Vec3::Zero();
-  for (size_t i = 0; i < inputs.size() && i < s.size(); ++i) {
-    const RigidBody& b = inputs[i];
-    if (b.is_static) continue;
-    const Mat3 rot = s[i].orientation.toRotationMatrix();
-    h += s[i].position.cross(b.mass * s[i].velocity) +
-         rot * b.inertia_body * rot.transpose() * s[i].angular_velocity;
-  }
-  return h;
-}
-
-std::vector<BodyFinal> initial_states(const std::vector<RigidBody>& inputs) {
-  std::vector<BodyFinal> s;
-  for (const RigidBody& b : inputs)
-    s.push_back({b.name, b.position, b.orientation, b.velocity, b.angular_velocity});
-  return s;
-}
-
-// Size of a body: its bounding-box diagonal (m).
-double body_size(const RigidBody& b) { return 2.0 * bounding_sphere(b).radius; }
-
-std::string fmt_dt(double dt) { return "self dt=" + fmt_num(dt, 3); }
-
-// f(0), ..., f(n - 1) on two threads (the machine's two cores), interleaved. Each value is
-// computed as it would be on one thread, so results are the same; f must not share mutable
-// state (the exact oracle does not). A thrown exception is rethrown here.
-template <class F>
-std::vector<double> parallel_map(size_t n, const F& f) {
-  std::vector<double> out(n, 0.0);
-  std::exception_ptr failure[2];
-  auto work = [&](size_t first, std::exception_ptr& error) {
-    try {
-      for (size_t t = first; t < n; t += 2) out[t] = f(t);
-    } catch (...) {
-      error = std::current_exception();
-    }
-  };
-  if (n < 8) {
-    work(0, failure[0]);
-    work(1, failure[1]);
-  } else {
-    std::thread helper(work, 1, std::ref(failure[1]));
-    work(0, failure[0]);
-    helper.join();
-  }
-  for (const std::exception_ptr& e : failure)
-    if (e) std::rethrow_exception(e);
-  return out;
-}
-
-// Default time steps for the sweep: the scene's dt scaled by 4, 2, 1, 1/2, 1/4.
-std::vector<double> sweep_steps(const Scene& scene) {
-  if (!scene.sim.sweep_dt.empty()) {
-    std::vector<double> s = scene.sim.sweep_dt;
-    std::sort(s.rbegin(), s.rend());
-    return s;
-  }
-  const double dt = scene.sim.dt;
-  return {4 * dt, 2 * dt, dt, dt / 2, dt / 4};
-}
-
-// Contact phases besides the scene as written (phase 0: first contact on a step boundary, as
-// every analytic scene is written): first contact 1/3 and 2/3 of a step later.
-struct ContactPhase {
-  const char* label;  // as written into metric names and JSON
-  double fraction;    // of a step
-};
-constexpr ContactPhase kContactPhases[] = {{"1_3", 1.0 / 3.0}, {"2_3", 2.0 / 3.0}};
-
-// The scene with every moving body moved back along its velocity by `shift` seconds and one
-// more step of duration: first contact comes `shift` later in the step, and the run ends
-// dt - shift after the written end, in free flight (no gravity: the closed form's final
-// velocities are unchanged).
-Scene shifted_scene(const Scene& scene, double shift) {
-  Scene out = scene;
-  for (BodySpec& b : out.bodies)
-    if (!b.is_static) b.position -= b.velocity * shift;
-  out.sim.duration += scene.sim.dt;
-  return out;
-}
 
 }  // namespace
 
@@ -363,7 +229,8 @@ class Evaluator {
 
     for (const std::string& name : names) {
       const Backend& be = backend(name);
-      const ContactRun run = timed_contact(name == "exact" ? exact : be, a, b);
+      const ContactRun run =
+          timed_contact(name == "exact" ? exact : be, a, b, cache_, opt_.timing_budget_s);
       set_status(name, run.result.status, run.result.message);
       Json& bj = backend_json(name);
       bj["runtime_s"] = bj["runtime_s"].get<double>() + run.runtime_s;
@@ -414,7 +281,7 @@ class Evaluator {
         Backend pre = be;
         pre.name = name + "+prebuilt";
         pre.contact = v->contact;
-        const ContactRun pr = timed_contact(pre, a, b);
+        const ContactRun pr = timed_contact(pre, a, b, cache_, opt_.timing_budget_s);
         const ContactPoint* pc = deepest(pr.result);
         if (pr.result.status != Status::Ok || !pc || !same_answer(*c, *pc))
           out_.disagreements.push_back(name + " on " + pair +
@@ -437,28 +304,6 @@ class Evaluator {
       if (name == "custom" && ex)
         check_expect_contact("custom", *ex, touch, c->normal, c->depth, tol);
     }
-  }
-
-  // A contact query timed for about timing_budget_s (median of the repeats), or the cached
-  // result of the same query (a reference backend's, see result_cache.h).
-  ContactRun timed_contact(const Backend& be, const RigidBody& a, const RigidBody& b) {
-    const bool cacheable = cache_.enabled() && ResultCache::caches(be.name);
-    const std::string key = cacheable ? cache_.contact_key(be.name, a, b) : std::string();
-    if (cacheable)
-      if (auto hit = cache_.load_contact(key)) {
-        ContactRun run;
-        run.result = std::move(hit->result);
-        run.runtime_s = hit->runtime_s;
-        run.cached = true;
-        return run;
-      }
-    ContactRun probe = run_contact(be, a, b);
-    int repeats = 1;
-    if (probe.result.status == Status::Ok && probe.runtime_s > 0)
-      repeats = static_cast<int>(std::clamp(opt_.timing_budget_s / probe.runtime_s, 1.0, 200.0));
-    ContactRun run = repeats > 1 ? run_contact(be, a, b, repeats) : probe;
-    if (cacheable) cache_.store(key, run.result, run.runtime_s);
-    return run;
   }
 
   // Violations of [expect.contact] by one subject's answer: touching, then (where it touches)
@@ -484,61 +329,36 @@ class Evaluator {
   }
 
   // -- impulse, trajectory, stability ----------------------------------------------------------
+
+  // What every backend's dynamics is measured against, from the scene alone (and, for
+  // `angular`, every backend's main run).
+  struct DynamicsFrame {
+    double e0_kin = 0.0, e0 = 0.0;  // initial kinetic and total energy
+    Vec3 p0 = Vec3::Zero(), h0 = Vec3::Zero();
+    bool closed = false;   // momentum is an invariant: no static body, no gravity
+    bool angular = false;  // angular metrics only where something rotates
+    double p_scale = 0.0, h_scale = 0.0;
+    std::vector<std::optional<RefState>> expected;  // [expect] final velocities
+    bool have_expect = false;
+    bool phases = false;  // the contact-phase runs apply
+    long sample_every = 1;
+    bool wants_sweep = false;
+    std::vector<double> dts;  // the sweep's steps, finest last
+    double finest = 0.0;
+  };
+
+  // The swept runs of one backend; `fine` is the finest step's when it ran.
+  struct SweepRuns {
+    std::optional<DynRun> fine;
+    std::vector<DynRun> runs;
+    bool wants_velocity = false;   // the impulse or trajectory check asks for velocity errors
+    bool stability_sweep = false;  // a stability verdict at every step of the scene's own sweep
+  };
+
   void dynamics_checks() {
     const std::vector<std::string> names =
         select_backends(scene_, opt_.backends, Capability::Dynamics, table_);
-    const double e0_kin = initial_kinetic_energy(inputs_);
-    const std::vector<BodyFinal> s0 = initial_states(inputs_);
-    const double e0 = total_energy(inputs_, s0, scene_.sim.gravity);
-    const Vec3 p0 = linear_momentum(inputs_, s0), h0 = angular_momentum(inputs_, s0);
-    bool any_static = false;
-    double mass_total = 0.0, size_max = 0.0;
-    for (const RigidBody& b : inputs_) {
-      any_static = any_static || b.is_static;
-      if (!b.is_static) mass_total += b.mass;
-      size_max = std::max(size_max, body_size(b));
-    }
-    const bool closed = !any_static && scene_.sim.gravity.norm() == 0.0;
-    if (!closed)
-      out_.skipped.push_back("momentum drift: not an invariant here (static bodies or gravity)");
-    bool angular = false;  // angular metrics only where something rotates
-    for (const RigidBody& b : inputs_) angular = angular || b.angular_velocity.norm() > 0;
-    // Momentum scale: the largest momentum any body has or could get from the energy.
-    const double p_scale =
-        std::max(p0.norm(), std::sqrt(2.0 * mass_total * std::max(e0_kin, 1e-300)));
-    const double h_scale = std::max(h0.norm(), p_scale * size_max);
-
-    // Reference for final velocities: the [expect] block, if it gives any.
-    std::vector<std::optional<RefState>> expected(inputs_.size());
-    bool have_expect = false;
-    if (scene_.expect)
-      for (const ExpectBody& eb : scene_.expect->bodies)
-        for (size_t i = 0; i < inputs_.size(); ++i)
-          if (inputs_[i].name == eb.name && (eb.velocity || eb.angular_velocity)) {
-            expected[i] = RefState{eb.velocity, eb.angular_velocity};
-            have_expect = true;
-          }
-    for (const auto& r : expected)
-      angular = angular || (r && r->angular_velocity && r->angular_velocity->norm() > 0);
-
-    // Contact phases apply where the closed form does not depend on when in a step contact
-    // begins: an impulse scene with [expect] velocities, no gravity, nothing spinning (moving a
-    // spinning body back would also need its rotation undone).
-    bool phases = opt_.phases && have_expect && scene_.has_check(CheckKind::Impulse) &&
-                  scene_.sim.gravity.norm() == 0.0;
-    for (const RigidBody& b : inputs_)
-      phases = phases && (b.is_static || b.angular_velocity.norm() == 0.0);
-    if (have_expect && scene_.has_check(CheckKind::Impulse) && !phases && opt_.phases)
-      out_.skipped.push_back(
-          "contact phases: gravity or a spinning body (the closed form depends on the phase)");
-
-    const long steps = scene_.sim.steps();
-    const long sample_every = std::max<long>(1, steps / 400);
-    const bool wants_sweep = opt_.sweep && (scene_.has_check(CheckKind::Impulse) ||
-                                            scene_.has_check(CheckKind::Trajectory));
-    const std::vector<double> dts = sweep_steps(scene_);
-    const double finest = dts.back();
-
+    DynamicsFrame fr = dynamics_frame();
     // Every backend's main run first: whether the angular metrics apply is decided from the
     // scene and from all results before any metric is emitted, so that every backend gets the
     // same metric set whatever the order of the backends.
@@ -550,313 +370,293 @@ class Evaluator {
         continue;
       }
       mains.emplace_back(name,
-                         run_dynamics(be, scene_, scene_.sim.dt, sample_every, cache_, inputs_));
+                         run_dynamics(be, scene_, scene_.sim.dt, fr.sample_every, cache_, inputs_));
     }
     for (const auto& [name, run] : mains)
       if (run.result.status == Status::Ok)
         for (const BodyFinal& f : run.result.finals)
-          angular = angular || f.angular_velocity.norm() > 1e-12;
+          fr.angular = fr.angular || f.angular_velocity.norm() > 1e-12;
+    for (const auto& [name, main] : mains) backend_dynamics(name, main, fr);
+    if (!fr.angular) out_.skipped.push_back("angular metrics: nothing rotates in this scene");
+  }
 
-    for (const auto& entry : mains) {
-      const std::string& name = entry.first;  // (not a structured binding: lambdas below)
-      const DynRun& main = entry.second;
-      const Backend& be = backend(name);
-      Json& bj = backend_json(name);
-      bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
-      if (main.cached) bj["cached"] = true;
-      // The sampled trajectory, for results.json and the 3-D replay (rbx view).
-      const size_t moving = static_cast<size_t>(std::count_if(
-          inputs_.begin(), inputs_.end(), [](const RigidBody& b) { return !b.is_static; }));
-      bj["trajectory"] = trajectory_json(main.result.samples, inputs_, frame_budget(moving));
-      if (main.result.status != Status::Ok) {
-        if (scene_.has_check(CheckKind::Stability))
-          stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
-        // The engine under test stopped before t = duration: it fails [expect.body] (no final
-        // state to compare is not a pass).
-        if ((name == "custom" || name == "custom-seed") && scene_.expect &&
-            !scene_.expect->bodies.empty()) {
-          out_.expect_failures.push_back(
-              name + ": the run stopped before t = duration: " + main.result.message);
-          expect_bodies_bound_ = true;
-        }
-        continue;
-      }
-
-      // Self-consistency reference: the same backend at the finest step of the sweep.
-      std::optional<DynRun> fine;
-      std::vector<DynRun> sweep_runs;
-      // Velocity errors belong to the impulse and trajectory checks: a stability-only scene
-      // does not pay for the self-consistency run.
-      const bool wants_velocity =
-          scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory);
-      const bool stability_sweep =
-          scene_.has_check(CheckKind::Stability) && !scene_.sim.sweep_dt.empty() && wants_sweep;
-      if (wants_sweep || (!have_expect && wants_velocity) ||
-          scene_.has_check(CheckKind::Trajectory)) {
-        // Without a sweep only the finest step is needed (the self-consistency reference).
-        const std::vector<double> to_run = wants_sweep ? dts : std::vector<double>{finest};
-        for (double dt : to_run) {
-          if (std::abs(dt - scene_.sim.dt) <= 1e-15 * dt)
-            sweep_runs.push_back(main);
-          else {
-            // The finest run of a trajectory check is sampled at the same times as the main run;
-            // so is every swept run of a stability scene that names its own sweep (its verdict
-            // is given at each step: the thin wall must not tunnel at any).
-            const bool sample =
-                (scene_.has_check(CheckKind::Trajectory) && dt == finest) || stability_sweep;
-            const long every =
-                sample ? std::max<long>(1, std::lround(sample_every * scene_.sim.dt / dt)) : 0;
-            sweep_runs.push_back(run_dynamics(be, scene_, dt, every, cache_, inputs_));
-          }
-        }
-        if (sweep_runs.back().result.status == Status::Ok) fine = sweep_runs.back();
-      }
-      auto ref_of = [&](const DynRun& r) {
-        std::vector<std::optional<RefState>> ref(inputs_.size());
-        for (size_t i = 0; i < inputs_.size(); ++i)
-          ref[i] = RefState{
-              r.result.finals[i].velocity,
-              angular ? std::optional<Vec3>(r.result.finals[i].angular_velocity) : std::nullopt};
-        return ref;
-      };
-      std::string against;
-      std::vector<std::optional<RefState>> ref;
-      if (have_expect) {
-        against = "analytic";
-        ref = expected;
-      } else if (fine) {
-        against = fmt_dt(finest);
-        ref = ref_of(*fine);
-      }
-      if (!against.empty() && !(fine && !have_expect && std::abs(finest - scene_.sim.dt) < 1e-15)) {
-        metric(primary_check(), name, "", "velocity_err_ke",
-               ke_norm_error(inputs_, main.result.finals, ref, e0_kin), against);
-      } else if (against.empty() && wants_velocity) {
-        out_.skipped.push_back(name + ": no reference for the velocity error");
-      }
-      // The same impact with first contact 1/3 and 2/3 of a step later; the headline stays the
-      // scene as written.
-      double worst = 0.0, written = 0.0;
-      std::string worst_phase = "written";
-      if (have_expect)
-        written = worst = ke_norm_error(inputs_, main.result.finals, expected, e0_kin);
-      FirstImpulse worst_fi = main.result.first_impulse;
-      std::vector<RigidBody> worst_start = inputs_;  // the bodies at t = 0 of the worst run
-      if (phases) {
-        Json pj = {{"written", written}};
-        for (const ContactPhase& ph : kContactPhases) {
-          const Scene shifted = shifted_scene(scene_, ph.fraction * scene_.sim.dt);
-          const DynRun r =
-              run_dynamics(be, shifted, scene_.sim.dt, 0, cache_, make_bodies(shifted));
-          if (r.result.status != Status::Ok) {
-            pj[ph.label] = "error: " + r.result.message;
-            continue;
-          }
-          const double err = ke_norm_error(inputs_, r.result.finals, expected, e0_kin);
-          pj[ph.label] = err;
-          metric(primary_check(), name, "", std::string("velocity_err_ke_phase_") + ph.label, err,
-                 "analytic");
-          if (err > worst) {
-            worst = err;
-            worst_phase = ph.label;
-            worst_fi = r.result.first_impulse;
-            worst_start = make_bodies(shifted);
-          }
-        }
-        pj["worst"] = worst;
-        pj["worst_phase"] = worst_phase;
-        bj["contact_phase"] = pj;
-        if (written <= kMarkVelocityErr && worst > kMarkVelocityErr)
-          out_.disagreements.push_back(name + ": velocity error " + fmt_num(worst, 3) +
-                                       " with first contact " + phase_text(worst_phase) +
-                                       " (as written: " + fmt_num(written, 3) + ")");
-      }
-      if (have_expect && scene_.has_check(CheckKind::Impulse) &&
-          std::max(written, worst) > kMarkVelocityErr)
-        // The scene as written explains itself when it misses; else the worst phase does.
-        written > kMarkVelocityErr
-            ? explain_impact(name, main.result.first_impulse, inputs_, written, worst, worst_phase,
-                             expected)
-            : explain_impact(name, worst_fi, worst_start, written, worst, worst_phase, expected);
-      if (wants_sweep && !against.empty()) {
-        for (const DynRun& r : sweep_runs) {
-          if (r.result.status != Status::Ok) continue;
-          if (!have_expect && &r == &sweep_runs.back()) continue;  // zero by construction
-          out_.sweep.push_back({name, "dynamics", r.dt, r.runtime_s,
-                                ke_norm_error(inputs_, r.result.finals, ref, e0_kin), against});
-        }
-      }
-      // State divergence over time: how far any point of a body is from where the finest-step
-      // run puts it at the same sample time, |dx| + (size / 2) * rotation angle (an upper bound),
-      // relative to the body's size.
-      if (scene_.has_check(CheckKind::Trajectory) && fine && !fine->result.samples.empty() &&
-          std::abs(finest - scene_.sim.dt) > 1e-15) {
-        double worst = 0.0;
-        size_t k = 0;
-        for (const StateSample& smp : main.result.samples) {
-          while (k + 1 < fine->result.samples.size() &&
-                 std::abs(fine->result.samples[k + 1].time - smp.time) <=
-                     std::abs(fine->result.samples[k].time - smp.time))
-            ++k;
-          const StateSample& ref = fine->result.samples[k];
-          if (std::abs(ref.time - smp.time) > 0.5 * scene_.sim.dt) continue;  // no partner
-          for (size_t i = 0; i < inputs_.size() && i < ref.bodies.size(); ++i)
-            if (!inputs_[i].is_static)
-              worst = std::max(
-                  worst,
-                  (smp.bodies[i].position - ref.bodies[i].position).norm() / body_size(inputs_[i]) +
-                      0.5 * smp.bodies[i].orientation.angularDistance(ref.bodies[i].orientation));
-        }
-        metric("trajectory", name, "", "state_divergence_err", worst, fmt_dt(finest));
-      }
-      // Contact time: first event against the finest-step run of the same backend.
-      if (fine && !main.result.events.empty() && !fine->result.events.empty() &&
-          std::abs(finest - scene_.sim.dt) > 1e-15)
-        metric(primary_check(), name, "", "contact_time_err",
-               std::abs(main.result.events.front().time - fine->result.events.front().time),
-               fmt_dt(finest));
-      // Conservation: momentum (where it is an invariant), energy against what e allows.
-      const std::vector<BodyFinal>& f = main.result.finals;
-      if (closed) {
-        metric(primary_check(), name, "", "momentum_drift_err",
-               (linear_momentum(inputs_, f) - p0).norm() / p_scale, "invariant");
-        if (angular)
-          metric(primary_check(), name, "", "angular_momentum_drift_err",
-                 (angular_momentum(inputs_, f) - h0).norm() / h_scale, "invariant");
-      }
-      const double e1 = total_energy(inputs_, f, scene_.sim.gravity);
-      const double e_scale = std::max(std::abs(e0), e0_kin);
-      if (e_scale > 0) {
-        metric(primary_check(), name, "", "energy_change_rel", (e1 - e0) / e_scale, "initial");
-        // Against the closed form's final kinetic energy where [expect] gives every moving
-        // body's velocities, else the invariant rule of the restitution.
-        const EnergyError err = energy_error(e0, e1, kinetic_energy(inputs_, f),
-                                             expected_kinetic_energy(inputs_, f, expected),
-                                             scene_.sim.restitution, e_scale);
-        metric(primary_check(), name, "", "energy_err", err.value, err.against);
-      }
-      // [expect.body] binds the custom engine, both the extended one and the seed's algorithm;
-      // every backend, custom included, is marked by the same rule where it misses the closed
-      // form.
-      if ((name == "custom" || name == "custom-seed") && scene_.expect) {
-        check_expect_bodies(name, main.result.finals);
-        expect_bodies_bound_ = true;
-      }
-      if (scene_.expect)
-        mark_expect_disagreement(
-            name, main.result.finals,
-            have_expect ? ke_norm_error(inputs_, main.result.finals, expected, e0_kin) : 0.0);
-      if (scene_.has_check(CheckKind::Stability))
-        stability(name, main, e0, p0, h0, closed, p_scale, h_scale);
-      // The verdict at every other swept step (report rows; not metrics of the check).
-      if (stability_sweep)
-        for (const DynRun& r : sweep_runs)
-          if (std::abs(r.dt - scene_.sim.dt) > 1e-15 * r.dt)
-            stability(name, r, e0, p0, h0, closed, p_scale, h_scale, /*swept=*/true);
+  DynamicsFrame dynamics_frame() {
+    DynamicsFrame fr;
+    fr.e0_kin = initial_kinetic_energy(inputs_);
+    const std::vector<BodyFinal> s0 = initial_states(inputs_);
+    fr.e0 = total_energy(inputs_, s0, scene_.sim.gravity);
+    fr.p0 = linear_momentum(inputs_, s0);
+    fr.h0 = angular_momentum(inputs_, s0);
+    bool any_static = false;
+    double mass_total = 0.0, size_max = 0.0;
+    for (const RigidBody& b : inputs_) {
+      any_static = any_static || b.is_static;
+      if (!b.is_static) mass_total += b.mass;
+      size_max = std::max(size_max, body_size(b));
     }
-    if (!angular) out_.skipped.push_back("angular metrics: nothing rotates in this scene");
+    fr.closed = !any_static && scene_.sim.gravity.norm() == 0.0;
+    if (!fr.closed)
+      out_.skipped.push_back("momentum drift: not an invariant here (static bodies or gravity)");
+    for (const RigidBody& b : inputs_) fr.angular = fr.angular || b.angular_velocity.norm() > 0;
+    // Momentum scale: the largest momentum any body has or could get from the energy.
+    fr.p_scale = std::max(fr.p0.norm(), std::sqrt(2.0 * mass_total * std::max(fr.e0_kin, 1e-300)));
+    fr.h_scale = std::max(fr.h0.norm(), fr.p_scale * size_max);
+
+    // Reference for final velocities: the [expect] block, if it gives any.
+    fr.expected.resize(inputs_.size());
+    if (scene_.expect)
+      for (const ExpectBody& eb : scene_.expect->bodies)
+        for (size_t i = 0; i < inputs_.size(); ++i)
+          if (inputs_[i].name == eb.name && (eb.velocity || eb.angular_velocity)) {
+            fr.expected[i] = RefState{eb.velocity, eb.angular_velocity};
+            fr.have_expect = true;
+          }
+    for (const auto& r : fr.expected)
+      fr.angular = fr.angular || (r && r->angular_velocity && r->angular_velocity->norm() > 0);
+
+    // Contact phases apply where the closed form does not depend on when in a step contact
+    // begins: an impulse scene with [expect] velocities, no gravity, nothing spinning (moving a
+    // spinning body back would also need its rotation undone).
+    fr.phases = opt_.phases && fr.have_expect && scene_.has_check(CheckKind::Impulse) &&
+                scene_.sim.gravity.norm() == 0.0;
+    for (const RigidBody& b : inputs_)
+      fr.phases = fr.phases && (b.is_static || b.angular_velocity.norm() == 0.0);
+    if (fr.have_expect && scene_.has_check(CheckKind::Impulse) && !fr.phases && opt_.phases)
+      out_.skipped.push_back(
+          "contact phases: gravity or a spinning body (the closed form depends on the phase)");
+
+    fr.sample_every = std::max<long>(1, scene_.sim.steps() / 400);
+    fr.wants_sweep = opt_.sweep && (scene_.has_check(CheckKind::Impulse) ||
+                                    scene_.has_check(CheckKind::Trajectory));
+    fr.dts = sweep_steps(scene_);
+    fr.finest = fr.dts.back();
+    return fr;
   }
 
-  // "1/3 of a step later" for a phase label.
-  static std::string phase_text(const std::string& label) {
-    if (label == "written") return "as written";
-    return label.substr(0, 1) + "/" + label.substr(2) + " of a step later";
-  }
-
-  // Why an impact missed its closed form, from what the backend's first impulse saw against
-  // the truth: the exact oracle at the poses of the step that detected it, reached in free
-  // flight from t = 0 (valid up to the first impulse; spinning bodies are not reconstructed).
-  // `fi` and `start` (the bodies at t = 0) are those of the run with the larger error.
-  void explain_impact(const std::string& name, const FirstImpulse& fi,
-                      const std::vector<RigidBody>& start, double written, double worst,
-                      const std::string& worst_phase,
-                      const std::vector<std::optional<RefState>>& expected) {
-    Cause c;
-    c.backend = name;
-    c.scene = scene_.name;
-    std::ostringstream d;
-    const std::string errors = "velocity error " + fmt_num(written, 2) + " as written" +
-                               (worst_phase != "written" && worst > written
-                                    ? ", " + fmt_num(worst, 2) + " " + phase_text(worst_phase)
-                                    : std::string());
-    if (!fi.seen) {
-      c.kind = "no impulse applied";
-      c.detail = errors;
-      out_.causes.push_back(c);
+  // Every metric of one backend's dynamics, in a fixed order: velocity against the closed form
+  // or its finest step, the contact phases, the sweep, trajectory divergence, contact time,
+  // conservation, [expect], stability.
+  void backend_dynamics(const std::string& name, const DynRun& main, const DynamicsFrame& fr) {
+    Json& bj = backend_json(name);
+    bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
+    if (main.cached) bj["cached"] = true;
+    // The sampled trajectory, for results.json and the 3-D replay (rbx view).
+    const size_t moving = static_cast<size_t>(std::count_if(
+        inputs_.begin(), inputs_.end(), [](const RigidBody& b) { return !b.is_static; }));
+    bj["trajectory"] = trajectory_json(main.result.samples, inputs_, frame_budget(moving));
+    if (main.result.status != Status::Ok) {
+      stopped_run(name, main, fr);
       return;
     }
-    auto index = [&](const std::string& n) {
-      for (size_t i = 0; i < inputs_.size(); ++i)
-        if (inputs_[i].name == n) return static_cast<long>(i);
-      return -1L;
-    };
-    const long ia = index(fi.body_a), ib = index(fi.body_b);
-    bool spinning = false;
-    for (const RigidBody& b : inputs_) spinning = spinning || b.angular_velocity.norm() > 0.0;
-    const double t = fi.step * scene_.sim.dt;
-    std::optional<SatResult> truth;
-    if (ia >= 0 && ib >= 0 && !spinning) {
-      auto placed = [&](long i) {
-        RigidBody b = start[i];
-        if (!b.is_static) b.position += b.velocity * t + 0.5 * scene_.sim.gravity * t * t;
-        return b;
-      };
-      const RigidBody a = placed(ia), b = placed(ib);
-      truth = sat_query(*a.shape, a.pose(), *b.shape, b.pose());
-    }
-    d << fi.contact_points << (fi.contact_points == 1 ? " point" : " points");
-    double angle = 0.0;
-    size_t corners = 0;
-    if (truth && truth->touching) {
-      corners = truth->manifold.size();
-      angle = std::acos(std::clamp(fi.normal.dot(truth->normal), -1.0, 1.0)) * 180.0 / M_PI;
-      Vec3 centre = Vec3::Zero();
-      for (const Vec3& p : truth->manifold) centre += p;
-      if (corners) centre /= static_cast<double>(corners);
-      const std::string what = corners >= 3
-                                   ? "face patch of " + std::to_string(corners) + " corners"
-                               : corners == 2 ? "edge contact"
-                                              : "single-point contact";
-      d << " against a true " << what;
-      // Where one point stands for the patch, how far from its centre (libraries that report
-      // one event per pair give one of their points, not a mean).
-      if (fi.contact_points == 1)
-        d << ", " << fmt_num((fi.point - centre).norm(), 2) << " m from its centre";
-      d << "; normal " << fmt_num(angle, 2) << "° off";
-      // The closed-form impulse on the first body the [expect] block moves.
-      for (long i : {ia, ib}) {
-        const RigidBody& b = inputs_[i];
-        if (b.is_static || !expected[i] || !expected[i]->velocity) continue;
-        const double j =
-            std::abs(b.mass * (*expected[i]->velocity - b.velocity).dot(truth->normal));
-        d << "; impulse in that step " << fmt_num(fi.impulse, 3) << " N s against " << fmt_num(j, 3)
-          << " closed form";
-        break;
+    const SweepRuns sw = sweep_runs(backend(name), main, fr);
+    std::string against;
+    const std::vector<std::optional<RefState>> ref =
+        velocity_reference(name, main, sw, fr, against);
+    contact_phases(name, main, fr, bj);
+    if (fr.wants_sweep && !against.empty()) {
+      for (const DynRun& r : sw.runs) {
+        if (r.result.status != Status::Ok) continue;
+        if (!fr.have_expect && &r == &sw.runs.back()) continue;  // zero by construction
+        out_.sweep.push_back({name, "dynamics", r.dt, r.runtime_s,
+                              ke_norm_error(inputs_, r.result.finals, ref, fr.e0_kin), against});
       }
-    } else {
-      d << (spinning ? " (bodies spin: no free-flight truth)"
-                     : " (the oracle sees no contact at those poses)");
     }
-    d << "; first seen " << fmt_num(fi.depth, 2) << " m deep at step " << fi.step
-      << " (entry phase " << fmt_num(fi.entry_phase, 2) << ")"
-      << (written <= kMarkVelocityErr ? " in the run " + phase_text(worst_phase) : std::string())
-      << "; " << errors;
-    // The first measured sign, in this order: the normal, the manifold, the depth, else the
-    // response itself.
-    if (truth && truth->touching && angle > kMarkAngleDeg)
-      c.kind = "normal off the truth at first impulse";
-    else if (corners >= 3 && fi.contact_points == 1)
-      c.kind = "one contact point on a face patch";
-    else if (written <= kMarkVelocityErr && worst > kMarkVelocityErr)
-      c.kind =
-          "right only when contact begins on a step boundary: the response depends on the "
-          "depth at detection";
-    else if (fi.approach_speed > 0 && fi.depth > 0.5 * fi.approach_speed * scene_.sim.dt)
-      c.kind = "contact first seen deep (more than half a step of approach)";
-    else
-      c.kind = "contact seen as the truth (points, normal, depth): the error is in the response";
-    c.detail = d.str();
-    out_.causes.push_back(c);
+    trajectory_divergence(name, main, sw, fr);
+    // Contact time: first event against the finest-step run of the same backend.
+    if (sw.fine && !main.result.events.empty() && !sw.fine->result.events.empty() &&
+        std::abs(fr.finest - scene_.sim.dt) > 1e-15)
+      metric(primary_check(), name, "", "contact_time_err",
+             std::abs(main.result.events.front().time - sw.fine->result.events.front().time),
+             fmt_dt(fr.finest));
+    conservation(name, main.result.finals, fr);
+    // [expect.body] binds the custom engine, both the extended one and the seed's algorithm;
+    // every backend, custom included, is marked by the same rule where it misses the closed
+    // form.
+    if ((name == "custom" || name == "custom-seed") && scene_.expect) {
+      check_expect_bodies(name, main.result.finals);
+      expect_bodies_bound_ = true;
+    }
+    if (scene_.expect)
+      mark_expect_disagreement(
+          name, main.result.finals,
+          fr.have_expect ? ke_norm_error(inputs_, main.result.finals, fr.expected, fr.e0_kin)
+                         : 0.0);
+    if (scene_.has_check(CheckKind::Stability)) stability(name, main, fr);
+    // The verdict at every other swept step (report rows; not metrics of the check).
+    if (sw.stability_sweep)
+      for (const DynRun& r : sw.runs)
+        if (std::abs(r.dt - scene_.sim.dt) > 1e-15 * r.dt) stability(name, r, fr, /*swept=*/true);
+  }
+
+  // A run that stopped early: its stability verdict, and a failed [expect.body] for the engine
+  // under test (no final state to compare is not a pass).
+  void stopped_run(const std::string& name, const DynRun& main, const DynamicsFrame& fr) {
+    if (scene_.has_check(CheckKind::Stability)) stability(name, main, fr);
+    if ((name == "custom" || name == "custom-seed") && scene_.expect &&
+        !scene_.expect->bodies.empty()) {
+      out_.expect_failures.push_back(
+          name + ": the run stopped before t = duration: " + main.result.message);
+      expect_bodies_bound_ = true;
+    }
+  }
+
+  // The backend at every step of the sweep (or only the finest, the self-consistency
+  // reference, when no sweep is asked for).
+  SweepRuns sweep_runs(const Backend& be, const DynRun& main, const DynamicsFrame& fr) {
+    SweepRuns sw;
+    // Velocity errors belong to the impulse and trajectory checks: a stability-only scene
+    // does not pay for the self-consistency run.
+    sw.wants_velocity =
+        scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory);
+    sw.stability_sweep =
+        scene_.has_check(CheckKind::Stability) && !scene_.sim.sweep_dt.empty() && fr.wants_sweep;
+    if (!fr.wants_sweep && (fr.have_expect || !sw.wants_velocity) &&
+        !scene_.has_check(CheckKind::Trajectory))
+      return sw;
+    const std::vector<double> to_run = fr.wants_sweep ? fr.dts : std::vector<double>{fr.finest};
+    for (double dt : to_run) {
+      if (std::abs(dt - scene_.sim.dt) <= 1e-15 * dt) {
+        sw.runs.push_back(main);
+        continue;
+      }
+      // The finest run of a trajectory check is sampled at the same times as the main run; so
+      // is every swept run of a stability scene that names its own sweep (its verdict is given
+      // at each step: the thin wall must not tunnel at any).
+      const bool sample =
+          (scene_.has_check(CheckKind::Trajectory) && dt == fr.finest) || sw.stability_sweep;
+      const long every =
+          sample ? std::max<long>(1, std::lround(fr.sample_every * scene_.sim.dt / dt)) : 0;
+      sw.runs.push_back(run_dynamics(be, scene_, dt, every, cache_, inputs_));
+    }
+    if (sw.runs.back().result.status == Status::Ok) sw.fine = sw.runs.back();
+    return sw;
+  }
+
+  // The final velocities the main run is measured against ([expect], else the finest step's
+  // run; `against` names it, "" : none) and the velocity error metric against them.
+  std::vector<std::optional<RefState>> velocity_reference(const std::string& name,
+                                                          const DynRun& main, const SweepRuns& sw,
+                                                          const DynamicsFrame& fr,
+                                                          std::string& against) {
+    std::vector<std::optional<RefState>> ref;
+    if (fr.have_expect) {
+      against = "analytic";
+      ref = fr.expected;
+    } else if (sw.fine) {
+      against = fmt_dt(fr.finest);
+      ref.resize(inputs_.size());
+      for (size_t i = 0; i < inputs_.size(); ++i)
+        ref[i] =
+            RefState{sw.fine->result.finals[i].velocity,
+                     fr.angular ? std::optional<Vec3>(sw.fine->result.finals[i].angular_velocity)
+                                : std::nullopt};
+    }
+    if (!against.empty() &&
+        !(sw.fine && !fr.have_expect && std::abs(fr.finest - scene_.sim.dt) < 1e-15)) {
+      metric(primary_check(), name, "", "velocity_err_ke",
+             ke_norm_error(inputs_, main.result.finals, ref, fr.e0_kin), against);
+    } else if (against.empty() && sw.wants_velocity) {
+      out_.skipped.push_back(name + ": no reference for the velocity error");
+    }
+    return ref;
+  }
+
+  // The same impact with first contact 1/3 and 2/3 of a step later (the headline stays the
+  // scene as written), and the cause of a miss.
+  void contact_phases(const std::string& name, const DynRun& main, const DynamicsFrame& fr,
+                      Json& bj) {
+    double worst = 0.0, written = 0.0;
+    std::string worst_phase = "written";
+    if (fr.have_expect)
+      written = worst = ke_norm_error(inputs_, main.result.finals, fr.expected, fr.e0_kin);
+    FirstImpulse worst_fi = main.result.first_impulse;
+    std::vector<RigidBody> worst_start = inputs_;  // the bodies at t = 0 of the worst run
+    if (fr.phases) {
+      Json pj = {{"written", written}};
+      for (const ContactPhase& ph : kContactPhases) {
+        const Scene shifted = shifted_scene(scene_, ph.fraction * scene_.sim.dt);
+        const DynRun r =
+            run_dynamics(backend(name), shifted, scene_.sim.dt, 0, cache_, make_bodies(shifted));
+        if (r.result.status != Status::Ok) {
+          pj[ph.label] = "error: " + r.result.message;
+          continue;
+        }
+        const double err = ke_norm_error(inputs_, r.result.finals, fr.expected, fr.e0_kin);
+        pj[ph.label] = err;
+        metric(primary_check(), name, "", std::string("velocity_err_ke_phase_") + ph.label, err,
+               "analytic");
+        if (err > worst) {
+          worst = err;
+          worst_phase = ph.label;
+          worst_fi = r.result.first_impulse;
+          worst_start = make_bodies(shifted);
+        }
+      }
+      pj["worst"] = worst;
+      pj["worst_phase"] = worst_phase;
+      bj["contact_phase"] = pj;
+      if (written <= kMarkVelocityErr && worst > kMarkVelocityErr)
+        out_.disagreements.push_back(name + ": velocity error " + fmt_num(worst, 3) +
+                                     " with first contact " + phase_text(worst_phase) +
+                                     " (as written: " + fmt_num(written, 3) + ")");
+    }
+    if (fr.have_expect && scene_.has_check(CheckKind::Impulse) &&
+        std::max(written, worst) > kMarkVelocityErr) {
+      // The scene as written explains itself when it misses; else the worst phase does.
+      const bool as_written = written > kMarkVelocityErr;
+      out_.causes.push_back(impact_cause(
+          scene_, inputs_, name, as_written ? main.result.first_impulse : worst_fi,
+          as_written ? inputs_ : worst_start, written, worst, worst_phase, fr.expected));
+    }
+  }
+
+  // State divergence over time: how far any point of a body is from where the finest-step run
+  // puts it at the same sample time, |dx| + (size / 2) * rotation angle (an upper bound),
+  // relative to the body's size.
+  void trajectory_divergence(const std::string& name, const DynRun& main, const SweepRuns& sw,
+                             const DynamicsFrame& fr) {
+    if (!scene_.has_check(CheckKind::Trajectory) || !sw.fine || sw.fine->result.samples.empty() ||
+        std::abs(fr.finest - scene_.sim.dt) <= 1e-15)
+      return;
+    const std::vector<StateSample>& fine = sw.fine->result.samples;
+    double worst = 0.0;
+    size_t k = 0;
+    for (const StateSample& smp : main.result.samples) {
+      while (k + 1 < fine.size() &&
+             std::abs(fine[k + 1].time - smp.time) <= std::abs(fine[k].time - smp.time))
+        ++k;
+      const StateSample& ref = fine[k];
+      if (std::abs(ref.time - smp.time) > 0.5 * scene_.sim.dt) continue;  // no partner
+      for (size_t i = 0; i < inputs_.size() && i < ref.bodies.size(); ++i)
+        if (!inputs_[i].is_static)
+          worst = std::max(
+              worst,
+              (smp.bodies[i].position - ref.bodies[i].position).norm() / body_size(inputs_[i]) +
+                  0.5 * smp.bodies[i].orientation.angularDistance(ref.bodies[i].orientation));
+    }
+    metric("trajectory", name, "", "state_divergence_err", worst, fmt_dt(fr.finest));
+  }
+
+  // Conservation: momentum (where it is an invariant), energy against what e allows.
+  void conservation(const std::string& name, const std::vector<BodyFinal>& f,
+                    const DynamicsFrame& fr) {
+    if (fr.closed) {
+      metric(primary_check(), name, "", "momentum_drift_err",
+             (linear_momentum(inputs_, f) - fr.p0).norm() / fr.p_scale, "invariant");
+      if (fr.angular)
+        metric(primary_check(), name, "", "angular_momentum_drift_err",
+               (angular_momentum(inputs_, f) - fr.h0).norm() / fr.h_scale, "invariant");
+    }
+    const double e1 = total_energy(inputs_, f, scene_.sim.gravity);
+    const double e_scale = std::max(std::abs(fr.e0), fr.e0_kin);
+    if (e_scale <= 0) return;
+    metric(primary_check(), name, "", "energy_change_rel", (e1 - fr.e0) / e_scale, "initial");
+    // Against the closed form's final kinetic energy where [expect] gives every moving body's
+    // velocities, else the invariant rule of the restitution.
+    const EnergyError err = energy_error(fr.e0, e1, kinetic_energy(inputs_, f),
+                                         expected_kinetic_energy(inputs_, f, fr.expected),
+                                         scene_.sim.restitution, e_scale);
+    metric(primary_check(), name, "", "energy_err", err.value, err.against);
   }
 
   std::string primary_check() const {
@@ -906,167 +706,43 @@ class Evaluator {
   // maximum penetration (whole run and at rest), tunnelling, jitter at rest, and a verdict.
   // `swept`: a run at another step of the scene's sweep: its verdict goes to the JSON's
   // `stability_sweep` (and the report's table), not to the metrics.
-  void stability(const std::string& name, const DynRun& run, double e0, const Vec3& p0,
-                 const Vec3& h0, bool closed, double p_scale, double h_scale, bool swept = false) {
+  void stability(const std::string& name, const DynRun& run, const DynamicsFrame& fr,
+                 bool swept = false) {
+    const StabilityGeometry geo = stability_geometry(inputs_);
+    StabilityInvariants inv{fr.e0, fr.p0, fr.h0, fr.closed, fr.p_scale, fr.h_scale};
+    const StabilityTrace tr = trace_stability(inputs_, run.result, sample_overlaps(run, geo), geo,
+                                              inv, scene_.sim.gravity);
+    const double jitter = rest_jitter(inputs_, run.result.samples, scene_.sim.gravity);
     Json s;
-    const auto& samples = run.result.samples;
-    bool nonfinite = run.result.status == Status::Error &&
-                     run.result.message.find("non-finite") != std::string::npos;
-    double e_max = e0, e_min = e0, e_end = e0, pen_max = 0.0, drift = 0.0, hdrift = 0.0;
-    // Penetration at rest: the least, over the last fifth of the run, of each sample's deepest
-    // overlap. An impact overlaps for a step or two and is gone; sinking persists in every sample.
-    double pen_rest = std::numeric_limits<double>::infinity();
-    const double e_scale = std::max({std::abs(e0), initial_kinetic_energy(inputs_), 1e-300});
-    int tunnelled = 0;
-    // Per body, once: the exact query's topology, and a radius about the centre of mass that
-    // holds every vertex (the bounding sphere's, plus its centre's offset from the COM).
-    std::vector<SatShape> sat_shapes;
-    std::vector<double> radius;
-    for (const RigidBody& b : inputs_) {
-      sat_shapes.emplace_back(*b.shape);
-      radius.push_back(bounding_sphere(b).radius + b.shape->bounds().center().norm());
-    }
-    // Initial separating direction per pair (exact), to see who ends up past whom. Watched:
-    // every pair with a static body (walls, floors), and every pair in scenes of up to three
-    // bodies; free bodies in a crowd legitimately change sides, and 500,000 pairs cost too much.
-    std::vector<std::tuple<size_t, size_t, Vec3, double>> watch;
-    for (size_t i = 0; i < inputs_.size(); ++i)
-      for (size_t k = i + 1; k < inputs_.size(); ++k) {
-        if (inputs_[i].is_static && inputs_[k].is_static) continue;
-        if (inputs_.size() > 3 && !inputs_[i].is_static && !inputs_[k].is_static) continue;
-        const SatResult sat =
-            sat_query(sat_shapes[i], inputs_[i].pose(), sat_shapes[k], inputs_[k].pose());
-        if (sat.touching) continue;
-        // Half-thickness of both bodies along the separating normal, at the t = 0 poses.
-        double reach = 0.0;
-        for (size_t m : {i, k}) {
-          double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-          for (size_t v = 0; v < inputs_[m].shape->vertices().size(); ++v) {
-            const double d = inputs_[m].world_vertex(static_cast<int>(v)).dot(sat.normal);
-            lo = std::min(lo, d);
-            hi = std::max(hi, d);
-          }
-          reach += 0.5 * (hi - lo);
-        }
-        watch.emplace_back(i, k, sat.normal, reach);
-      }
-    std::vector<bool> passed(watch.size(), false);
-    // Penetration: exact depth of every pair in bounding range, relative to the smaller body;
-    // the deepest per sample, for the samples before the first non-finite one.
-    auto deepest_overlap = [&](const StateSample& smp) {
-      double pen_sample = 0.0;
-      for (size_t i = 0; i < inputs_.size(); ++i) {
-        for (size_t k = i + 1; k < inputs_.size(); ++k) {
-          if (inputs_[i].is_static && inputs_[k].is_static) continue;
-          const Pose pa{smp.bodies[i].position, smp.bodies[i].orientation};
-          const Pose pb{smp.bodies[k].position, smp.bodies[k].orientation};
-          const double reach = radius[i] + radius[k];
-          if ((pa.position - pb.position).norm() > reach + 1e-9 * reach) continue;
-          const SatResult sat = sat_query(sat_shapes[i], pa, sat_shapes[k], pb);
-          if (!sat.touching) continue;
-          pen_sample = std::max(pen_sample,
-                                sat.depth / std::min(body_size(inputs_[i]), body_size(inputs_[k])));
-        }
-      }
-      return pen_sample;
-    };
-    size_t finite_samples = samples.size();
-    for (size_t t = 0; t < samples.size() && finite_samples == samples.size(); ++t)
-      for (const BodyFinal& b : samples[t].bodies)
-        if (!b.position.allFinite() || !b.velocity.allFinite() || !b.angular_velocity.allFinite())
-          finite_samples = t;
-    // A cached reference run's overlaps are cached with it (they cost more than the run).
-    std::optional<std::vector<double>> stored;
-    if (!run.cache_key.empty()) stored = cache_.load_derived(run.cache_key, "stability overlaps");
-    const std::vector<double> overlaps =
-        stored && stored->size() == finite_samples
-            ? *stored
-            : parallel_map(finite_samples, [&](size_t t) { return deepest_overlap(samples[t]); });
-    if (!run.cache_key.empty() && !(stored && stored->size() == finite_samples))
-      cache_.store_derived(run.cache_key, "stability overlaps", overlaps);
-    // "At rest": the last fifth of the run, as for the jitter below.
-    const size_t rest_from = samples.size() * 4 / 5;
-    size_t sample_index = 0;
-    for (const StateSample& smp : samples) {
-      const bool at_rest = sample_index++ >= rest_from;
-      for (const BodyFinal& b : smp.bodies)
-        if (!b.position.allFinite() || !b.velocity.allFinite() || !b.angular_velocity.allFinite())
-          nonfinite = true;
-      if (nonfinite) break;
-      const double e = total_energy(inputs_, smp.bodies, scene_.sim.gravity);
-      e_max = std::max(e_max, e);
-      e_min = std::min(e_min, e);
-      e_end = e;
-      if (closed) {
-        drift = std::max(drift, (linear_momentum(inputs_, smp.bodies) - p0).norm() / p_scale);
-        hdrift = std::max(hdrift, (angular_momentum(inputs_, smp.bodies) - h0).norm() / h_scale);
-      }
-      const double pen_sample = overlaps[sample_index - 1];
-      pen_max = std::max(pen_max, pen_sample);
-      if (at_rest) pen_rest = std::min(pen_rest, pen_sample);
-      // Tunnelling: a pair that started apart and now lies fully on the other side of its
-      // initial separating plane, while too close sideways to have gone round: passed through.
-      for (size_t w = 0; w < watch.size(); ++w) {
-        const auto& [i, k, n, reach] = watch[w];
-        const Vec3 d0 = inputs_[i].position - inputs_[k].position;
-        const Vec3 d = smp.bodies[i].position - smp.bodies[k].position;
-        const double side0 = d0.dot(n), side = d.dot(n);
-        const double lateral = (d - side * n).norm();
-        const double beside = radius[i] + radius[k];
-        if (side0 > 0 && side < -reach && lateral < beside) passed[w] = true;
-      }
-    }
-    for (bool p : passed) tunnelled += p ? 1 : 0;
-    // Jitter at rest: RMS speed over the last fifth of the run (only meaningful under gravity).
-    double jitter = 0.0;
-    if (scene_.sim.gravity.norm() > 0 && samples.size() >= 5) {
-      double sum = 0.0;
-      int count = 0;
-      for (size_t t = samples.size() * 4 / 5; t < samples.size(); ++t)
-        for (size_t i = 0; i < inputs_.size(); ++i)
-          if (!inputs_[i].is_static) {
-            sum += samples[t].bodies[i].velocity.squaredNorm();
-            ++count;
-          }
-      jitter = count ? std::sqrt(sum / count) : 0.0;
-    }
-    const double growth = (e_max - e0) / e_scale;
-    if (!std::isfinite(pen_rest)) pen_rest = 0.0;  // no sample at rest
-    // Signed drift: the largest |E - E0| / scale over the run, with its sign (gain +, loss -);
-    // and the change at the end (the final state when the run finished).
-    const double drift_e = e_max - e0 >= e0 - e_min ? growth : (e_min - e0) / e_scale;
-    if (run.result.status == Status::Ok && !nonfinite)
-      e_end = total_energy(inputs_, run.result.finals, scene_.sim.gravity);
-    const double e_change = (e_end - e0) / e_scale;
     s["status"] = to_string(run.result.status);
     s["dt"] = run.dt;
     s["restitution"] = scene_.sim.restitution;
-    s["nonfinite"] = nonfinite;
-    s["energy_growth_rel"] = growth;
-    s["energy_drift_rel"] = drift_e;
-    s["energy_change_rel"] = e_change;
-    if (closed) {
-      s["momentum_drift_rel"] = drift;
-      s["angular_momentum_drift_rel"] = hdrift;
+    s["nonfinite"] = tr.nonfinite;
+    s["energy_growth_rel"] = tr.growth;
+    s["energy_drift_rel"] = tr.drift_e;
+    s["energy_change_rel"] = tr.e_change;
+    if (fr.closed) {
+      s["momentum_drift_rel"] = tr.drift;
+      s["angular_momentum_drift_rel"] = tr.hdrift;
     }
-    s["max_penetration_rel"] = pen_max;
-    s["rest_penetration_rel"] = pen_rest;
-    s["tunnelled_pairs"] = tunnelled;
+    s["max_penetration_rel"] = tr.pen_max;
+    s["rest_penetration_rel"] = tr.pen_rest;
+    s["tunnelled_pairs"] = tr.tunnelled;
     if (scene_.sim.gravity.norm() > 0) s["jitter_rms_mps"] = jitter;
     // Verdict: the rules of stability_verdict (metrics.h).
     StabilityFacts facts;
-    facts.nonfinite = nonfinite;
+    facts.nonfinite = tr.nonfinite;
     facts.stopped = run.result.status == Status::Error;
     facts.stop_message = run.result.message;
-    facts.energy_growth = growth;
-    facts.closed = closed;
-    facts.momentum_drift = drift;
-    facts.max_penetration = pen_max;
-    facts.rest_penetration = pen_rest;
-    facts.energy_final = e_change;
+    facts.energy_growth = tr.growth;
+    facts.closed = fr.closed;
+    facts.momentum_drift = tr.drift;
+    facts.max_penetration = tr.pen_max;
+    facts.rest_penetration = tr.pen_rest;
+    facts.energy_final = tr.e_change;
     facts.restitution = scene_.sim.restitution;
     facts.friction = scene_.sim.friction;
-    facts.tunnelled_pairs = tunnelled;
+    facts.tunnelled_pairs = tr.tunnelled;
     const StabilityVerdict verdict = stability_verdict(facts);
     s["verdict"] = verdict.verdict;
     s["why"] = verdict.why;
@@ -1075,11 +751,25 @@ class Evaluator {
       return;
     }
     stability_json_[name] = s;
-    metric("stability", name, "", "energy_growth_err", std::max(growth, 0.0), "invariant");
-    metric("stability", name, "", "max_penetration_rel_err", pen_max, "exact");
-    metric("stability", name, "", "tunnelled_pairs_err", tunnelled, "invariant");
+    metric("stability", name, "", "energy_growth_err", std::max(tr.growth, 0.0), "invariant");
+    metric("stability", name, "", "max_penetration_rel_err", tr.pen_max, "exact");
+    metric("stability", name, "", "tunnelled_pairs_err", tr.tunnelled, "invariant");
     if (scene_.sim.gravity.norm() > 0)
       metric("stability", name, "", "jitter_rms_mps_err", jitter, "invariant");
+  }
+
+  // The deepest exact overlap of every finite sample; a cached reference run's overlaps are
+  // cached with it (they cost more than the run).
+  std::vector<double> sample_overlaps(const DynRun& run, const StabilityGeometry& geo) {
+    const auto& samples = run.result.samples;
+    const size_t finite_samples = finite_prefix(samples);
+    std::optional<std::vector<double>> stored;
+    if (!run.cache_key.empty()) stored = cache_.load_derived(run.cache_key, "stability overlaps");
+    if (stored && stored->size() == finite_samples) return *stored;
+    const std::vector<double> overlaps = parallel_map(
+        finite_samples, [&](size_t t) { return deepest_overlap(geo, inputs_, samples[t]); });
+    if (!run.cache_key.empty()) cache_.store_derived(run.cache_key, "stability overlaps", overlaps);
+    return overlaps;
   }
 
   // -- mass ------------------------------------------------------------------------------------

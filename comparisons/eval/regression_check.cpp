@@ -1,7 +1,8 @@
-// `rbx check`'s measuring and comparing: reruns the scene library and compares every accuracy metric (names with "err")
-// with the committed baseline; exit 1 on any regression. Timings never fail the check.
-// Every changed metric is named, worse and better, grouped by scene and backend; `--update`
-// merges this run into the baseline and refuses while anything is worse (--accept-worse).
+// `rbx check`'s measuring and comparing: reruns the scene library and compares every accuracy
+// metric (names with "err") with the committed baseline; exit 1 on any regression. Timings never
+// fail the check. Every changed metric is named, worse and better, grouped by scene and backend;
+// `--update` merges this run into the baseline and refuses while anything is worse
+// (--accept-worse).
 #include "comparisons/eval/regression_check.h"
 
 #include <algorithm>
@@ -132,8 +133,7 @@ CheckRun measure_check(const std::vector<Scene>& scenes, const CheckSettings& se
         run.cached += bj.value("cached", false) ? 1 : 0;
       }
     std::string subject;
-    if (known_failure_passes(s, ev, subject))
-      run.now_passing.push_back({scene, s.file, subject});
+    if (known_failure_passes(s, ev, subject)) run.now_passing.push_back({scene, s.file, subject});
   }
   if (set.explore) measure_explore(set, run);
   run.runtime_s = clock.seconds();

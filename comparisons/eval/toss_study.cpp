@@ -57,8 +57,9 @@ std::vector<const Backend*> select_toss_backends(const std::string& list) {
   return out;
 }
 
-TossEvaluation evaluate_tosses(const std::vector<const Backend*>& chosen, const std::vector<Toss>& tosses,
-                        const std::vector<std::pair<std::string, ContactParams>>& stored) {
+TossEvaluation evaluate_tosses(const std::vector<const Backend*>& chosen,
+                               const std::vector<Toss>& tosses,
+                               const std::vector<std::pair<std::string, ContactParams>>& stored) {
   TossEvaluation ev;
   for (const Backend* b : chosen) {
     std::string source;
@@ -72,7 +73,7 @@ TossEvaluation evaluate_tosses(const std::vector<const Backend*>& chosen, const 
 }
 
 Json toss_evaluation_json(const std::string& data, const std::vector<Toss>& tosses,
-                     const std::string& params_file, const TossEvaluation& ev) {
+                          const std::string& params_file, const TossEvaluation& ev) {
   Json j;
   j["data"] = data;
   j["tosses"] = tosses.size();

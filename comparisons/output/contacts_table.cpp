@@ -22,8 +22,7 @@ void print_contacts(std::ostream& out, const Scene& scene, const ContactsCompari
       const ContactPoint* q = deepest(r.run.result);
       table.add({r.backend, to_string(r.run.result.status),
                  std::to_string(r.run.result.contacts.size()), q ? fmt_vec(q->normal) : "-",
-                 q ? fmt_num(q->depth, 5) : "-", q ? fmt_vec(q->point) : "-", r.angle,
-                 r.depth_diff,
+                 q ? fmt_num(q->depth, 5) : "-", q ? fmt_vec(q->point) : "-", r.angle, r.depth_diff,
                  r.mark == "disagrees"  ? "✗"
                  : r.mark == "deviates" ? "~"
                                         : "",
@@ -31,7 +30,8 @@ void print_contacts(std::ostream& out, const Scene& scene, const ContactsCompari
     }
     table.print(out);
     for (const ContactsRow& r : p.rows)
-      if (!r.run.result.message.empty()) out << "  " << r.backend << ": " << r.run.result.message << "\n";
+      if (!r.run.result.message.empty())
+        out << "  " << r.backend << ": " << r.run.result.message << "\n";
   }
   for (const std::string& m : c.marks) out << "  " << m << "\n";
   if (!c.pairs.empty()) return;

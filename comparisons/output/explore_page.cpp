@@ -149,7 +149,6 @@ std::string explore_markdown(const Json& j, bool have_figure) {
   return o.str();
 }
 
-
 bool draw_explore_figure(const std::string& dir) {
   const std::string script =
       std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/explore_plots.py";

@@ -194,7 +194,9 @@ std::vector<std::string> report_columns(const std::vector<SceneEvaluation>& evs)
 }
 
 // The headline of every scene for every backend, ✗ and ~ marked.
-std::string summary_section(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs, const std::vector<std::string>& cols, bool views_ok) {
+std::string summary_section(const std::vector<Scene>& scenes,
+                            const std::vector<SceneEvaluation>& evs,
+                            const std::vector<std::string>& cols, bool views_ok) {
   std::ostringstream md;
   md << "## Summary\n\n";
   md << "Headline error of each backend on each scene. Contact scenes: **normal angle (deg) / "
@@ -238,7 +240,9 @@ std::string summary_section(const std::vector<Scene>& scenes, const std::vector<
 }
 
 // The impact scenes also run with first contact 1/3 and 2/3 of a step later.
-std::string contact_phase_section(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs, const std::vector<std::string>& cols) {
+std::string contact_phase_section(const std::vector<Scene>& scenes,
+                                  const std::vector<SceneEvaluation>& evs,
+                                  const std::vector<std::string>& cols) {
   std::ostringstream md;
   Table phases({"scene", "backend", "as written", "1/3 later", "2/3 later", "worst"});
   for (size_t i = 0; i < evs.size(); ++i)
@@ -251,8 +255,8 @@ std::string contact_phase_section(const std::vector<Scene>& scenes, const std::v
         return p[k].is_number() ? fmt_num(p[k].get<double>(), 2)
                                 : md_escape(p[k].get<std::string>());
       };
-      phases.add({md_escape(evs[i].family + "/" + scenes[i].name), c, cell("written"),
-                  cell("1_3"), cell("2_3"), cell("worst")});
+      phases.add({md_escape(evs[i].family + "/" + scenes[i].name), c, cell("written"), cell("1_3"),
+                  cell("2_3"), cell("worst")});
     }
   if (phases.size() > 0) {
     md << "## Contact phase\n\n";
@@ -268,7 +272,9 @@ std::string contact_phase_section(const std::vector<Scene>& scenes, const std::v
 }
 
 // Disagreements, grouped by backend, then the why-list.
-std::string disagreement_section(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs, const std::vector<std::string>& cols) {
+std::string disagreement_section(const std::vector<Scene>& scenes,
+                                 const std::vector<SceneEvaluation>& evs,
+                                 const std::vector<std::string>& cols) {
   std::ostringstream md;
   md << "## Who disagrees with the truth\n\n";
   std::map<std::string, std::vector<std::string>> by_backend;
@@ -292,7 +298,9 @@ std::string disagreement_section(const std::vector<Scene>& scenes, const std::ve
 }
 
 // The error-against-run-time figures and the query-time table.
-std::string error_vs_runtime_section(const std::vector<SceneEvaluation>& evs, const std::vector<std::string>& cols, bool figures_ok, const std::string& figures_msg) {
+std::string error_vs_runtime_section(const std::vector<SceneEvaluation>& evs,
+                                     const std::vector<std::string>& cols, bool figures_ok,
+                                     const std::string& figures_msg) {
   std::ostringstream md;
   md << "## Error against run time\n\n";
   md << "Dynamics: each backend is run at every time step of the scene's `sweep_dt` (default 4, "
@@ -322,7 +330,8 @@ std::string error_vs_runtime_section(const std::vector<SceneEvaluation>& evs, co
 }
 
 // Every stability verdict, at the scene's step and along its own sweep.
-std::string stability_section(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs) {
+std::string stability_section(const std::vector<Scene>& scenes,
+                              const std::vector<SceneEvaluation>& evs) {
   std::ostringstream md;
   md << "## Stability\n\n";
   md << "Verdicts, worst first: **unstable** (non-finite state, energy gained beyond 1 %, "
@@ -366,7 +375,9 @@ std::string stability_section(const std::vector<Scene>& scenes, const std::vecto
 }
 
 // One section per scene: statuses, metrics, findings and its figures.
-std::string scene_details_section(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs, bool figures_ok, bool views_ok) {
+std::string scene_details_section(const std::vector<Scene>& scenes,
+                                  const std::vector<SceneEvaluation>& evs, bool figures_ok,
+                                  bool views_ok) {
   std::ostringstream md;
   md << "## Scenes\n\n";
   for (size_t i = 0; i < evs.size(); ++i) {
@@ -430,8 +441,8 @@ Json geometry_json(const Scene& scene) {
 }
 
 std::string report_markdown(const std::vector<Scene>& scenes,
-                           const std::vector<SceneEvaluation>& evs, double total_s, bool figures_ok,
-                           const std::string& figures_msg, bool views_ok) {
+                            const std::vector<SceneEvaluation>& evs, double total_s,
+                            bool figures_ok, const std::string& figures_msg, bool views_ok) {
   std::ostringstream md;
   const std::vector<std::string> cols = report_columns(evs);
   md << "# rbx accuracy report\n\n";
@@ -484,16 +495,14 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
     std::vector<std::pair<std::string, Json>> stab_rows;  // the scene's step, then its sweep
     for (const auto& [name, s] : evs[i].json["stability"].items()) {
       stab_rows.emplace_back(name, s);
-      if (evs[i].json.contains("stability_sweep") &&
-          evs[i].json["stability_sweep"].contains(name))
+      if (evs[i].json.contains("stability_sweep") && evs[i].json["stability_sweep"].contains(name))
         for (const Json& sw : evs[i].json["stability_sweep"][name])
           stab_rows.emplace_back(name, sw);
     }
     for (const auto& [name, s] : stab_rows)
       stab << sc << "," << fam << "," << name << "," << fmt_num(s["dt"].get<double>(), 17) << ","
-           << fmt_num(s["restitution"].get<double>(), 17) << ","
-           << s["verdict"].get<std::string>() << ","
-           << fmt_num(s["energy_growth_rel"].get<double>(), 17) << ","
+           << fmt_num(s["restitution"].get<double>(), 17) << "," << s["verdict"].get<std::string>()
+           << "," << fmt_num(s["energy_growth_rel"].get<double>(), 17) << ","
            << fmt_num(s["energy_drift_rel"].get<double>(), 17) << ","
            << fmt_num(s["max_penetration_rel"].get<double>(), 17) << ","
            << fmt_num(s["rest_penetration_rel"].get<double>(), 17) << ","
@@ -504,7 +513,6 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
   write_text((tmp / "metrics.csv").string(), metrics.str());
   write_text((tmp / "sweep.csv").string(), sweep.str());
   write_text((tmp / "stability.csv").string(), stab.str());
-
 }
 
 bool draw_report_figures(const std::string& dir, std::string& message) {

@@ -7,11 +7,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "asset_view_css.h"
+#include "asset_view_js.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/trajectory.h"
 #include "comparisons/output/scorecard.h"
-#include "asset_view_css.h"
-#include "asset_view_js.h"
 #include "comparisons/scene/scene_file.h"
 
 namespace fs = std::filesystem;
@@ -45,7 +45,6 @@ Json events_json(const Json& contacts) {
   }
   return out;
 }
-
 
 // JSON inside a <script> element: no "<", ">" or "&" (their \u escapes mean the same in JSON
 // strings, and they occur nowhere else), so no scene text can close the element.
@@ -218,7 +217,8 @@ std::string view_page(const Json& data, const std::string& three_js, const std::
   const Json& ref = data["reference"];
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rbx view: "
-    << html_escape(title) << "</title>\n<style>\n" << kViewStyle << "</style>\n";
+    << html_escape(title) << "</title>\n<style>\n"
+    << kViewStyle << "</style>\n";
   if (!three_src.empty())
     h << "<script src=\"" << html_escape(three_src) << "\"></script>\n";
   else
@@ -247,7 +247,8 @@ std::string view_page(const Json& data, const std::string& three_js, const std::
        "id=\"toggles\"></span></div>\n"
        "</header>\n<div id=\"stage\"><canvas id=\"view\"></canvas><div id=\"labels\"></div></div>\n"
        "<pre id=\"rbx-state\">{}</pre>\n<script id=\"rbx-data\" type=\"application/json\">"
-    << script_safe_json(data) << "</script>\n<script>\n" << kViewScript << "</script>\n</body></html>\n";
+    << script_safe_json(data) << "</script>\n<script>\n"
+    << kViewScript << "</script>\n</body></html>\n";
   return h.str();
 }
 

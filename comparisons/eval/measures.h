@@ -1,0 +1,132 @@
+// What the harness measures, as free functions of the bodies and the runs: contact queries and
+// dynamics runs (through the reference-result cache), energies and momenta, the sweep's steps
+// and contact phases, and the stability check's trace (exact overlaps, tunnelling, drift).
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "comparisons/eval/contact_eval.h"
+#include "comparisons/eval/result_cache.h"
+#include "engine/body.h"
+#include "engine/scene.h"
+#include "reference/backend.h"
+#include "reference/exact.h"
+
+namespace rbx {
+
+/// A dynamics run with its wall-clock time; library exceptions become status Error.
+struct DynRun {
+  DynamicsResult result;
+  double runtime_s = 0.0;
+  double dt = 0.0;
+  bool cached = false;    // from the reference-result cache
+  std::string cache_key;  // the run's cache key ("" : not cacheable)
+};
+
+/// Runs `b` on the scene at step `dt`, sampling every `sample_every` steps (0: none). A
+/// reference backend's run comes from the cache when it holds this very call (the bodies as
+/// built from the scene, the settings, dt and sampling); otherwise it runs and is stored.
+DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every,
+                    const ResultCache& cache, const std::vector<RigidBody>& bodies);
+
+/// A contact query timed for about `budget_s` (median of the repeats, at most 200), or the
+/// cached result of the same query (a reference backend's, see result_cache.h).
+ContactRun timed_contact(const Backend& be, const RigidBody& a, const RigidBody& b,
+                         const ResultCache& cache, double budget_s);
+
+/// Kinetic energy of the bodies at t = 0 (J).
+double initial_kinetic_energy(const std::vector<RigidBody>& inputs);
+/// Linear momentum of the moving bodies in states `s` (kg m/s).
+Vec3 linear_momentum(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& s);
+/// Angular momentum about the origin of the moving bodies in states `s` (kg m^2/s).
+Vec3 angular_momentum(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& s);
+/// The bodies' states at t = 0.
+std::vector<BodyFinal> initial_states(const std::vector<RigidBody>& inputs);
+/// Size of a body: its bounding-box diagonal (m).
+double body_size(const RigidBody& b);
+/// "self dt=..." : a metric measured against the same backend at step `dt`.
+std::string fmt_dt(double dt);
+
+/// f(0), ..., f(n - 1) on two threads (the machine's two cores), interleaved. Each value is
+/// computed as it would be on one thread, so results are the same; f must not share mutable
+/// state (the exact oracle does not). A thrown exception is rethrown here.
+std::vector<double> parallel_map(size_t n, const std::function<double(size_t)>& f);
+
+/// Time steps of the sweep, coarsest first: the scene's sweep_dt, else its dt scaled by 4, 2,
+/// 1, 1/2, 1/4.
+std::vector<double> sweep_steps(const Scene& scene);
+
+/// Contact phases besides the scene as written (phase 0: first contact on a step boundary, as
+/// every analytic scene is written): first contact 1/3 and 2/3 of a step later.
+struct ContactPhase {
+  const char* label;  // as written into metric names and JSON
+  double fraction;    // of a step
+};
+constexpr ContactPhase kContactPhases[] = {{"1_3", 1.0 / 3.0}, {"2_3", 2.0 / 3.0}};
+
+/// The scene with every moving body moved back along its velocity by `shift` seconds and one
+/// more step of duration: first contact comes `shift` later in the step, and the run ends
+/// dt - shift after the written end, in free flight (no gravity: the closed form's final
+/// velocities are unchanged).
+Scene shifted_scene(const Scene& scene, double shift);
+
+/// The bodies' geometry for the stability check, built once per run.
+struct StabilityGeometry {
+  std::vector<SatShape> shapes;  // each body's exact-query topology
+  std::vector<double> radius;    // about the centre of mass, holding every vertex
+  /// A pair watched for tunnelling: apart at t = 0 along `normal`, with the half-thicknesses
+  /// of both bodies along it summed in `reach`.
+  struct Watch {
+    size_t i, k;
+    Vec3 normal;
+    double reach;
+  };
+  std::vector<Watch> watch;
+};
+
+/// Watched: every pair with a static body (walls, floors), and every pair in scenes of up to
+/// three bodies; free bodies in a crowd legitimately change sides, and 500,000 pairs cost too
+/// much.
+StabilityGeometry stability_geometry(const std::vector<RigidBody>& inputs);
+
+/// The deepest exact overlap of any pair in a sample, relative to the pair's smaller body.
+double deepest_overlap(const StabilityGeometry& g, const std::vector<RigidBody>& inputs,
+                       const StateSample& smp);
+
+/// The number of samples before the first one with a non-finite state.
+size_t finite_prefix(const std::vector<StateSample>& samples);
+
+/// The initial invariants a run is measured against.
+struct StabilityInvariants {
+  double e0;
+  Vec3 p0, h0;
+  bool closed;  // momentum is an invariant
+  double p_scale, h_scale;
+};
+
+/// What the stability check reads off a run's samples.
+struct StabilityTrace {
+  bool nonfinite = false;
+  double growth = 0.0;    // the largest energy gain, relative
+  double drift_e = 0.0;   // the largest |E - E0|, relative, signed (+ gained, - lost)
+  double e_change = 0.0;  // at the end (the final state when the run finished)
+  double drift = 0.0, hdrift = 0.0;  // momentum drifts (closed systems)
+  double pen_max = 0.0;   // the deepest overlap of any sample
+  double pen_rest = 0.0;  // the least over the last fifth of the run of each sample's deepest
+  int tunnelled = 0;      // watched pairs that passed through each other
+};
+
+/// The trace of `run` from `overlaps` (deepest_overlap of each finite sample).
+StabilityTrace trace_stability(const std::vector<RigidBody>& inputs, const DynamicsResult& run,
+                               const std::vector<double>& overlaps, const StabilityGeometry& g,
+                               const StabilityInvariants& inv, const Vec3& gravity);
+
+/// Jitter at rest: RMS speed of the moving bodies over the last fifth of the run (0 without
+/// gravity, where it means nothing, or with fewer than 5 samples).
+double rest_jitter(const std::vector<RigidBody>& inputs, const std::vector<StateSample>& samples,
+                   const Vec3& gravity);
+
+}  // namespace rbx
