@@ -15,10 +15,10 @@ std::string phase_text(const std::string& label) {
 }
 
 Cause impact_cause(const Scene& scene, const std::vector<RigidBody>& inputs,
-                 const std::string& name, const FirstImpulse& fi,
-                 const std::vector<RigidBody>& start, double written, double worst,
-                 const std::string& worst_phase,
-                 const std::vector<std::optional<RefState>>& expected) {
+                   const std::string& name, const FirstImpulse& fi,
+                   const std::vector<RigidBody>& start, double written, double worst,
+                   const std::string& worst_phase,
+                   const std::vector<std::optional<RefState>>& expected) {
   Cause c;
   c.backend = name;
   c.scene = scene.name;
@@ -60,8 +60,7 @@ Cause impact_cause(const Scene& scene, const std::vector<RigidBody>& inputs,
     Vec3 centre = Vec3::Zero();
     for (const Vec3& p : truth->manifold) centre += p;
     if (corners) centre /= static_cast<double>(corners);
-    const std::string what = corners >= 3
-                                 ? "face patch of " + std::to_string(corners) + " corners"
+    const std::string what = corners >= 3 ? "face patch of " + std::to_string(corners) + " corners"
                              : corners == 2 ? "edge contact"
                                             : "single-point contact";
     d << " against a true " << what;
@@ -74,8 +73,7 @@ Cause impact_cause(const Scene& scene, const std::vector<RigidBody>& inputs,
     for (long i : {ia, ib}) {
       const RigidBody& b = inputs[i];
       if (b.is_static || !expected[i] || !expected[i]->velocity) continue;
-      const double j =
-          std::abs(b.mass * (*expected[i]->velocity - b.velocity).dot(truth->normal));
+      const double j = std::abs(b.mass * (*expected[i]->velocity - b.velocity).dot(truth->normal));
       d << "; impulse in that step " << fmt_num(fi.impulse, 3) << " N s against " << fmt_num(j, 3)
         << " closed form";
       break;
@@ -84,8 +82,8 @@ Cause impact_cause(const Scene& scene, const std::vector<RigidBody>& inputs,
     d << (spinning ? " (bodies spin: no free-flight truth)"
                    : " (the oracle sees no contact at those poses)");
   }
-  d << "; first seen " << fmt_num(fi.depth, 2) << " m deep at step " << fi.step
-    << " (entry phase " << fmt_num(fi.entry_phase, 2) << ")"
+  d << "; first seen " << fmt_num(fi.depth, 2) << " m deep at step " << fi.step << " (entry phase "
+    << fmt_num(fi.entry_phase, 2) << ")"
     << (written <= kMarkVelocityErr ? " in the run " + phase_text(worst_phase) : std::string())
     << "; " << errors;
   // The first measured sign, in this order: the normal, the manifold, the depth, else the

@@ -151,7 +151,6 @@ Scene shifted_scene(const Scene& scene, double shift) {
   return out;
 }
 
-
 StabilityGeometry stability_geometry(const std::vector<RigidBody>& inputs) {
   StabilityGeometry g;
   for (const RigidBody& b : inputs) {
