@@ -1,8 +1,5 @@
 // The closed-form kinds of `rbx explore`: random single-point impacts and random flat landings
 // with friction, each drawn, realised as a scene with its closed form, judged and shrunk.
-#include "comparisons/eval/explore.h"
-#include "comparisons/eval/explore_detail.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +8,8 @@
 #include <sstream>
 
 #include "comparisons/eval/contact_eval.h"
+#include "comparisons/eval/explore.h"
+#include "comparisons/eval/explore_detail.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/metrics.h"
 #include "comparisons/scene/mesh_io.h"
