@@ -160,12 +160,12 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
   return goals;
 }
 
-void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
-                      const std::vector<PerfGoal>& goals, double timing_s, const std::string& out,
-                      bool contract_copy) {
+namespace {
+
+// perf.json: the machine, the settings, every row, the goals and the fitted exponents.
+Json perf_json(const BenchPlan& plan, const BenchResults& results,
+               const std::vector<PerfGoal>& goals) {
   const std::vector<NarrowBackend> nb = narrow_backends();
-  std::vector<int> sizes = {8};
-  sizes.insert(sizes.end(), plan.hull_sizes.begin(), plan.hull_sizes.end());
   Json j;
   j["generated_by"] = "rbx bench";
   j["mode"] = plan.quick ? "quick" : "full";
@@ -220,6 +220,11 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
       if (std::isfinite(e)) j["exponents"][b.backend + "/" + b.variant + "/" + k.name] = e;
     }
 
+  return j;
+}
+
+// perf.csv: one line per row.
+std::string perf_csv(const BenchResults& results) {
   std::ostringstream csv;
   csv << "kind,backend,variant,method,scene,vertices,pose,bodies,value,unit\n";
   for (const NarrowRow& r : results.narrow)
@@ -232,7 +237,12 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
     csv << "step," << r.backend << "," << r.variant << ",," << r.scene << ",,," << r.bodies << ","
         << bench_num(r.us_per_body_step, 6) << ",us_per_body_step\n";
 
-  // perf.md
+  return csv.str();
+}
+
+// perf.md's head: how it was timed, the goals and why a goal is not met.
+std::string goals_markdown(const BenchPlan& plan, const BenchResults& results,
+                           const std::vector<PerfGoal>& goals, double timing_s) {
   std::ostringstream md;
   md << "# Performance: `rbx bench" << (plan.quick ? " --quick" : "") << "`\n\n";
   md << "Machine: " << cpu_model() << ", " << results.cpus << " CPUs (shared); Release build; "
@@ -255,6 +265,15 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
         std::find(behind.begin(), behind.end(), g.behind) == behind.end())
       behind.push_back(g.behind);
   for (const std::string& b : behind) md << "\nWhy not met: " << b << "\n";
+  return md.str();
+}
+
+// The narrow phase: every contact backend per pose kind and size, with its exponent.
+std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) {
+  const std::vector<NarrowBackend> nb = narrow_backends();
+  std::vector<int> sizes = {8};
+  sizes.insert(sizes.end(), plan.hull_sizes.begin(), plan.hull_sizes.end());
+  std::ostringstream md;
   md << "\n## Narrow phase\n\n"
      << "Every contact backend through the registry's `ContactFn` on the same pairs: two unit "
         "boxes (N = 8), and two hulls of N random points on a sphere of diameter 1 m (every "
@@ -308,6 +327,12 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
     }
     md << "\n![narrow phase, " << k.name << "](figures/perf_narrowphase_" << k.name << ".png)\n\n";
   }
+  return md.str();
+}
+
+// The broad phase: every method per crowd size.
+std::string broad_markdown(const BenchPlan& plan, const BenchResults& results) {
+  std::ostringstream md;
   md << "## Broad phase\n\nFinding the pairs that pass the seed's bounding-sphere check in a crowd "
         "of 0.2 m cubes at random positions, one per 0.125 m^3 (so the pairs per body stay "
         "constant), after a small random motion of every body per step (not timed). Every method "
@@ -331,6 +356,12 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
        << plan.crowd_sizes.back() << ") |\n";
   }
   md << "\n![broad phase](figures/perf_broadphase.png)\n\n";
+  return md.str();
+}
+
+// The whole step per scene and engine.
+std::string step_markdown(const BenchResults& results) {
+  std::ostringstream md;
   md << "## Whole step\n\nscenes/many/ through each engine for two durations; microseconds per "
         "moving body per step = (time of the long run - time of the short run) / (extra steps x "
         "moving bodies), so building the world and the shapes cancels. `custom (fast)` is the "
@@ -347,6 +378,20 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
        << r.status << " |\n";
   md << "\n";
 
+  return md.str();
+}
+
+}  // namespace
+
+void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
+                      const std::vector<PerfGoal>& goals, double timing_s, const std::string& out,
+                      bool contract_copy) {
+  const Json j = perf_json(plan, results, goals);
+  std::ostringstream csv;
+  csv << perf_csv(results);
+  std::ostringstream md;
+  md << goals_markdown(plan, results, goals, timing_s) << narrow_markdown(plan, results)
+     << broad_markdown(plan, results) << step_markdown(results);
   // Everything is built in a temporary folder, figures drawn there, then each file moved into
   // the output folder (other files there, such as `rbx report`'s, are kept).
   const fs::path target(out);

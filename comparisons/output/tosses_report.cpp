@@ -43,27 +43,10 @@ Table toss_results_table(const std::vector<BackendTosses>& rs, bool markdown) {
   return t;
 }
 
-std::string tosses_report_section(const std::string& dir, const std::string& out_dir,
-                                  const std::string& backend_list) {
-  const fs::path d(dir);
-  const std::string data =
-      (fs::exists(d / "test.csv.gz") ? d / "test.csv.gz" : d / "test.csv").string();
-  const std::vector<Toss> tosses = read_tosses(data);
-  const std::string params_path = (d / "params.json").string();
-  const auto stored = read_params_file(params_path);
-  // Backends without dynamics named in the report's --backends are simply not tossed.
-  std::vector<const Backend*> chosen;
-  for (const Backend* b : select_toss_backends(backend_list))
-    if (b->dynamics) chosen.push_back(b);
-  if (chosen.empty()) return "";
+namespace {
 
-  Stopwatch clock;
-  const TossEvaluation ev = evaluate_tosses(chosen, tosses, stored);
-  const double eval_s = clock.seconds();
-  const fs::path out(out_dir);
-  write_json((out / "tosses.json").string(), toss_evaluation_json(data, tosses, params_path, ev));
-
-  // Per-toss errors (the distribution figure).
+// Per-toss errors (the distribution figure).
+void write_per_toss_csv(const fs::path& out, const TossEvaluation& ev) {
   std::ostringstream per;
   per << "params,backend,toss,position_error,orientation_error_deg,final_position_error\n";
   for (const auto* set : {&ev.stored, &ev.published})
@@ -73,8 +56,10 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
             << "," << fmt_num(e.position, 9) << "," << fmt_num(e.orientation_deg, 9) << ","
             << fmt_num(e.final_position, 9) << "\n";
   write_text((out / "tosses_per_toss.csv").string(), per.str());
+}
 
-  // Median position error over tosses at each sample time (what the error is made of).
+// Median position error over tosses at each sample time (what the error is made of).
+void write_error_time_csv(const fs::path& out, const TossEvaluation& ev) {
   const double rate = CubeTossModel{}.sample_rate;
   std::ostringstream over;
   over << "backend,t,median_position_error,tosses\n";
@@ -89,24 +74,32 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
     }
   }
   write_text((out / "tosses_error_time.csv").string(), over.str());
+}
 
-  // Best, median and worst toss of the best backend, drawn for every backend.
-  const std::vector<size_t> order = toss_ranking(ev.stored);
-  const BackendTosses& best = ev.stored[order.front()];
-  std::vector<std::pair<std::string, long>> picks;  // label, toss id
-  if (!best.tosses.empty()) {
-    std::vector<TossErrors> sorted = best.tosses;
-    std::stable_sort(sorted.begin(), sorted.end(), [](const TossErrors& a, const TossErrors& b) {
-      return a.position < b.position;
-    });
-    picks = {{"best", sorted.front().toss_id},
-             {"median", sorted[(sorted.size() - 1) / 2].toss_id},
-             {"worst", sorted.back().toss_id}};
-  }
+// The best, median and worst toss of `best` (label, toss id); none when it has no tosses.
+std::vector<std::pair<std::string, long>> toss_picks(const BackendTosses& best) {
+  if (best.tosses.empty()) return {};
+  std::vector<TossErrors> sorted = best.tosses;
+  std::stable_sort(sorted.begin(), sorted.end(), [](const TossErrors& a, const TossErrors& b) {
+    return a.position < b.position;
+  });
+  return {{"best", sorted.front().toss_id},
+          {"median", sorted[(sorted.size() - 1) / 2].toss_id},
+          {"worst", sorted.back().toss_id}};
+}
+
+// The picked tosses drawn for every backend: their height and angle in tosses_traj.csv and one
+// 3-D replay each (every backend's cube, the measured cube as a ghost). Returns the replays'
+// file names in pick order ("" : not written).
+std::vector<std::string> write_picked_tosses(const fs::path& out,
+                                             const std::vector<std::pair<std::string, long>>& picks,
+                                             const std::vector<Toss>& tosses,
+                                             const std::vector<const Backend*>& chosen,
+                                             const TossEvaluation& ev, const std::string& best) {
+  const double rate = CubeTossModel{}.sample_rate;
   std::ostringstream traj;
   traj << "pick,toss,source,t,z,angle_deg\n";
-  // One 3-D replay per pick: every backend's cube, the measured cube as a ghost.
-  std::vector<std::string> replays;  // page file names, in pick order ("" : not written)
+  std::vector<std::string> replays;
   const fs::path views = out / "views";
   for (const auto& [label, id] : picks) {
     const Toss& t =
@@ -132,8 +125,7 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
       if (!fs::exists(views / "three.min.js"))
         fs::copy_file(three_js_path(), views / "three.min.js");
       const std::string name = "toss_" + label + "_" + std::to_string(id) + ".html";
-      const std::string title =
-          "toss " + std::to_string(id) + " (" + label + " of " + best.name + ")";
+      const std::string title = "toss " + std::to_string(id) + " (" + label + " of " + best + ")";
       write_text((views / name).string(),
                  view_page(toss_replay_data(t, runs, title), "", "three.min.js"));
       replays.push_back(name);
@@ -143,17 +135,80 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
     }
   }
   write_text((out / "tosses_traj.csv").string(), traj.str());
+  return replays;
+}
 
-  // Figures through matplotlib (the report's own figures need the same python3).
-  bool figures_ok = false;
+// Figures through matplotlib (the report's own figures need the same python3).
+bool draw_tosses_figures(const std::string& out_dir) {
   const std::string script =
       std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/tosses_plots.py";
-  if (fs::exists("/usr/bin/python3")) {
-    const std::string cmd = "/usr/bin/python3 '" + script + "' '" + out_dir + "' > '" +
-                            (out / "tosses_figures.log").string() + "' 2>&1";
-    figures_ok = std::system(cmd.c_str()) == 0;
-    if (figures_ok) fs::remove(out / "tosses_figures.log");
+  if (!fs::exists("/usr/bin/python3")) return false;
+  const fs::path out(out_dir);
+  const std::string cmd = "/usr/bin/python3 '" + script + "' '" + out_dir + "' > '" +
+                          (out / "tosses_figures.log").string() + "' 2>&1";
+  const bool ok = std::system(cmd.c_str()) == 0;
+  if (ok) fs::remove(out / "tosses_figures.log");
+  return ok;
+}
+
+// What the error is made of: the median over tosses at a few times after release.
+std::string error_over_time_table(const TossEvaluation& ev, const std::vector<size_t>& order) {
+  const double rate = CubeTossModel{}.sample_rate;
+  const std::vector<double> marks = {0.1, 0.2, 0.3, 0.5};  // s
+  Table t({"backend", "t = 0.1 s", "0.2 s", "0.3 s", "0.5 s", "last sample",
+           "horizontal share at the last sample"});
+  for (size_t k : order) {
+    const BackendTosses& r = ev.stored[k];
+    std::vector<std::string> cells = {r.name};
+    auto median_at = [&](const std::vector<double> TossErrors::*series, long i) {
+      std::vector<double> v;
+      for (const TossErrors& e : r.tosses) {
+        const auto& s = e.*series;
+        if (s.empty()) continue;
+        v.push_back(i < 0 ? s.back() : s[std::min<size_t>(static_cast<size_t>(i), s.size() - 1)]);
+      }
+      return spread_of(v).median;
+    };
+    for (double m : marks)
+      cells.push_back(
+          fmt_num(median_at(&TossErrors::position_by_sample, std::lround(m * rate) - 1), 3));
+    const double last = median_at(&TossErrors::position_by_sample, -1);
+    cells.push_back(fmt_num(last, 3));
+    cells.push_back(fmt_num(median_at(&TossErrors::horizontal_by_sample, -1) / last, 3));
+    t.add(cells);
   }
+  return t.markdown();
+}
+
+}  // namespace
+
+std::string tosses_report_section(const std::string& dir, const std::string& out_dir,
+                                  const std::string& backend_list) {
+  const fs::path d(dir);
+  const std::string data =
+      (fs::exists(d / "test.csv.gz") ? d / "test.csv.gz" : d / "test.csv").string();
+  const std::vector<Toss> tosses = read_tosses(data);
+  const std::string params_path = (d / "params.json").string();
+  const auto stored = read_params_file(params_path);
+  // Backends without dynamics named in the report's --backends are simply not tossed.
+  std::vector<const Backend*> chosen;
+  for (const Backend* b : select_toss_backends(backend_list))
+    if (b->dynamics) chosen.push_back(b);
+  if (chosen.empty()) return "";
+
+  Stopwatch clock;
+  const TossEvaluation ev = evaluate_tosses(chosen, tosses, stored);
+  const double eval_s = clock.seconds();
+  const fs::path out(out_dir);
+  write_json((out / "tosses.json").string(), toss_evaluation_json(data, tosses, params_path, ev));
+  write_per_toss_csv(out, ev);
+  write_error_time_csv(out, ev);
+  const std::vector<size_t> order = toss_ranking(ev.stored);
+  const BackendTosses& best = ev.stored[order.front()];
+  const std::vector<std::pair<std::string, long>> picks = toss_picks(best);
+  const std::vector<std::string> replays =
+      write_picked_tosses(out, picks, tosses, chosen, ev, best.name);
+  const bool figures_ok = draw_tosses_figures(out_dir);
 
   size_t samples = 0;
   for (const Toss& t : tosses) samples += t.samples.size();
@@ -177,37 +232,11 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
      << "The same parameters for every backend: the difference to the table above is what "
         "fitting buys; what remains is the contact model.\n\n"
      << toss_results_table(ev.published, true).markdown() << "\n";
-  // What the error is made of: the median over tosses at a few times after release.
-  {
-    const std::vector<double> marks = {0.1, 0.2, 0.3, 0.5};  // s
-    Table t({"backend", "t = 0.1 s", "0.2 s", "0.3 s", "0.5 s", "last sample",
-             "horizontal share at the last sample"});
-    for (size_t k : order) {
-      const BackendTosses& r = ev.stored[k];
-      std::vector<std::string> cells = {r.name};
-      auto median_at = [&](const std::vector<double> TossErrors::*series, long i) {
-        std::vector<double> v;
-        for (const TossErrors& e : r.tosses) {
-          const auto& s = e.*series;
-          if (s.empty()) continue;
-          v.push_back(i < 0 ? s.back() : s[std::min<size_t>(static_cast<size_t>(i), s.size() - 1)]);
-        }
-        return spread_of(v).median;
-      };
-      for (double m : marks)
-        cells.push_back(
-            fmt_num(median_at(&TossErrors::position_by_sample, std::lround(m * rate) - 1), 3));
-      const double last = median_at(&TossErrors::position_by_sample, -1);
-      cells.push_back(fmt_num(last, 3));
-      cells.push_back(fmt_num(median_at(&TossErrors::horizontal_by_sample, -1) / last, 3));
-      t.add(cells);
-    }
-    md << "Median position error (cube widths) over the tosses at times after release (a toss "
-          "already at rest counts with its last sample; the first measured impact comes at 0.115 s "
-          "(median; 0.07 to 0.18 s)) and the horizontal (x, y) part of the final error, at the "
-          "fitted parameters:\n\n"
-       << t.markdown() << "\n";
-  }
+  md << "Median position error (cube widths) over the tosses at times after release (a toss "
+        "already at rest counts with its last sample; the first measured impact comes at 0.115 s "
+        "(median; 0.07 to 0.18 s)) and the horizontal (x, y) part of the final error, at the "
+        "fitted parameters:\n\n"
+     << error_over_time_table(ev, order) << "\n";
   if (figures_ok) {
     md << "![toss error distribution](figures/tosses_errors.png)\n\n"
        << "Left: position error per toss, every backend (fitted and published parameters). "

@@ -31,8 +31,7 @@ void check_shape_keys(const Reader& r, const toml::table& t, const std::string& 
     std::vector<std::string> owners;  // shapes that take this key (none: any shape)
     for (const auto& [k, shape] : kShapeKeys)
       if (k == key) owners.push_back(shape);
-    if (!owners.empty() &&
-        std::find(owners.begin(), owners.end(), to_string(kind)) == owners.end())
+    if (!owners.empty() && std::find(owners.begin(), owners.end(), to_string(kind)) == owners.end())
       r.fail(key_line(t, key), p + key,
              "only valid for shape = \"" + join_quoted(owners) + "\", but this body's shape is \"" +
                  to_string(kind) + "\"",
@@ -41,8 +40,8 @@ void check_shape_keys(const Reader& r, const toml::table& t, const std::string& 
 }
 
 // A length of a shape (radius, height), `fallback` when absent.
-double positive_length(const Reader& r, const toml::table& t, const std::string& p,
-                       const char* key, double fallback, const char* what) {
+double positive_length(const Reader& r, const toml::table& t, const std::string& p, const char* key,
+                       double fallback, const char* what) {
   const toml::node* n = t.get(key);
   if (!n) return fallback;
   const double v = r.number(*n, p + key, std::string("body.") + key);
@@ -80,8 +79,7 @@ ConvexPolyhedron read_icosphere(const Reader& r, const toml::table& t, const std
   if (const toml::node* n = t.get("subdivisions")) {
     subdivisions = r.integer(*n, p + "subdivisions", "body.subdivisions");
     if (subdivisions < 0 || subdivisions > 6)
-      r.fail(line_of(n), p + "subdivisions",
-             "must be in 0..6, got " + std::to_string(subdivisions),
+      r.fail(line_of(n), p + "subdivisions", "must be in 0..6, got " + std::to_string(subdivisions),
              "6 already gives 81920 triangles, and 2 (320 triangles) is the default");
   }
   return make_icosphere(radius, static_cast<int>(subdivisions));

@@ -63,11 +63,6 @@ const KeyInfo kKeys[] = {
 
 }  // namespace
 
-
-
-
-
-
 // Keys of the sub-tables of one level, from the table above: prefix "sim." -> {"dt", ...}.
 std::vector<std::string> keys_under(const std::string& prefix) {
   std::vector<std::string> out;
@@ -211,7 +206,6 @@ int key_line(const toml::table& t, const std::string& key) {
   return 0;
 }
 
-
 // Line of a value in the scene file (0 if none, as for values from --set).
 int line_of(const toml::node* n) {
   if (!n) return 0;
@@ -219,7 +213,6 @@ int line_of(const toml::node* n) {
   if (src.path && *src.path == kOverrideSource) return 0;
   return static_cast<int>(src.begin.line);
 }
-
 
 // A name from a fixed list, with "did you mean" for anything else.
 std::string one_of(const Reader& r, const toml::node& n, const std::string& key,

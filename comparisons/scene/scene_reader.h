@@ -17,7 +17,8 @@
 
 namespace rbx::scene_detail {
 
-inline const std::vector<std::string> kChecks = {"contact", "impulse", "trajectory", "stability", "mass"};
+inline const std::vector<std::string> kChecks = {"contact", "impulse", "trajectory", "stability",
+                                                 "mass"};
 inline const std::vector<std::string> kBackends = {
     "custom",    "custom-seed", "exact",      "fcl",     "fcl-hull",    "fcl-epa",
     "fcl-indep", "libccd-mpr",  "libccd-epa", "bullet",  "bullet-hull", "bullet-sat",
