@@ -168,6 +168,92 @@ struct DesignShrinker {
   }
 };
 
+// The closed form of a single-point impact with restitution e at point p (ra, rb from the
+// centres) and normal n from B toward A (seed corrections: world-frame inverse inertia,
+// velocity of the point): the impulse and every velocity and angular momentum after it.
+struct SinglePointImpulse {
+  double j = 0.0, vn = 0.0;  // impulse (N s), normal velocity before (m/s)
+  Vec3 va, wa, vb, wb;       // velocities and angular velocities after
+  Vec3 La, Lb;               // angular momenta after (B: zero when static)
+};
+
+SinglePointImpulse single_point_impulse(const RigidBody& A, const RigidBody& B, const Vec3& ra,
+                                        const Vec3& rb, const Vec3& normal, double restitution) {
+  SinglePointImpulse r;
+  const Mat3 ia = A.inverse_inertia_world();
+  const Mat3 ib = B.is_static ? Mat3::Zero() : B.inverse_inertia_world();
+  const double inv_mb = B.is_static ? 0.0 : 1.0 / B.mass;
+  const double k = 1.0 / A.mass + inv_mb + normal.dot((ia * ra.cross(normal)).cross(ra)) +
+                   normal.dot((ib * rb.cross(normal)).cross(rb));
+  r.vn = (A.velocity - B.velocity).dot(normal);
+  r.j = -(1.0 + restitution) * r.vn / k;
+  r.va = A.velocity + r.j / A.mass * normal;
+  r.wa = ia * ra.cross(r.j * normal);
+  r.vb = B.velocity - r.j * inv_mb * normal;
+  r.wb = -(ib * rb.cross(r.j * normal));
+  r.La = A.inertia_world() * r.wa;
+  r.Lb = B.is_static ? Vec3::Zero() : Vec3(B.inertia_world() * r.wb);
+  return r;
+}
+
+// Free flight after the impact for `flight` seconds: false at a second contact (checked at 20
+// times); else the final orientations in qa, qb (torque-free rotation from L).
+bool free_flight(double flight, const std::vector<RigidBody>& after, const RigidBody& A,
+                 const RigidBody& B, const SinglePointImpulse& imp, double size, Quat& qa,
+                 Quat& qb) {
+  for (int step = 1; step <= 20; ++step) {
+    const double t = flight * step / 20.0;
+    RigidBody a2 = after[0], b2 = after[1];
+    a2.position += imp.va * t;
+    a2.orientation = free_rotation(A.inverse_inertia_body, A.orientation, imp.La, t);
+    if (!B.is_static) {
+      b2.position += imp.vb * t;
+      b2.orientation = free_rotation(B.inverse_inertia_body, B.orientation, imp.Lb, t);
+    }
+    const SatResult r = sat_query(*a2.shape, a2.pose(), *b2.shape, b2.pose());
+    if (r.touching || r.depth > -1e-6 * size) return false;
+    qa = a2.orientation;
+    qb = b2.orientation;
+  }
+  return true;
+}
+
+// The leading comment of an impact scene: how its closed form was derived.
+std::string impact_derivation(const ImpactSample& s, const Vec3& p, const Vec3& normal,
+                              const SinglePointImpulse& imp) {
+  std::ostringstream d;
+  d << "# Closed form (rbx explore, impact kind): no spin before the impact, so the contact\n"
+       "# pose is the start pose moved along the velocities: first contact at t = "
+    << num(s.contact_time) << " s,\n# phase " << num(s.phase)
+    << " of its step. The exact oracle's contact, one point (vertex of A on a face of B):\n"
+    << "#   p = " << vec(p) << ", n = " << vec(normal) << " (from B toward A)\n"
+    << "# j = -(1 + e) (v_rel . n) / (1/mA + 1/mB + n.((IA^-1 (rA x n)) x rA) + same for B)\n"
+    << "#   = " << num(imp.j) << " N s (v_rel . n = " << num(imp.vn) << " m/s)\n"
+    << "# v' = v + j n / m, w' = I^-1 (r x j n) (B: minus); after it, torque-free flight to t = "
+    << num(s.duration)
+    << " s\n# (angular momentum kept, w = R I^-1 R^T L, integrated by RK4 at "
+       "1e-5 s); no second contact\n# (the exact oracle at 20 times of the flight).\n";
+  return d.str();
+}
+
+// The [expect] block of an impact scene; `speed` is the relative speed before it.
+std::string impact_expect(const ImpactSample& s, double speed, const SinglePointImpulse& imp,
+                          bool b_static) {
+  std::ostringstream x;
+  char buf[200];
+  x << "[expect]\n# The closed form is exact to round-off; 1e-3 of the speed is the harness's mark "
+       "of a\n# clear velocity disagreement (0.1 % in the energy norm): below it, a "
+       "deviation.\n";
+  std::snprintf(buf, sizeof buf, "tolerance = %.3g\n", 1e-3 * std::max(1e-9, speed));
+  x << buf;
+  x << "[expect.body.A]\nvelocity = " << vec(imp.va)
+    << "\nangular_velocity = " << vec(s.expect_angular_velocity[0]) << "\n";
+  if (!b_static)
+    x << "[expect.body.B]\nvelocity = " << vec(imp.vb)
+      << "\nangular_velocity = " << vec(s.expect_angular_velocity[1]) << "\n";
+  return x.str();
+}
+
 }  // namespace
 
 bool realize_impact(ImpactSample& s) {
@@ -249,74 +335,24 @@ bool realize_impact(ImpactSample& s) {
   for (const Vec3& m : sat.manifold)
     if ((m - p).norm() > 1e-6 * size) return false;  // not a single point
   const Vec3 normal = sat.normal;
-  // 4. The closed form: single-point impulse with restitution e at exact's point and normal
-  //    (seed corrections: world-frame inverse inertia, velocity of the point).
-  const Vec3 ra = p - after[0].position, rb = p - after[1].position;
-  const Mat3 ia = A.inverse_inertia_world();
-  const Mat3 ib = B.is_static ? Mat3::Zero() : B.inverse_inertia_world();
-  const double inv_mb = B.is_static ? 0.0 : 1.0 / B.mass;
-  const double k = 1.0 / A.mass + inv_mb + normal.dot((ia * ra.cross(normal)).cross(ra)) +
-                   normal.dot((ib * rb.cross(normal)).cross(rb));
-  const double vn = (A.velocity - B.velocity).dot(normal);
-  const double j = -(1.0 + s.restitution) * vn / k;
-  const Vec3 va = A.velocity + j / A.mass * normal, wa = ia * ra.cross(j * normal);
-  const Vec3 vb = B.velocity - j * inv_mb * normal, wb = -(ib * rb.cross(j * normal));
-  const Vec3 La = A.inertia_world() * wa,
-             Lb = B.is_static ? Vec3::Zero() : Vec3(B.inertia_world() * wb);
-  // 5. Free flight to the end: no second contact (checked at 20 times), final spin from L.
-  const double flight = s.duration - s.contact_time;
+  // 4. The closed form at exact's point and normal; 5. free flight to the end.
+  const SinglePointImpulse imp = single_point_impulse(A, B, p - after[0].position,
+                                                      p - after[1].position, normal, s.restitution);
   Quat qa = A.orientation, qb = B.orientation;
-  for (int step = 1; step <= 20; ++step) {
-    const double t = flight * step / 20.0;
-    RigidBody a2 = after[0], b2 = after[1];
-    a2.position += va * t;
-    a2.orientation = free_rotation(A.inverse_inertia_body, A.orientation, La, t);
-    if (!B.is_static) {
-      b2.position += vb * t;
-      b2.orientation = free_rotation(B.inverse_inertia_body, B.orientation, Lb, t);
-    }
-    const SatResult r = sat_query(*a2.shape, a2.pose(), *b2.shape, b2.pose());
-    if (r.touching || r.depth > -1e-6 * size) return false;
-    qa = a2.orientation;
-    qb = b2.orientation;
-  }
+  if (!free_flight(s.duration - s.contact_time, after, A, B, imp, size, qa, qb)) return false;
   auto spin = [](const RigidBody& b, const Quat& q, const Vec3& L) {
     const Mat3 R = q.toRotationMatrix();
     return Vec3(R * b.inverse_inertia_body * R.transpose() * L);
   };
-  s.expect_velocity[0] = va;
-  s.expect_angular_velocity[0] = spin(A, qa, La);
-  s.expect_angular_momentum[0] = La;
-  s.expect_velocity[1] = vb;
-  s.expect_angular_velocity[1] = B.is_static ? Vec3::Zero() : spin(B, qb, Lb);
-  s.expect_angular_momentum[1] = Lb;
+  s.expect_velocity[0] = imp.va;
+  s.expect_angular_velocity[0] = spin(A, qa, imp.La);
+  s.expect_angular_momentum[0] = imp.La;
+  s.expect_velocity[1] = imp.vb;
+  s.expect_angular_velocity[1] = B.is_static ? Vec3::Zero() : spin(B, qb, imp.Lb);
+  s.expect_angular_momentum[1] = imp.Lb;
   // 6. The scene with its derivation and [expect].
-  std::ostringstream d;
-  d << "# Closed form (rbx explore, impact kind): no spin before the impact, so the contact\n"
-       "# pose is the start pose moved along the velocities: first contact at t = "
-    << num(s.contact_time) << " s,\n# phase " << num(s.phase)
-    << " of its step. The exact oracle's contact, one point (vertex of A on a face of B):\n"
-    << "#   p = " << vec(p) << ", n = " << vec(normal) << " (from B toward A)\n"
-    << "# j = -(1 + e) (v_rel . n) / (1/mA + 1/mB + n.((IA^-1 (rA x n)) x rA) + same for B)\n"
-    << "#   = " << num(j) << " N s (v_rel . n = " << num(vn) << " m/s)\n"
-    << "# v' = v + j n / m, w' = I^-1 (r x j n) (B: minus); after it, torque-free flight to t = "
-    << num(s.duration)
-    << " s\n# (angular momentum kept, w = R I^-1 R^T L, integrated by RK4 at "
-       "1e-5 s); no second contact\n# (the exact oracle at 20 times of the flight).\n";
-  std::ostringstream x;
-  char buf[200];
-  x << "[expect]\n# The closed form is exact to round-off; 1e-3 of the speed is the harness's mark "
-       "of a\n# clear velocity disagreement (0.1 % in the energy norm): below it, a "
-       "deviation.\n";
-  std::snprintf(buf, sizeof buf, "tolerance = %.3g\n", 1e-3 * std::max(1e-9, v_rel.norm()));
-  x << buf;
-  x << "[expect.body.A]\nvelocity = " << vec(va)
-    << "\nangular_velocity = " << vec(s.expect_angular_velocity[0]) << "\n";
-  if (!B.is_static)
-    x << "[expect.body.B]\nvelocity = " << vec(vb)
-      << "\nangular_velocity = " << vec(s.expect_angular_velocity[1]) << "\n";
-  s.derivation = d.str();
-  s.text = impact_text(s, "", s.derivation + x.str());
+  s.derivation = impact_derivation(s, p, normal, imp);
+  s.text = impact_text(s, "", s.derivation + impact_expect(s, v_rel.norm(), imp, B.is_static));
   return true;
 }
 

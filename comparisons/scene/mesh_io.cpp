@@ -291,11 +291,9 @@ std::string annotate(const std::string& message, const ObjLines& lines,
   return out;
 }
 
-}  // namespace
-
-ConvexPolyhedron load_obj(const std::string& path, bool hull) {
+// The file's text: a readable regular text file, or ObjReadError / GeometryError saying why not.
+std::string read_obj_text(const std::string& path) {
   namespace fs = std::filesystem;
-  // Readable regular text file.
   std::error_code ec;
   if (!fs::exists(path, ec)) throw GeometryError(path + ": file not found");
   if (fs::is_directory(path, ec)) throw GeometryError(path + ": is a folder, not an OBJ file");
@@ -318,6 +316,47 @@ ConvexPolyhedron load_obj(const std::string& path, bool hull) {
   if (text.find('\0') != std::string::npos)
     throw ObjReadError(path + ": contains NUL bytes: a binary file, not a text OBJ file",
                        "name a text OBJ file (v x y z and f i j k lines)");
+  return text;
+}
+
+// Every polygon fan-triangulated (shapes in file order), indices checked first; `face_of` maps
+// each triangle to its OBJ face (0-based, file order). Nothing is merged: duplicate vertices
+// stay distinct, so a mesh that relies on them is open.
+std::vector<std::array<int, 3>> fan_triangles(const std::vector<tinyobj::shape_t>& shapes, int nv,
+                                              const ObjLines& lines, const std::string& path,
+                                              std::vector<int>& face_of) {
+  std::vector<std::array<int, 3>> triangles;
+  int face = 0;
+  for (const tinyobj::shape_t& shape : shapes) {
+    size_t offset = 0;
+    for (const unsigned char corners : shape.mesh.num_face_vertices) {
+      std::vector<int> poly;
+      for (size_t k = 0; k < corners; ++k) {
+        const int v = shape.mesh.indices[offset + k].vertex_index;
+        if (v < 0 || v >= nv) {
+          const int line =
+              face < static_cast<int>(lines.face_line.size()) ? lines.face_line[face] : -1;
+          throw GeometryError(path + ": line " + std::to_string(line) + ": face refers to vertex " +
+                              std::to_string(v + 1) + ", but the file has " + std::to_string(nv) +
+                              " vertices (OBJ counts from 1)");
+        }
+        poly.push_back(v);
+      }
+      offset += corners;
+      for (size_t k = 1; k + 1 < poly.size(); ++k) {
+        triangles.push_back({poly[0], poly[k], poly[k + 1]});
+        face_of.push_back(face);
+      }
+      ++face;
+    }
+  }
+  return triangles;
+}
+
+}  // namespace
+
+ConvexPolyhedron load_obj(const std::string& path, bool hull) {
+  const std::string text = read_obj_text(path);
   const ObjLines lines = scan_obj_lines(text, path, /*check_faces=*/!hull);
 
   // Parse without tinyobjloader's triangulation: we fan-triangulate below, after checking the
@@ -358,35 +397,10 @@ ConvexPolyhedron load_obj(const std::string& path, bool hull) {
     }
   }
 
-  // Fan-triangulate every polygon (shapes in file order), checking indices first. Nothing is
-  // merged: duplicate vertices stay distinct, so a mesh that relies on them is open.
-  std::vector<std::array<int, 3>> triangles;
+  // Fan-triangulate, checking indices first.
   std::vector<int> triangle_face;  // triangle -> OBJ face number (0-based, file order)
-  int face = 0;
-  for (const tinyobj::shape_t& shape : shapes) {
-    size_t offset = 0;
-    for (const unsigned char corners : shape.mesh.num_face_vertices) {
-      std::vector<int> poly;
-      for (size_t k = 0; k < corners; ++k) {
-        const int v = shape.mesh.indices[offset + k].vertex_index;
-        if (v < 0 || v >= nv) {
-          const int line =
-              face < static_cast<int>(lines.face_line.size()) ? lines.face_line[face] : -1;
-          throw GeometryError(path + ": line " + std::to_string(line) + ": face refers to vertex " +
-                              std::to_string(v + 1) + ", but the file has " + std::to_string(nv) +
-                              " vertices (OBJ counts from 1)");
-        }
-        poly.push_back(v);
-      }
-      offset += corners;
-      for (size_t k = 1; k + 1 < poly.size(); ++k) {
-        triangles.push_back({poly[0], poly[k], poly[k + 1]});
-        triangle_face.push_back(face);
-      }
-      ++face;
-    }
-  }
-
+  const std::vector<std::array<int, 3>> triangles =
+      fan_triangles(shapes, nv, lines, path, triangle_face);
   if (triangles.empty()) throw GeometryError(path + ": no faces ('f' lines)");
 
   ConvexPolyhedron mesh = [&] {
