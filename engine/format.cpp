@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 namespace rbx {
 
@@ -18,11 +19,13 @@ std::string format_number(double x, const NumberFormat& f) {
   int digits = f.digits;
   if (digits <= 0) {
     // Shortest: the fewest significant digits that read back as the same double.
+    const double a = std::abs(x);
+    const bool exponent_allowed = !f.plain_decimals || a < 1e-5 || a >= 1e15;
     for (digits = 1; digits < 17; ++digits) {
       std::snprintf(buffer, sizeof buffer, "%.*g", digits, x);
-      if (std::strtod(buffer, nullptr) == x) break;
+      if (std::strtod(buffer, nullptr) == x && (exponent_allowed || !std::strchr(buffer, 'e')))
+        break;
     }
-    const double a = std::abs(x);
     if (f.integer_digits && a >= 1 && a < 1e6)
       digits = std::max(digits, 1 + static_cast<int>(std::log10(a)));
   }

@@ -21,6 +21,9 @@ struct NumberFormat {
   /// With digits = 0: values of magnitude in [1, 1e6) keep every integer digit ("604800", not
   /// "6.048e+05"), which reads better in messages about scene values.
   bool integer_digits = false;
+  /// With digits = 0: magnitudes in [1e-5, 1e15) take as many digits as they need to be written
+  /// without an exponent ("90", not "9e+01"), as a scene file reads best.
+  bool plain_decimals = false;
 };
 
 /// `x` as text in the style `f`.

@@ -58,7 +58,9 @@ std::string mark_of(double angle, double derr, double size, double tol) {
 ContactsRow compare_row(const std::string& name, const ContactRun& run, const ContactPoint* t,
                         const RigidBody& a, const RigidBody& b, double tol, Json& bj,
                         std::vector<std::string>& marks) {
-  ContactsRow row{name, run};
+  ContactsRow row;
+  row.backend = name;
+  row.run = run;
   const ContactPoint* c = deepest(run.result);
   if (run.result.status != Status::Ok) {
     bj["status"] = to_string(run.result.status);

@@ -16,6 +16,7 @@
 #include "engine/body.h"
 #include "engine/bounding.h"
 #include "engine/detect.h"
+#include "engine/format.h"
 #include "reference/exact.h"
 
 namespace rbx {
@@ -242,15 +243,13 @@ ContactSample make_contact_sample(uint64_t seed, uint64_t index) {
 namespace explore_detail {
 
 std::string num(double x) {
-  // The shortest text that reads back as the same double (at most 17 significant digits).
-  char buf[40];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-    // Plain decimals for ordinary magnitudes ("90.0", not "9e+01").
-    const bool plain = std::abs(x) < 1e-5 || std::abs(x) >= 1e15 || !std::strchr(buf, 'e');
-    if (plain && std::strtod(buf, nullptr) == x) break;
-  }
-  std::string s = buf;
+  // The shortest text that reads back as the same double, plain decimals for ordinary
+  // magnitudes ("90.0", not "9e+01").
+  NumberFormat f;
+  f.digits = 0;
+  f.signed_zero = true;
+  f.plain_decimals = true;
+  std::string s = format_number(x, f);
   // TOML floats need a '.' or an exponent to read back as floats everywhere; integers are fine
   // as vector components, but keep the text uniform.
   if (s.find_first_of(".en") == std::string::npos) s += ".0";
@@ -445,9 +444,10 @@ Vec3 euler_deg(const Quat& q) {
 // x to the nearest multiple of grid, as the decimal number a reader would write (3 * 0.1 is
 // 0.30000000000000004; its 12-digit text reads back as 0.3).
 double round_to(double x, double grid) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.12g", std::round(x / grid) * grid);
-  return std::strtod(buf, nullptr);
+  NumberFormat f;
+  f.digits = 12;
+  f.signed_zero = true;
+  return std::strtod(format_number(std::round(x / grid) * grid, f).c_str(), nullptr);
 }
 
 // Each coordinate to the nearest multiple of grid (as above).

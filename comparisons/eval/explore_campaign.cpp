@@ -75,19 +75,20 @@ std::string expect_block(const std::string& text) {
       sat_query(*bodies[0].shape, bodies[0].pose(), *bodies[1].shape, bodies[1].pose());
   const double size =
       std::min(2.0 * bounding_sphere(bodies[0]).radius, 2.0 * bounding_sphere(bodies[1]).radius);
-  char buf[512];
+  NumberFormat full;  // every digit, as the oracle computed it
+  full.digits = 17;
+  full.signed_zero = true;
   std::ostringstream o;
   o << "# Truth: the exact oracle (separating axes over faces and edge pairs), not a closed form.\n"
        "# Tolerance: 1e-6 of the smaller body (round-off of exact methods is ~1e-15 relative;\n"
        "# the disagreements explore looks for are above 1 degree or 1 % of that size).\n";
   o << "[expect]\n";
-  std::snprintf(buf, sizeof buf, "tolerance = %.3g\n", std::max(1e-12, 1e-6 * size));
-  o << buf << "[expect.contact]\n"
+  o << "tolerance = " << fmt_num(std::max(1e-12, 1e-6 * size), 3) << "\n[expect.contact]\n"
     << "touching = " << (sat.touching ? "true" : "false") << "\n";
   if (sat.touching) {
-    std::snprintf(buf, sizeof buf, "normal = [%.17g, %.17g, %.17g]\ndepth = %.17g\n",
-                  sat.normal.x(), sat.normal.y(), sat.normal.z(), std::max(sat.depth, 0.0));
-    o << buf;
+    o << "normal = [" << format_number(sat.normal.x(), full) << ", "
+      << format_number(sat.normal.y(), full) << ", " << format_number(sat.normal.z(), full)
+      << "]\ndepth = " << format_number(std::max(sat.depth, 0.0), full) << "\n";
   }
   return o.str();
 }

@@ -17,6 +17,7 @@
 #include "engine/body.h"
 #include "engine/bounding.h"
 #include "engine/detect.h"
+#include "engine/format.h"
 #include "reference/exact.h"
 
 namespace rbx {
@@ -240,12 +241,10 @@ std::string impact_derivation(const ImpactSample& s, const Vec3& p, const Vec3& 
 std::string impact_expect(const ImpactSample& s, double speed, const SinglePointImpulse& imp,
                           bool b_static) {
   std::ostringstream x;
-  char buf[200];
   x << "[expect]\n# The closed form is exact to round-off; 1e-3 of the speed is the harness's mark "
        "of a\n# clear velocity disagreement (0.1 % in the energy norm): below it, a "
        "deviation.\n";
-  std::snprintf(buf, sizeof buf, "tolerance = %.3g\n", 1e-3 * std::max(1e-9, speed));
-  x << buf;
+  x << "tolerance = " << fmt_num(1e-3 * std::max(1e-9, speed), 3) << "\n";
   x << "[expect.body.A]\nvelocity = " << vec(imp.va)
     << "\nangular_velocity = " << vec(s.expect_angular_velocity[0]) << "\n";
   if (!b_static)

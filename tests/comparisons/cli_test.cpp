@@ -217,8 +217,9 @@ TEST(Cli, ContactsRunsEveryBackendInTheContractConvention) {
     EXPECT_NEAR(c["normal"][0].get<double>(), -1.0, 1e-6) << name;  // MuJoCo: float vertices
     // MuJoCo 2.2.2's box-box collider reports half the depth: passed on, and labelled.
     EXPECT_NEAR(c["depth"].get<double>(), name == "mujoco" ? 0.05 : 0.1, 1e-6) << name;
-    if (name == "mujoco")
+    if (name == "mujoco") {
       EXPECT_NE(b["message"].get<std::string>().find("half"), std::string::npos);
+    }
     ++answered;
   }
   EXPECT_GE(answered, 9);  // every contact backend but the INDEP one
