@@ -98,12 +98,12 @@ namespace {
 
 // ---------------------------------------------------------------------------------------------
 // Active sets (small islands). Outline of solve_active_set:
-//   build K and b                      (ActiveSet constructor)
+//   build K and b                                  (ActiveSet constructor)
 //   repeat up to 20 rounds:
-//     solve the guess                  (solve_guess)
-//     turn the sliding directions      (settle_slip_directions)
-//     no exact answer: drop the assumption it breaks most, or refuse   (drop_assumption)
-//     correct the guess where the answer breaks it, else apply it      (correct_guess, apply)
+//     solve the guess                              (solve_guess)
+//     turn the sliding directions                  (settle_slip_directions)
+//     no exact answer: drop an assumption, or refuse   (drop_assumption)
+//     guess broken: correct it; else apply the answer  (correct_guess, apply_answer)
 
 // A point's guess: pressed and sticking, pressed and sliding, or separating.
 enum class Mode { Separate, Stick, Slide };

@@ -11,6 +11,14 @@ namespace rbx {
 /// Tunables of the world step (engine/world.h) and the stages it calls. Scene physics
 /// (restitution, friction, gravity, dt) is not here: it comes from the scene (SimSettings).
 struct WorldSettings {
+  // Resting contact (World::solver_settings).
+
+  /// Steps of gravity: an approach no faster than this many steps of gravity (m/s, this many
+  /// times |g| dt) is a body settling, not a collision, and gets e = 0; else a resting body with
+  /// e > 0 bounces by e g dt for ever. Zero without gravity: every approach is then a
+  /// collision, as in the seed.
+  double rest_gravity_steps = 2.0;
+
   // Contact solver (engine/contact_solver.cpp).
 
   /// Relative: a sweep that changes no point's velocity by more than this fraction of the

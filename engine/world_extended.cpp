@@ -64,13 +64,11 @@ std::vector<PairManifold> World::detect_manifolds() {
 }
 
 ContactSolverSettings World::solver_settings() const {
-  // Resting threshold: an approach no faster than two steps of gravity is a body settling, not
-  // a collision, and gets e = 0 (else a resting body with e > 0 bounces by e g dt for ever).
-  // Zero without gravity: every approach is then a collision, as in the seed.
+  // Resting threshold: a few steps of gravity (WorldSettings::rest_gravity_steps).
   ContactSolverSettings settings;
   settings.restitution = sim_.restitution;
   settings.friction = sim_.friction;
-  settings.rest_speed = 2.0 * sim_.gravity.norm() * sim_.dt;
+  settings.rest_speed = tunables_.rest_gravity_steps * sim_.gravity.norm() * sim_.dt;
   settings.tunables = tunables_;
   return settings;
 }
