@@ -17,6 +17,12 @@ constexpr double kPad = 1e-9;
 // Bodies per leaf of the tree.
 constexpr int kLeafSize = 4;
 
+// Whether two closed boxes overlap (touching counts).
+bool overlap(const Vec3& a_min, const Vec3& a_max, const Vec3& b_min, const Vec3& b_max) {
+  return a_min.x() <= b_max.x() && b_min.x() <= a_max.x() && a_min.y() <= b_max.y() &&
+         b_min.y() <= a_max.y() && a_min.z() <= b_max.z() && b_min.z() <= a_max.z();
+}
+
 }  // namespace
 
 const char* to_string(BroadPhaseMethod method) {
@@ -145,13 +151,12 @@ bool BroadPhase::grid() {
   // cell = the largest box, each body in the cell of its box's lower corner, cells stored
   // densely (a counting sort of the bodies by cell). Two boxes no larger than a cell overlap only
   // if their cells are neighbours (each index within 1), so each body looks in its own cell and
-  // 13 of its 26 neighbours (the other 13 look back at it): O(N + cells + pairs). Measured on
-  // many_1000 (1000 cubes 1.5 m apart, 2,550 pairs a step): the tree's build and dual traversal
-  // took 40 % of a step. Used when there are at least 64 moving bodies (below, the tree is as
-  // cheap), every moving box is within 2x of the median size, and the grid has at most 8 cells
-  // per body (else it is mostly empty and the tree is the better index).
+  // 13 of its 26 neighbours (the other 13 look back at it): O(N + cells + pairs). Used when
+  // there are at least grid_min_moving bodies (WorldSettings), every moving box is within 2x of the
+  // median size, and the grid has at most 8 cells per body (else it is mostly empty and the tree is
+  // the better index).
   const int m_count = static_cast<int>(moving_.size());
-  if (m_count < 64) return false;
+  if (m_count < tunables_.grid_min_moving) return false;
   extent_.resize(m_count);
   for (int m = 0; m < m_count; ++m)
     extent_[m] = (box_max_[moving_[m]] - box_min_[moving_[m]]).maxCoeff();
@@ -195,11 +200,7 @@ bool BroadPhase::grid() {
     leaf_spheres_[x] = spheres_[in_cells_[x]];
   }
   auto test = [&](int x, int y) {
-    const Vec3 &a_min = leaf_min_[x], &a_max = leaf_max_[x];
-    const Vec3 &b_min = leaf_min_[y], &b_max = leaf_max_[y];
-    if (!(a_min.x() <= b_max.x() && b_min.x() <= a_max.x() && a_min.y() <= b_max.y() &&
-          b_min.y() <= a_max.y() && a_min.z() <= b_max.z() && b_min.z() <= a_max.z()))
-      return;
+    if (!overlap(leaf_min_[x], leaf_max_[x], leaf_min_[y], leaf_max_[y])) return;
     int i = in_cells_[x], j = in_cells_[y];
     if (i > j) std::swap(x, y), std::swap(i, j);
     const BoundingSphere &sa = leaf_spheres_[x], &sb = leaf_spheres_[y];
@@ -228,23 +229,36 @@ bool BroadPhase::grid() {
   return true;
 }
 
+// The tree's stages: statics apart, then the grid or the hierarchy (build, statics against it,
+// the tree against itself).
 void BroadPhase::tree() {
   const int n = static_cast<int>(spheres_.size());
   used_grid_ = false;
   if (n < 2) return;
-  auto overlap = [](const Vec3& a_min, const Vec3& a_max, const Vec3& b_min, const Vec3& b_max) {
-    return a_min.x() <= b_max.x() && b_min.x() <= a_max.x() && a_min.y() <= b_max.y() &&
-           b_min.y() <= a_max.y() && a_min.z() <= b_max.z() && b_min.z() <= a_max.z();
-  };
+  split_statics();
+  if (moving_.empty()) return;
+  used_grid_ = grid();
+  if (used_grid_) {
+    for (int i : statics_)
+      for (int j : moving_)
+        if (overlap(box_min_[j], box_max_[j], box_min_[i], box_max_[i])) test_pair(i, j);
+    return;
+  }
+  build_tree();
+  statics_against_tree();
+  tree_against_itself();
+}
+
+void BroadPhase::split_statics() {
   // Static bodies (walls, a floor) stay out of the tree, whose nodes their boxes would widen:
   // each is queried against the tree of moving bodies, and statics against statics in a double
-  // loop. That is for a few statics; beyond 32 (a static terrain) they go into the tree with the
-  // rest, as before, and the double loop is not run.
-  constexpr size_t kStaticsApart = 32;
+  // loop. That is for a few statics; beyond statics_apart (a static terrain) they go into the
+  // tree with the rest, as before, and the double loop is not run.
+  const int n = static_cast<int>(spheres_.size());
   moving_.clear();
   statics_.clear();
   for (int i = 0; i < n; ++i) (static_[i] ? statics_ : moving_).push_back(i);
-  if (statics_.size() > kStaticsApart) {
+  if (statics_.size() > tunables_.statics_apart) {
     moving_.resize(n);
     for (int i = 0; i < n; ++i) moving_[i] = i;
     statics_.clear();
@@ -254,16 +268,11 @@ void BroadPhase::tree() {
       const int i = statics_[s], j = statics_[t];
       if (overlap(box_min_[i], box_max_[i], box_min_[j], box_max_[j])) test_pair(i, j);
     }
-  const int m_count = static_cast<int>(moving_.size());
-  if (m_count == 0) return;
-  used_grid_ = grid();
-  if (used_grid_) {
-    for (int i : statics_)
-      for (int j : moving_)
-        if (overlap(box_min_[j], box_max_[j], box_min_[i], box_max_[i])) test_pair(i, j);
-    return;
-  }
+}
+
+void BroadPhase::build_tree() {
   // Build: the shared hierarchy (engine/bvh.h) over the moving bodies' padded boxes.
+  const int m_count = static_cast<int>(moving_.size());
   leaf_min_.resize(m_count);
   leaf_max_.resize(m_count);
   for (int m = 0; m < m_count; ++m) {
@@ -272,18 +281,20 @@ void BroadPhase::tree() {
   }
   tree_ = Bvh::build(leaf_min_, leaf_max_, kLeafSize);
   // Tree positions to bodies.
-  std::vector<int>& order = tree_order_;
-  order.resize(m_count);
-  for (int m = 0; m < m_count; ++m) order[m] = moving_[tree_.order[m]];
-  const std::vector<BvhNode>& nodes = tree_.nodes;
+  tree_order_.resize(m_count);
+  for (int m = 0; m < m_count; ++m) tree_order_[m] = moving_[tree_.order[m]];
   // The leaves' boxes in tree order, so that the traversal reads memory in sequence.
   leaf_spheres_.resize(m_count);
   for (int m = 0; m < m_count; ++m) {
-    leaf_min_[m] = box_min_[order[m]];
-    leaf_max_[m] = box_max_[order[m]];
-    leaf_spheres_[m] = spheres_[order[m]];
+    leaf_min_[m] = box_min_[tree_order_[m]];
+    leaf_max_[m] = box_max_[tree_order_[m]];
+    leaf_spheres_[m] = spheres_[tree_order_[m]];
   }
+}
+
+void BroadPhase::statics_against_tree() {
   // Each static body against the tree: every moving body whose box overlaps its box.
+  const std::vector<BvhNode>& nodes = tree_.nodes;
   for (int i : statics_) {
     tree_.search(
         [&](int k) { return overlap(nodes[k].min, nodes[k].max, box_min_[i], box_max_[i]); },
@@ -294,20 +305,25 @@ void BroadPhase::tree() {
           return false;
         });
   }
-  // Query: the tree against itself (a dual traversal). A node is paired with itself (its two
-  // children with themselves and with each other) and two nodes whose boxes overlap are opened,
-  // the larger first; two leaves test their bodies' boxes, then the seed's sphere test. Every
-  // pair of bodies is reached exactly once, through the lowest node holding both.
+}
+
+void BroadPhase::test_leaves(int m, int q) {
   // Boxes at tree positions m and q overlap: the seed's test on the same spheres, written with
   // the lower body index first as bounding_check(bodies[i], bodies[j]) is, i < j.
-  auto test_leaves = [&](int m, int q) {
-    if (!overlap(leaf_min_[m], leaf_max_[m], leaf_min_[q], leaf_max_[q])) return;
-    if (order[m] > order[q]) std::swap(m, q);
-    const BoundingSphere& sa = leaf_spheres_[m];
-    const BoundingSphere& sb = leaf_spheres_[q];
-    if ((sa.center - sb.center).norm() <= sa.radius + sb.radius)
-      pairs_.push_back({order[m], order[q]});
-  };
+  if (!overlap(leaf_min_[m], leaf_max_[m], leaf_min_[q], leaf_max_[q])) return;
+  if (tree_order_[m] > tree_order_[q]) std::swap(m, q);
+  const BoundingSphere& sa = leaf_spheres_[m];
+  const BoundingSphere& sb = leaf_spheres_[q];
+  if ((sa.center - sb.center).norm() <= sa.radius + sb.radius)
+    pairs_.push_back({tree_order_[m], tree_order_[q]});
+}
+
+void BroadPhase::tree_against_itself() {
+  // A dual traversal. A node is paired with itself (its two children with themselves and with
+  // each other) and two nodes whose boxes overlap are opened, the larger first; two leaves
+  // test their bodies' boxes, then the seed's sphere test. Every pair of bodies is reached
+  // exactly once, through the lowest node holding both.
+  const std::vector<BvhNode>& nodes = tree_.nodes;
   std::vector<std::pair<int, int>>& stack = node_pairs_;
   stack.clear();
   stack.push_back({0, 0});

@@ -23,6 +23,7 @@
 #include "engine/body.h"
 #include "engine/bounding.h"
 #include "engine/bvh.h"
+#include "engine/settings.h"
 
 namespace rbx {
 
@@ -38,7 +39,11 @@ using BodyPair = std::pair<int, int>;
 /// A broad phase with reusable storage (and, for sweep and prune, the order of the last call).
 class BroadPhase {
  public:
-  explicit BroadPhase(BroadPhaseMethod method = BroadPhaseMethod::Tree) : method_(method) {}
+  /// `tunables`: when the tree takes the grid or keeps statics apart (the pairs do not depend
+  /// on them).
+  explicit BroadPhase(BroadPhaseMethod method = BroadPhaseMethod::Tree,
+                      const WorldSettings& tunables = WorldSettings())
+      : method_(method), tunables_(tunables) {}
 
   /// Every pair i < j of `bodies` for which bounding_check is true, sorted by (i, j). The
   /// reference stays valid until the next call.
@@ -55,6 +60,14 @@ class BroadPhase {
   void all_pairs();
   void sweep_and_prune();
   void tree();
+  // The tree's stages: statics apart from the moving bodies (tested among themselves), the
+  // hierarchy over the moving bodies, each static against it, the hierarchy against itself.
+  void split_statics();
+  void build_tree();
+  void statics_against_tree();
+  void tree_against_itself();
+  // Two leaves at tree positions m and q: box overlap, then the seed's sphere test.
+  void test_leaves(int m, int q);
   // The tree's alternative for many moving bodies of like size; false when not suitable.
   bool grid();
   // The seed's test (bounding_check) on the cached spheres: |c_i - c_j| <= r_i + r_j.
@@ -63,6 +76,7 @@ class BroadPhase {
   void test_pair(int i, int j);
 
   BroadPhaseMethod method_;
+  WorldSettings tunables_;
   bool used_grid_ = false;
   std::vector<BoundingSphere> spheres_;          // this call's bounding spheres (bounding_sphere())
   std::vector<Vec3> box_min_, box_max_;          // m, padded boxes around them

@@ -17,6 +17,7 @@
 
 #include "engine/body.h"
 #include "engine/manifold.h"
+#include "engine/settings.h"
 
 namespace rbx {
 
@@ -32,7 +33,8 @@ struct PairManifold {
   Pose pose_a, pose_b;  // the bodies' poses at detection (anchors for the position projection)
 };
 
-/// Tunables of the solver. Every value is justified where it is used.
+/// What one solve is asked: the scene's restitution and friction, the resting threshold, and
+/// the engine's tunables (engine/settings.h).
 struct ContactSolverSettings {
   double restitution = 1.0;  // Newton's e on the normal velocity, [0, 1]
   double friction = 0.0;     // Coulomb mu >= 0
@@ -42,6 +44,7 @@ struct ContactSolverSettings {
   // stacks and piles, larger, go to the projections at O(points) per sweep. 0 leaves every
   // island to the projections alone (tests compare the two).
   int active_set_rows = 16;
+  WorldSettings tunables;  // convergence test and caps of the projections
 };
 
 /// One solved point: the accumulated impulses (N s) in the manifold's frame.
@@ -94,8 +97,9 @@ std::vector<std::vector<double>> normal_velocities(const std::vector<RigidBody>&
 /// moved, each point's penetration is re-evaluated from its anchors on both bodies and a
 /// fraction of what exceeds a slop is removed by moving the bodies apart along the normal.
 /// Velocities are not touched, so no kinetic energy is added; the potential energy can rise
-/// only by the penetration it removes.
+/// only by the penetration it removes. `tunables`: the fraction, iterations and slop.
 void project_contact_positions(std::vector<RigidBody>& bodies,
-                               const std::vector<PairManifold>& manifolds);
+                               const std::vector<PairManifold>& manifolds,
+                               const WorldSettings& tunables = WorldSettings());
 
 }  // namespace rbx

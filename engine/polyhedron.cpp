@@ -23,8 +23,11 @@ std::string fmt_vec(const Vec3& v) {
 
 }  // namespace
 
-ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
-                                                  std::vector<std::array<int, 3>> triangles) {
+namespace {
+
+// Counts and finiteness: at least a tetrahedron, every vertex finite.
+void check_counts(const std::vector<Vec3>& vertices,
+                  const std::vector<std::array<int, 3>>& triangles) {
   const int nv = static_cast<int>(vertices.size());
   if (nv < 4)
     throw GeometryError("a polyhedron needs at least 4 vertices, got " + std::to_string(nv));
@@ -34,20 +37,12 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
   for (int i = 0; i < nv; ++i)
     if (!vertices[i].allFinite())
       throw GeometryError("vertex " + std::to_string(i) + " is not finite");
+}
 
-  // Scale for tolerances: the largest extent of the vertex cloud.
-  ConvexPolyhedron p;
-  p.bounds_.min = p.bounds_.max = vertices[0];
-  for (const Vec3& v : vertices) {
-    p.bounds_.min = p.bounds_.min.cwiseMin(v);
-    p.bounds_.max = p.bounds_.max.cwiseMax(v);
-  }
-  const double scale = std::max((p.bounds_.max - p.bounds_.min).maxCoeff(), 1e-300);
-  // Round-off of plane offsets grows with |x| * eps; 1e-9 of the size leaves room for meshes
-  // written with ~10 significant digits (OBJ files) while still catching real dents.
-  const double tol = 1e-9 * std::max(scale, p.bounds_.max.cwiseAbs().maxCoeff());
-
-  // Indices in range, no degenerate triangle.
+// Indices in range, no degenerate triangle (area against `scale`, m), no unused vertex.
+void check_triangles(const std::vector<Vec3>& vertices,
+                     const std::vector<std::array<int, 3>>& triangles, double scale) {
+  const int nv = static_cast<int>(vertices.size());
   std::vector<int> uses(nv, 0);
   for (size_t f = 0; f < triangles.size(); ++f) {
     const auto& t = triangles[f];
@@ -64,8 +59,12 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
   for (int i = 0; i < nv; ++i)
     if (uses[i] == 0)
       throw GeometryError("vertex " + std::to_string(i) + " is not used by any face");
+}
 
-  // Closed and consistently oriented: each directed edge once, and its reverse once.
+// Closed and consistently oriented: each directed edge once, and its reverse once. Fills the
+// unique edges (a < b) and, for each, its two triangles (a -> b first).
+void link_edges(const std::vector<std::array<int, 3>>& triangles, std::vector<Edge>& edges,
+                std::vector<std::array<int, 2>>& edge_faces) {
   std::map<std::pair<int, int>, int> directed;
   for (size_t f = 0; f < triangles.size(); ++f) {
     const auto& t = triangles[f];
@@ -83,11 +82,32 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
                           std::to_string(e.second) + " of face " + std::to_string(f) +
                           " has no neighbouring face");
     if (e.first < e.second) {
-      p.edges_.push_back({e.first, e.second});
-      p.edge_faces_.push_back({f, directed[{e.second, e.first}]});
+      edges.push_back({e.first, e.second});
+      edge_faces.push_back({f, directed[{e.second, e.first}]});
     }
   }
+}
 
+}  // namespace
+
+// Outline: counts, bounds and tolerance, triangles, edges (closed, oriented), volume (outward),
+// planes, convexity, then the hierarchy.
+ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
+                                                  std::vector<std::array<int, 3>> triangles) {
+  check_counts(vertices, triangles);
+  // Scale for tolerances: the largest extent of the vertex cloud.
+  ConvexPolyhedron p;
+  p.bounds_.min = p.bounds_.max = vertices[0];
+  for (const Vec3& v : vertices) {
+    p.bounds_.min = p.bounds_.min.cwiseMin(v);
+    p.bounds_.max = p.bounds_.max.cwiseMax(v);
+  }
+  const double scale = std::max((p.bounds_.max - p.bounds_.min).maxCoeff(), 1e-300);
+  // Round-off of plane offsets grows with |x| * eps; 1e-9 of the size leaves room for meshes
+  // written with ~10 significant digits (OBJ files) while still catching real dents.
+  const double tol = 1e-9 * std::max(scale, p.bounds_.max.cwiseAbs().maxCoeff());
+  check_triangles(vertices, triangles, scale);
+  link_edges(triangles, p.edges_, p.edge_faces_);
   p.vertices_ = std::move(vertices);
   p.triangles_ = std::move(triangles);
 
@@ -104,16 +124,23 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
     const Vec3 n = (p.vertices_[t[1]] - a).cross(p.vertices_[t[2]] - a).normalized();
     p.planes_.push_back({n, n.dot(a)});
   }
+  p.check_convex(tol);
+  for (size_t f = 0; f < p.planes_.size(); ++f)
+    p.new_plane_.push_back(f == 0 || p.planes_[f].normal != p.planes_[f - 1].normal);
+  p.build_hierarchy();
+  return p;
+}
+
+void ConvexPolyhedron::check_convex(double tol) const {
   // Every vertex against every plane is O(F V) (an icosphere of subdivision 6: 3.4e9 tests).
   // A box tree over the vertices prunes: a box lying behind a face plane by more than tol / 2
   // (far above the round-off of the two dot products) cannot hold an outside vertex, so only
   // the boxes the plane cuts are opened, and only their leaves are tested vertex by vertex.
-  const Bvh tree = Bvh::build(p.vertices_, p.vertices_, 16);
-  auto vertex_outside = [&](size_t f, int i) {
-    return p.planes_[f].distance(p.vertices_[i]) > tol;
-  };
-  for (size_t f = 0; f < p.planes_.size(); ++f) {
-    const Plane& plane = p.planes_[f];
+  const int nv = static_cast<int>(vertices_.size());
+  const Bvh tree = Bvh::build(vertices_, vertices_, 16);
+  auto vertex_outside = [&](size_t f, int i) { return planes_[f].distance(vertices_[i]) > tol; };
+  for (size_t f = 0; f < planes_.size(); ++f) {
+    const Plane& plane = planes_[f];
     // Height of a node's box corner furthest along the normal: skipped when <= tol / 2.
     auto reach = [&](int k) {
       const BvhNode& node = tree.nodes[k];
@@ -127,17 +154,12 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
     // Name the lowest-numbered outside vertex of the first face that has one.
     for (int i = 0; i < nv; ++i) {
       if (!vertex_outside(f, i)) continue;
-      throw GeometryError("mesh is not convex: vertex " + std::to_string(i) + " " +
-                          fmt_vec(p.vertices_[i]) + " lies " +
-                          std::to_string(plane.distance(p.vertices_[i])) +
-                          " outside the plane of face " + std::to_string(f) +
-                          " (use hull = true for its convex hull)");
+      throw GeometryError(
+          "mesh is not convex: vertex " + std::to_string(i) + " " + fmt_vec(vertices_[i]) +
+          " lies " + std::to_string(plane.distance(vertices_[i])) + " outside the plane of face " +
+          std::to_string(f) + " (use hull = true for its convex hull)");
     }
   }
-  for (size_t f = 0; f < p.planes_.size(); ++f)
-    p.new_plane_.push_back(f == 0 || p.planes_[f].normal != p.planes_[f - 1].normal);
-  p.build_hierarchy();
-  return p;
 }
 
 void ConvexPolyhedron::build_hierarchy() {

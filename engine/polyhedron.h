@@ -100,6 +100,9 @@ class ConvexPolyhedron {
 
   // Builds hierarchy_ from the shape's current geometry (or clears it for a small shape).
   void build_hierarchy();
+  // Throws GeometryError naming the first face with a vertex more than `tol` (m) outside its
+  // plane.
+  void check_convex(double tol) const;
 };
 
 /// Box with full extents `size`, centred at the origin (12 triangles).

@@ -9,15 +9,18 @@
 #include "engine/bounding.h"
 #include "engine/integrate.h"
 #include "engine/response.h"
+#include "engine/time_of_impact.h"
 
 namespace rbx {
 
 World::World(SimSettings sim, std::vector<RigidBody> bodies, DetectorVariant variant,
-             BroadPhaseMethod broad_phase)
+             BroadPhaseMethod broad_phase, const WorldSettings& tunables)
     : sim_(std::move(sim)),
       bodies_(std::move(bodies)),
       variant_(variant),
-      broad_phase_(broad_phase) {
+      tunables_(tunables),
+      broad_phase_(broad_phase, tunables),
+      ahead_broad_phase_(BroadPhaseMethod::Tree, tunables) {
   // Energy guard budget: the initial kinetic energy, or the work gravity could do over the
   // bodies' own sizes, whichever is larger, so a scene starting at rest is not flagged.
   energy0_ = energy();
@@ -111,13 +114,21 @@ bool World::check_state() {
 
 bool World::step() {
   if (!failure_.empty()) return false;
+  if (contact_model_ == ContactModel::Extended)
+    step_extended();  // manifolds, friction, resting contact, time of impact
+  else
+    step_seed();
+  ++step_;
+  time_ = step_ * sim_.dt;
+  return check_state();
+}
+
+void World::step_seed() {
   // Bounding check, detection and response, in index order (deterministic). Responses change
   // velocities only, never poses, so the pairs passing the bounding check are fixed for the
   // whole step and the broad phase can find them all first; it returns them in the seed's
   // (i, j) order, so the contacts are resolved in the same order as by the double loop.
-  if (contact_model_ == ContactModel::Extended) {
-    step_extended();  // manifolds, friction, resting contact, time of impact
-  } else if (broad_phase_.method() == BroadPhaseMethod::AllPairs) {
+  if (broad_phase_.method() == BroadPhaseMethod::AllPairs) {
     // The seed's double loop, kept as it was (the oracle of the broad phase).
     const int n = static_cast<int>(bodies_.size());
     for (int i = 0; i < n; ++i)
@@ -126,14 +137,25 @@ bool World::step() {
     for (const BodyPair& pair : broad_phase_.find_pairs(bodies_))
       collide_pair(pair.first, pair.second, true);
   }
-  if (contact_model_ == ContactModel::Seed) {
-    const std::vector<ShapeFacts>& facts = shape_facts();
-    for (size_t i = 0; i < bodies_.size(); ++i)
-      integrate(bodies_[i], sim_, sim_.dt, &facts[i].principal);
+  const std::vector<ShapeFacts>& facts = shape_facts();
+  for (size_t i = 0; i < bodies_.size(); ++i)
+    integrate(bodies_[i], sim_, sim_.dt, &facts[i].principal);
+}
+
+const std::vector<World::ShapeFacts>& World::shape_facts() {
+  if (facts_.size() != bodies_.size()) {
+    facts_.assign(bodies_.size(), {});
+    for (size_t k = 0; k < bodies_.size(); ++k) {
+      const ConvexPolyhedron& shape = *bodies_[k].shape;
+      ShapeFacts& f = facts_[k];
+      f.thickness = shape_thickness(shape);
+      for (const Vec3& v : shape.vertices()) f.radius = std::max(f.radius, v.norm());
+      f.reach = tolerance_reach(shape);
+      f.own_tol = point_in_mesh_tolerance(shape, shape);
+      f.principal = principal_frame(bodies_[k].inertia_body);
+    }
   }
-  ++step_;
-  time_ = step_ * sim_.dt;
-  return check_state();
+  return facts_;
 }
 
 RunResult World::run() {

@@ -1,6 +1,7 @@
 // The world step: broad phase (the bounding check), detection, response, integration.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "engine/integrate.h"
 #include "engine/scene.h"
 #include "engine/separation.h"
+#include "engine/settings.h"
 
 namespace rbx {
 
@@ -34,19 +36,29 @@ struct RunResult {
   std::vector<RigidBody> bodies;  // final states
 };
 
-/// A set of bodies stepped by the seed's algorithm.
+/// A set of bodies stepped by one of two contact models (ContactModel): the seed's algorithm
+/// (the default) or the extended engine's.
 class World {
  public:
   /// `broad_phase` chooses how the pairs passing the bounding check are found; every method
   /// finds the same pairs and the world resolves them in the seed's (i, j) order, so results
-  /// do not depend on it (AllPairs is the seed's double loop).
+  /// do not depend on it (AllPairs is the seed's double loop). `tunables`: the broad phase's
+  /// settings and the extended step's solver, projection and time-of-impact ones
+  /// (engine/settings.h).
   World(SimSettings sim, std::vector<RigidBody> bodies,
         DetectorVariant variant = DetectorVariant::Accelerated,
-        BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree);
+        BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree,
+        const WorldSettings& tunables = WorldSettings());
 
-  /// Advances one step of sim.dt: for every pair passing the bounding check (in (i, j) order),
-  /// the face, vertex and edge tests in that order, resolving after each hit; then integration
-  /// of every body.
+  /// Advances one step of sim.dt with the chosen contact model.
+  ///  - Seed: for every pair passing the bounding check (in (i, j) order), the face, vertex
+  ///    and edge tests in that order, resolving each hit by a single-point frictionless
+  ///    impulse; then integration of every body.
+  ///  - Extended (world_extended.cpp): one manifold per pair passing the bounding check and not
+  ///    proved apart; this step's forces; simultaneous impulses with Coulomb friction and
+  ///    resting contact (engine/contact_solver.h); one event per colliding manifold; time of
+  ///    impact for pairs the step would bring into contact; integration; position projection
+  ///    of the pairs that pressed together.
   /// Returns false (and sets failure()) when the state became non-finite or the energy grew
   /// past sim.max_energy_ratio; the world must not be stepped further then.
   bool step();
@@ -74,19 +86,35 @@ class World {
   // bounding check.
   void collide_pair(int i, int j, bool bounded);
   bool check_state();
+  // The seed's detection, response and integration for one step.
+  void step_seed();
   // The extended engine's detection, response and integration for one step
-  // (engine/world_extended.cpp).
+  // (engine/world_extended.cpp), and its stages in the order it calls them.
   void step_extended();
+  // One manifold per pair passing the bounding check, not proved apart, at the step's poses.
+  std::vector<PairManifold> detect_manifolds();
+  // The solver's settings for this step: the scene's restitution and friction, the resting
+  // threshold, the world's tunables.
+  ContactSolverSettings solver_settings() const;
+  // Appends one event per manifold whose total normal impulse is positive (with `rest_speed`,
+  // only those with a point approaching faster): the impulse at its centre of pressure, at
+  // `time`. Returns every manifold's total normal impulse (N s).
+  std::vector<double> record_events(const std::vector<PairManifold>& manifolds,
+                                    const std::vector<SolvedPoint>& solved, double time,
+                                    std::optional<double> rest_speed);
   // Time of impact within the step for pairs separated at its start: moves, resolves and
   // finishes the step for each such pair; returns which bodies it carried through the step.
   std::vector<bool> time_of_impact_step(const std::vector<PairManifold>& manifolds,
                                         const ContactSolverSettings& settings);
+  // Integrates every body the time of impact did not carry (`moved`) through the step.
+  void integrate_bodies(const std::vector<bool>& moved);
 
   SimSettings sim_;
   std::vector<RigidBody> bodies_;
   DetectorVariant variant_;
   DetectionCache detection_;  // the pair being resolved: placed once per pair per step
   ContactModel contact_model_ = ContactModel::Seed;
+  WorldSettings tunables_;  // before the broad phases, which are built from it
   BroadPhase broad_phase_;
   // The extended step's second broad phase, on the poses at the step's end (new contacts).
   BroadPhase ahead_broad_phase_;
@@ -115,7 +143,7 @@ class World {
   bool separated(int i, int j);
 };
 
-/// Builds every body of the scene and runs it with the custom engine.
+/// Builds every body of the scene and runs it with the custom engine (the seed's contact model).
 RunResult run_scene(const Scene& scene, DetectorVariant variant = DetectorVariant::Accelerated,
                     BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree);
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <set>
 #include <tuple>
 #include <utility>
@@ -18,9 +19,39 @@
 
 namespace rbx {
 
+// The step as a list of stages: detect, approach velocities, forces, solve, events, time of
+// impact, integrate, project.
 void World::step_extended() {
-  const double dt = sim_.dt;
-  // Detection: one manifold per pair passing the bounding check, at the step's start poses.
+  std::vector<PairManifold> manifolds = detect_manifolds();
+  // Approach velocities before this step's forces: the restitution law's v_n0.
+  const std::vector<std::vector<double>> approach = normal_velocities(bodies_, manifolds);
+  // Symplectic: forces first (Guendelman et al. 2003), so the contacts see this step's gravity
+  // and a resting body ends the step at rest. The seed's Euler adds gravity after the move;
+  // there the solve runs before it, as the seed's impulses do.
+  if (sim_.integrator == Integrator::Symplectic)
+    for (RigidBody& b : bodies_)
+      if (!b.is_static) b.velocity += sim_.gravity * sim_.dt;
+  const ContactSolverSettings settings = solver_settings();
+  const std::vector<SolvedPoint> solved =
+      solve_contact_velocities(bodies_, manifolds, approach, settings);
+  // One event per manifold that was a collision.
+  const std::vector<double> impulse = record_events(manifolds, solved, time_, settings.rest_speed);
+  // Time of impact: pairs separated at the step's start that the step's motion brings into
+  // contact (engine/time_of_impact.h) are moved to their first contact, resolved there, and
+  // moved on for the rest of the step: an adaptive step for those two bodies only.
+  const std::vector<bool> moved = time_of_impact_step(manifolds, settings);
+  integrate_bodies(moved);
+  // Only pairs that pressed together (a normal impulse) are projected apart: a penetration
+  // that no approach caused, such as two overlapping bodies moving together
+  // (stress/zero_relative_velocity), is left as it is, as the seed leaves it.
+  std::vector<PairManifold> pressed;
+  for (size_t m = 0; m < manifolds.size(); ++m)
+    if (impulse[m] > 0.0) pressed.push_back(std::move(manifolds[m]));
+  project_contact_positions(bodies_, pressed, tunables_);
+}
+
+std::vector<PairManifold> World::detect_manifolds() {
+  // One manifold per pair passing the bounding check, at the step's start poses.
   std::vector<PairManifold> manifolds;
   for (const BodyPair& pair : broad_phase_.find_pairs(bodies_)) {
     const RigidBody &a = bodies_[pair.first], &b = bodies_[pair.second];
@@ -29,36 +60,31 @@ void World::step_extended() {
     auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant_);
     if (m) manifolds.push_back({pair.first, pair.second, std::move(*m), a.pose(), b.pose()});
   }
+  return manifolds;
+}
 
-  // Approach velocities before this step's forces: the restitution law's v_n0.
-  const std::vector<std::vector<double>> approach = normal_velocities(bodies_, manifolds);
-  // Symplectic: forces first (Guendelman et al. 2003), so the contacts see this step's gravity
-  // and a resting body ends the step at rest. The seed's Euler adds gravity after the move;
-  // there the solve runs before it, as the seed's impulses do.
-  const bool symplectic = sim_.integrator == Integrator::Symplectic;
-  if (symplectic)
-    for (RigidBody& b : bodies_)
-      if (!b.is_static) b.velocity += sim_.gravity * dt;
-
-  // Resting threshold: an approach no faster than two steps of gravity is a body settling, not
-  // a collision, and gets e = 0 (else a resting body with e > 0 bounces by e g dt for ever).
-  // Zero without gravity: every approach is then a collision, as in the seed.
+ContactSolverSettings World::solver_settings() const {
+  // Resting threshold: a few steps of gravity (WorldSettings::rest_gravity_steps).
   ContactSolverSettings settings;
   settings.restitution = sim_.restitution;
   settings.friction = sim_.friction;
-  settings.rest_speed = 2.0 * sim_.gravity.norm() * dt;
-  const std::vector<SolvedPoint> solved =
-      solve_contact_velocities(bodies_, manifolds, approach, settings);
+  settings.rest_speed = tunables_.rest_gravity_steps * sim_.gravity.norm() * sim_.dt;
+  settings.tunables = tunables_;
+  return settings;
+}
 
-  // One event per manifold that was a collision: its total normal impulse at the centre of
-  // the normal impulses (the centre of pressure).
+std::vector<double> World::record_events(const std::vector<PairManifold>& manifolds,
+                                         const std::vector<SolvedPoint>& solved, double time,
+                                         std::optional<double> rest_speed) {
+  // A manifold's event: its total normal impulse at the centre of the normal impulses (the
+  // centre of pressure), with the detector's contact for the rest.
   std::vector<double> impulse(manifolds.size(), 0.0);
   std::vector<Vec3> moment(manifolds.size(), Vec3::Zero());
-  std::vector<bool> collision(manifolds.size(), false);
+  std::vector<bool> collision(manifolds.size(), !rest_speed);
   for (const SolvedPoint& p : solved) {
     impulse[p.manifold] += p.normal_impulse;
     moment[p.manifold] += p.normal_impulse * p.point;
-    if (p.approach_speed > settings.rest_speed) collision[p.manifold] = true;
+    if (rest_speed && p.approach_speed > *rest_speed) collision[p.manifold] = true;
   }
   for (size_t m = 0; m < manifolds.size(); ++m) {
     if (!collision[m] || !(impulse[m] > 0.0)) continue;
@@ -67,48 +93,22 @@ void World::step_extended() {
     c.normal = manifolds[m].manifold.normal;
     c.depth = manifolds[m].manifold.depth;
     events_.push_back(
-        {time_, step_, bodies_[manifolds[m].a].name, bodies_[manifolds[m].b].name, c, impulse[m]});
+        {time, step_, bodies_[manifolds[m].a].name, bodies_[manifolds[m].b].name, c, impulse[m]});
   }
+  return impulse;
+}
 
-  // Time of impact: pairs separated at the step's start that the step's motion brings into
-  // contact (engine/time_of_impact.h) are moved to their first contact, resolved there, and
-  // moved on for the rest of the step: an adaptive step for those two bodies only.
-  std::vector<bool> moved = time_of_impact_step(manifolds, settings);
-
-  // Integration (gravity already in the velocities for the symplectic scheme), then the
-  // position projection on the moved poses.
+void World::integrate_bodies(const std::vector<bool>& moved) {
+  // Gravity is already in the velocities for the symplectic scheme.
   const std::vector<ShapeFacts>& facts = shape_facts();
   for (size_t i = 0; i < bodies_.size(); ++i) {
     RigidBody& b = bodies_[i];
     if (moved[i]) continue;  // already carried through the step by its time of impact
-    if (symplectic)
-      integrate_symplectic(b, Vec3::Zero(), dt, &facts[i].principal);
+    if (sim_.integrator == Integrator::Symplectic)
+      integrate_symplectic(b, Vec3::Zero(), sim_.dt, &facts[i].principal);
     else
-      integrate(b, sim_, dt, &facts[i].principal);
+      integrate(b, sim_, sim_.dt, &facts[i].principal);
   }
-  // Only pairs that pressed together (a normal impulse) are projected apart: a penetration
-  // that no approach caused, such as two overlapping bodies moving together
-  // (stress/zero_relative_velocity), is left as it is, as the seed leaves it.
-  std::vector<PairManifold> pressed;
-  for (size_t m = 0; m < manifolds.size(); ++m)
-    if (impulse[m] > 0.0) pressed.push_back(std::move(manifolds[m]));
-  project_contact_positions(bodies_, pressed);
-}
-
-const std::vector<World::ShapeFacts>& World::shape_facts() {
-  if (facts_.size() != bodies_.size()) {
-    facts_.assign(bodies_.size(), {});
-    for (size_t k = 0; k < bodies_.size(); ++k) {
-      const ConvexPolyhedron& shape = *bodies_[k].shape;
-      ShapeFacts& f = facts_[k];
-      f.thickness = shape_thickness(shape);
-      for (const Vec3& v : shape.vertices()) f.radius = std::max(f.radius, v.norm());
-      f.reach = tolerance_reach(shape);
-      f.own_tol = point_in_mesh_tolerance(shape, shape);
-      f.principal = principal_frame(bodies_[k].inertia_body);
-    }
-  }
-  return facts_;
 }
 
 bool World::separated(int i, int j) {
@@ -147,19 +147,21 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
   }
   std::set<std::pair<int, int>> touching;
   for (const PairManifold& pm : manifolds) touching.insert({pm.a, pm.b});
-  // Candidates: a pair whose relative sweep exceeds a quarter of the thinner thickness (below
-  // that, the next step's detection after penetration finds the contact: nothing can pass
-  // through) and whose swept spheres meet. The faster body of such a pair sweeps more than an
-  // eighth of the thinnest body, which keeps the search to the fast bodies.
+  // Candidates: a pair whose relative sweep exceeds toi_pair_sweep of the thinner thickness
+  // (below that, the next step's detection after penetration finds the contact: nothing can
+  // pass through) and whose swept spheres meet. The faster body of such a pair sweeps more
+  // than half of that, toi_body_sweep of the thinnest body, which keeps the search to the
+  // fast bodies.
   std::vector<std::tuple<double, int, int>> hits;  // (time of impact, i, j), i < j
   for (size_t i = 0; i < n; ++i) {
-    if (!(sweep[i] > 0.125 * thinnest)) continue;
+    if (!(sweep[i] > tunables_.toi_body_sweep * thinnest)) continue;
     for (size_t j = 0; j < n; ++j) {
       if (j == i) continue;
       if (sweep[j] > sweep[i] || (sweep[j] == sweep[i] && j < i)) continue;  // the faster one asks
       const int lo = static_cast<int>(std::min(i, j)), hi = static_cast<int>(std::max(i, j));
       if (touching.count({lo, hi})) continue;
-      if (!(sweep[i] + sweep[j] > 0.25 * std::min(facts[i].thickness, facts[j].thickness)))
+      if (!(sweep[i] + sweep[j] >
+            tunables_.toi_pair_sweep * std::min(facts[i].thickness, facts[j].thickness)))
         continue;
       const RigidBody &a = bodies_[lo], &b = bodies_[hi];
       // Swept spheres (the bounding check along the step): the centres' closest approach over
@@ -202,19 +204,9 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
     if (auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant_)) {
       const std::vector<PairManifold> one = {{i, j, std::move(*m), a.pose(), b.pose()}};
       const auto approach = normal_velocities(bodies_, one);
-      double impulse = 0.0;
-      Vec3 moment = Vec3::Zero();
-      for (const SolvedPoint& p : solve_contact_velocities(bodies_, one, approach, settings)) {
-        impulse += p.normal_impulse;
-        moment += p.normal_impulse * p.point;
-      }
-      if (impulse > 0.0) {
-        ContactPoint c = one[0].manifold.detector_contact;
-        c.point = moment / impulse;
-        c.normal = one[0].manifold.normal;
-        c.depth = one[0].manifold.depth;
-        events_.push_back({time_ + t, step_, a.name, b.name, c, impulse});
-      }
+      // Every impact here is a collision: its event whatever its approach speed.
+      record_events(one, solve_contact_velocities(bodies_, one, approach, settings), time_ + t,
+                    std::nullopt);
     }
     a = advanced(a, dt - t);
     b = advanced(b, dt - t);

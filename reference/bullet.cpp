@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "reference/dynamics_recorder.h"
 #include "reference/prebuilt_cache.h"
 
 namespace rbx {
@@ -243,19 +244,146 @@ BodyFinal final_state(const std::string& name, const BulletBody& bb) {
   return f;
 }
 
+/// The single-impulse settings of docs/references.md on the world's solver (`fair_world`).
+void make_solver_fair(btDiscreteDynamicsWorld& world, const BulletSettings& settings) {
+  btContactSolverInfo& info = world.getSolverInfo();
+  // Restitution applies at any approach speed (default: none below 0.2 m/s).
+  info.m_restitutionVelocityThreshold = settings.restitution_threshold;
+  // Split impulse for every penetration depth (default: only below -0.04 m; shallower
+  // penetration is fixed by Baumgarte, m_erp2 * depth / dt added to the velocity target):
+  // position error is then removed by a separate push that adds no velocity.
+  info.m_splitImpulse = 1;
+  info.m_splitImpulsePenetrationThreshold = settings.split_impulse_threshold;
+  // No warm starting: each step's solve starts from zero impulse, not 0.85 of the last
+  // step's. Done by the factor, not by clearing SOLVER_USE_WARMSTARTING: without that flag
+  // solveGroupCacheFriendlyFinish skips writeBackContacts, so the manifold points would
+  // never carry the applied impulses the events below are read from.
+  info.m_warmstartingFactor = 0;
+  // Enough Gauss-Seidel sweeps for multi-point manifolds to converge (default 10); a
+  // single-point impact is exact after the first.
+  info.m_numIterations = 100;
+}
+
+/// Scene body `i` as a Bullet body, in the principal frame of its inertia. Not yet in a world.
+BulletBody make_bullet_body(const RigidBody& rb, int i, const Scene& scene,
+                            const BulletSettings& settings) {
+  const bool fair = settings.fair_world;
+  BulletBody bb;
+  // Bullet stores a diagonal local inertia only, so the hull is placed in the principal
+  // frame of I_body (vertices Q^T v) and the body's rotation becomes R * Q. Bullet's own
+  // calculateLocalInertia is the hull's bounding box's, hence supplied here.
+  // A native box keeps the body axes: is_native_box guarantees a diagonal inertia there.
+  Vec3 moments = Vec3::Zero();
+  bb.box = native_box(rb, settings);
+  if (bb.box) {
+    if (!rb.is_static) moments = rb.inertia_body.diagonal();
+  } else if (!rb.is_static) {
+    principal_axes(rb.inertia_body, &bb.principal, &moments);
+  }
+  bb.shape = make_shape(rb, bb.principal.transpose(), settings);
+  // Static bodies: mass 0 and zero inertia make Bullet's static object.
+  const double mass = rb.is_static ? 0.0 : rb.mass;
+  btRigidBody::btRigidBodyConstructionInfo ci(mass, nullptr, bb.shape.get(), to_bt(moments));
+  ci.m_startWorldTransform = body_transform(rb, bb.principal);
+  // Bullet combines restitution (and friction) as the product of the two bodies' values;
+  // sqrt(e) on every body gives e for every pair (to 1 ulp), where "e on one body, 1 on the
+  // rest" would give 1 between two of the rest.
+  ci.m_restitution = std::sqrt(scene.sim.restitution);
+  if (fair) {
+    // Coulomb friction from the scene by the same product rule (the fair default is 0;
+    // Bullet's body default is 0.5). Damping 0: Bullet's default, made explicit.
+    ci.m_friction = std::sqrt(scene.sim.friction);
+    ci.m_rollingFriction = 0;
+    ci.m_spinningFriction = 0;
+    ci.m_linearDamping = 0;
+    ci.m_angularDamping = 0;
+    ci.m_additionalDamping = false;
+  }
+  bb.body = std::make_unique<btRigidBody>(ci);
+  bb.body->setUserIndex(i);
+  if (!rb.is_static) {
+    bb.body->setLinearVelocity(to_bt(rb.velocity));
+    bb.body->setAngularVelocity(to_bt(rb.angular_velocity));
+  }
+  // Gyroscopic term: Bullet's default flag BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY is
+  // kept. It advances Euler's equations I w' + w x I w = 0 in body axes by one Newton step
+  // of implicit Euler, so a torque-free asymmetric body precesses (without it w stays
+  // fixed in the world and angular momentum is not conserved). It is first order and
+  // slightly dissipative (|L| drifts by ~1.2 dt per second here, see the test). The
+  // explicit variant is explicit Euler clamped by m_maxGyroscopicForce; the implicit
+  // world-frame one linearises about the world inertia. This one uses the diagonal local
+  // inertia, which the principal frame above makes exact.
+  if (fair) {
+    // Never sleep: a slow body must keep integrating.
+    bb.body->setActivationState(DISABLE_DEACTIVATION);
+    // Contacts are solved only once the hulls overlap (default: any point within the
+    // breaking threshold, i.e. before touching), so the impulse acts at contact.
+    bb.body->setContactProcessingThreshold(settings.processing_threshold);
+  }
+  return bb;
+}
+
+/// Events of step `k` (time step dt): manifold points the solver used this step with a
+/// positive impulse, appended to `events`. Points beyond the processing threshold were not
+/// solved and may keep an old impulse.
+void read_events(const btCollisionDispatcher& dispatcher, long k, double dt,
+                 const std::vector<std::string>& names, const std::vector<BulletBody>& bodies,
+                 const BulletSettings& settings, std::vector<CollisionEvent>& events) {
+  for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+    const btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
+    int i0 = manifold->getBody0()->getUserIndex();
+    int i1 = manifold->getBody1()->getUserIndex();
+    for (int p = 0; p < manifold->getNumContacts(); ++p) {
+      const btManifoldPoint& cp = manifold->getContactPoint(p);
+      if (cp.getAppliedImpulse() <= 0 ||
+          cp.getDistance() > manifold->getContactProcessingThreshold())
+        continue;
+      CollisionEvent ev;
+      ev.time = k * dt;  // detection runs at the start-of-step poses
+      ev.step = k;
+      // Normal from body 1 toward body 0; order the pair by scene index.
+      Vec3 n = from_bt(cp.m_normalWorldOnB).normalized();
+      int ia = i0, ib = i1;
+      if (ia > ib) {
+        std::swap(ia, ib);
+        n = -n;
+      }
+      ev.body_a = names[ia];
+      ev.body_b = names[ib];
+      ev.contact.normal = n;
+      ev.contact.depth = std::max(0.0, -static_cast<double>(cp.getDistance()));
+      ev.contact.point =
+          0.5 * (from_bt(cp.getPositionWorldOnA()) + from_bt(cp.getPositionWorldOnB()));
+      ev.contact.feature = pair_feature(bodies[i0].box, bodies[i1].box, settings);
+      ev.impulse = cp.getAppliedImpulse();  // N s, along the normal
+      events.push_back(ev);
+    }
+  }
+}
+
+/// Throws when a body's state is not finite after step `k`: an error, not a result.
+void check_finite(const std::vector<BulletBody>& bodies, const std::vector<std::string>& names,
+                  long k) {
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    const btRigidBody& b = *bodies[i].body;
+    if (!std::isfinite(b.getWorldTransform().getOrigin().length2()) ||
+        !std::isfinite(b.getLinearVelocity().length2()) ||
+        !std::isfinite(b.getAngularVelocity().length2()))
+      throw std::runtime_error("non-finite state of body " + names[i] + " at step " +
+                               std::to_string(k + 1));
+  }
+}
+
 /// Runs the scene in a btDiscreteDynamicsWorld. `settings.fair_world`: the single-impulse
 /// settings of docs/references.md; otherwise Bullet's defaults for the world, solver and bodies
 /// (the scene's shapes, masses, inertia, restitution and gravity are used either way).
 DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
                          const BulletSettings& settings) {
-  const bool fair = settings.fair_world;
   DynamicsResult result;
   try {
     const double dt = opt.dt > 0 ? opt.dt : scene.sim.dt;  // s
     if (!(dt > 0)) throw std::invalid_argument("time step must be > 0");
     const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
-    const double e = scene.sim.restitution;
-    const double mu = scene.sim.friction;
 
     btDefaultCollisionConfiguration configuration;
     btCollisionDispatcher dispatcher(&configuration);
@@ -266,25 +394,7 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
     world.getDispatchInfo().m_enableSatConvex = settings.polyhedral_hulls && settings.sat_convex;
     // Bullet's default gravity is (0, -10, 0); the scene's is the input in both modes.
     world.setGravity(to_bt(scene.sim.gravity));
-
-    if (fair) {
-      btContactSolverInfo& info = world.getSolverInfo();
-      // Restitution applies at any approach speed (default: none below 0.2 m/s).
-      info.m_restitutionVelocityThreshold = settings.restitution_threshold;
-      // Split impulse for every penetration depth (default: only below -0.04 m; shallower
-      // penetration is fixed by Baumgarte, m_erp2 * depth / dt added to the velocity target):
-      // position error is then removed by a separate push that adds no velocity.
-      info.m_splitImpulse = 1;
-      info.m_splitImpulsePenetrationThreshold = settings.split_impulse_threshold;
-      // No warm starting: each step's solve starts from zero impulse, not 0.85 of the last
-      // step's. Done by the factor, not by clearing SOLVER_USE_WARMSTARTING: without that flag
-      // solveGroupCacheFriendlyFinish skips writeBackContacts, so the manifold points would
-      // never carry the applied impulses the events below are read from.
-      info.m_warmstartingFactor = 0;
-      // Enough Gauss-Seidel sweeps for multi-point manifolds to converge (default 10); a
-      // single-point impact is exact after the first.
-      info.m_numIterations = 100;
-    }
+    if (settings.fair_world) make_solver_fair(world, settings);
 
     // Bodies: the engine's own (make_body), so hull, mass, centre of mass and inertia are
     // exactly the custom engine's.
@@ -298,138 +408,30 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
           if (bb.body) world->removeRigidBody(bb.body.get());
       }
     } remover{&world, &bodies};
-
     std::vector<std::string> names;
     for (size_t i = 0; i < scene.bodies.size(); ++i) {
       const RigidBody rb = make_body(scene.bodies[i]);
       names.push_back(rb.name);
-      BulletBody bb;
-      // Bullet stores a diagonal local inertia only, so the hull is placed in the principal
-      // frame of I_body (vertices Q^T v) and the body's rotation becomes R * Q. Bullet's own
-      // calculateLocalInertia is the hull's bounding box's, hence supplied here.
-      // A native box keeps the body axes: is_native_box guarantees a diagonal inertia there.
-      Vec3 moments = Vec3::Zero();
-      bb.box = native_box(rb, settings);
-      if (bb.box) {
-        if (!rb.is_static) moments = rb.inertia_body.diagonal();
-      } else if (!rb.is_static) {
-        principal_axes(rb.inertia_body, &bb.principal, &moments);
-      }
-      bb.shape = make_shape(rb, bb.principal.transpose(), settings);
-      // Static bodies: mass 0 and zero inertia make Bullet's static object.
-      const double mass = rb.is_static ? 0.0 : rb.mass;
-      btRigidBody::btRigidBodyConstructionInfo ci(mass, nullptr, bb.shape.get(), to_bt(moments));
-      ci.m_startWorldTransform = body_transform(rb, bb.principal);
-      // Bullet combines restitution (and friction) as the product of the two bodies' values;
-      // sqrt(e) on every body gives e for every pair (to 1 ulp), where "e on one body, 1 on the
-      // rest" would give 1 between two of the rest.
-      ci.m_restitution = std::sqrt(e);
-      if (fair) {
-        // Coulomb friction from the scene by the same product rule (the fair default is 0;
-        // Bullet's body default is 0.5). Damping 0: Bullet's default, made explicit.
-        ci.m_friction = std::sqrt(mu);
-        ci.m_rollingFriction = 0;
-        ci.m_spinningFriction = 0;
-        ci.m_linearDamping = 0;
-        ci.m_angularDamping = 0;
-        ci.m_additionalDamping = false;
-      }
-      bb.body = std::make_unique<btRigidBody>(ci);
-      bb.body->setUserIndex(static_cast<int>(i));
-      if (!rb.is_static) {
-        bb.body->setLinearVelocity(to_bt(rb.velocity));
-        bb.body->setAngularVelocity(to_bt(rb.angular_velocity));
-      }
-      // Gyroscopic term: Bullet's default flag BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY is
-      // kept. It advances Euler's equations I w' + w x I w = 0 in body axes by one Newton step
-      // of implicit Euler, so a torque-free asymmetric body precesses (without it w stays
-      // fixed in the world and angular momentum is not conserved). It is first order and
-      // slightly dissipative (|L| drifts by ~1.2 dt per second here, see the test). The
-      // explicit variant is explicit Euler clamped by m_maxGyroscopicForce; the implicit
-      // world-frame one linearises about the world inertia. This one uses the diagonal local
-      // inertia, which the principal frame above makes exact.
-      if (fair) {
-        // Never sleep: a slow body must keep integrating.
-        bb.body->setActivationState(DISABLE_DEACTIVATION);
-        // Contacts are solved only once the hulls overlap (default: any point within the
-        // breaking threshold, i.e. before touching), so the impulse acts at contact.
-        bb.body->setContactProcessingThreshold(settings.processing_threshold);
-      }
-      world.addRigidBody(bb.body.get());
-      bodies.push_back(std::move(bb));
+      bodies.push_back(make_bullet_body(rb, static_cast<int>(i), scene, settings));
+      world.addRigidBody(bodies.back().body.get());
     }
 
-    // Samples: t = 0 and then every `sample_every` steps.
-    auto sample = [&](double t) {
-      StateSample s;
-      s.time = t;
-      for (size_t i = 0; i < bodies.size(); ++i)
-        s.bodies.push_back(final_state(names[i], bodies[i]));
-      result.samples.push_back(std::move(s));
-    };
-    if (opt.sample_every > 0) sample(0.0);
-
-    std::vector<BodyFinal> before;  // states before the step, until the first impulse
+    DynamicsRecorder recorder(result, opt, [&] {
+      std::vector<BodyFinal> states;
+      for (size_t i = 0; i < bodies.size(); ++i) states.push_back(final_state(names[i], bodies[i]));
+      return states;
+    });
+    recorder.start();
     for (long k = 0; k < steps; ++k) {
-      const size_t events_before = result.events.size();
-      if (!result.first_impulse.seen) {
-        before.clear();
-        for (size_t i = 0; i < bodies.size(); ++i)
-          before.push_back(final_state(names[i], bodies[i]));
-      }
+      recorder.before_step(result.events);
       // One internal step of exactly dt (maxSubSteps = 0: no fixed 1/60 s sub-stepping and no
       // interpolated motion states).
       world.stepSimulation(dt, 0, dt);
-
-      // Events: manifold points the solver used this step with a positive impulse. Points
-      // beyond the processing threshold were not solved and may keep an old impulse.
-      for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
-        const btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
-        int i0 = manifold->getBody0()->getUserIndex();
-        int i1 = manifold->getBody1()->getUserIndex();
-        for (int p = 0; p < manifold->getNumContacts(); ++p) {
-          const btManifoldPoint& cp = manifold->getContactPoint(p);
-          if (cp.getAppliedImpulse() <= 0 ||
-              cp.getDistance() > manifold->getContactProcessingThreshold())
-            continue;
-          CollisionEvent ev;
-          ev.time = k * dt;  // detection runs at the start-of-step poses
-          ev.step = k;
-          // Normal from body 1 toward body 0; order the pair by scene index.
-          Vec3 n = from_bt(cp.m_normalWorldOnB).normalized();
-          int ia = i0, ib = i1;
-          if (ia > ib) {
-            std::swap(ia, ib);
-            n = -n;
-          }
-          ev.body_a = names[ia];
-          ev.body_b = names[ib];
-          ev.contact.normal = n;
-          ev.contact.depth = std::max(0.0, -static_cast<double>(cp.getDistance()));
-          ev.contact.point =
-              0.5 * (from_bt(cp.getPositionWorldOnA()) + from_bt(cp.getPositionWorldOnB()));
-          ev.contact.feature = pair_feature(bodies[i0].box, bodies[i1].box, settings);
-          ev.impulse = cp.getAppliedImpulse();  // N s, along the normal
-          result.events.push_back(ev);
-        }
-      }
-
+      read_events(dispatcher, k, dt, names, bodies, settings, result.events);
       // The first impulse: one event per manifold point, so the count is the events'.
-      if (!result.first_impulse.seen && result.events.size() > events_before)
-        result.first_impulse = first_impulse_of(
-            {result.events.begin() + static_cast<long>(events_before), result.events.end()}, before,
-            dt);
-
-      // A non-finite state is an error, not a result.
-      for (size_t i = 0; i < bodies.size(); ++i) {
-        const btRigidBody& b = *bodies[i].body;
-        if (!std::isfinite(b.getWorldTransform().getOrigin().length2()) ||
-            !std::isfinite(b.getLinearVelocity().length2()) ||
-            !std::isfinite(b.getAngularVelocity().length2()))
-          throw std::runtime_error("non-finite state of body " + names[i] + " at step " +
-                                   std::to_string(k + 1));
-      }
-      if (opt.sample_every > 0 && (k + 1) % opt.sample_every == 0) sample((k + 1) * dt);
+      recorder.first_impulse_from_step(result.events, dt);
+      check_finite(bodies, names, k);
+      recorder.after_step(k + 1, (k + 1) * dt);
     }
 
     for (size_t i = 0; i < bodies.size(); ++i)

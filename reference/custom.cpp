@@ -4,6 +4,7 @@
 
 #include "engine/contact_plane.h"
 #include "engine/detect.h"
+#include "reference/dynamics_recorder.h"
 
 namespace rbx {
 
@@ -53,26 +54,18 @@ DynamicsResult run_dynamics(const Scene& scene, const DynamicsOptions& opt, Cont
     World world(sim, make_bodies(scene));
     world.set_contact_model(model);
     const long steps = sim.steps();
-    auto sample = [&] {
-      StateSample s{world.time(), {}};
-      for (const RigidBody& b : world.bodies()) s.bodies.push_back(final_of(b));
-      r.samples.push_back(std::move(s));
-    };
-    if (opt.sample_every > 0) sample();
-    // States before each step until the first impulse (the engine resolves one point per pair).
-    std::vector<BodyFinal> before;
+    DynamicsRecorder recorder(r, opt, [&] {
+      std::vector<BodyFinal> states;
+      for (const RigidBody& b : world.bodies()) states.push_back(final_of(b));
+      return states;
+    });
+    recorder.start();
     while (world.steps_taken() < steps) {
-      const size_t events_before = world.events().size();
-      if (!r.first_impulse.seen) {
-        before.clear();
-        for (const RigidBody& b : world.bodies()) before.push_back(final_of(b));
-      }
+      recorder.before_step(world.events());
       if (!world.step()) break;
-      if (!r.first_impulse.seen && world.events().size() > events_before)
-        r.first_impulse = first_impulse_of(
-            {world.events().begin() + static_cast<long>(events_before), world.events().end()},
-            before, sim.dt);
-      if (opt.sample_every > 0 && world.steps_taken() % opt.sample_every == 0) sample();
+      // The first impulse from the step's events (the engine's: one per resolved contact).
+      recorder.first_impulse_from_step(world.events(), sim.dt);
+      recorder.after_step(world.steps_taken(), world.time());
     }
     if (!world.failure().empty()) {
       r.status = Status::Error;

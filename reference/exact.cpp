@@ -125,82 +125,85 @@ using exact_detail::FeatureEdge;
 using exact_detail::MergedFace;
 using exact_detail::Topology;
 
-// Merges coplanar triangles into polygonal faces and lists the edges of the solid.
-Topology build_topology(const ConvexPolyhedron& p) {
+// Directed edge -> the triangle that uses it (closed, consistently oriented mesh).
+using EdgeOwners = std::map<std::pair<int, int>, int>;
+
+EdgeOwners edge_owners(const ConvexPolyhedron& p) {
+  const auto& tri = p.triangles();
+  EdgeOwners owner;
+  for (int t = 0; t < static_cast<int>(tri.size()); ++t)
+    for (int k = 0; k < 3; ++k) owner[{tri[t][k], tri[t][(k + 1) % 3]}] = t;
+  return owner;
+}
+
+// The triangles coplanar with `seed` and joined to it (flood fill across edges, coplanarity
+// measured against the seed plane, so no drift); marks them face `id` in face_of.
+std::vector<int> coplanar_region(const ConvexPolyhedron& p, const EdgeOwners& owner, int seed,
+                                 int id, double merge_tol, std::vector<int>& face_of) {
   const auto& v = p.vertices();
   const auto& tri = p.triangles();
   const auto& planes = p.planes();
-  const int nt = static_cast<int>(tri.size());
-
-  // Directed edge -> the triangle that uses it (closed, consistently oriented mesh).
-  std::map<std::pair<int, int>, int> owner;
-  for (int t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k) owner[{tri[t][k], tri[t][(k + 1) % 3]}] = t;
-  auto across = [&](int u, int w) { return owner.at({w, u}); };
-
-  // Same scale as ConvexPolyhedron's convexity tolerance.
-  const Aabb& box = p.bounds();
-  const double scale = std::max((box.max - box.min).maxCoeff(),
-                                box.max.cwiseAbs().cwiseMax(box.min.cwiseAbs()).maxCoeff());
-  const double merge_tol = kMergeRelative * scale;
-
-  Topology topo;
-  std::vector<int> face_of(nt, -1);
-  for (int seed = 0; seed < nt; ++seed) {
-    if (face_of[seed] >= 0) continue;
-    const int id = static_cast<int>(topo.faces.size());
-    // Flood fill across edges, measuring coplanarity against the seed plane (no drift).
-    std::vector<int> members{seed};
-    face_of[seed] = id;
-    for (size_t q = 0; q < members.size(); ++q) {
-      const int t = members[q];
-      for (int k = 0; k < 3; ++k) {
-        const int nb = across(tri[t][k], tri[t][(k + 1) % 3]);
-        if (face_of[nb] >= 0 || planes[nb].normal.dot(planes[seed].normal) <= 0) continue;
-        bool coplanar = true;
-        for (int w : tri[nb])
-          coplanar = coplanar && std::abs(planes[seed].distance(v[w])) <= merge_tol;
-        if (!coplanar) continue;
-        face_of[nb] = id;
-        members.push_back(nb);
-      }
+  std::vector<int> members{seed};
+  face_of[seed] = id;
+  for (size_t q = 0; q < members.size(); ++q) {
+    const int t = members[q];
+    for (int k = 0; k < 3; ++k) {
+      const int nb = owner.at({tri[t][(k + 1) % 3], tri[t][k]});
+      if (face_of[nb] >= 0 || planes[nb].normal.dot(planes[seed].normal) <= 0) continue;
+      bool coplanar = true;
+      for (int w : tri[nb])
+        coplanar = coplanar && std::abs(planes[seed].distance(v[w])) <= merge_tol;
+      if (!coplanar) continue;
+      face_of[nb] = id;
+      members.push_back(nb);
     }
-    // Area-weighted normal and the vertex set.
-    MergedFace face;
-    Vec3 area_vector = Vec3::Zero();
-    for (int t : members) {
-      area_vector += (v[tri[t][1]] - v[tri[t][0]]).cross(v[tri[t][2]] - v[tri[t][0]]);
-      face.vertices.insert(face.vertices.end(), tri[t].begin(), tri[t].end());
-    }
-    face.normal = area_vector.normalized();
-    face.area = 0.5 * area_vector.norm();
-    std::sort(face.vertices.begin(), face.vertices.end());
-    face.vertices.erase(std::unique(face.vertices.begin(), face.vertices.end()),
-                        face.vertices.end());
-    // Boundary loop: directed edges whose reverse belongs to another face, chained.
-    std::map<int, int> next;
-    for (int t : members)
-      for (int k = 0; k < 3; ++k) {
-        const int u = tri[t][k], w = tri[t][(k + 1) % 3];
-        if (face_of[across(u, w)] == id) continue;
-        if (!next.emplace(u, w).second)
-          throw GeometryError("exact: merged face " + std::to_string(id) +
-                              " is not a simple polygon");
-      }
-    int at = next.begin()->first;
-    for (size_t steps = 0; steps < next.size(); ++steps) {
-      face.loop.push_back(at);
-      at = next.at(at);
-    }
-    if (at != face.loop.front())
-      throw GeometryError("exact: boundary of merged face " + std::to_string(id) +
-                          " is not one loop");
-    topo.faces.push_back(std::move(face));
   }
+  return members;
+}
 
-  // Edges of the solid, grouped into classes of parallel directions. Classes are found through a
-  // grid of cells of 1e-5 on the unit direction (>> kParallelSine): a parallel direction, +d or
-  // -d, lies in one of the 27 cells around it, so the search is exact and O(edges).
+// Face `id` of the triangles `members`: area-weighted normal, area, vertex set and boundary
+// loop (the directed edges whose reverse belongs to another face, chained).
+MergedFace merged_face(const ConvexPolyhedron& p, const EdgeOwners& owner,
+                       const std::vector<int>& members, int id, const std::vector<int>& face_of) {
+  const auto& v = p.vertices();
+  const auto& tri = p.triangles();
+  MergedFace face;
+  Vec3 area_vector = Vec3::Zero();
+  for (int t : members) {
+    area_vector += (v[tri[t][1]] - v[tri[t][0]]).cross(v[tri[t][2]] - v[tri[t][0]]);
+    face.vertices.insert(face.vertices.end(), tri[t].begin(), tri[t].end());
+  }
+  face.normal = area_vector.normalized();
+  face.area = 0.5 * area_vector.norm();
+  std::sort(face.vertices.begin(), face.vertices.end());
+  face.vertices.erase(std::unique(face.vertices.begin(), face.vertices.end()), face.vertices.end());
+  std::map<int, int> next;
+  for (int t : members)
+    for (int k = 0; k < 3; ++k) {
+      const int u = tri[t][k], w = tri[t][(k + 1) % 3];
+      if (face_of[owner.at({w, u})] == id) continue;
+      if (!next.emplace(u, w).second)
+        throw GeometryError("exact: merged face " + std::to_string(id) +
+                            " is not a simple polygon");
+    }
+  int at = next.begin()->first;
+  for (size_t steps = 0; steps < next.size(); ++steps) {
+    face.loop.push_back(at);
+    at = next.at(at);
+  }
+  if (at != face.loop.front())
+    throw GeometryError("exact: boundary of merged face " + std::to_string(id) +
+                        " is not one loop");
+  return face;
+}
+
+// Edges of the solid (between two merged faces), grouped into classes of parallel directions.
+// Classes are found through a grid of cells of 1e-5 on the unit direction (>> kParallelSine):
+// a parallel direction, +d or -d, lies in one of the 27 cells around it, so the search is exact
+// and O(edges).
+void classify_edges(const ConvexPolyhedron& p, const EdgeOwners& owner,
+                    const std::vector<int>& face_of, Topology& topo) {
+  const auto& v = p.vertices();
   constexpr double kCell = 1e-5;
   std::unordered_map<long long, std::vector<int>> grid;
   auto cell_of = [&](const Vec3& d) {
@@ -235,13 +238,37 @@ Topology build_topology(const ConvexPolyhedron& p) {
     }
     topo.edges.push_back({e.a, e.b, f0, f1, cls});
   }
+}
 
-  topo.neighbours.assign(v.size(), {});
+// Merges coplanar triangles into polygonal faces and lists the edges of the solid.
+Topology build_topology(const ConvexPolyhedron& p) {
+  const EdgeOwners owner = edge_owners(p);
+  // Same scale as ConvexPolyhedron's convexity tolerance.
+  const Aabb& box = p.bounds();
+  const double scale = std::max((box.max - box.min).maxCoeff(),
+                                box.max.cwiseAbs().cwiseMax(box.min.cwiseAbs()).maxCoeff());
+  const double merge_tol = kMergeRelative * scale;
+
+  // Faces: each triangle not yet merged seeds one.
+  Topology topo;
+  const int nt = static_cast<int>(p.triangles().size());
+  std::vector<int> face_of(nt, -1);
+  for (int seed = 0; seed < nt; ++seed) {
+    if (face_of[seed] >= 0) continue;
+    const int id = static_cast<int>(topo.faces.size());
+    const std::vector<int> members = coplanar_region(p, owner, seed, id, merge_tol, face_of);
+    topo.faces.push_back(merged_face(p, owner, members, id, face_of));
+  }
+  classify_edges(p, owner, face_of, topo);
+
+  // Adjacency: each vertex's mesh neighbours and the faces touching it.
+  const size_t nv = p.vertices().size();
+  topo.neighbours.assign(nv, {});
   for (const Edge& e : p.edges()) {
     topo.neighbours[e.a].push_back(e.b);
     topo.neighbours[e.b].push_back(e.a);
   }
-  topo.vertex_faces.assign(v.size(), {});
+  topo.vertex_faces.assign(nv, {});
   for (size_t f = 0; f < topo.faces.size(); ++f)
     for (int w : topo.faces[f].vertices) topo.vertex_faces[w].push_back(static_cast<int>(f));
   return topo;

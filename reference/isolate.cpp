@@ -360,17 +360,24 @@ CallSnapshot snapshot(const CallState& st) {
   return s;
 }
 
-// Forks a child that runs `body(frame_fd, state)` with its stderr captured, then supervises
-// it: frames go to `on_frame`; the shared call state is read at every frame and every 50 ms,
-// and a call past its deadline gets the child killed. The child's stderr is passed on, except
-// what arrives while a call runs, held until the call ends (it names a failure).
-template <class Body, class OnFrame>
-ChildEnd supervise(const Body& body, const OnFrame& on_frame) {
-  ChildEnd end;
-  void* page =
+// A forked child, as its parent holds it.
+struct Child {
+  pid_t pid = -1;
+  void* page = nullptr;        // the shared page holding `state`
+  CallState* state = nullptr;  // the call the child is in
+  int frames = -1;             // read end of the frames pipe
+  int errs = -1;               // read end of the child's stderr
+};
+
+// Maps the shared call state, opens the two pipes and forks a child that runs
+// `body(frame_fd, state)` with its stderr into the pipe; returns the parent's side.
+template <class Body>
+Child fork_child(const Body& body) {
+  Child child;
+  child.page =
       mmap(nullptr, sizeof(CallState), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
-  if (page == MAP_FAILED) throw std::runtime_error(std::string("mmap: ") + strerror(errno));
-  CallState* state = new (page) CallState();
+  if (child.page == MAP_FAILED) throw std::runtime_error(std::string("mmap: ") + strerror(errno));
+  child.state = new (child.page) CallState();
   int frames[2], errs[2];
   if (pipe(frames) != 0 || pipe(errs) != 0)
     throw std::runtime_error(std::string("pipe: ") + strerror(errno));
@@ -378,44 +385,122 @@ ChildEnd supervise(const Body& body, const OnFrame& on_frame) {
   std::fflush(nullptr);
   std::cout.flush();
   std::cerr.flush();
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error(std::string("fork: ") + strerror(errno));
-  if (pid == 0) {
+  child.pid = fork();
+  if (child.pid < 0) throw std::runtime_error(std::string("fork: ") + strerror(errno));
+  if (child.pid == 0) {
     close(frames[0]);
     close(errs[0]);
     dup2(errs[1], STDERR_FILENO);
     close(errs[1]);
-    body(frames[1], *state);
+    body(frames[1], *child.state);
     std::fflush(nullptr);
     _exit(0);  // not exit(): the parent's atexit hooks and static destructors are not ours
   }
   close(frames[1]);
   close(errs[1]);
-  std::string inbox;  // frame bytes not yet parsed
-  std::string held;   // stderr held while a call runs
+  child.frames = frames[0];
+  child.errs = errs[0];
+  return child;
+}
+
+// The child's stderr as the parent passes it on: what arrives while a call runs is held until
+// that call ends (it names a failure); the rest is written at once.
+struct StderrRelay {
+  std::string held;  // stderr of the call in progress
   uint64_t held_seq = 0;
-  pollfd fds[2] = {{frames[0], POLLIN, 0}, {errs[0], POLLIN, 0}};
+
+  void write_held() {
+    if (held.empty()) return;
+    std::cerr.write(held.data(), static_cast<std::streamsize>(held.size())).flush();
+    held.clear();
+  }
+  // Writes what was held once its call is over.
+  void release_if_over(const CallSnapshot& now) {
+    if (!now.in_call || now.seq != held_seq) write_held();
+  }
+  // Passes on, or holds, `n` bytes the child just wrote.
+  void take(const char* buf, ssize_t n, const CallSnapshot& now) {
+    if (!now.in_call) {
+      std::cerr.write(buf, n).flush();
+      return;
+    }
+    if (now.seq != held_seq) write_held();
+    held.append(buf, static_cast<size_t>(n));
+    held_seq = now.seq;
+  }
+};
+
+// Every complete frame in `inbox` (a type, then a length-prefixed payload), consumed: 'X' an
+// item's exception and 'C' a lone call's answer go to `end`, the others to `on_frame`.
+template <class OnFrame>
+void read_frames(std::string& inbox, ChildEnd& end, const OnFrame& on_frame) {
+  for (;;) {
+    Reader r{inbox};
+    const char type = r.pod<char>();
+    const std::string payload = r.str();
+    if (!r.ok) break;
+    inbox.erase(0, r.pos);
+    if (type == 'X') {
+      end.threw = payload;
+    } else if (type == 'C') {
+      end.has_answer = true;
+      end.answer = payload;
+    } else {
+      on_frame(type, payload);
+    }
+  }
+}
+
+// Ends the child (killed when it timed out), closes the pipes, reaps it unless `exited`, and
+// records the call it was in: a call begun and never ended is the one that failed.
+void finish_child(const Child& child, pollfd (&fds)[2], bool exited, StderrRelay& relay,
+                  ChildEnd& end) {
+  if (end.timed_out) kill(child.pid, SIGKILL);
+  for (pollfd& p : fds)
+    if (p.fd >= 0) close(p.fd);
+  while (!exited && waitpid(child.pid, &end.wait_status, 0) < 0 && errno == EINTR) {
+  }
+  const CallSnapshot last = snapshot(*child.state);
+  end.in_call = last.in_call;
+  end.backend = last.backend;
+  end.call_deadline_s = last.deadline_s;
+  end.call_elapsed_s = last.elapsed_s;
+  if (last.in_call)
+    end.call_stderr = relay.held;
+  else
+    relay.write_held();
+  child.state->~CallState();
+  munmap(child.page, sizeof(CallState));
+}
+
+// Forks a child that runs `body(frame_fd, state)` with its stderr captured, then supervises
+// it: frames go to `on_frame`; the shared call state is read at every frame and every 50 ms,
+// and a call past its deadline gets the child killed. The child's stderr is passed on, except
+// what arrives while a call runs, held until the call ends (it names a failure).
+template <class Body, class OnFrame>
+ChildEnd supervise(const Body& body, const OnFrame& on_frame) {
+  ChildEnd end;
+  const Child child = fork_child(body);
+  std::string inbox;  // frame bytes not yet parsed
+  StderrRelay relay;
+  pollfd fds[2] = {{child.frames, POLLIN, 0}, {child.errs, POLLIN, 0}};
   int open_fds = 2;
   char buf[65536];
-  CallSnapshot last;
   bool exited = false;
   while (open_fds > 0) {
     // The deadline of the call in progress, if any.
-    last = snapshot(*state);
+    const CallSnapshot last = snapshot(*child.state);
     if (!exited && last.in_call && last.elapsed_s > last.deadline_s) {
       end.timed_out = true;
       break;
     }
-    if (!held.empty() && (!last.in_call || last.seq != held_seq)) {
-      std::cerr.write(held.data(), static_cast<std::streamsize>(held.size())).flush();
-      held.clear();
-    }
+    relay.release_if_over(last);
     // Another thread's child, forked meanwhile, may hold copies of these pipes: the end of
     // this child is seen by waitpid, not by the pipes' end of file.
     const int ready = poll(fds, 2, exited ? 0 : 50);
     if (ready <= 0) {
       if (exited) break;
-      if (waitpid(pid, &end.wait_status, WNOHANG) == pid) exited = true;
+      if (waitpid(child.pid, &end.wait_status, WNOHANG) == child.pid) exited = true;
       continue;
     }
     for (int k = 0; k < 2; ++k) {
@@ -429,55 +514,14 @@ ChildEnd supervise(const Body& body, const OnFrame& on_frame) {
         continue;
       }
       if (k == 1) {
-        const CallSnapshot now = snapshot(*state);
-        if (now.in_call) {
-          if (!held.empty() && now.seq != held_seq) {
-            std::cerr.write(held.data(), static_cast<std::streamsize>(held.size())).flush();
-            held.clear();
-          }
-          held.append(buf, static_cast<size_t>(n));
-          held_seq = now.seq;
-        } else {
-          std::cerr.write(buf, n).flush();
-        }
+        relay.take(buf, n, snapshot(*child.state));
         continue;
       }
       inbox.append(buf, static_cast<size_t>(n));
-      // Every complete frame: a type, then a length-prefixed payload.
-      for (;;) {
-        Reader r{inbox};
-        const char type = r.pod<char>();
-        const std::string payload = r.str();
-        if (!r.ok) break;
-        inbox.erase(0, r.pos);
-        if (type == 'X') {
-          end.threw = payload;
-        } else if (type == 'C') {
-          end.has_answer = true;
-          end.answer = payload;
-        } else {
-          on_frame(type, payload);
-        }
-      }
+      read_frames(inbox, end, on_frame);
     }
   }
-  if (end.timed_out) kill(pid, SIGKILL);
-  for (pollfd& p : fds)
-    if (p.fd >= 0) close(p.fd);
-  while (!exited && waitpid(pid, &end.wait_status, 0) < 0 && errno == EINTR) {
-  }
-  // The state the child left: a call begun and never ended is the one that failed.
-  last = snapshot(*state);
-  end.in_call = last.in_call;
-  end.backend = last.backend;
-  end.call_deadline_s = last.deadline_s;
-  end.call_elapsed_s = last.elapsed_s;
-  if (last.in_call)
-    end.call_stderr = held;
-  else if (!held.empty())
-    std::cerr.write(held.data(), static_cast<std::streamsize>(held.size())).flush();
-  state->~CallState();
-  munmap(page, sizeof(CallState));
+  finish_child(child, fds, exited, relay, end);
   return end;
 }
 

@@ -40,6 +40,7 @@
 
 #include "engine/format.h"
 #include "reference/c_error_trap.h"
+#include "reference/dynamics_recorder.h"
 #include "reference/prebuilt_cache.h"
 
 namespace {
@@ -579,17 +580,13 @@ ContactResult mujoco_hull_contact_prebuilt(const RigidBody& a, const RigidBody& 
   return prebuilt_query(a, b, mujoco_hull_settings(), cache);
 }
 
-DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
-                                    const MujocoSettings& settings) {
-  DynamicsResult r;
-  const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
-  if (!(dt > 0.0)) return {Status::Error, "MuJoCo: time step must be > 0", {}, {}, {}, {}};
-  const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
-  std::vector<RigidBody> bodies;
-  bodies.reserve(scene.bodies.size());
-  for (const BodySpec& spec : scene.bodies) bodies.push_back(make_body(spec));
+namespace {
 
-  // Restitution through the soft contact's damping (MuJoCo has no coefficient of restitution).
+// The model options of a scene run at time step dt. Restitution goes through the soft
+// contact's damping (MuJoCo has no coefficient of restitution); `note` says when the scene's
+// restitution is below what the soft contact can reach.
+ModelOptions model_options(const Scene& scene, double dt, const std::vector<RigidBody>& bodies,
+                           const MujocoSettings& settings, std::string& note) {
   ModelOptions mo;
   mo.dt = dt;
   mo.gravity = scene.sim.gravity;
@@ -604,9 +601,86 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
   if (mo.box_geoms) mo.contact.stiffness *= settings.box_stiffness_factor;
   if (const double reached = soft_contact_restitution(zeta, 0.5);
       reached > scene.sim.restitution + 1e-9)
-    r.message = "restitution " + num(scene.sim.restitution) +
-                " below what the soft contact can reach; used " + num(reached);
+    note = "restitution " + num(scene.sim.restitution) +
+           " below what the soft contact can reach; used " + num(reached);
+  return mo;
+}
 
+// Collision events: one per contact episode of a pair (the soft impact spans several steps),
+// at its first step with a pushing force; the impulse sums force * dt over the episode.
+struct Episodes {
+  using Pair = std::pair<int, int>;
+  std::map<Pair, size_t> open;     // pair -> its episode's index in the run's events
+  std::map<Pair, int> points;      // pushing contacts per pair in the last step
+  std::map<Pair, double> deepest;  // m, per pair in the last step
+
+  // Reads the contacts of step `step` (d->contact and efc_force describe the state at its
+  // start) into `events`: new episodes appended, open ones given this step's impulse.
+  void read_step(const mjModel* mc, mjData* dd, const std::vector<int>& scene_of_geom,
+                 const std::vector<RigidBody>& bodies, bool box_geoms, long step, double dt,
+                 std::vector<CollisionEvent>& events);
+  // The pair whose episode is event `index`, or (-1, -1).
+  Pair pair_of(size_t index) const {
+    Pair key{-1, -1};
+    for (const auto& [k, idx] : open)
+      if (idx == index) key = k;
+    return key;
+  }
+};
+
+void Episodes::read_step(const mjModel* mc, mjData* dd, const std::vector<int>& scene_of_geom,
+                         const std::vector<RigidBody>& bodies, bool box_geoms, long step, double dt,
+                         std::vector<CollisionEvent>& events) {
+  std::map<Pair, size_t> still_open;
+  points.clear();
+  deepest.clear();
+  for (int c = 0; c < dd->ncon; ++c) {
+    const mjContact& con = dd->contact[c];
+    if (con.efc_address < 0) continue;
+    mjtNum frame_force[6];  // contact frame: [0] is the normal force (N)
+    mj_contactForce(mc, dd, c, frame_force);
+    const double force = frame_force[0];
+    if (!(force > 0.0)) continue;
+    const int g1 = scene_of_geom[con.geom1], g2 = scene_of_geom[con.geom2];
+    const int ia = std::min(g1, g2), ib = std::max(g1, g2);
+    const Pair key{ia, ib};
+    // The pair's episode: opened by another of its contact points this step (a multi-point
+    // manifold is one episode, not one per point), open since an earlier step, or new.
+    size_t idx;
+    if (auto in_step = still_open.find(key); in_step != still_open.end()) {
+      idx = in_step->second;
+    } else if (auto earlier = open.find(key); earlier != open.end()) {
+      idx = earlier->second;
+    } else {
+      CollisionEvent ev;
+      ev.time = step * dt;
+      ev.step = step;
+      ev.body_a = bodies[ia].name;
+      ev.body_b = bodies[ib].name;
+      ev.contact = convert_contact(con, g1 == ia);
+      ev.contact.feature = box_geoms ? "box-box" : "mesh";
+      events.push_back(ev);
+      idx = events.size() - 1;
+    }
+    events[idx].impulse += force * dt;
+    still_open[key] = idx;
+    ++points[key];
+    deepest[key] = std::max(deepest[key], -con.dist);
+  }
+  open = std::move(still_open);
+}
+
+}  // namespace
+
+DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+                                    const MujocoSettings& settings) {
+  DynamicsResult r;
+  const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
+  if (!(dt > 0.0)) return {Status::Error, "MuJoCo: time step must be > 0", {}, {}, {}, {}};
+  const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
+  const std::vector<RigidBody> bodies = make_bodies(scene);
+
+  const ModelOptions mo = model_options(scene, dt, bodies, settings, r.message);
   std::string error;
   auto [m, d] = make_simulation(bodies, /*all_free=*/false, mo, &error);
   if (!m) {
@@ -622,25 +696,16 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
   std::vector<int> scene_of_geom(mc->ngeom, -1);
   for (size_t i = 0; i < bodies.size(); ++i) scene_of_geom[geom_of(mc, i)] = static_cast<int>(i);
 
-  auto sample = [&](double time) {
-    StateSample s;
-    s.time = time;
-    for (size_t i = 0; i < bodies.size(); ++i) s.bodies.push_back(read_state(mc, dd, bodies[i], i));
-    r.samples.push_back(std::move(s));
-  };
-
-  // Collision events: one per contact episode of a pair (the soft impact spans several steps),
-  // at its first step with a pushing force; the impulse sums force * dt over the episode.
-  std::map<std::pair<int, int>, size_t> open_episode;  // pair -> index in r.events
+  DynamicsRecorder recorder(r, opt, [&] {
+    std::vector<BodyFinal> states;
+    for (size_t i = 0; i < bodies.size(); ++i) states.push_back(read_state(mc, dd, bodies[i], i));
+    return states;
+  });
+  Episodes episodes;
   t_trap.clear_warning();
-  std::vector<BodyFinal> before;  // states before the step, until the first impulse
+  recorder.start();
   for (long step = 0; step < steps; ++step) {
-    if (opt.sample_every > 0 && step % opt.sample_every == 0) sample(step * dt);
-    const size_t events_before = r.events.size();
-    if (!r.first_impulse.seen) {
-      before.clear();
-      for (size_t i = 0; i < bodies.size(); ++i) before.push_back(read_state(mc, dd, bodies[i], i));
-    }
+    recorder.before_step(r.events);
     if (!guarded([&] { mj_step(mc, dd); })) {
       r.status = Status::Error;
       r.message = "MuJoCo mj_step at step " + std::to_string(step) + ": " + t_trap.error;
@@ -651,64 +716,17 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
       r.message = "MuJoCo warning at step " + std::to_string(step) + ": " + t_trap.warning;
       return r;
     }
-    // d->contact and efc_force describe the state at the start of this step.
-    std::map<std::pair<int, int>, size_t> still_open;
-    std::map<std::pair<int, int>, int> points;      // pushing contacts per pair this step
-    std::map<std::pair<int, int>, double> deepest;  // m, per pair this step
-    for (int c = 0; c < dd->ncon; ++c) {
-      const mjContact& con = dd->contact[c];
-      if (con.efc_address < 0) continue;
-      mjtNum frame_force[6];  // contact frame: [0] is the normal force (N)
-      mj_contactForce(mc, dd, c, frame_force);
-      const double force = frame_force[0];
-      if (!(force > 0.0)) continue;
-      const int g1 = scene_of_geom[con.geom1], g2 = scene_of_geom[con.geom2];
-      const int ia = std::min(g1, g2), ib = std::max(g1, g2);
-      const std::pair<int, int> key{ia, ib};
-      // The pair's episode: opened by another of its contact points this step (a multi-point
-      // manifold is one episode, not one per point), open since an earlier step, or new.
-      size_t idx;
-      if (auto in_step = still_open.find(key); in_step != still_open.end()) {
-        idx = in_step->second;
-      } else if (auto earlier = open_episode.find(key); earlier != open_episode.end()) {
-        idx = earlier->second;
-      } else {
-        CollisionEvent ev;
-        ev.time = step * dt;
-        ev.step = step;
-        ev.body_a = bodies[ia].name;
-        ev.body_b = bodies[ib].name;
-        ev.contact = convert_contact(con, g1 == ia);
-        ev.contact.feature = mo.box_geoms ? "box-box" : "mesh";
-        r.events.push_back(ev);
-        idx = r.events.size() - 1;
-      }
-      r.events[idx].impulse += force * dt;
-      still_open[key] = idx;
-      ++points[key];
-      deepest[key] = std::max(deepest[key], -con.dist);
-    }
-    open_episode = std::move(still_open);
+    episodes.read_step(mc, dd, scene_of_geom, bodies, mo.box_geoms, step, dt, r.events);
     // The first impulse: the episode's event holds one contact; count and depth are the step's.
-    if (!r.first_impulse.seen && r.events.size() > events_before) {
-      const CollisionEvent& first = r.events[events_before];
-      std::pair<int, int> key{-1, -1};
-      for (const auto& [k, idx] : open_episode)
-        if (idx == events_before) key = k;
-      r.first_impulse = first_impulse_of({first}, before, dt, points[key]);
-      r.first_impulse.depth = deepest[key];
+    if (const CollisionEvent* first = recorder.first_new_event(r.events)) {
+      const Episodes::Pair key = episodes.pair_of(static_cast<size_t>(first - r.events.data()));
+      recorder.first_impulse_from_event(*first, dt, episodes.points[key]);
+      r.first_impulse.depth = episodes.deepest[key];
     }
+    recorder.after_step(step + 1, (step + 1) * dt);
   }
-  if (opt.sample_every > 0 && steps % opt.sample_every == 0) sample(steps * dt);
 
-  for (size_t i = 0; i < bodies.size(); ++i) {
-    BodyFinal f = read_state(mc, dd, bodies[i], i);
-    if (!f.position.allFinite() || !f.velocity.allFinite() || !f.angular_velocity.allFinite()) {
-      r.status = Status::Error;
-      r.message = "MuJoCo: non-finite final state of " + f.name;
-    }
-    r.finals.push_back(f);
-  }
+  recorder.finish("MuJoCo");
   return r;
 }
 

@@ -31,6 +31,7 @@
 #include <utility>
 
 #include "reference/c_error_trap.h"
+#include "reference/dynamics_recorder.h"
 #include "reference/prebuilt_cache.h"
 
 namespace {
@@ -390,38 +391,24 @@ DynamicsResult ode_hull_dynamics(const Scene& scene, const DynamicsOptions& opt)
   return ode_dynamics_with(scene, opt, ode_hull_settings());
 }
 
-DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
-                                 const OdeSettings& settings) {
-  // One ODE world steps at a time in the process: ODE 0.16's worlds share its default
-  // self-threaded stepping implementation, and two dWorldStep calls on two threads (rbx report
-  // runs scenes on every core) fail its assertion in WaitWakeup (threading_fake_sync.h:83),
-  // measured on analytic/headon_e0. Contact queries (dCollide) need no lock.
-  static std::mutex world_step_lock;
-  const std::lock_guard<std::mutex> lock(world_step_lock);
-  init_ode();
-  DynamicsResult r;
-  const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
-  if (!(dt > 0.0)) return {Status::Error, "ODE: time step must be > 0", {}, {}, {}, {}};
-  const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
-  std::vector<RigidBody> bodies;
-  bodies.reserve(scene.bodies.size());
-  for (const BodySpec& spec : scene.bodies) bodies.push_back(make_body(spec));
+namespace {
 
-  // World: gravity from the scene; ERP and CFM from the settings, ODE's defaults (0.2, 1e-10).
-  //  - CFM softens each contact by a relative CFM / (dt * inverse effective mass), ~1e-7 here.
-  //  - Position correction: a contact's target separation speed is
-  //    max(e * approach speed, ERP * depth / dt), so a contact first seen at depth d leaves at
-  //    >= 0.2 d / dt whatever e is: it changes impacts only for e below ~0.2 * (d / (v dt)) (an
-  //    e = 0 head-on impact seen 1 mm deep at dt = 1 ms separates at 0.2 m/s). Capping that
-  //    velocity at 0 (dWorldSetContactMaxCorrectingVel) made e = 0 exact, but with ODE's
-  //    one-point convex manifold a resting cube then tips about its single contact and sinks
-  //    (0.77 m in 2 s in a 3-cube stack), so the defaults stay. Measured again with dBox
-  //    (rbx compare, ode): the cap at 0 makes headon_e0 exact at every contact phase (0.23 ->
-  //    2e-24 with contact 1/3 of a step in) but resting_stack and friction/stack_five then sink
-  //    to 43 % of a body (6e-6 with the default); a 2 mm contact surface layer instead makes
-  //    both stacks blow up (jitter 77-93 m/s). No world setting serves both, so ODE's e = 0
-  //    impacts seen inside a step stay a measured limitation (the report's contact-phase table).
-  WorldOwner w;
+// The scene's ODE world, space and contact group in `w`: gravity from the scene; ERP and CFM
+// from the settings, ODE's defaults (0.2, 1e-10).
+//  - CFM softens each contact by a relative CFM / (dt * inverse effective mass), ~1e-7 here.
+//  - Position correction: a contact's target separation speed is
+//    max(e * approach speed, ERP * depth / dt), so a contact first seen at depth d leaves at
+//    >= 0.2 d / dt whatever e is: it changes impacts only for e below ~0.2 * (d / (v dt)) (an
+//    e = 0 head-on impact seen 1 mm deep at dt = 1 ms separates at 0.2 m/s). Capping that
+//    velocity at 0 (dWorldSetContactMaxCorrectingVel) made e = 0 exact, but with ODE's
+//    one-point convex manifold a resting cube then tips about its single contact and sinks
+//    (0.77 m in 2 s in a 3-cube stack), so the defaults stay. Measured again with dBox
+//    (rbx compare, ode): the cap at 0 makes headon_e0 exact at every contact phase (0.23 ->
+//    2e-24 with contact 1/3 of a step in) but resting_stack and friction/stack_five then sink
+//    to 43 % of a body (6e-6 with the default); a 2 mm contact surface layer instead makes
+//    both stacks blow up (jitter 77-93 m/s). No world setting serves both, so ODE's e = 0
+//    impacts seen inside a step stay a measured limitation (the report's contact-phase table).
+void create_world(WorldOwner& w, const Scene& scene, const OdeSettings& settings) {
   w.world = dWorldCreate();
   w.space = dSimpleSpaceCreate(nullptr);
   w.contacts = dJointGroupCreate(0);
@@ -429,9 +416,13 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
   dWorldSetGravity(w.world, g.x(), g.y(), g.z());
   dWorldSetERP(w.world, settings.erp);
   dWorldSetCFM(w.world, settings.cfm);
+}
 
-  // Bodies: our mass and inertia about the centre of mass at the body origin.
-  std::vector<dBodyID> ode_bodies(bodies.size(), nullptr);
+// Bodies: our mass and inertia about the centre of mass at the body origin; a static body is a
+// geom without a body (null in `ode_bodies`). Returns "" or why ODE refused a body.
+std::string add_bodies(WorldOwner& w, const std::vector<RigidBody>& bodies,
+                       const OdeSettings& settings, std::vector<dBodyID>& ode_bodies) {
+  ode_bodies.assign(bodies.size(), nullptr);
   for (size_t i = 0; i < bodies.size(); ++i) {
     const RigidBody& b = bodies[i];
     w.geoms.push_back(make_geom(w.space, b, settings.native_boxes));
@@ -447,11 +438,8 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
     dMassSetParameters(&mass, b.mass, 0, 0, 0, I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2),
                        I(1, 2));
     // dBodySetMass checks the mass (dMassCheck) and calls dDebug on failure.
-    if (!guarded([&] { dBodySetMass(body, &mass); })) {
-      r.status = Status::Error;
-      r.message = std::string("ODE dBodySetMass (") + b.name + "): " + t_trap.error;
-      return r;
-    }
+    if (!guarded([&] { dBodySetMass(body, &mass); }))
+      return std::string("ODE dBodySetMass (") + b.name + "): " + t_trap.error;
     const Quat o = b.orientation.normalized();
     const dQuaternion q = {o.w(), o.x(), o.y(), o.z()};
     dBodySetPosition(body, b.position.x(), b.position.y(), b.position.z());
@@ -465,15 +453,95 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
     dGeomSetBody(geom, body);
     ode_bodies[i] = body;
   }
+  return "";
+}
 
-  auto sample = [&](double time) {
-    StateSample s;
-    s.time = time;
+// Events of step `step`: one per pair where the bodies were closing at some contact point and
+// the contact pushed; point and normal averaged over the pair's points, depth the largest,
+// impulse the sum of the normal impulses f . n dt. Appended to `events` in pair order.
+void pair_events(const CollideContext& ctx, const std::vector<RigidBody>& bodies,
+                 const std::vector<dBodyID>& ode_bodies, long step, double dt,
+                 std::vector<CollisionEvent>& events) {
+  std::map<std::pair<int, int>, CollisionEvent> by_pair;
+  std::map<std::pair<int, int>, int> pair_points;
+  std::map<std::pair<int, int>, bool> pair_closing;
+  for (const StepContact& sc : ctx.contacts) {
+    const std::pair<int, int> key{sc.a, sc.b};
+    const ContactPoint cp = convert_contact(sc.geom, sc.feature);
+    // Force along the normal (N). With two bodies f1 acts on a; with one, ODE moves the
+    // body into the first slot, so take whichever slot is filled (the push is >= 0).
+    const dJointFeedback& fb = *sc.feedback;
+    const Vec3 f1(fb.f1[0], fb.f1[1], fb.f1[2]), f2(fb.f2[0], fb.f2[1], fb.f2[2]);
+    const double push = (ode_bodies[sc.a] && ode_bodies[sc.b])
+                            ? f1.dot(cp.normal)
+                            : std::max(std::abs(f1.dot(cp.normal)), std::abs(f2.dot(cp.normal)));
+    const double impulse = push * dt;  // N s
+    CollisionEvent& ev = by_pair[key];
+    if (pair_points[key]++ == 0) {
+      ev.time = step * dt;
+      ev.step = step;
+      ev.body_a = bodies[sc.a].name;
+      ev.body_b = bodies[sc.b].name;
+      ev.contact = cp;
+      ev.contact.point.setZero();
+      ev.contact.normal.setZero();
+      ev.contact.depth = 0.0;
+    }
+    ev.contact.point += cp.point;
+    ev.contact.normal += cp.normal;
+    ev.contact.depth = std::max(ev.contact.depth, cp.depth);
+    ev.impulse += impulse;
+    if (sc.approach < -kClosingSpeed) pair_closing[key] = true;
+  }
+  for (auto& [key, ev] : by_pair) {
+    if (!pair_closing[key] || !(ev.impulse > 0.0)) continue;
+    ev.contact.point /= pair_points[key];
+    if (ev.contact.normal.norm() > 0.0) ev.contact.normal.normalize();
+    events.push_back(ev);
+  }
+}
+
+// How many of the step's contact points belong to the pair of `event`.
+int points_of(const CollideContext& ctx, const std::vector<RigidBody>& bodies,
+              const CollisionEvent& event) {
+  int points = 0;
+  for (const StepContact& sc : ctx.contacts)
+    if (bodies[sc.a].name == event.body_a && bodies[sc.b].name == event.body_b) ++points;
+  return points;
+}
+
+}  // namespace
+
+DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+                                 const OdeSettings& settings) {
+  // One ODE world steps at a time in the process: ODE 0.16's worlds share its default
+  // self-threaded stepping implementation, and two dWorldStep calls on two threads (rbx report
+  // runs scenes on every core) fail its assertion in WaitWakeup (threading_fake_sync.h:83),
+  // measured on analytic/headon_e0. Contact queries (dCollide) need no lock.
+  static std::mutex world_step_lock;
+  const std::lock_guard<std::mutex> lock(world_step_lock);
+  init_ode();
+  DynamicsResult r;
+  const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
+  if (!(dt > 0.0)) return {Status::Error, "ODE: time step must be > 0", {}, {}, {}, {}};
+  const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
+  const std::vector<RigidBody> bodies = make_bodies(scene);
+
+  WorldOwner w;
+  create_world(w, scene, settings);
+  std::vector<dBodyID> ode_bodies;
+  if (std::string error = add_bodies(w, bodies, settings, ode_bodies); !error.empty()) {
+    r.status = Status::Error;
+    r.message = std::move(error);
+    return r;
+  }
+
+  DynamicsRecorder recorder(r, opt, [&] {
+    std::vector<BodyFinal> states;
     for (size_t i = 0; i < bodies.size(); ++i)
-      s.bodies.push_back(read_state(bodies[i], ode_bodies[i]));
-    r.samples.push_back(std::move(s));
-  };
-
+      states.push_back(read_state(bodies[i], ode_bodies[i]));
+    return states;
+  });
   CollideContext ctx;
   ctx.world = w.world;
   ctx.group = w.contacts;
@@ -482,15 +550,9 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
   t_trap.clear_warning();
   t_trap.warning_count = 0;
   long first_message_step = -1;
-  std::vector<BodyFinal> before;  // states before the step, until the first impulse
+  recorder.start();
   for (long step = 0; step < steps; ++step) {
-    if (opt.sample_every > 0 && step % opt.sample_every == 0) sample(step * dt);
-    const size_t events_before = r.events.size();
-    if (!r.first_impulse.seen) {
-      before.clear();
-      for (size_t i = 0; i < bodies.size(); ++i)
-        before.push_back(read_state(bodies[i], ode_bodies[i]));
-    }
+    recorder.before_step(r.events);
     ctx.contacts.clear();
     ctx.feedback.clear();
     CollideContext* c = &ctx;
@@ -505,70 +567,19 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
       return r;
     }
     if (t_trap.has_warning() && first_message_step < 0) first_message_step = step;
-    // Events: one per pair and step where the bodies were closing at some contact point and
-    // the contact pushed; point and normal averaged over the pair's points, depth the largest,
-    // impulse the sum of the normal impulses f . n dt.
-    std::map<std::pair<int, int>, CollisionEvent> pair_events;
-    std::map<std::pair<int, int>, int> pair_points;
-    std::map<std::pair<int, int>, bool> pair_closing;
-    for (const StepContact& sc : ctx.contacts) {
-      const std::pair<int, int> key{sc.a, sc.b};
-      const ContactPoint cp = convert_contact(sc.geom, sc.feature);
-      // Force along the normal (N). With two bodies f1 acts on a; with one, ODE moves the
-      // body into the first slot, so take whichever slot is filled (the push is >= 0).
-      const dJointFeedback& fb = *sc.feedback;
-      const Vec3 f1(fb.f1[0], fb.f1[1], fb.f1[2]), f2(fb.f2[0], fb.f2[1], fb.f2[2]);
-      const double push = (ode_bodies[sc.a] && ode_bodies[sc.b])
-                              ? f1.dot(cp.normal)
-                              : std::max(std::abs(f1.dot(cp.normal)), std::abs(f2.dot(cp.normal)));
-      const double impulse = push * dt;  // N s
-      CollisionEvent& ev = pair_events[key];
-      if (pair_points[key]++ == 0) {
-        ev.time = step * dt;
-        ev.step = step;
-        ev.body_a = bodies[sc.a].name;
-        ev.body_b = bodies[sc.b].name;
-        ev.contact = cp;
-        ev.contact.point.setZero();
-        ev.contact.normal.setZero();
-        ev.contact.depth = 0.0;
-      }
-      ev.contact.point += cp.point;
-      ev.contact.normal += cp.normal;
-      ev.contact.depth = std::max(ev.contact.depth, cp.depth);
-      ev.impulse += impulse;
-      if (sc.approach < -kClosingSpeed) pair_closing[key] = true;
-    }
-    for (auto& [key, ev] : pair_events) {
-      if (!pair_closing[key] || !(ev.impulse > 0.0)) continue;
-      ev.contact.point /= pair_points[key];
-      if (ev.contact.normal.norm() > 0.0) ev.contact.normal.normalize();
-      r.events.push_back(ev);
-    }
-    // The first impulse: ODE's events merge a pair's points, so the count is ODE's own.
-    if (!r.first_impulse.seen && r.events.size() > events_before) {
-      const CollisionEvent& first = r.events[events_before];
-      int points = 0;
-      for (const StepContact& sc : ctx.contacts)
-        if (bodies[sc.a].name == first.body_a && bodies[sc.b].name == first.body_b) ++points;
-      r.first_impulse = first_impulse_of({first}, before, dt, points);
-      // The deepest of the pair's points (the event keeps the largest depth already).
-    }
+    pair_events(ctx, bodies, ode_bodies, step, dt, r.events);
+    // The first impulse: ODE's events merge a pair's points, so the count is ODE's own (the
+    // event keeps the deepest of the pair's points already).
+    if (const CollisionEvent* first = recorder.first_new_event(r.events))
+      recorder.first_impulse_from_event(*first, dt, points_of(ctx, bodies, *first));
     dJointGroupEmpty(w.contacts);
+    recorder.after_step(step + 1, (step + 1) * dt);
   }
-  if (opt.sample_every > 0 && steps % opt.sample_every == 0) sample(steps * dt);
   if (t_trap.warning_count > 0)
     r.message = std::to_string(t_trap.warning_count) + " ODE message(s), the first at step " +
                 std::to_string(first_message_step) + ": " + t_trap.warning;
 
-  for (size_t i = 0; i < bodies.size(); ++i) {
-    BodyFinal f = read_state(bodies[i], ode_bodies[i]);
-    if (!f.position.allFinite() || !f.velocity.allFinite() || !f.angular_velocity.allFinite()) {
-      r.status = Status::Error;
-      r.message = "ODE: non-finite final state of " + f.name;
-    }
-    r.finals.push_back(f);
-  }
+  recorder.finish("ODE");
   return r;
 }
 

@@ -109,11 +109,4 @@ const QueryVariant* find_query_variant(const std::string& backend, const std::st
   return nullptr;
 }
 
-std::vector<RigidBody> make_bodies(const Scene& scene) {
-  std::vector<RigidBody> bodies;
-  bodies.reserve(scene.bodies.size());
-  for (const BodySpec& spec : scene.bodies) bodies.push_back(make_body(spec));
-  return bodies;
-}
-
 }  // namespace rbx

@@ -127,6 +127,33 @@ TEST(BroadPhase, ManyStaticBodiesGoIntoTheTree) {
   EXPECT_EQ(tree.find_pairs(bodies), expected);
 }
 
+TEST(BroadPhase, TheThresholdsChooseTheIndexNotThePairs) {
+  // 100 moving boxes of like size and two static slabs: by default the grid (at least
+  // grid_min_moving moving bodies) with the statics apart; with the thresholds moved, the
+  // hierarchy, and the statics in it. The pairs are the oracle's every time.
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<RigidBody> bodies;
+  for (int i = 0; i < 102; ++i) {
+    const bool slab = i == 10 || i == 60;
+    const Vec3 size = slab ? Vec3(20.0, 0.2, 20.0) : Vec3::Constant(0.3 + 0.2 * unit(rng));
+    bodies.push_back(test::box_body("b" + std::to_string(i), size, 1.0,
+                                    4.0 * Vec3(unit(rng), unit(rng), unit(rng)), Quat::Identity(),
+                                    Vec3::Zero(), Vec3::Zero(), slab));
+  }
+  const std::vector<BodyPair> expected = oracle_pairs(bodies);
+  EXPECT_GT(expected.size(), bodies.size());
+  BroadPhase by_default(BroadPhaseMethod::Tree);
+  EXPECT_EQ(by_default.find_pairs(bodies), expected);
+  EXPECT_TRUE(by_default.used_grid());
+  WorldSettings moved;
+  moved.grid_min_moving = 1000;
+  moved.statics_apart = 0;
+  BroadPhase hierarchy(BroadPhaseMethod::Tree, moved);
+  EXPECT_EQ(hierarchy.find_pairs(bodies), expected);
+  EXPECT_FALSE(hierarchy.used_grid());
+}
+
 TEST(BroadPhase, ExactlyTouchingSpheresArePairs) {
   // A (6, 4, 12) box has half extents (3, 2, 6), so its bounding sphere has radius
   // sqrt(9 + 4 + 36) = 7 exactly. Centres 14 apart: |c_a - c_b| = 14 = 7 + 7, touching

@@ -1,0 +1,136 @@
+// DynamicsRecorder: what every dynamics adapter records the same way. Samples at t = 0 and
+// after every sample_every steps; the states before the step of the first impulse, read no more
+// after it; the first impulse from all the step's events or from its first event alone.
+#include "reference/dynamics_recorder.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <vector>
+
+namespace rbx {
+namespace {
+
+// A fake run: one body whose velocity is the step count, and the events a test adds.
+struct FakeRun {
+  long steps = 0;
+  int reads = 0;  // how many times the recorder read the states
+  std::vector<CollisionEvent> events;
+  std::vector<BodyFinal> states() {
+    ++reads;
+    BodyFinal a;
+    a.name = "a";
+    a.position = Vec3(0.0, 1.0, 0.0);
+    a.velocity = Vec3(0.0, -static_cast<double>(steps), 0.0);
+    BodyFinal floor;
+    floor.name = "floor";
+    return {a, floor};
+  }
+  // An event of the pair (a, floor) at `point` (m), normal +y, at the current step.
+  void hit(const Vec3& point, double impulse) {
+    CollisionEvent ev;
+    ev.step = steps;
+    ev.body_a = "a";
+    ev.body_b = "floor";
+    ev.contact.point = point;
+    ev.contact.normal = Vec3::UnitY();
+    ev.contact.depth = 0.001;
+    ev.impulse = impulse;
+    events.push_back(ev);
+  }
+};
+
+TEST(DynamicsRecorder, SamplesAtTheStartAndEverySampleEverySteps) {
+  DynamicsResult result;
+  FakeRun run;
+  DynamicsRecorder recorder(result, {0.0, 2}, [&] { return run.states(); });
+  recorder.start();
+  for (long k = 0; k < 5; ++k) {
+    recorder.before_step(run.events);
+    ++run.steps;
+    recorder.after_step(k + 1, (k + 1) * 0.1);
+  }
+  ASSERT_EQ(result.samples.size(), 3u);
+  EXPECT_EQ(result.samples[0].time, 0.0);
+  EXPECT_EQ(result.samples[1].time, 2 * 0.1);
+  EXPECT_EQ(result.samples[2].time, 4 * 0.1);
+  EXPECT_EQ(result.samples[2].bodies[0].velocity.y(), -4.0);
+}
+
+TEST(DynamicsRecorder, NoSamplesWhenNotAsked) {
+  DynamicsResult result;
+  FakeRun run;
+  DynamicsRecorder recorder(result, {}, [&] { return run.states(); });
+  recorder.start();
+  recorder.after_step(1, 0.1);
+  EXPECT_TRUE(result.samples.empty());
+}
+
+TEST(DynamicsRecorder, TheFirstImpulseComesFromTheStepsEventsAndTheStatesBeforeIt) {
+  DynamicsResult result;
+  FakeRun run;
+  DynamicsRecorder recorder(result, {}, [&] { return run.states(); });
+  recorder.start();
+  // Two quiet steps, then a step with two points of the pair, then one more event.
+  for (long k = 0; k < 4; ++k) {
+    recorder.before_step(run.events);
+    ++run.steps;
+    if (k == 2) {
+      run.hit(Vec3(-0.1, 0.0, 0.0), 1.0);
+      run.hit(Vec3(0.1, 0.0, 0.0), 2.0);
+    }
+    if (k == 3) run.hit(Vec3::Zero(), 5.0);
+    recorder.first_impulse_from_step(run.events, 0.01);
+  }
+  const FirstImpulse& f = result.first_impulse;
+  ASSERT_TRUE(f.seen);
+  EXPECT_EQ(f.step, 3);
+  EXPECT_EQ(f.contact_points, 2);
+  EXPECT_EQ(f.impulse, 3.0);
+  EXPECT_EQ(f.point, Vec3::Zero());
+  // Before the step of the impulse the body moved at -2 m/s toward the floor.
+  EXPECT_EQ(f.approach_speed, 2.0);
+  // States were read before each step up to that one, and not after it.
+  EXPECT_EQ(run.reads, 3);
+}
+
+TEST(DynamicsRecorder, AFirstEventOfMergedPointsTakesTheLibrarysCount) {
+  DynamicsResult result;
+  FakeRun run;
+  DynamicsRecorder recorder(result, {}, [&] { return run.states(); });
+  recorder.before_step(run.events);
+  EXPECT_EQ(recorder.first_new_event(run.events), nullptr);  // nothing added yet
+  run.hit(Vec3::Zero(), 4.0);
+  const CollisionEvent* first = recorder.first_new_event(run.events);
+  ASSERT_EQ(first, &run.events[0]);
+  recorder.first_impulse_from_event(*first, 0.01, 4);
+  EXPECT_TRUE(result.first_impulse.seen);
+  EXPECT_EQ(result.first_impulse.contact_points, 4);
+  // Seen: the next step's events are not a first impulse.
+  recorder.before_step(run.events);
+  run.hit(Vec3::Zero(), 1.0);
+  EXPECT_EQ(recorder.first_new_event(run.events), nullptr);
+}
+
+TEST(DynamicsRecorder, AFiniteRunKeepsItsStatusAndANonFiniteOneIsAnError) {
+  DynamicsResult result;
+  FakeRun run;
+  DynamicsRecorder recorder(result, {}, [&] { return run.states(); });
+  recorder.finish("Lib");
+  EXPECT_EQ(result.status, Status::Ok);
+  EXPECT_EQ(result.finals.size(), 2u);
+
+  DynamicsResult bad;
+  DynamicsRecorder broken(bad, {}, [&] {
+    std::vector<BodyFinal> states = run.states();
+    states[0].velocity.x() = std::numeric_limits<double>::quiet_NaN();
+    return states;
+  });
+  broken.finish("Lib");
+  EXPECT_EQ(bad.status, Status::Error);
+  EXPECT_EQ(bad.message, "Lib: non-finite final state of a");
+  EXPECT_EQ(bad.finals.size(), 2u);
+}
+
+}  // namespace
+}  // namespace rbx
