@@ -120,3 +120,12 @@ TEST(Layers, CommandsParseAndCallTheLayersBelow) {
   // What computes or writes lives below: the command layer stays the smaller one.
   EXPECT_LT(lines_under("comparisons/cli"), lines_under("comparisons/output"));
 }
+
+TEST(Layers, NoSourceFileIsOver900Lines) {
+  // A file past 900 lines holds more than one idea (docs/style.md): split it by what it does.
+  for (const char* folder : {"engine", "reference", "comparisons"})
+    for (const std::string& f : sources_under(folder)) {
+      const std::string text = read(f);
+      EXPECT_LE(std::count(text.begin(), text.end(), '\n'), 900) << f;
+    }
+}
