@@ -135,6 +135,16 @@ struct DesignShrinker {
   bool (*realize)(Sample&) = nullptr;
   SampleOutcome (*evaluate)(const Sample&, const std::vector<std::string>&) = nullptr;
 
+  DesignShrinker(const Sample& start, const std::string& backend, const std::string& signature,
+                 int budget, bool (*realize_fn)(Sample&),
+                 SampleOutcome (*evaluate_fn)(const Sample&, const std::vector<std::string>&))
+      : sample(start),
+        names{backend},
+        sig(signature),
+        max_evaluations(budget),
+        realize(realize_fn),
+        evaluate(evaluate_fn) {}
+
   // True (and c, realized, becomes the sample) when c still shows the signature.
   bool keeps(Sample c, SampleOutcome* out = nullptr) {
     if (evaluations >= max_evaluations) return false;
@@ -462,15 +472,10 @@ SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<st
 
 ImpactShrinkResult shrink_impact(const ImpactSample& start, const std::string& backend,
                                  const std::string& sig, int max_evaluations) {
-  DesignShrinker<ImpactSample> k;
-  k.sample = start;
-  k.names = {backend};
-  k.sig = sig;
-  k.max_evaluations = max_evaluations;
-  k.realize = realize_impact;
-  k.evaluate = [](const ImpactSample& s, const std::vector<std::string>& names) {
-    return evaluate_impact_sample(s, names);
-  };
+  DesignShrinker<ImpactSample> k(start, backend, sig, max_evaluations, realize_impact,
+                                 [](const ImpactSample& s, const std::vector<std::string>& names) {
+                                   return evaluate_impact_sample(s, names);
+                                 });
   // 1. Fewer points of A: its hull's own vertices, then chunks (halves first).
   if (k.sample.a.shape_class != "box") {
     ImpactSample c = k.sample;
@@ -718,13 +723,11 @@ SampleOutcome evaluate_landing_sample(const LandingSample& s,
 
 LandingShrinkResult shrink_landing(const LandingSample& start, const std::string& backend,
                                    const std::string& sig, int max_evaluations) {
-  DesignShrinker<LandingSample> k;
-  k.sample = start;
-  k.names = {backend};
-  k.sig = sig;
-  k.max_evaluations = max_evaluations;
-  k.realize = realize_landing;
-  k.evaluate = evaluate_landing_sample;
+  DesignShrinker<LandingSample> k(
+      start, backend, sig, max_evaluations, realize_landing,
+      [](const LandingSample& s, const std::vector<std::string>& names) {
+        return evaluate_landing_sample(s, names);
+      });
   // Each design number set to `first`, else toward rounder values, coarsest grid first; a grid
   // that leaves it as it is, or is kept, ends that number's search.
   auto round_down = [&k](double LandingSample::*field, double first,

@@ -72,31 +72,37 @@ ConvexPolyhedron read_box(const Reader& r, const toml::table& t, const std::stri
   return make_box(b.box_size);
 }
 
+// A count of a shape (subdivisions, sides) in [lo, hi], `fallback` when absent; `fix` says
+// what to write instead.
+int bounded_count(const Reader& r, const toml::table& t, const std::string& p, const char* key,
+                  long fallback, long lo, long hi, const std::string& fix) {
+  const toml::node* n = t.get(key);
+  if (!n) return static_cast<int>(fallback);
+  const long v = r.integer(*n, p + key, std::string("body.") + key);
+  if (v < lo || v > hi)
+    r.fail(line_of(n), p + key,
+           "must be in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +
+               std::to_string(v),
+           fix);
+  return static_cast<int>(v);
+}
+
 // Defaults: radius 0.5 with 2 subdivisions.
 ConvexPolyhedron read_icosphere(const Reader& r, const toml::table& t, const std::string& p) {
   const double radius = positive_length(r, t, p, "radius", 0.5, "radius");
-  long subdivisions = 2;
-  if (const toml::node* n = t.get("subdivisions")) {
-    subdivisions = r.integer(*n, p + "subdivisions", "body.subdivisions");
-    if (subdivisions < 0 || subdivisions > 6)
-      r.fail(line_of(n), p + "subdivisions", "must be in 0..6, got " + std::to_string(subdivisions),
-             "6 already gives 81920 triangles, and 2 (320 triangles) is the default");
-  }
-  return make_icosphere(radius, static_cast<int>(subdivisions));
+  return make_icosphere(
+      radius,
+      bounded_count(r, t, p, "subdivisions", 2, 0, 6,
+                    "6 already gives 81920 triangles, and 2 (320 triangles) is the default"));
 }
 
 // Defaults: radius 0.5, height 1, 6 sides.
 ConvexPolyhedron read_prism(const Reader& r, const toml::table& t, const std::string& p) {
   const double radius = positive_length(r, t, p, "radius", 0.5, "radius");
   const double height = positive_length(r, t, p, "height", 1.0, "height");
-  long sides = 6;
-  if (const toml::node* n = t.get("sides")) {
-    sides = r.integer(*n, p + "sides", "body.sides");
-    if (sides < 3 || sides > 100000)
-      r.fail(line_of(n), p + "sides", "must be in 3..100000, got " + std::to_string(sides),
-             "use 3 (a triangular prism) or more, up to 100000");
-  }
-  return make_prism(radius, height, static_cast<int>(sides));
+  return make_prism(radius, height,
+                    bounded_count(r, t, p, "sides", 6, 3, 100000,
+                                  "use 3 (a triangular prism) or more, up to 100000"));
 }
 
 ConvexPolyhedron read_convex(const Reader& r, const toml::table& t, const std::string& p) {
