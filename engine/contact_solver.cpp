@@ -767,8 +767,8 @@ void project_contact_positions(std::vector<RigidBody>& bodies,
     for (const PairManifold& pm : manifolds) {
       RigidBody &a = bodies[pm.a], &b = bodies[pm.b];
       const BodyInverse &A = inv[pm.a], &B = inv[pm.b];
-      const double size_a = (a.shape->bounds().max - a.shape->bounds().min).norm();
-      const double size_b = (b.shape->bounds().max - b.shape->bounds().min).norm();
+      const double size_a = shape_size(*a.shape);
+      const double size_b = shape_size(*b.shape);
       const double slop = tunables.position_slop * std::min(size_a, size_b);
       const Vec3& n = pm.manifold.normal;
       for (const ManifoldPoint& p : pm.manifold.points) {

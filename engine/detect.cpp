@@ -13,7 +13,6 @@ namespace rbx {
 namespace {
 
 // Size (m) of a shape: the diagonal of its local bounding box.
-double shape_size(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
 
 }  // namespace
 

@@ -37,7 +37,6 @@ __attribute__((always_inline)) inline double plane_distance(const AcceleratedVie
 }
 
 // Size (m) of a shape: the diagonal of its local bounding box.
-double shape_size(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
 
 // Places a shape: small shapes get world vertices in workspace slot `slot`; their world normals
 // follow in place_normals.

@@ -13,7 +13,6 @@ namespace rbx {
 namespace {
 
 // Size of a shape (m): the diagonal of its bounds.
-double size_of(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
 
 // The edges of the solid: an edge whose two triangles are not coplanar. Triangulation diagonals
 // of a flat face are skipped (their crossings lie inside a face contact and add nothing).
@@ -127,7 +126,7 @@ std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const P
   }
 
   // Merge coincident points (a stacked cube's corners sit on the corners below it).
-  const double merge = 1e-7 * std::max(size_of(a), size_of(b));
+  const double merge = 1e-7 * std::max(shape_size(a), shape_size(b));
   for (const ManifoldPoint& p : pts) {
     const bool dup = std::any_of(m.points.begin(), m.points.end(), [&](const ManifoldPoint& q) {
       return (q.point - p.point).norm() <= merge;

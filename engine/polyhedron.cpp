@@ -281,4 +281,6 @@ ConvexPolyhedron make_prism(double radius, double height, int sides) {
   return ConvexPolyhedron::from_triangles(std::move(v), std::move(t));
 }
 
+double shape_size(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
+
 }  // namespace rbx

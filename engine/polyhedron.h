@@ -105,6 +105,10 @@ class ConvexPolyhedron {
   void check_convex(double tol) const;
 };
 
+/// The size of a shape: the diagonal of its bounding box (m). Every tolerance and error that is
+/// relative to a body is a fraction of it (of the smaller body's, for a pair).
+double shape_size(const ConvexPolyhedron& s);
+
 /// Box with full extents `size`, centred at the origin (12 triangles).
 ConvexPolyhedron make_box(const Vec3& size);
 /// Icosahedron subdivided `subdivisions` times and projected onto the sphere of `radius`.

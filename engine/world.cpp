@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "engine/bounding.h"
+#include "engine/format.h"
 #include "engine/integrate.h"
 #include "engine/response.h"
 #include "engine/time_of_impact.h"
@@ -62,12 +63,10 @@ namespace {
 // Shortest decimal that reads back as the same double, so that a message never shows two
 // different numbers alike (max_energy_ratio = 1.000001 printed "1" with 6 digits).
 std::string shortest(double v) {
-  char buffer[40];
-  for (int precision = 1; precision <= 17; ++precision) {
-    std::snprintf(buffer, sizeof buffer, "%.*g", precision, v);
-    if (std::strtod(buffer, nullptr) == v) break;
-  }
-  return buffer;
+  NumberFormat f;
+  f.digits = 0;
+  f.signed_zero = true;
+  return format_number(v, f);
 }
 
 }  // namespace

@@ -19,11 +19,11 @@ std::optional<ContactPoint> first_hit(const RigidBody& a, const RigidBody& b,
   return detect(*a.shape, a.pose(), *b.shape, b.pose(), variant, cache);
 }
 
-}  // namespace
-
-ContactResult custom_contact(const RigidBody& a, const RigidBody& b) {
+// The contact of the `custom` backend on either detector.
+ContactResult chosen_plane_contact(const RigidBody& a, const RigidBody& b,
+                                   DetectorVariant variant) {
   ContactResult r;
-  auto c = first_hit(a, b, DetectorVariant::Accelerated);
+  auto c = first_hit(a, b, variant);
   if (!c) return r;
   // Departure from the seed (engine/contact_plane.h): the tests find the contact and its point;
   // the plane is the direction of least overlap, not the first face hit.
@@ -34,10 +34,14 @@ ContactResult custom_contact(const RigidBody& a, const RigidBody& b) {
   return r;
 }
 
-ContactResult custom_seed_contact(const RigidBody& a, const RigidBody& b) {
-  ContactResult r;
-  if (const auto c = first_hit(a, b, DetectorVariant::Faithful)) r.contacts.push_back(*c);
-  return r;
+}  // namespace
+
+ContactResult custom_contact(const RigidBody& a, const RigidBody& b) {
+  return chosen_plane_contact(a, b, DetectorVariant::Accelerated);
+}
+
+ContactResult custom_faithful_contact(const RigidBody& a, const RigidBody& b) {
+  return chosen_plane_contact(a, b, DetectorVariant::Faithful);
 }
 
 namespace {

@@ -8,8 +8,9 @@ namespace rbx {
 /// Contact at the current poses: the Moore & Wilhelms detector finds it and its point, the plane
 /// is the direction of least overlap (engine/contact_plane.h), from either body order alike.
 ContactResult custom_contact(const RigidBody& a, const RigidBody& b);
-/// Contact by the faithful seed loops (the oracle of the fast detector).
-ContactResult custom_seed_contact(const RigidBody& a, const RigidBody& b);
+/// custom_contact on the faithful detector: the seed's loops over every primitive (the
+/// accelerated detector's oracle), then the same chosen plane; the same answer, slower.
+ContactResult custom_faithful_contact(const RigidBody& a, const RigidBody& b);
 /// Whole-scene run with the extended engine: manifolds, Coulomb friction, resting contact, time
 /// of impact (the `custom` backend).
 DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt);

@@ -80,8 +80,10 @@ const Backend* find_backend(const std::string& name, const std::vector<Backend>*
 const std::vector<QueryVariant>& query_variants() {
   // backend, variant, what differs, contact query.
   static const std::vector<QueryVariant> table = {
-      {"custom", "seed", "the seed's faithful loops (the fast detector's oracle)",
-       custom_seed_contact},
+      {"custom", "faithful",
+       "custom on the faithful detector: the seed's loops over every primitive (the "
+       "accelerated detector's oracle), the same chosen plane",
+       custom_faithful_contact},
       {"fcl", "prebuilt",
        "each fcl::Box or Convex built once and kept, as a user holding FCL "
        "objects",

@@ -70,8 +70,8 @@ std::vector<NarrowBackend> narrow_backends() {
     return find_query_variant(name, v)->contact;
   };
   return {
-      {"custom", "fast", registry("custom"), 8192, 2048},
-      {"custom", "seed", variant("custom", "seed"), 2048, 512},
+      {"custom", "accelerated", registry("custom"), 8192, 2048},
+      {"custom", "faithful", variant("custom", "faithful"), 2048, 512},
       {"exact", "default", registry("exact"), 2048, 512},
       {"fcl", "default", registry("fcl"), 8192, 2048},
       {"fcl", "prebuilt", variant("fcl", "prebuilt"), 8192, 2048},
@@ -286,7 +286,7 @@ CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
         };
         bc.min_time_s = plan.min_time;
         // The cases behind the goals, and every cheap one, are repeated (fastest kept).
-        const bool goal = (b.backend == "custom" && b.variant == "fast") ||
+        const bool goal = (b.backend == "custom" && b.variant == "accelerated") ||
                           b.backend == "fcl-box" || (b.backend == "fcl" && n == 2048);
         bc.repetitions = goal || n <= 128 ? kBenchRepetitions : 1;
         set.cases.push_back(bc);
@@ -402,11 +402,13 @@ struct StepRunner {
   SceneRun run;
 };
 const StepRunner kStepRunners[] = {
-    {"custom", "fast", [](const Scene& s) { return run_registry_backend("custom", s); }},
-    {"custom", "seed",
+    {"custom", "accelerated", [](const Scene& s) { return run_registry_backend("custom", s); }},
+    {"custom", "faithful",
      [](const Scene& s) {
-       // The seed's detector and all-pairs bounding check.
+       // The `custom` backend's engine (extended contact model) on the faithful detector and
+       // the all-pairs bounding check.
        World w(s.sim, make_bodies(s), DetectorVariant::Faithful, BroadPhaseMethod::AllPairs);
+       w.set_contact_model(ContactModel::Extended);
        const RunResult r = w.run();
        return r.ok ? std::string() : r.message;
      }},

@@ -145,8 +145,6 @@ ExploreBody random_body(SampleRng& r, double scale) {
   return e;
 }
 
-double extent(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
-
 }  // namespace explore_detail
 
 using namespace explore_detail;
@@ -168,7 +166,7 @@ ContactSample make_contact_sample(uint64_t seed, uint64_t index) {
   s.a.position = Vec3(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1));
 
   const auto shape_a = build_shape(s.a), shape_b = build_shape(s.b);
-  const double small = std::min(extent(*shape_a), extent(*shape_b));
+  const double small = std::min(shape_size(*shape_a), shape_size(*shape_b));
   // B is placed so that the projections of A and B on n overlap by `overlap` (negative: a gap),
   // plus a sideways offset; n points from A toward B.
   Vec3 n = r.direction();
@@ -190,7 +188,7 @@ ContactSample make_contact_sample(uint64_t seed, uint64_t index) {
     // Near a face diagonal: the smaller body pushed in around a corner of the larger one,
     // along the direction from the larger one's origin through that corner (FCL issue 545).
     s.pose_class = "diagonal";
-    const bool a_big = extent(*shape_a) >= extent(*shape_b);
+    const bool a_big = shape_size(*shape_a) >= shape_size(*shape_b);
     const ConvexPolyhedron& big = a_big ? *shape_a : *shape_b;
     const Quat& q = a_big ? s.a.orientation : s.b.orientation;
     const Vec3 corner = big.vertices()[r.integer(0, static_cast<int>(big.vertices().size()) - 1)];
@@ -311,7 +309,7 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
   SampleOutcome out;
   out.shapes = shapes;
   const SatResult sat = sat_query(*a.shape, a.pose(), *b.shape, b.pose());
-  const double size = std::min(2.0 * bounding_sphere(a).radius, 2.0 * bounding_sphere(b).radius);
+  const double size = std::min(shape_size(*a.shape), shape_size(*b.shape));
   out.touching = sat.touching;
   out.depth_rel = sat.depth / size;
   out.feature = sat.touching ? sat.axis_kind : "separated";
@@ -539,7 +537,8 @@ ShrinkResult shrink(const ContactSample& start, const std::string& backend, cons
     }
   }
   // 4. Rounder positions, sizes and points, on grids relative to the smaller body's extent.
-  const double small = std::min(extent(*build_shape(r.sample.a)), extent(*build_shape(r.sample.b)));
+  const double small =
+      std::min(shape_size(*build_shape(r.sample.a)), shape_size(*build_shape(r.sample.b)));
   const double unit = std::pow(10.0, std::floor(std::log10(small)));
   const double grids[] = {1, 0.5, 0.1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6};
   for (ExploreBody ContactSample::*body : {&ContactSample::a, &ContactSample::b}) {
@@ -581,8 +580,7 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
   hopt.timing_budget_s = 0.0;  // one query each: no timing repeats
   const SceneEvaluation ev = evaluate_scene(scene, hopt);
   const std::vector<RigidBody> bodies = make_bodies(scene);
-  const double size =
-      std::min(2.0 * bounding_sphere(bodies[0]).radius, 2.0 * bounding_sphere(bodies[1]).radius);
+  const double size = std::min(shape_size(*bodies[0].shape), shape_size(*bodies[1].shape));
   auto metric = [&](const std::string& name) -> double {
     for (const Metric& m : ev.metrics)
       if (m.backend == b.backend && m.name == name) return m.value;

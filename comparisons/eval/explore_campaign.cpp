@@ -73,8 +73,7 @@ std::string expect_block(const std::string& text) {
   const std::vector<RigidBody> bodies = make_bodies(scene);
   const SatResult sat =
       sat_query(*bodies[0].shape, bodies[0].pose(), *bodies[1].shape, bodies[1].pose());
-  const double size =
-      std::min(2.0 * bounding_sphere(bodies[0]).radius, 2.0 * bounding_sphere(bodies[1]).radius);
+  const double size = std::min(shape_size(*bodies[0].shape), shape_size(*bodies[1].shape));
   NumberFormat full;  // every digit, as the oracle computed it
   full.digits = 17;
   full.signed_zero = true;

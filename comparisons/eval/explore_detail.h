@@ -19,8 +19,6 @@ Quat build_orientation(const ExploreBody& e);
 RigidBody build_body(const ExploreBody& e, const std::string& name);
 /// A random body of roughly `scale` metres: a box, a hull of 4 to 2000 points, or a sliver.
 ExploreBody random_body(SampleRng& r, double scale);
-/// Diagonal of a shape's bounding box (m).
-double extent(const ConvexPolyhedron& s);
 
 /// The shortest text that reads back as the same double (TOML float syntax).
 std::string num(double x);

@@ -291,8 +291,8 @@ bool realize_impact(ImpactSample& s) {
   local_c[(axis + 1) % 3] = s.face_u * s.b.box_size[(axis + 1) % 3];
   local_c[(axis + 2) % 3] = s.face_v * s.b.box_size[(axis + 2) % 3];
   const Vec3 point = B0.pose().apply(local_c);
-  const double size_a = extent(*A0.shape);
-  const double size = std::min(size_a, extent(*B0.shape));
+  const double size_a = shape_size(*A0.shape);
+  const double size = std::min(size_a, shape_size(*B0.shape));
   int lowest = -1;
   double low = 1e300, second = 1e300;
   for (int i = 0; i < static_cast<int>(A0.shape->vertices().size()); ++i) {
@@ -460,7 +460,7 @@ SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<st
         o.momentum_err_ke = std::sqrt(num_p / (2.0 * e_ref));
         const double v0 = s.velocity_a.norm();
         if ((run.finals[0].velocity - s.velocity_a).norm() <= 1e-9 * v0 &&
-            run.finals[0].angular_velocity.norm() <= 1e-9 * v0 / extent(*inputs[0].shape))
+            run.finals[0].angular_velocity.norm() <= 1e-9 * v0 / shape_size(*inputs[0].shape))
           o.error = "missed";  // A flew on untouched
         else if (!(o.momentum_err_ke <= kMarkVelocityErr))
           o.error = "impulse";

@@ -98,7 +98,7 @@ std::vector<BodyFinal> initial_states(const std::vector<RigidBody>& inputs) {
 }
 
 // Size of a body: its bounding-box diagonal (m).
-double body_size(const RigidBody& b) { return 2.0 * bounding_sphere(b).radius; }
+double body_size(const RigidBody& b) { return shape_size(*b.shape); }
 
 std::string fmt_dt(double dt) { return "self dt=" + fmt_num(dt, 3); }
 

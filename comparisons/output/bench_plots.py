@@ -46,7 +46,7 @@ def narrowphase(rows, out):
             box = [(n, t * 1e-3) for n, t in pts if n == 8]
             colour = COLOURS.get(backend, "black")
             marker = MARKERS.get(backend, "o")
-            dashed = variant == "seed"
+            dashed = variant == "faithful"
             label = backend if variant == "default" else f"{backend} ({variant})"
             if hull:
                 ax.plot([p[0] for p in hull], [p[1] for p in hull], marker=marker, color=colour,

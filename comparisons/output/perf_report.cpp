@@ -67,23 +67,24 @@ constexpr const char* kDetectorProfile =
 
 std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& results) {
   std::vector<PerfGoal> goals;
-  const double fast_exp = series_exponent(results.narrow, "custom", "fast", "touching");
-  goals.push_back({"custom (fast), touching: time grows no faster than N^1.2",
+  const double fast_exp = series_exponent(results.narrow, "custom", "accelerated", "touching");
+  goals.push_back({"custom (accelerated), touching: time grows no faster than N^1.2",
                    "exponent " + bench_num(fast_exp) +
                        " (N = " + std::to_string(plan.hull_sizes.front()) + " to " +
                        std::to_string(plan.hull_sizes.back()) + ")",
                    std::isfinite(fast_exp) && fast_exp <= 1.2, ""});
-  const double fast_2048 = find_time(results.narrow, "custom", "fast", "touching", 2048);
+  const double fast_2048 = find_time(results.narrow, "custom", "accelerated", "touching", 2048);
   // Against FCL with its shapes built once (custom keeps its hierarchies per shape too): the
   // per-call `fcl` row also pays for building fcl::Convex, which would flatter custom.
   const double fcl_2048 = find_time(results.narrow, "fcl", "prebuilt", "touching", 2048);
-  goals.push_back({"custom (fast) no slower than fcl (shapes prebuilt) at N = 2048, touching",
-                   fmt_duration_ns(fast_2048) + " vs " + fmt_duration_ns(fcl_2048) + ": ratio " +
-                       bench_num(fast_2048 / fcl_2048),
-                   fast_2048 <= fcl_2048, kDetectorProfile});
-  const double fast_box = find_time(results.narrow, "custom", "fast", "touching", 8);
+  goals.push_back(
+      {"custom (accelerated) no slower than fcl (shapes prebuilt) at N = 2048, touching",
+       fmt_duration_ns(fast_2048) + " vs " + fmt_duration_ns(fcl_2048) + ": ratio " +
+           bench_num(fast_2048 / fcl_2048),
+       fast_2048 <= fcl_2048, kDetectorProfile});
+  const double fast_box = find_time(results.narrow, "custom", "accelerated", "touching", 8);
   const double fclbox = find_time(results.narrow, "fcl-box", "default", "touching", 8);
-  goals.push_back({"custom (fast) within 1.5x of fcl-box on two boxes, touching",
+  goals.push_back({"custom (accelerated) within 1.5x of fcl-box on two boxes, touching",
                    fmt_duration_ns(fast_box) + " vs " + fmt_duration_ns(fclbox) + ": ratio " +
                        bench_num(fast_box / fclbox),
                    fast_box <= 1.5 * fclbox, ""});
@@ -110,7 +111,7 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
     bool met = true;
     int compared = 0;
     for (int n : plan.hull_sizes) {
-      const double c = find_time(results.narrow, "custom", "fast", "touching", n);
+      const double c = find_time(results.narrow, "custom", "accelerated", "touching", n);
       const double f = find_time(results.narrow, "fcl", "prebuilt", "touching", n);
       if (!std::isfinite(c) || !std::isfinite(f)) continue;
       ++compared;
@@ -119,14 +120,14 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
                   bench_num(c / f, 2) + "x";
     }
     goals.push_back(
-        {"custom (fast) no slower than fcl (shapes prebuilt) at every hull size timed, "
+        {"custom (accelerated) no slower than fcl (shapes prebuilt) at every hull size timed, "
          "touching (issue 11)",
          measured.empty() ? "not measured" : measured, met && compared > 0, kDetectorProfile});
   }
   for (const char* scene : {"many_100", "many_1000"}) {
     double custom = NAN, bullet = NAN;
     for (const StepRow& r : results.step)
-      if (r.scene == scene && r.variant != "seed") {
+      if (r.scene == scene && r.variant != "faithful") {
         if (r.backend == "custom") custom = r.us_per_body_step;
         if (r.backend == "bullet") bullet = r.us_per_body_step;
       }
@@ -142,7 +143,7 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
     double custom = NAN, seed = NAN;
     for (const StepRow& r : results.step)
       if (r.scene == "many_1000") {
-        if (r.backend == "custom" && r.variant != "seed") custom = r.us_per_body_step;
+        if (r.backend == "custom" && r.variant != "faithful") custom = r.us_per_body_step;
         if (r.backend == "custom-seed") seed = r.us_per_body_step;
       }
     goals.push_back({"custom step within 2x of custom-seed per body-step on many_1000 (issue 15)",
@@ -364,10 +365,11 @@ std::string step_markdown(const BenchResults& results) {
   std::ostringstream md;
   md << "## Whole step\n\nscenes/many/ through each engine for two durations; microseconds per "
         "moving body per step = (time of the long run - time of the short run) / (extra steps x "
-        "moving bodies), so building the world and the shapes cancels. `custom (fast)` is the "
-        "registry's dynamics (fast detector, tree broad phase); `custom (seed)` is the extended "
-        "engine "
-        "(friction, manifolds, time of impact) on the seed's detector with the all-pairs check; "
+        "moving bodies), so building the world and the shapes cancels. `custom (accelerated)` is "
+        "the "
+        "registry's dynamics (accelerated detector, tree broad phase); `custom (faithful)` is the "
+        "same engine (friction, manifolds, time of impact) on the faithful detector (the seed's "
+        "loops) with the all-pairs check; "
         "`custom-seed` is the seed's algorithm as the custom-seed backend runs it (first hit, "
         "single-point frictionless impulse).\n\n"
         "| scene | moving bodies | backend | variant | µs per body per step | status |\n"

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "comparisons/cli/commands.h"
+#include "engine/detect.h"
 #include "reference/backend.h"
 #include "reference/custom.h"
 
@@ -195,7 +196,13 @@ TEST(Check, AChangeThatOnlyBreaksRandomPosesIsNamedByTheExploreSamples) {
   // scene alone passes; with explore's fixed samples the check names the regression.
   std::vector<Backend> broken = backends();
   for (Backend& b : broken)
-    if (b.name == "custom") b.contact = custom_seed_contact;
+    if (b.name == "custom")
+      b.contact = [](const RigidBody& a, const RigidBody& c) {
+        ContactResult r;
+        if (const auto hit = detect(*a.shape, a.pose(), *c.shape, c.pose()))
+          r.contacts.push_back(*hit);
+        return r;
+      };
   const fs::path dir = temp_dir("check_random_poses");
   ReportOptions opt;
   opt.inputs = {RBX_SOURCE_DIR "/scenes/contact/axis_x.toml"};

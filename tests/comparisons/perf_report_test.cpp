@@ -25,7 +25,7 @@ PerfGoal detector_goal(double ratio) {
     fcl.ns_per_query = 1000.0 * n;
     NarrowRow custom = fcl;
     custom.backend = "custom";
-    custom.variant = "fast";
+    custom.variant = "accelerated";
     custom.ns_per_query = ratio * fcl.ns_per_query;
     results.narrow.push_back(fcl);
     results.narrow.push_back(custom);

@@ -364,7 +364,7 @@ TEST(Detect, RotatedPosesGiveWorldFrameResults) {
 }
 
 TEST(Detect, FastVariantMatchesSeed) {
-  // One hand-built pose here; tests/engine/fast_detect_test.cpp holds the randomised check.
+  // One hand-built pose here; tests/engine/accelerated_detect_test.cpp holds the randomised check.
   const CrossedBars s;
   const auto seed = detect(s.a, s.pa, s.b, s.pb, DetectorVariant::Faithful);
   const auto fast = detect(s.a, s.pa, s.b, s.pb, DetectorVariant::Accelerated);

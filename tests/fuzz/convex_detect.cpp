@@ -39,7 +39,6 @@ Pose decode_pose(ByteReader& in, double reach) {
 }
 
 // Size (m) of a shape: the diagonal of its bounding box.
-double size_of(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
 
 // World bounding box of a placed shape.
 Aabb world_box(const ConvexPolyhedron& s, const Pose& pose) {
@@ -86,14 +85,15 @@ void convex_detect(const uint8_t* data, size_t size) {
   } catch (const GeometryError&) {
     return;  // flat or too few distinct points: not a pair to test
   }
-  const double reach = size_of(*a) + size_of(*b);
+  const double reach = shape_size(*a) + shape_size(*b);
   const Pose pa = decode_pose(in, reach);
   const Pose pb = decode_pose(in, reach);
 
-  const std::optional<ContactPoint> seed = detect(*a, pa, *b, pb, DetectorVariant::Faithful);
-  const std::optional<ContactPoint> fast = detect(*a, pa, *b, pb, DetectorVariant::Accelerated);
-  if (seed) check_contact(*seed, "Seed");
-  if (fast) check_contact(*fast, "Fast");
+  const std::optional<ContactPoint> faithful = detect(*a, pa, *b, pb, DetectorVariant::Faithful);
+  const std::optional<ContactPoint> accelerated =
+      detect(*a, pa, *b, pb, DetectorVariant::Accelerated);
+  if (faithful) check_contact(*faithful, "Faithful");
+  if (accelerated) check_contact(*accelerated, "Accelerated");
 
   // Apart shapes have no contact. The detector counts points up to its tolerance outside a face
   // plane as inside; near a sharp vertex that slab reaches tol / sin(angle) out, and the 1/8
@@ -102,22 +102,26 @@ void convex_detect(const uint8_t* data, size_t size) {
   const Aabb box_a = world_box(*a, pa), box_b = world_box(*b, pb);
   const double gap =
       std::max((box_a.min - box_b.max).maxCoeff(), (box_b.min - box_a.max).maxCoeff());
-  const double larger = std::max(size_of(*a), size_of(*b));
+  const double larger = std::max(shape_size(*a), shape_size(*b));
   if (gap > 1e-3 * larger)
-    require(!seed,
-            "contact between shapes " + std::to_string(gap) + " m apart: " + describe(*seed));
+    require(!faithful,
+            "contact between shapes " + std::to_string(gap) + " m apart: " + describe(*faithful));
 
-  // Fast must give Seed's answer (engine/detect.h), to round-off: both sum the same handful of
-  // terms of order `reach`, so 1e-9 of it is ~10^6 ulps of room for a different order of sums.
-  require(seed.has_value() == fast.has_value(), "Fast and Seed disagree on touching");
-  if (seed && fast) {
+  // Accelerated must give Faithful's answer (engine/detect.h), to round-off: both sum the same
+  // handful of terms of order `reach`, so 1e-9 of it is ~10^6 ulps of room for a different order of
+  // sums.
+  require(faithful.has_value() == accelerated.has_value(),
+          "Accelerated and Faithful disagree on touching");
+  if (faithful && accelerated) {
     const double tol = 1e-9 * reach;
-    require(seed->feature == fast->feature,
-            "Fast and Seed disagree on the feature: " + describe(*seed) + " vs " + describe(*fast));
-    require((seed->point - fast->point).norm() <= tol &&
-                (seed->normal - fast->normal).norm() <= 1e-9 &&
-                std::abs(seed->depth - fast->depth) <= tol,
-            "Fast and Seed disagree: " + describe(*seed) + " vs " + describe(*fast));
+    require(faithful->feature == accelerated->feature,
+            "Accelerated and Faithful disagree on the feature: " + describe(*faithful) + " vs " +
+                describe(*accelerated));
+    require((faithful->point - accelerated->point).norm() <= tol &&
+                (faithful->normal - accelerated->normal).norm() <= 1e-9 &&
+                std::abs(faithful->depth - accelerated->depth) <= tol,
+            "Accelerated and Faithful disagree: " + describe(*faithful) + " vs " +
+                describe(*accelerated));
   }
 }
 

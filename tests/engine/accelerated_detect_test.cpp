@@ -1,4 +1,4 @@
-// The fast detector against the faithful seed loops (its oracle): on thousands of fixed-seed
+// The accelerated detector against the faithful seed loops (its oracle): on thousands of fixed-seed
 // poses of boxes, prisms and (sheared) icospheres from 8 to 642 vertices, touching, deep and
 // separated, the fast path returns the same hit or miss, feature, point, normal and depth as
 // the seed path, for the full detector and for each feature test alone (the world calls those).
@@ -151,7 +151,7 @@ void expect_representative(const Tally& t, const std::string& name) {
   EXPECT_GE(t.misses, total / 10) << name << ": too few misses for the sample to test them";
 }
 
-TEST(FastDetect, BoxesMatchSeed) {
+TEST(AcceleratedDetect, BoxesMatchSeed) {
   const ConvexPolyhedron a = make_box(Vec3(1, 1, 1)), b = make_box(Vec3(1.2, 0.6, 0.9));
   Tally t;
   random_poses(a, b, 3000, 1, "box-box", t);
@@ -163,7 +163,7 @@ TEST(FastDetect, BoxesMatchSeed) {
   EXPECT_GT(t.features["edge"], 0);
 }
 
-TEST(FastDetect, PrismsMatchSeed) {
+TEST(AcceleratedDetect, PrismsMatchSeed) {
   // 8 sides: 28 triangles (plain loops); 24 sides: 92 triangles (hierarchies); both have
   // fan-triangulated caps, so several coplanar triangles share a plane.
   const ConvexPolyhedron p8 = make_prism(0.5, 0.8, 8), p24 = make_prism(0.5, 1.0, 24);
@@ -181,7 +181,7 @@ TEST(FastDetect, PrismsMatchSeed) {
   EXPECT_GT(t.features["edge"], 0);
 }
 
-TEST(FastDetect, IcospheresMatchSeed) {
+TEST(AcceleratedDetect, IcospheresMatchSeed) {
   const ConvexPolyhedron s1 = sheared_icosphere(1), s2 = sheared_icosphere(2);
   const ConvexPolyhedron i2 = make_icosphere(0.5, 2), i3 = make_icosphere(0.5, 3);
   const ConvexPolyhedron box = make_box(Vec3(1, 1, 1));
@@ -197,7 +197,7 @@ TEST(FastDetect, IcospheresMatchSeed) {
 
 // Hulls above kLinearVertices search their trees (caps grown over edges, bounded clusters of
 // face planes); the smaller ones above scan. Both sizes against each other and a box.
-TEST(FastDetect, HullsThatSearchTheirTreesMatchSeed) {
+TEST(AcceleratedDetect, HullsThatSearchTheirTreesMatchSeed) {
   const ConvexPolyhedron s3 = sheared_icosphere(3), i3 = make_icosphere(0.5, 3);
   const ConvexPolyhedron s2 = sheared_icosphere(2), box = make_box(Vec3(1, 1, 1));
   ASSERT_GT(static_cast<int>(s3.vertices().size()), detail::kLinearVertices);
@@ -215,7 +215,7 @@ TEST(FastDetect, HullsThatSearchTheirTreesMatchSeed) {
 // missing from it would be a hit never tested. Checked against the seed's expression on every
 // vertex, at touching poses, for a scanned and a searched hull; the cap must also leave most
 // vertices out (otherwise it culls nothing and the check proves little).
-TEST(FastDetect, TheCapHoldsEveryVertexNearTheFacingPlane) {
+TEST(AcceleratedDetect, TheCapHoldsEveryVertexNearTheFacingPlane) {
   for (int subdivisions : {2, 3}) {
     const ConvexPolyhedron a = sheared_icosphere(subdivisions), b = make_icosphere(0.5, 3);
     std::mt19937_64 rng(20 + subdivisions);
@@ -253,7 +253,7 @@ TEST(FastDetect, TheCapHoldsEveryVertexNearTheFacingPlane) {
 
 // Shapes destroyed and rebuilt, likely at reused addresses: the hierarchies each shape carries
 // (built with it) always belong to the shape asked about.
-TEST(FastDetect, CacheFollowsShapes) {
+TEST(AcceleratedDetect, CacheFollowsShapes) {
   Tally t;
   for (int round = 0; round < 20; ++round) {
     // A new shape each round, likely at the address of the last one, with a different size.
@@ -267,7 +267,7 @@ TEST(FastDetect, CacheFollowsShapes) {
 // A different shape at the same poses must give its own answer, never the last pair's (the
 // accelerated path once reused the last pair's world data when poses matched). Boxes of growing
 // size, at the same fixed poses, one after the other.
-TEST(FastDetect, SamePosesNewShapes) {
+TEST(AcceleratedDetect, SamePosesNewShapes) {
   Pose pa, pb;
   pb.position = Vec3(1.0, 0.1, 0.05);
   pb.orientation = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
@@ -297,7 +297,7 @@ TEST(FastDetect, SamePosesNewShapes) {
 // equal shapes at the same poses, the first ones destroyed before the second query (found by
 // the convex_detect fuzzer: a read of a dead shape, reported by ASan, which `./rbx test
 // --sanitize` turns into a failure here).
-TEST(FastDetect, EqualShapesAfterTheFirstAreDestroyed) {
+TEST(AcceleratedDetect, EqualShapesAfterTheFirstAreDestroyed) {
   Pose pa, pb;
   pb.position = Vec3(0.9, 0.1, 0.05);
   pb.orientation = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
@@ -321,7 +321,7 @@ TEST(FastDetect, EqualShapesAfterTheFirstAreDestroyed) {
 // in two caches and queried alternately on one thread give exactly the answers each gives on
 // its own. The pairs differ in size class (a hierarchy-carrying icosphere against a box, two
 // small boxes), so both paths of the accelerated view hold state at the same time.
-TEST(FastDetect, InterleavedQueriesOnTwoCachesDoNotInterfere) {
+TEST(AcceleratedDetect, InterleavedQueriesOnTwoCachesDoNotInterfere) {
   const ConvexPolyhedron sphere = sheared_icosphere(2);
   const ConvexPolyhedron box = make_box(Vec3(1.0, 0.8, 0.6));
   const ConvexPolyhedron cube = make_box(Vec3::Constant(0.7));
