@@ -166,3 +166,42 @@ TEST(Harness, TheThinWallGetsAVerdictAtEverySweptStep) {
 
 }  // namespace
 }  // namespace rbx
+
+namespace rbx {
+namespace {
+
+// Two unit cubes overlapping by 0.1 along x ([-0.5, 0.5] and [0.4, 1.4]), with a stated point.
+SceneEvaluation with_stated_point(const std::string& point) {
+  const Scene scene = parse_scene(
+      "checks = [\"contact\"]\n[sim]\nduration = 0\n[[body]]\nname = \"A\"\n"
+      "[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n"
+      "[expect]\ntolerance = 1e-6\n[expect.contact]\ntouching = true\nnormal = [-1, 0, 0]\n"
+      "depth = 0.1\npoint = " +
+          point + "\n",
+      "stated_point.toml");
+  HarnessOptions opt;
+  opt.backends = "exact";
+  opt.sweep = false;
+  return evaluate_scene(scene, opt);
+}
+
+TEST(HarnessExpect, AStatedContactPointMustLieInTheTrueContactRegion) {
+  // Inside both cubes (the overlap slab x in [0.4, 0.5]), on its face, or at a corner of the
+  // patch: right, whichever model's representative point it is.
+  for (const char* inside : {"[0.45, 0, 0]", "[0.5, 0.2, -0.3]", "[0.4, 0.5, 0.5]"}) {
+    const SceneEvaluation ev = with_stated_point(inside);
+    EXPECT_TRUE(ev.expect_failures.empty()) << inside << ": " << ev.expect_failures.front();
+    EXPECT_TRUE(ev.expect_checked) << inside;
+  }
+  // Outside B by 0.02 (x = 0.38), or beyond the patch sideways: the stated point is wrong, and
+  // the line says by how much.
+  for (const char* outside : {"[0.38, 0, 0]", "[0.45, 0.7, 0]"}) {
+    const SceneEvaluation ev = with_stated_point(outside);
+    ASSERT_EQ(ev.expect_failures.size(), 1u) << outside;
+    EXPECT_NE(ev.expect_failures.front().find("from the true contact region"), std::string::npos)
+        << ev.expect_failures.front();
+  }
+}
+
+}  // namespace
+}  // namespace rbx
