@@ -630,72 +630,77 @@ std::vector<std::string> run_items_isolated(size_t lo, size_t hi,
   return results;
 }
 
+namespace {
+
+// Status and message of each kind of call's record, and where its wall time goes (a mass call
+// has none).
+template <class Record>
+struct RecordAccess;
+template <>
+struct RecordAccess<TimedContact> {
+  static Status& status(TimedContact& t) { return t.result.status; }
+  static std::string& message(TimedContact& t) { return t.result.message; }
+  static void set_runtime(TimedContact& t, double s) { t.runtime_s = s; }
+};
+template <>
+struct RecordAccess<TimedDynamics> {
+  static Status& status(TimedDynamics& t) { return t.result.status; }
+  static std::string& message(TimedDynamics& t) { return t.result.message; }
+  static void set_runtime(TimedDynamics& t, double s) { t.runtime_s = s; }
+};
+template <>
+struct RecordAccess<MassResult> {
+  static Status& status(MassResult& m) { return m.status; }
+  static std::string& message(MassResult& m) { return m.message; }
+  static void set_runtime(MassResult&, double) {}
+};
+
+// One library call in a supervised child: a thrown exception is the record's status error, a
+// child that died, stalled or answered nothing is the record of its status and message.
+template <class Record>
+Record isolated_call(const std::string& backend, double deadline_s,
+                     const std::function<Record()>& call) {
+  using Access = RecordAccess<Record>;
+  const CallOutcome out = isolated(backend, deadline_s, [&] {
+    Record r;
+    try {
+      r = call();
+    } catch (const std::exception& e) {
+      r = Record{};
+      Access::status(r) = Status::Error;
+      Access::message(r) = e.what();
+    } catch (...) {
+      r = Record{};
+      Access::status(r) = Status::Error;
+      Access::message(r) = "library call threw a non-standard exception";
+    }
+    return encode(r);
+  });
+  Record r;
+  if (out.status == Status::Ok && decode(out.bytes, r)) return r;
+  r = Record{};
+  Access::status(r) = out.status == Status::Ok ? Status::Error : out.status;
+  Access::message(r) =
+      out.status == Status::Ok ? backend + ": isolated call returned no result" : out.message;
+  Access::set_runtime(r, out.elapsed_s);
+  return r;
+}
+
+}  // namespace
+
 TimedContact isolated_contact(const std::string& backend, double deadline_s,
                               const std::function<TimedContact()>& call) {
-  const CallOutcome out = isolated(backend, deadline_s, [&] {
-    TimedContact t;
-    try {
-      t = call();
-    } catch (const std::exception& e) {
-      t.result = {Status::Error, e.what(), {}};
-    } catch (...) {
-      t.result = {Status::Error, "library call threw a non-standard exception", {}};
-    }
-    return encode(t);
-  });
-  TimedContact t;
-  if (out.status == Status::Ok && decode(out.bytes, t)) return t;
-  t = TimedContact{};
-  t.result.status = out.status == Status::Ok ? Status::Error : out.status;
-  t.result.message =
-      out.status == Status::Ok ? backend + ": isolated call returned no result" : out.message;
-  t.runtime_s = out.elapsed_s;
-  return t;
+  return isolated_call(backend, deadline_s, call);
 }
 
 TimedDynamics isolated_dynamics(const std::string& backend, double deadline_s,
                                 const std::function<TimedDynamics()>& call) {
-  const CallOutcome out = isolated(backend, deadline_s, [&] {
-    TimedDynamics t;
-    try {
-      t = call();
-    } catch (const std::exception& e) {
-      t = TimedDynamics{};
-      t.result.status = Status::Error;
-      t.result.message = e.what();
-    }
-    return encode(t);
-  });
-  TimedDynamics t;
-  if (out.status == Status::Ok && decode(out.bytes, t)) return t;
-  t = TimedDynamics{};
-  t.result.status = out.status == Status::Ok ? Status::Error : out.status;
-  t.result.message =
-      out.status == Status::Ok ? backend + ": isolated call returned no result" : out.message;
-  t.runtime_s = out.elapsed_s;
-  return t;
+  return isolated_call(backend, deadline_s, call);
 }
 
 MassResult isolated_mass(const std::string& backend, double deadline_s,
                          const std::function<MassResult()>& call) {
-  const CallOutcome out = isolated(backend, deadline_s, [&] {
-    MassResult m;
-    try {
-      m = call();
-    } catch (const std::exception& e) {
-      m = MassResult{};
-      m.status = Status::Error;
-      m.message = e.what();
-    }
-    return encode(m);
-  });
-  MassResult m;
-  if (out.status == Status::Ok && decode(out.bytes, m)) return m;
-  m = MassResult{};
-  m.status = out.status == Status::Ok ? Status::Error : out.status;
-  m.message =
-      out.status == Status::Ok ? backend + ": isolated call returned no result" : out.message;
-  return m;
+  return isolated_call(backend, deadline_s, call);
 }
 
 ContactResult run_isolated(const std::function<ContactResult()>& query, double timeout_s) {
