@@ -281,3 +281,27 @@ TEST_F(ViewBrowser, FailsOnABrokenPage) {
 
 }  // namespace
 }  // namespace rbx
+
+namespace rbx {
+namespace {
+
+TEST_F(ViewBrowser, WithoutWebGLThePageSaysWhyOnTheScreen) {
+  // Chromium with WebGL turned off (--disable-3d-apis): the page cannot draw, and says so in
+  // visible text, not only in its hidden state.
+  const fs::path dir = temp_dir("no_webgl");
+  const nlohmann::json d = data_of("scenes/analytic/headon_e05.toml");
+  const fs::path page = dir / "page.html", dom = dir / "page.dom";
+  std::ofstream(page) << view_page(d, three_js());
+  shell(chromium("--disable-3d-apis --dump-dom 'file://" + page.string() + "'", 1000) + " > '" +
+        dom.string() + "' 2>/dev/null");
+  const std::string html = read_file(dom);
+  ASSERT_NE(html.find("rbx-state"), std::string::npos) << "the page was not dumped";
+  const size_t note = html.find("id=\"rbx-no-webgl\"");
+  ASSERT_NE(note, std::string::npos) << "no visible notice";
+  EXPECT_NE(html.find("did not provide", note), std::string::npos);
+  EXPECT_NE(html.find("WebGL unavailable"), std::string::npos);  // the state says why too
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rbx

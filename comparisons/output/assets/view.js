@@ -66,7 +66,16 @@
     renderer = new THREE.WebGLRenderer({canvas: canvas, antialias: true, preserveDrawingBuffer: true});
     state.webgl = true;
   } catch (e) {
-    state.error = "WebGL unavailable: " + e.message; publish(); return;
+    // Said on the page, not only in the hidden state: without WebGL nothing else is drawn.
+    state.error = "WebGL unavailable: " + e.message;
+    var note = text(document.createElement("div"),
+      "This page draws every backend's run with WebGL, which this browser did not provide (" +
+      e.message + "). Turn on hardware acceleration or WebGL in the browser's settings, or " +
+      "open the page in another browser; the numbers are in the report beside it.");
+    note.id = "rbx-no-webgl";
+    canvas.style.display = "none";
+    document.getElementById("stage").appendChild(note);
+    publish(); return;
   }
   renderer.setPixelRatio(1);
   renderer.setScissorTest(true);
