@@ -2,25 +2,16 @@
 // report.md, results.json, CSV files and figures into one folder, atomically.
 #include <unistd.h>
 
-#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <map>
 #include <mutex>
-#include <set>
-#include <sstream>
 
 #include "comparisons/cli/commands.h"
-#include "comparisons/eval/harness.h"
 #include "comparisons/eval/parallel.h"
 #include "comparisons/eval/scene_batch.h"
 #include "comparisons/eval/tosses.h"
-#include "comparisons/eval/trajectory.h"
 #include "comparisons/output/report_writer.h"
-#include "comparisons/output/scorecard.h"
-#include "comparisons/output/table.h"
 #include "comparisons/output/tosses_report.h"
 #include "comparisons/output/view_page.h"
 #include "comparisons/scene/repo_path.h"
