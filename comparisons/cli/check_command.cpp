@@ -42,6 +42,7 @@ int check_command(const ReportOptions& opt) {
   const std::vector<Backend>& table = opt.registry ? *opt.registry : backends();
   if (opt.backends != "all") set.only = parse_backend_list(opt.backends, table);
   set.explore = opt.explore || opt.inputs.empty();
+  set.explore_samples = opt.explore_samples;
   set.use_cache = !opt.no_cache;
   set.registry = opt.registry;
 

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/select_backends.h"
 #include "comparisons/scene/scene_collection.h"
 #include "engine/scene.h"
@@ -49,6 +50,8 @@ struct ReportOptions {
   bool explore = false;
   /// Backends to choose from (nullptr: the registry); tests pass a table with a broken engine.
   const std::vector<Backend>* registry = nullptr;
+  /// check: explore's fixed sample set; tests narrow it (the sanitizer build is ~15x slower).
+  ExploreCheckSet explore_samples;
   std::string backends;  // --backends LIST
   bool quiet = false;    // no progress line
   int threads = 0;       // report: threads per rank (0: the cores of the node, divided among ranks)

@@ -96,7 +96,7 @@ void measure_explore(const CheckSettings& set, CheckRun& run) {
     if (b.dynamics) impact.push_back(b.name);
   }
   for (const ExploreCheckMetric& m :
-       explore_check_metrics(contact, impact, ExploreCheckSet{}, set.registry)) {
+       explore_check_metrics(contact, impact, set.explore_samples, set.registry)) {
     run.scene_in_run.insert(m.scene);
     run.now[key_of(m.scene, m.metric)] = m.metric.value;
   }

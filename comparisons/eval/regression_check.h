@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/json_io.h"
 
@@ -14,9 +15,10 @@ namespace rbx {
 
 /// What a check measures.
 struct CheckSettings {
-  std::vector<std::string> only;  // backends compared (and merged); empty: every one
-  bool explore = false;           // also explore's fixed random samples
-  bool use_cache = true;          // reference results from the cache
+  std::vector<std::string> only;    // backends compared (and merged); empty: every one
+  bool explore = false;             // also explore's fixed random samples
+  ExploreCheckSet explore_samples;  // which samples (the baseline's set unless a test narrows it)
+  bool use_cache = true;            // reference results from the cache
   /// Backends to choose from (nullptr: the registry); tests pass a table with a broken engine.
   const std::vector<Backend>* registry = nullptr;
   /// True when `backend`'s metrics are compared.
