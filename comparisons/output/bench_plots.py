@@ -15,11 +15,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-# One colour and marker per backend, stable across figures (the order of the registry).
-BACKENDS = ["custom", "exact", "fcl", "fcl-epa", "fcl-indep", "fcl-box", "libccd-mpr", "bullet",
-            "bullet-sat", "mujoco", "ode", "libccd"]
-COLOURS = dict(zip(BACKENDS, plt.cm.tab20.colors[::2] + plt.cm.tab20.colors[1::2]))
-MARKERS = dict(zip(BACKENDS, "os^vD<>pPX*h"))
+import backend_style  # noqa: E402
+
 METHOD_STYLE = {"all-pairs": ("tab:red", "o"), "sweep-and-prune": ("tab:orange", "s"),
                 "tree": ("tab:blue", "^")}
 
@@ -44,8 +41,7 @@ def narrowphase(rows, out):
             pts.sort()
             hull = [(n, t * 1e-3) for n, t in pts if n > 8]
             box = [(n, t * 1e-3) for n, t in pts if n == 8]
-            colour = COLOURS.get(backend, "black")
-            marker = MARKERS.get(backend, "o")
+            colour, marker = backend_style.style(backend)
             dashed = variant == "faithful"
             label = backend if variant == "default" else f"{backend} ({variant})"
             if hull:
@@ -101,7 +97,7 @@ def step(rows, out):
     fig, ax = plt.subplots(figsize=(7, 4))
     labels = [f'{r["scene"]}\n{r["backend"]}' + ("" if r["variant"] == "default"
                                                  else f' ({r["variant"]})') for r in bars]
-    colours = [COLOURS.get(r["backend"], "black") for r in bars]
+    colours = [backend_style.colour(r["backend"], [r["backend"] for r in bars]) for r in bars]
     ax.bar(range(len(bars)), [max(r["us_per_body_step"], 1e-3) for r in bars], color=colours)
     ax.set_xticks(range(len(bars)))
     ax.set_xticklabels(labels, fontsize=7)

@@ -14,6 +14,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import backend_style  # noqa: E402
+
 FLOOR = 1e-17  # errors at round-off are drawn at this floor on log axes
 METRICS = [("normal_err_deg", "normal error (deg)"),
            ("depth_err_rel", "depth error / smaller body size"),
@@ -24,7 +26,6 @@ def main(out):
     j = json.load(open(os.path.join(out, "explore.json")))
     fig, axes = plt.subplots(1, len(METRICS), figsize=(5 * len(METRICS), 4.2), sharey=True)
     names = list(j["backends"])
-    colours = plt.cm.tab20.colors
     for ax, (key, label) in zip(axes, METRICS):
         for k, name in enumerate(names):
             e = j["backends"][name]["errors"][key]
@@ -33,7 +34,8 @@ def main(out):
             q = [max(v, FLOOR) for v in e["quantiles_every_5"]]
             frac = [p / 100 for p in range(0, 101, 5)]
             ax.step(q, frac, where="post", label=f"{name} (n={e['n']})",
-                    color=colours[k % len(colours)], linestyle="-" if k < 10 else "--")
+                    color=backend_style.colour(name, names),
+                    linestyle="-" if k % 2 == 0 else "--")
         ax.set_xscale("log")
         ax.set_xlabel(label)
         ax.grid(True, which="both", alpha=0.3)

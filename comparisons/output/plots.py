@@ -18,28 +18,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-# Colour-blind-safe colours (Okabe & Ito 2008) crossed with distinct markers: backends are data
-# (names come from results.json), so each name met gets the next (colour, marker) pair, in the
-# order below first, so that a backend keeps its look across figures of one report.
-OKABE_ITO = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#56B4E9", "#D55E00", "#F0E442",
-             "#000000"]
-MARKER_CYCLE = "os^DvP<X>*ph"
-PREFERRED = ["custom", "custom-seed", "exact", "fcl", "fcl-hull", "fcl-epa", "fcl-indep",
-             "fcl-box", "libccd-mpr", "libccd-epa", "bullet", "bullet-hull", "bullet-sat", "mujoco", "mujoco-hull",
-             "ode", "ode-hull"]
-_STYLE = {}
-
-
-def style(backend):
-    """(colour, marker) of a backend: every name gets a pair no other name in the report has."""
-    if backend not in _STYLE:
-        k = len(_STYLE)
-        _STYLE[backend] = (OKABE_ITO[k % len(OKABE_ITO)], MARKER_CYCLE[k % len(MARKER_CYCLE)])
-    return _STYLE[backend]
-
-
-def order(names):
-    return sorted(names, key=lambda b: (PREFERRED.index(b) if b in PREFERRED else 99, b))
+# One (colour, marker) per backend, the same in every figure (backend_style.py).
+from backend_style import order, style  # noqa: E402,F401
 
 
 # Errors below ROUNDOFF are round-off (a few ulps of double precision on unit-sized numbers) and

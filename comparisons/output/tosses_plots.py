@@ -14,6 +14,9 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
+
+import backend_style  # noqa: E402
 
 
 def rows(path):
@@ -23,8 +26,8 @@ def rows(path):
 
 
 def colour_of(names):
-    """One stable colour per backend name (sorted, so the same name gets the same colour)."""
-    return {n: plt.cm.tab10.colors[i % 10] for i, n in enumerate(sorted(names))}
+    """Each backend's colour, the same in every figure (backend_style.py)."""
+    return {n: backend_style.colour(n, names) for n in names}
 
 
 def save(fig, out, name):
@@ -44,19 +47,27 @@ def error_figure(report, out):
         len(by.get(("stored", b), [1e9])) // 2])
     colours = colour_of(names)
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.5))
-    data, labels, cols = [], [], []
-    for b in names:
-        for p in ("stored", "published"):
+    # Per backend its two boxes side by side (fitted dark, published light), one label between
+    # them, rotated so that long names never overlap.
+    data, positions, cols, alphas, ticks = [], [], [], [], []
+    for i, b in enumerate(names):
+        for k, p in enumerate(("stored", "published")):
             if (p, b) in by:
                 data.append(by[(p, b)])
-                labels.append(f"{b}\n{'fitted' if p == 'stored' else 'published'}")
+                positions.append(3 * i + 1 + k)
                 cols.append(colours[b])
-    parts = ax.boxplot(data, whis=(10, 90), showfliers=True, patch_artist=True)
-    for patch, c, lab in zip(parts["boxes"], cols, labels):
+                alphas.append(0.85 if p == "stored" else 0.3)
+        ticks.append(3 * i + 1.5)
+    parts = ax.boxplot(data, positions=positions, whis=(10, 90), showfliers=True,
+                       patch_artist=True, widths=0.8)
+    for patch, c, a in zip(parts["boxes"], cols, alphas):
         patch.set_facecolor(c)
-        patch.set_alpha(0.35 if "published" in lab else 0.8)
-    ax.set_xticks(range(1, len(labels) + 1))
-    ax.set_xticklabels(labels, fontsize=8)
+        patch.set_alpha(a)
+    ax.set_xticks(ticks)
+    ax.set_xticklabels(names, fontsize=8, rotation=35, ha="right")
+    ax.legend(handles=[Patch(facecolor="grey", alpha=0.85, label="fitted parameters"),
+                       Patch(facecolor="grey", alpha=0.3, label="published parameters")],
+              fontsize=8, loc="upper left")
     ax.set_yscale("log")
     ax.set_ylabel("mean position error per toss (cube widths)")
     ax.set_title("position error per toss (box: quartiles, whiskers: 10-90 %)")
