@@ -190,6 +190,7 @@ struct Backend {
   DynamicsFn dynamics;      // empty: no dynamics
   MassFn mass = nullptr;    // empty: the library computes no mass properties of a hull
   bool library = true;      // an outside library's code: isolated with a deadline per call
+  bool friction = true;     // its dynamics apply Coulomb friction (false: mu is ignored)
 };
 
 /// Every backend, in report order.

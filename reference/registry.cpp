@@ -38,7 +38,7 @@ const std::vector<Backend>& backends() {
        custom_contact, custom_dynamics, nullptr, false},
       {"custom-seed",
        "rbx engine, the seed's algorithm: first hit, single-point frictionless impulse", nullptr,
-       custom_seed_dynamics, nullptr, false},
+       custom_seed_dynamics, nullptr, false, false},
       {"exact", "rbx oracle: separating-axis test over faces and edge pairs, clipped manifold",
        exact_contact, nullptr, nullptr, false},
       {"fcl", "FCL 0.7: Box (boxBoxIntersect) or Convex (libccd MPR)", fcl_contact, nullptr,

@@ -35,10 +35,13 @@ Table toss_results_table(const std::vector<BackendTosses>& rs, bool markdown) {
     }
     std::string status = to_string(r.status);
     if (!r.message.empty()) status += markdown ? ": " + r.message : "";
-    t.add({std::to_string(++rank), r.name, fmt_num(r.params.restitution, 3),
-           fmt_num(r.params.friction, 3), r.params_source, std::to_string(r.tosses.size()),
-           triple(spread_of(pos), 3), triple(spread_of(ang), 3), triple(spread_of(fin), 3),
-           fmt_num(r.runtime_s, 3), status});
+    // A backend that ignores friction shows none, not the mu it was handed.
+    const Backend* b = find_backend(r.name);
+    const std::string mu =
+        b && !b->friction ? "none (frictionless)" : fmt_num(r.params.friction, 3);
+    t.add({std::to_string(++rank), r.name, fmt_num(r.params.restitution, 3), mu, r.params_source,
+           std::to_string(r.tosses.size()), triple(spread_of(pos), 3), triple(spread_of(ang), 3),
+           triple(spread_of(fin), 3), fmt_num(r.runtime_s, 3), status});
   }
   return t;
 }
