@@ -11,6 +11,7 @@
 #include "comparisons/eval/parallel.h"
 #include "comparisons/eval/scene_batch.h"
 #include "comparisons/eval/tosses.h"
+#include "comparisons/output/report_pages.h"
 #include "comparisons/output/report_writer.h"
 #include "comparisons/output/tosses_report.h"
 #include "comparisons/output/view_page.h"
@@ -80,7 +81,7 @@ int report_command(const ReportOptions& opt) {
     write_report_tables(tmp.string(), scenes, evs);
     std::string figures_msg;
     const bool figures_ok = draw_report_figures(tmp.string(), figures_msg);
-    // --- replay pages (view-report): views/SLUG.html and index.html ---
+    // --- replay pages (view-report): views/SLUG.html ---
     bool views_ok = true;
     try {
       write_report_views(tmp.string(), scenes, evs);
@@ -89,12 +90,21 @@ int report_command(const ReportOptions& opt) {
       std::cerr << "report: no replay pages: " << e.what() << "\n";
     }
     // --- end replay pages ---
-    std::string md =
-        report_markdown(scenes, evs, clock.seconds(), figures_ok, figures_msg, views_ok);
+    // report.md is the summary (with the real tosses), details.md every table; index.html and
+    // details.html are the same as pages.
+    SummaryInputs in;
+    in.total_s = clock.seconds();
+    in.figures_ok = figures_ok;
+    in.figures_msg = figures_msg;
+    in.views_ok = views_ok;
     // Real impacts: every tosses data set under the inputs (comparisons/output/tosses_report.cpp).
     for (const std::string& dir : find_toss_datasets(opt.inputs))
-      md += tosses_report_section(dir, tmp.string(), opt.backends);
-    write_text((tmp / "report.md").string(), md);
+      in.tosses += tosses_report_section(dir, tmp.string(), opt.backends);
+    const std::string summary = report_summary_markdown(scenes, evs, in);
+    const std::string details = report_details_markdown(scenes, evs, figures_ok, views_ok);
+    write_text((tmp / "report.md").string(), summary);
+    write_text((tmp / "details.md").string(), details);
+    write_report_pages(tmp.string(), scenes, evs, summary, details, views_ok);
     // `rbx bench` output in the old folder is kept (its own command, not this report's).
     std::error_code ec;
     for (const char* f : {"perf.md", "perf.json", "perf.csv"})

@@ -181,18 +181,6 @@ std::string why_markdown(const std::vector<Scene>& scenes, const std::vector<Sce
   return md.str();
 }
 
-// Backends that appear anywhere in the evaluations, in registry order.
-std::vector<std::string> report_columns(const std::vector<SceneEvaluation>& evs) {
-  std::vector<std::string> cols;
-  for (const Backend& b : backends())
-    for (const SceneEvaluation& ev : evs)
-      if (ev.json["backends"].contains(b.name)) {
-        cols.push_back(b.name);
-        break;
-      }
-  return cols;
-}
-
 // The headline of every scene for every backend, ✗ and ~ marked.
 std::string summary_section(const std::vector<Scene>& scenes,
                             const std::vector<SceneEvaluation>& evs,
@@ -297,38 +285,6 @@ std::string disagreement_section(const std::vector<Scene>& scenes,
   return md.str();
 }
 
-// The error-against-run-time figures and the query-time table.
-std::string error_vs_runtime_section(const std::vector<SceneEvaluation>& evs,
-                                     const std::vector<std::string>& cols, bool figures_ok,
-                                     const std::string& figures_msg) {
-  std::ostringstream md;
-  md << "## Error against run time\n\n";
-  md << "Dynamics: each backend is run at every time step of the scene's `sweep_dt` (default 4, "
-        "2, 1, 1/2 and 1/4 times `dt`). One point per (backend, time step): the **median over the "
-        "family's closed-form scenes** of the velocity error in the kinetic-energy norm, with the "
-        "25-75 % band as a bar, against the median run time of one scene run; the large open "
-        "marker is the coarsest step; the same scenes stand behind every point of a curve "
-        "(self-consistency errors are in `sweep.csv` only). Contacts: one point per backend, "
-        "normal angle error and depth error in two panels, median over the scenes with the 25-75 "
-        "% band on both axes and the worst scene as a small hollow marker; filled markers time "
-        "the backend as it runs (the library's shape built in each query), the larger hollow "
-        "marker on the same row, joined by a dotted line, the same query with its shapes "
-        "prebuilt (the table below the figures). Errors under 1e-13 are round-off and are drawn at "
-        "1e-15 "
-        "in the grey band. The dashed line is the Pareto front over backends. Numbers: "
-        "`sweep.csv`, `metrics.csv`.\n\n";
-  std::set<std::string> families;
-  for (const SceneEvaluation& ev : evs)
-    for (const SweepPoint& p : ev.sweep)
-      families.insert(ev.family + (p.kind == "contact" ? "-contact" : ""));
-  if (!figures_ok) md << "_Figures were not drawn: " << figures_msg << "_\n\n";
-  for (const std::string& f : families)
-    md << "![error against run time, " << f << "](figures/error_vs_runtime_" << f << ".png)\n\n";
-  md << query_time_markdown(evs, cols);
-
-  return md.str();
-}
-
 // Every stability verdict, at the scene's step and along its own sweep.
 std::string stability_section(const std::vector<Scene>& scenes,
                               const std::vector<SceneEvaluation>& evs) {
@@ -426,6 +382,47 @@ std::string scene_details_section(const std::vector<Scene>& scenes,
 
 }  // namespace
 
+std::vector<std::string> report_columns(const std::vector<SceneEvaluation>& evs) {
+  std::vector<std::string> cols;
+  for (const Backend& b : backends())
+    for (const SceneEvaluation& ev : evs)
+      if (ev.json["backends"].contains(b.name)) {
+        cols.push_back(b.name);
+        break;
+      }
+  return cols;
+}
+
+std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs, bool figures_ok,
+                                      const std::string& figures_msg) {
+  std::ostringstream md;
+  md << "## Error against run time\n\n";
+  md << "Dynamics: each backend is run at every time step of the scene's `sweep_dt` (default 4, "
+        "2, 1, 1/2 and 1/4 times `dt`). One point per (backend, time step): the **median over the "
+        "family's closed-form scenes** of the velocity error in the kinetic-energy norm, with the "
+        "25-75 % band as a bar, against the median run time of one scene run; the large open "
+        "marker is the coarsest step; the same scenes stand behind every point of a curve "
+        "(self-consistency errors are in `sweep.csv` only). Contacts: one point per backend, "
+        "normal angle error and depth error in two panels, median over the scenes with the 25-75 "
+        "% band on both axes and the worst scene as a small hollow marker; filled markers time "
+        "the backend as it runs (the library's shape built in each query), the larger hollow "
+        "marker on the same row, joined by a dotted line, the same query with its shapes "
+        "prebuilt (the query-time table in details.md). Errors under 1e-13 are round-off and are "
+        "drawn at "
+        "1e-15 "
+        "in the grey band. The dashed line is the Pareto front over backends. Numbers: "
+        "`sweep.csv`, `metrics.csv`.\n\n";
+  std::set<std::string> families;
+  for (const SceneEvaluation& ev : evs)
+    for (const SweepPoint& p : ev.sweep)
+      families.insert(ev.family + (p.kind == "contact" ? "-contact" : ""));
+  if (!figures_ok) md << "_Figures were not drawn: " << figures_msg << "_\n\n";
+  for (const std::string& f : families)
+    md << "![error against run time, " << f << "](figures/error_vs_runtime_" << f << ".png)\n\n";
+
+  return md.str();
+}
+
 Json geometry_json(const Scene& scene) {
   Json g = Json::array();
   for (const RigidBody& b : make_bodies(scene)) {
@@ -440,25 +437,24 @@ Json geometry_json(const Scene& scene) {
   return g;
 }
 
-std::string report_markdown(const std::vector<Scene>& scenes,
-                            const std::vector<SceneEvaluation>& evs, double total_s,
-                            bool figures_ok, const std::string& figures_msg, bool views_ok) {
+std::string report_details_markdown(const std::vector<Scene>& scenes,
+                                    const std::vector<SceneEvaluation>& evs, bool figures_ok,
+                                    bool views_ok) {
   std::ostringstream md;
   const std::vector<std::string> cols = report_columns(evs);
-  md << "# rbx accuracy report\n\n";
-  md << scenes.size() << " scenes through " << cols.size() << " backends in " << fmt_num(total_s, 3)
-     << " s. Every number except run times is deterministic: the same scenes give the same "
-        "report.\n\n";
-  // --- scorecard and replay pages (view-report) ---
-  if (views_ok)
-    md << "Every scene has a 3-D replay of every backend's run: [index.html](index.html), or the "
-          "link on each scene below.\n\n";
-  md << scorecard_markdown(scenes, evs, cols, views_ok);
-  // --- end scorecard ---
+  md << "# rbx accuracy report: every table\n\n"
+        "The summary, its figures and the real tosses are in [report.md](report.md) "
+        "([index.html](index.html) as a page); here, every table in full and every scene's "
+        "numbers. The same numbers as CSV: [metrics.csv](metrics.csv), [sweep.csv](sweep.csv), "
+        "[stability.csv](stability.csv).\n\n";
+  std::vector<FailureCause> causes;
+  const std::vector<ScoreRow> rows = score_rows(scenes, evs, cols, &causes);
+  md << scorecard_markdown(rows, causes, 0, views_ok);
   md << summary_section(scenes, evs, cols, views_ok) << contact_phase_section(scenes, evs, cols)
-     << disagreement_section(scenes, evs, cols)
-     << error_vs_runtime_section(evs, cols, figures_ok, figures_msg)
-     << stability_section(scenes, evs) << scene_details_section(scenes, evs, figures_ok, views_ok);
+     << disagreement_section(scenes, evs, cols);
+  if (const std::string q = query_time_markdown(evs, cols); !q.empty())
+    md << "## Contact query time\n\n" << q;
+  md << stability_section(scenes, evs) << scene_details_section(scenes, evs, figures_ok, views_ok);
   return md.str();
 }
 

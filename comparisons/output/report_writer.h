@@ -1,4 +1,4 @@
-// The accuracy report's files (`rbx report`): report.md, results.json, metrics.csv, sweep.csv,
+// The accuracy report's files (`rbx report`): details.md, results.json, metrics.csv, sweep.csv,
 // stability.csv and the figures, from the scenes' evaluations.
 #pragma once
 
@@ -15,12 +15,20 @@ namespace rbx {
 /// body has more than 2,000 vertices), for the report's contact pictures.
 Json geometry_json(const Scene& scene);
 
-/// report.md: scorecard, summary, contact phase, who disagrees and why, error against run time,
-/// stability and every scene's detail. `total_s` is the evaluation's wall time; `figures_ok` and
-/// `figures_msg` say whether the figures were drawn; `views_ok` whether the replay pages were.
-std::string report_markdown(const std::vector<Scene>& scenes,
-                            const std::vector<SceneEvaluation>& evs, double total_s,
-                            bool figures_ok, const std::string& figures_msg, bool views_ok);
+/// Backends that appear anywhere in the evaluations, in registry order (the report's columns).
+std::vector<std::string> report_columns(const std::vector<SceneEvaluation>& evs);
+
+/// The error-against-run-time figures (linked; when `figures_ok` is false, why they are not).
+std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs, bool figures_ok,
+                                      const std::string& figures_msg);
+
+/// details.md: the scorecard with every failing scene named, the summary of every scene for
+/// every backend, contact phase, who disagrees and why, contact query time, stability and every
+/// scene's detail.
+/// `figures_ok` and `views_ok` say whether the figures and replay pages were written.
+std::string report_details_markdown(const std::vector<Scene>& scenes,
+                                    const std::vector<SceneEvaluation>& evs, bool figures_ok,
+                                    bool views_ok);
 
 /// results.json, metrics.csv, sweep.csv and stability.csv into `dir`.
 void write_report_tables(const std::string& dir, const std::vector<Scene>& scenes,

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 #include "comparisons/output/table.h"
 #include "engine/format.h"
@@ -79,7 +81,111 @@ std::string fmt_err(double x, const std::string& unit) {
   return x < 0 ? "-" : fmt_num(x, 2) + unit;
 }
 
+double max_of(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
+
+// What a scene measures: its checks decide, whatever errors the backends produced.
+Measure measure_of(const Scene& scene) {
+  if (scene.has_check(CheckKind::Contact)) return Measure::Contact;
+  if (scene.has_check(CheckKind::Mass)) return Measure::Mass;
+  return Measure::Dynamics;
+}
+
+// Adds one scene's errors and run time to a row (the backend answered, status ok).
+void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, const Json& bj) {
+  const std::string& b = row.backend;
+  if (row.measure == Measure::Contact) {
+    if (const double a = truth_metric(ev, b, "normal_err_deg"); a >= 0) {
+      row.error.push_back(a);
+      row.depth_error.push_back(std::max(truth_metric(ev, b, "depth_err"), 0.0));
+    }
+    for (const SweepPoint& p : ev.sweep) {
+      if (p.backend == b && p.kind == "contact") row.time.push_back(p.runtime_s);
+      if (p.backend == b && p.kind == "contact-prebuilt") row.prebuilt.push_back(p.runtime_s);
+    }
+    return;
+  }
+  if (row.measure == Measure::Mass) {
+    const double m =
+        std::max({truth_metric(ev, b, "mass_err_rel"), truth_metric(ev, b, "com_err_rel"),
+                  truth_metric(ev, b, "inertia_err_rel")});
+    if (m >= 0) row.error.push_back(m);
+    return;
+  }
+  if (const double v = truth_metric(ev, b, "velocity_err_ke"); v >= 0) row.error.push_back(v);
+  const long steps = scene.sim.steps();
+  if (steps > 0 && bj.contains("runtime_s"))
+    row.time.push_back(bj["runtime_s"].get<double>() / static_cast<double>(steps));
+}
+
+// Errors below this are round-off, as the error-against-time figures draw them (plots.py), so
+// they rank as equal: 4e-15 deg is not worse than 0 deg.
+constexpr double kRankRoundOff = 1e-13;
+
+// Ranking within a group: rows with an error first, by median error (contact: angle, then
+// depth), then most scenes within tolerance, then worst error, then run time.
+bool ranks_before(const ScoreRow& a, const ScoreRow& b) {
+  auto key = [](const ScoreRow& r) {
+    const double none = std::numeric_limits<double>::infinity();
+    auto rank_value = [&](const std::vector<double>& v, bool worst) {
+      if (v.empty()) return none;
+      const double x = worst ? max_of(v) : median_of(v);
+      return x < kRankRoundOff ? 0.0 : x;
+    };
+    return std::make_tuple(r.error.empty(), rank_value(r.error, false),
+                           rank_value(r.depth_error, false), -r.within, rank_value(r.error, true),
+                           rank_value(r.depth_error, true),
+                           r.time.empty() ? none : median_of(r.time));
+  };
+  return key(a) < key(b);
+}
+
+const char* measure_title(Measure m) {
+  switch (m) {
+    case Measure::Contact:
+      return "contacts: normal angle / depth error (m) against the truth, time per query";
+    case Measure::Mass:
+      return "mass properties: worst relative error of mass, centre of mass and inertia";
+    case Measure::Dynamics:
+      break;
+  }
+  return "dynamics: post-impact velocity error (kinetic-energy norm), time per step";
+}
+
 }  // namespace
+
+std::string ScoreRow::within_text() const {
+  return std::to_string(within) +
+         (within == run ? "" : " (" + std::to_string(run - within) + " not)") +
+         (touching ? ", " + std::to_string(touching) + " touching with no normal" : "");
+}
+
+std::string ScoreRow::median_text() const {
+  if (error.empty()) return "-";
+  const std::string n = " (" + std::to_string(error.size()) + ")";
+  if (measure == Measure::Contact)
+    return fmt_err(median_of(error), "°") + " / " + fmt_err(median_of(depth_error), "") + n;
+  return fmt_err(median_of(error), "") + n;
+}
+
+std::string ScoreRow::worst_text() const {
+  if (error.empty()) return "-";
+  if (measure == Measure::Contact)
+    return fmt_err(max_of(error), "°") + " / " + fmt_err(max_of(depth_error), "");
+  return fmt_err(max_of(error), "");
+}
+
+std::string ScoreRow::time_text() const {
+  if (time.empty()) return "-";
+  std::string t =
+      fmt_num(median_of(time) * 1e6, 3) + (measure == Measure::Contact ? " µs/query" : " µs/step");
+  // The library's query with its shapes built once, where it has that variant.
+  if (!prebuilt.empty()) t += " (" + fmt_num(median_of(prebuilt) * 1e6, 3) + " prebuilt)";
+  return t;
+}
+
+std::string group_title(const ScoreRow& row) {
+  return row.family + " — " + measure_title(row.measure);
+}
 
 std::string scene_slug(const std::string& family, const std::string& file) {
   return family + "_" + std::filesystem::path(file).stem().string();
@@ -95,112 +201,104 @@ std::string md_escape(const std::string& s) {
   return out;
 }
 
-std::string scorecard_markdown(const std::vector<Scene>& scenes,
-                               const std::vector<SceneEvaluation>& evs,
-                               const std::vector<std::string>& backends, bool views) {
-  std::vector<std::string> families;
-  for (const SceneEvaluation& ev : evs)
-    if (std::find(families.begin(), families.end(), ev.family) == families.end())
-      families.push_back(ev.family);
-  std::ostringstream md;
-  md << "## Scorecard\n\n"
-        "Per backend and scene family: scenes run (`unsupported` not counted), "
-        "how many are within tolerance (no ✗ and no ~ in the full table), the error against the "
-        "truth (the closed form, the `exact` oracle or the exact solid; self-consistency errors "
-        "are not counted), median and worst over the scenes that have one, and the median run "
-        "time per contact query or per time step (wall clock; the library builds its shapes "
-        "inside each query, the custom engine reuses its hulls; in brackets, the same query "
-        "with the library's shapes prebuilt, the fair comparison with custom). Contacts: normal "
-        "angle / depth "
-        "error (m). Dynamics: post-impact velocity error in the kinetic-energy norm. Mass: worst "
-        "relative error of mass, centre of mass and inertia.\n\n";
-  Table t({"backend", "family", "scenes run", "within tolerance", "median error", "worst error",
-           "median run time"});
-  // cause -> scene links, per backend, in the order causes were first met.
-  std::map<std::string, std::vector<std::pair<std::string, std::vector<std::string>>>> causes;
-  for (const std::string& b : backends) {
-    for (const std::string& fam : families) {
-      int run = 0, within = 0, touching = 0;  // touching: answered with no normal
-      std::vector<double> e1, e2, times, prebuilt;
-      bool contact = false;
+std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
+                                 const std::vector<SceneEvaluation>& evs,
+                                 const std::vector<std::string>& backends,
+                                 std::vector<FailureCause>* causes) {
+  // Groups (family, measure) in the order the scenes come.
+  std::vector<std::pair<std::string, Measure>> groups;
+  for (size_t i = 0; i < evs.size(); ++i) {
+    const std::pair<std::string, Measure> g{evs[i].family, measure_of(scenes[i])};
+    if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
+  }
+  std::vector<ScoreRow> rows;
+  std::vector<FailureCause> found;
+  for (const auto& [fam, measure] : groups) {
+    std::vector<ScoreRow> group;
+    for (const std::string& b : backends) {
+      ScoreRow row;
+      row.backend = b;
+      row.family = fam;
+      row.measure = measure;
       for (size_t i = 0; i < evs.size(); ++i) {
         const SceneEvaluation& ev = evs[i];
-        if (ev.family != fam || !ev.json["backends"].contains(b)) continue;
+        if (ev.family != fam || measure_of(scenes[i]) != measure ||
+            !ev.json["backends"].contains(b))
+          continue;
         const Json& bj = ev.json["backends"][b];
         if (bj["status"] == "unsupported") continue;
-        ++run;
+        ++row.run;
         const bool bad = bj["status"] == "error" || bj["status"] == "timeout" ||
                          about(ev.disagreements, b) || about(ev.deviations, b);
-        if (!bad)
-          ++within;
-        else {
+        if (bad) {
           const std::string c = cause(ev, b);
-          auto& list = causes[b];
-          auto it =
-              std::find_if(list.begin(), list.end(), [&](const auto& p) { return p.first == c; });
-          if (it == list.end()) it = list.insert(list.end(), {c, {}});
-          const std::string name = md_escape(fam + "/" + scenes[i].name);
-          it->second.push_back(
-              views ? "[" + name + "](views/" + scene_slug(fam, scenes[i].file) + ".html)" : name);
-        }
-        if (bj["status"] == "touching") ++touching;
-        if (bj["status"] != "ok") continue;
-        if (const double a = truth_metric(ev, b, "normal_err_deg"); a >= 0) {
-          contact = true;
-          e1.push_back(a);
-          e2.push_back(std::max(truth_metric(ev, b, "depth_err"), 0.0));
-          for (const SweepPoint& p : ev.sweep) {
-            if (p.backend == b && p.kind == "contact") times.push_back(p.runtime_s);
-            if (p.backend == b && p.kind == "contact-prebuilt") prebuilt.push_back(p.runtime_s);
-          }
-        } else if (const double v = truth_metric(ev, b, "velocity_err_ke"); v >= 0) {
-          e1.push_back(v);
-        } else if (const double m = std::max({truth_metric(ev, b, "mass_err_rel"),
-                                              truth_metric(ev, b, "com_err_rel"),
-                                              truth_metric(ev, b, "inertia_err_rel")});
-                   m >= 0) {
-          e1.push_back(m);
-        }
-        const long steps = scenes[i].sim.steps();
-        if (!scenes[i].has_check(CheckKind::Contact) && steps > 0 && bj.contains("runtime_s") &&
-            !scenes[i].has_check(CheckKind::Mass))
-          times.push_back(bj["runtime_s"].get<double>() / static_cast<double>(steps));
-      }
-      if (run == 0) continue;
-      std::string med = "-", worst = "-";
-      if (!e1.empty()) {
-        if (contact) {
-          med = fmt_err(median_of(e1), "°") + " / " + fmt_err(median_of(e2), "");
-          worst = fmt_err(*std::max_element(e1.begin(), e1.end()), "°") + " / " +
-                  fmt_err(*std::max_element(e2.begin(), e2.end()), "");
+          auto it = std::find_if(found.begin(), found.end(), [&](const FailureCause& f) {
+            return f.backend == b && f.cause == c;
+          });
+          if (it == found.end()) it = found.insert(found.end(), {b, c, {}});
+          it->scenes.push_back({fam + "/" + scenes[i].name, scene_slug(fam, scenes[i].file)});
         } else {
-          med = fmt_err(median_of(e1), "");
-          worst = fmt_err(*std::max_element(e1.begin(), e1.end()), "");
+          ++row.within;
         }
-        med += " (" + std::to_string(e1.size()) + ")";
+        if (bj["status"] == "touching") ++row.touching;
+        if (bj["status"] == "ok") add_scene(row, scenes[i], ev, bj);
       }
-      std::string time = "-";
-      if (!times.empty())
-        time = fmt_num(median_of(times) * 1e6, 3) + (contact ? " µs/query" : " µs/step");
-      // The library's query with its shapes built once, where it has that variant.
-      if (!prebuilt.empty()) time += " (" + fmt_num(median_of(prebuilt) * 1e6, 3) + " prebuilt)";
-      t.add({"**" + b + "**", fam, std::to_string(run),
-             std::to_string(within) +
-                 (within == run ? "" : " (" + std::to_string(run - within) + " not)") +
-                 (touching ? ", " + std::to_string(touching) + " touching with no normal" : ""),
-             med, worst, time});
+      if (row.run > 0) group.push_back(std::move(row));
     }
+    std::stable_sort(group.begin(), group.end(), ranks_before);
+    for (ScoreRow& r : group) rows.push_back(std::move(r));
   }
-  md << t.markdown() << "\n(n): scenes with an error against the truth.\n\n";
+  // Causes in backend order, each backend's in the order first met.
+  if (causes) {
+    causes->clear();
+    for (const std::string& b : backends)
+      for (const FailureCause& f : found)
+        if (f.backend == b) causes->push_back(f);
+  }
+  return rows;
+}
+
+std::string scorecard_markdown(const std::vector<ScoreRow>& rows,
+                               const std::vector<FailureCause>& causes, size_t max_scenes,
+                               bool views) {
+  std::ostringstream md;
+  md << "## Scorecard\n\n"
+        "One table per scene family, backends ranked by their median error against the truth "
+        "(the closed form, the `exact` oracle or the exact solid; self-consistency errors are "
+        "not counted), then by scenes within tolerance, worst error and run time. *Within "
+        "tolerance*: scenes with no ✗ and no ~ in the full tables (details.md); `unsupported` "
+        "scenes are not counted. (n): scenes with an error against the truth. Run time: median, "
+        "wall clock; a library builds its shapes inside each query, custom reuses its hulls; "
+        "in brackets the same query with the library's shapes prebuilt, the fair comparison "
+        "with custom.\n\n";
+  for (size_t k = 0; k < rows.size();) {
+    size_t end = k;
+    while (end < rows.size() && rows[end].family == rows[k].family &&
+           rows[end].measure == rows[k].measure)
+      ++end;
+    md << "### " << md_escape(group_title(rows[k])) << "\n\n";
+    Table t({"rank", "backend", "scenes run", "within tolerance", "median error", "worst error",
+             "median run time"});
+    for (size_t r = k; r < end; ++r)
+      t.add({std::to_string(r - k + 1), "**" + md_escape(rows[r].backend) + "**",
+             std::to_string(rows[r].run), rows[r].within_text(), rows[r].median_text(),
+             rows[r].worst_text(), rows[r].time_text()});
+    md << t.markdown() << "\n";
+    k = end;
+  }
   md << "### Causes of the failures, measured\n\n";
   if (causes.empty()) md << "Every backend is within tolerance on every scene it ran.\n";
-  for (const std::string& b : backends) {
-    if (!causes.count(b)) continue;
-    for (const auto& [c, list] : causes[b]) {
-      md << "- **" << b << "**: " << md_escape(c) << " — " << list.size() << ": ";
-      for (size_t k = 0; k < list.size(); ++k) md << (k ? ", " : "") << list[k];
-      md << "\n";
+  for (const FailureCause& f : causes) {
+    md << "- **" << md_escape(f.backend) << "**: " << md_escape(f.cause) << " — " << f.scenes.size()
+       << ": ";
+    const size_t shown = max_scenes == 0 ? f.scenes.size() : std::min(max_scenes, f.scenes.size());
+    for (size_t k = 0; k < shown; ++k) {
+      const std::string name = md_escape(f.scenes[k].name);
+      md << (k ? ", " : "")
+         << (views ? "[" + name + "](views/" + f.scenes[k].slug + ".html)" : name);
     }
+    if (shown < f.scenes.size()) md << " and " << f.scenes.size() - shown << " more";
+    md << "\n";
   }
   md << "\n";
   return md.str();

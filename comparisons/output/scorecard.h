@@ -17,11 +17,56 @@ std::string scene_slug(const std::string& family, const std::string& file);
 /// Text safe in Markdown (table cells and link text): \ ` * _ [ ] < > | # escaped.
 std::string md_escape(const std::string& s);
 
-/// The scorecard in Markdown. `backends` in the column order of the report; scenes link to
-/// `views/SLUG.html` when `views` is true.
-std::string scorecard_markdown(const std::vector<Scene>& scenes,
-                               const std::vector<SceneEvaluation>& evs,
-                               const std::vector<std::string>& backends, bool views);
+/// What a scorecard row's error measures: a contact query's normal angle and depth, a dynamic
+/// run's post-impact velocity, or mass properties. It comes from the scene's checks, so that a
+/// folder mixing contact and dynamics scenes gets one row per kind, each in its own unit.
+enum class Measure { Contact, Dynamics, Mass };
+
+/// One backend on one scene family and measure: what the scorecard shows.
+struct ScoreRow {
+  std::string backend, family;
+  Measure measure = Measure::Contact;
+  int run = 0, within = 0, touching = 0;  // touching: answered with no normal
+  /// Per scene with an error against the truth (closed form, `exact` oracle, exact solid):
+  /// contact normal angle (deg), velocity error (kinetic-energy norm) or mass relative error.
+  std::vector<double> error;
+  std::vector<double> depth_error;  // contact: depth error (m), beside `error`
+  /// Run time (s) per query (contact) or per step (dynamics); prebuilt: the library's shapes
+  /// built once (its "prebuilt" variant, where it has one).
+  std::vector<double> time, prebuilt;
+  /// The row's cells as text: within tolerance, median and worst error, run time.
+  std::string within_text() const, median_text() const, worst_text() const, time_text() const;
+};
+
+/// A scene named in a report: FAMILY/NAME and its slug (views/SLUG.html is its replay page).
+struct SceneRef {
+  std::string name, slug;
+};
+
+/// One measured cause of failures of a backend, with the scenes it explains.
+struct FailureCause {
+  std::string backend, cause;
+  std::vector<SceneRef> scenes;
+};
+
+/// The scorecard: one row per (backend, family, measure) in which the backend ran a scene,
+/// grouped by family and measure in the order the scenes come, and within a group ranked: first
+/// the rows with an error against the truth, by median error (contact: normal angle, then
+/// depth), then most scenes within tolerance, then worst error, then run time. `causes` gets the
+/// measured cause of every failure, per backend in `backends` order.
+std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
+                                 const std::vector<SceneEvaluation>& evs,
+                                 const std::vector<std::string>& backends,
+                                 std::vector<FailureCause>* causes = nullptr);
+
+/// The heading of a row's group: the family, and the measure with its unit.
+std::string group_title(const ScoreRow& row);
+
+/// The scorecard in Markdown: one ranked table per group, then the causes of the failures with
+/// at most `max_scenes` scenes each (0: all), linked to their replay pages when `views`.
+std::string scorecard_markdown(const std::vector<ScoreRow>& rows,
+                               const std::vector<FailureCause>& causes, size_t max_scenes,
+                               bool views);
 
 /// The contact query times in Markdown: per backend, the median over the scenes' queries of the
 /// time per query with the library's shapes built in the query (as the backend runs), with them

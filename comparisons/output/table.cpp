@@ -29,6 +29,45 @@ void Table::print(std::ostream& out) const {
   }
 }
 
+std::string html_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+std::string Table::html(const std::vector<std::string>& row_classes) const {
+  std::string s = "<table>\n<thead><tr>";
+  for (const std::string& cell : rows_.front()) s += "<th>" + html_escape(cell) + "</th>";
+  s += "</tr></thead>\n<tbody>\n";
+  for (size_t i = 1; i < rows_.size(); ++i) {
+    const std::string cls = i - 1 < row_classes.size() ? row_classes[i - 1] : "";
+    s += cls.empty() ? "<tr>" : "<tr class=\"" + html_escape(cls) + "\">";
+    for (const std::string& cell : rows_[i]) s += "<td>" + html_escape(cell) + "</td>";
+    s += "</tr>\n";
+  }
+  return s + "</tbody>\n</table>\n";
+}
+
 std::string Table::markdown() const {
   std::string s;
   for (size_t i = 0; i < rows_.size(); ++i) {

@@ -9,6 +9,9 @@
 
 namespace rbx {
 
+/// Text safe inside HTML element content and attribute values (& < > " ').
+std::string html_escape(const std::string& s);
+
 /// A table with a header row, columns padded to width.
 class Table {
  public:
@@ -19,6 +22,9 @@ class Table {
   void print(std::ostream& out) const;
   /// GitHub markdown table.
   std::string markdown() const;
+  /// HTML table, every cell escaped; row i (below the header) gets class `row_classes[i]` when
+  /// given and non-empty.
+  std::string html(const std::vector<std::string>& row_classes = {}) const;
   /// Number of rows below the header.
   size_t size() const { return rows_.empty() ? 0 : rows_.size() - 1; }
 

@@ -12,6 +12,7 @@
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/trajectory.h"
 #include "comparisons/output/scorecard.h"
+#include "comparisons/output/table.h"
 #include "comparisons/scene/scene_file.h"
 
 namespace fs = std::filesystem;
@@ -66,32 +67,6 @@ std::string script_safe_json(const Json& j) {
 }
 
 }  // namespace
-
-std::string html_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 Json view_data(const Scene& scene, const Json& result) {
   Json d;
@@ -257,23 +232,11 @@ void write_report_views(const std::string& dir, const std::vector<Scene>& scenes
   const fs::path views = fs::path(dir) / "views";
   fs::create_directories(views);
   fs::copy_file(three_js_path(), views / "three.min.js", fs::copy_options::overwrite_existing);
-  std::ostringstream index;
-  index
-      << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rbx report: 3-D "
-         "replays</title></head><body>\n<h1>rbx report: 3-D replay of every scene</h1>\n"
-         "<p>Each page plays every backend's run of the scene side by side. See also "
-         "<a href=\"report.md\">report.md</a>.</p>\n<ul>\n";
   for (size_t i = 0; i < scenes.size() && i < evs.size(); ++i) {
     const std::string slug = scene_slug(evs[i].family, scenes[i].file);
     write_text((views / (slug + ".html")).string(),
                view_page(view_data(scenes[i], evs[i].json), "", "three.min.js"));
-    index << "<li><a href=\"views/" << html_escape(slug) << ".html\">"
-          << html_escape(evs[i].family + "/" + scenes[i].name) << "</a>";
-    if (!scenes[i].description.empty()) index << ": " << html_escape(scenes[i].description);
-    index << "</li>\n";
   }
-  index << "</ul>\n</body></html>\n";
-  write_text((fs::path(dir) / "index.html").string(), index.str());
 }
 
 }  // namespace rbx

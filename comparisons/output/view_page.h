@@ -10,6 +10,7 @@
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/json_io.h"
 #include "comparisons/eval/tosses.h"
+#include "comparisons/output/table.h"  // html_escape
 #include "engine/scene.h"
 
 namespace rbx {
@@ -45,12 +46,9 @@ std::string three_js_path();
 std::string view_page(const Json& data, const std::string& three_js,
                       const std::string& three_src = "");
 
-/// Text safe inside HTML element content and attribute values (& < > " ').
-std::string html_escape(const std::string& s);
-
 /// The report's replay pages: DIR/views/SLUG.html for every scene (sharing one copy of three.js,
 /// DIR/views/three.min.js, so that 59 pages do not carry 59 copies of it; they still open
-/// offline from disk) and DIR/index.html listing them. Throws when three.js is absent.
+/// offline from disk); index.html links them (report_pages.h). Throws when three.js is absent.
 void write_report_views(const std::string& dir, const std::vector<Scene>& scenes,
                         const std::vector<SceneEvaluation>& evs);
 

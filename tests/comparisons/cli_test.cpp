@@ -297,7 +297,7 @@ TEST(LibraryContainment, AnAssertingLibraryIsItsBackendsErrorAndEveryOtherAnswer
       rbx("report tests/data/flat_dome_on_box.toml --out '" + (dir / "out").string() + "'");
   EXPECT_TRUE(r.code == 0 || r.code == 1) << r.code << r.err;
   std::stringstream md;
-  md << std::ifstream(dir / "out/report.md").rdbuf();
+  md << std::ifstream(dir / "out/details.md").rdbuf();
   EXPECT_NE(md.str().find("fcl-epa | error"), std::string::npos);
   fs::remove_all(dir);
 }
@@ -312,12 +312,13 @@ TEST(Cli, ReportWritesEverythingIntoItsFolder) {
   const CmdResult r =
       rbx("report scenes/seed/face_face.toml --out '" + (dir / "out").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
-  for (const char* f : {"report.md", "results.json", "metrics.csv", "sweep.csv", "stability.csv"})
+  for (const char* f : {"report.md", "details.md", "index.html", "details.html", "results.json",
+                        "metrics.csv", "sweep.csv", "stability.csv"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
   // The why-list comes from the evaluation's measured causes, whichever thread or rank ran the
   // scene: bullet-hull's one-point manifold on the seed's face-face impact.
   std::stringstream md;
-  md << std::ifstream(dir / "out/report.md").rdbuf();
+  md << std::ifstream(dir / "out/details.md").rdbuf();
   EXPECT_NE(md.str().find("  - one contact point on a face patch: face\\_face (1 point against a "
                           "true face patch of 4 corners"),
             std::string::npos);
@@ -527,7 +528,7 @@ TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSeedSinksOnTheStack) {
   ASSERT_EQ(r.code, 0) << r.err;
   std::stringstream csv, md;
   csv << std::ifstream(dir / "out/stability.csv").rdbuf();
-  md << std::ifstream(dir / "out/report.md").rdbuf();
+  md << std::ifstream(dir / "out/details.md").rdbuf();
   // stability.csv: dt and restitution columns; the seed's algorithm on the stack (dt 1e-3, e 0)
   // sinks, the extended engine rests.
   std::string header;
@@ -537,7 +538,7 @@ TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSeedSinksOnTheStack) {
       << csv.str();
   EXPECT_EQ(csv.str().find("resting_stack,stress,custom,0.001,0,sinks,"), std::string::npos)
       << csv.str();
-  // report.md: the stability table shows them too.
+  // details.md: the stability table shows them too.
   EXPECT_NE(md.str().find("| scene | backend | dt (s) | e | verdict |"), std::string::npos);
   // Summary: custom-seed's cells are marked like everyone else's; the known failure says so.
   std::string line;

@@ -1,0 +1,167 @@
+#include "comparisons/output/report_pages.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "comparisons/output/markdown_html.h"
+#include "comparisons/output/report_writer.h"
+#include "comparisons/output/scorecard.h"
+#include "comparisons/output/table.h"
+#include "comparisons/scene/scene_file.h"
+
+namespace rbx {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// A row's best run time: the library's prebuilt variant where it has one (how a user holding
+// the shapes runs it), else the time as it runs; negative when the row has no time.
+double best_time(const ScoreRow& r, bool& prebuilt) {
+  prebuilt = false;
+  if (r.time.empty()) return -1.0;
+  const double t = median_of(r.time);
+  if (!r.prebuilt.empty() && median_of(r.prebuilt) < t) {
+    prebuilt = true;
+    return median_of(r.prebuilt);
+  }
+  return t;
+}
+
+std::string short_measure(Measure m) {
+  switch (m) {
+    case Measure::Contact:
+      return "contacts";
+    case Measure::Mass:
+      return "mass";
+    case Measure::Dynamics:
+      break;
+  }
+  return "dynamics";
+}
+
+// Per group of the scorecard: the most accurate backend (the first ranked that is not the
+// oracle itself) and the fastest, each with what it costs in the other currency.
+std::string glance_markdown(const std::vector<ScoreRow>& rows) {
+  Table t({"family", "most accurate", "its median error", "within tolerance", "its run time",
+           "fastest", "its run time", "its median error", "within tolerance"});
+  for (size_t k = 0; k < rows.size();) {
+    size_t end = k;
+    while (end < rows.size() && rows[end].family == rows[k].family &&
+           rows[end].measure == rows[k].measure)
+      ++end;
+    const ScoreRow* best = nullptr;
+    const ScoreRow* fastest = nullptr;
+    double fastest_t = 0.0;
+    bool fastest_pre = false;
+    for (size_t r = k; r < end; ++r) {
+      const ScoreRow& row = rows[r];
+      if (row.backend == "exact") continue;  // the truth of contact scenes: not a contender
+      if (!best && !row.error.empty()) best = &row;
+      bool pre = false;
+      const double tr = best_time(row, pre);
+      if (tr >= 0 && (!fastest || tr < fastest_t)) fastest = &row, fastest_t = tr, fastest_pre = pre;
+    }
+    const std::string unit = rows[k].measure == Measure::Contact ? " µs/query" : " µs/step";
+    auto within = [](const ScoreRow& r) {
+      return std::to_string(r.within) + " of " + std::to_string(r.run);
+    };
+    t.add({md_escape(rows[k].family) + " (" + short_measure(rows[k].measure) + ")",
+           best ? "**" + md_escape(best->backend) + "**" : "-", best ? best->median_text() : "-",
+           best ? within(*best) : "-", best ? best->time_text() : "-",
+           fastest ? "**" + md_escape(fastest->backend) + "**" : "-",
+           fastest ? fmt_num(fastest_t * 1e6, 3) + unit + (fastest_pre ? " (prebuilt)" : "") : "-",
+           fastest ? fastest->median_text() : "-", fastest ? within(*fastest) : "-"});
+    k = end;
+  }
+  std::ostringstream md;
+  md << "## At a glance\n\n"
+        "Per scene family, the most accurate backend (the first of the family's ranked table "
+        "below; `exact`, the oracle, is left out) and the fastest (median run time; a library's "
+        "prebuilt-shape variant where that is faster), each with what it costs in the other "
+        "currency. Errors: contacts, normal angle / depth error (m); dynamics, post-impact "
+        "velocity error in the kinetic-energy norm; mass, relative error. (n): scenes with an "
+        "error against the truth.\n\n"
+     << t.markdown() << "\n";
+  return md.str();
+}
+
+}  // namespace
+
+std::string report_summary_markdown(const std::vector<Scene>& scenes,
+                                    const std::vector<SceneEvaluation>& evs,
+                                    const SummaryInputs& in) {
+  const std::vector<std::string> cols = report_columns(evs);
+  std::vector<FailureCause> causes;
+  const std::vector<ScoreRow> rows = score_rows(scenes, evs, cols, &causes);
+  std::ostringstream md;
+  md << "# rbx accuracy report\n\n"
+     << scenes.size() << " scenes through " << cols.size() << " backends in "
+     << fmt_num(in.total_s, 3)
+     << " s. Every number except run times is deterministic: the same scenes give the same "
+        "report.\n\n"
+        "As a page: [index.html](index.html), this summary with its figures and every scene "
+        "one click away"
+     << (in.views_ok ? " (its numbers and its 3-D replay)" : " (its numbers)")
+     << ". Every table in full, and every scene's numbers: [details.md](details.md) "
+        "([details.html](details.html)); as data: [metrics.csv](metrics.csv), "
+        "[sweep.csv](sweep.csv), [stability.csv](stability.csv), "
+        "[results.json](results.json).\n\n";
+  md << glance_markdown(rows);
+  // The causes name a few scenes each here; details.md names every one.
+  md << scorecard_markdown(rows, causes, 4, in.views_ok);
+  md << error_vs_runtime_markdown(evs, in.figures_ok, in.figures_msg);
+  md << in.tosses;
+  return md.str();
+}
+
+void write_report_pages(const std::string& dir, const std::vector<Scene>& scenes,
+                        const std::vector<SceneEvaluation>& evs, const std::string& summary_md,
+                        const std::string& details_md, bool views_ok) {
+  // Which backends are outside tolerance on each scene, from the measured causes.
+  std::vector<FailureCause> causes;
+  score_rows(scenes, evs, report_columns(evs), &causes);
+  std::map<std::string, std::vector<std::string>> outside;  // slug -> backends
+  for (const FailureCause& f : causes)
+    for (const SceneRef& s : f.scenes) {
+      std::vector<std::string>& list = outside[s.slug];
+      if (std::find(list.begin(), list.end(), f.backend) == list.end())
+        list.push_back(f.backend);
+    }
+  std::ostringstream body;
+  body << markdown_to_html(summary_md);
+  body << "<h2 id=\"scenes\">Every scene</h2>\n<p>Each scene's numbers (every backend, every "
+          "metric) are in details.html"
+       << (views_ok ? "; its replay plays every backend's run side by side in 3-D" : "")
+       << ".</p>\n";
+  body << "<table>\n<thead><tr><th>scene</th><th>description</th><th>checks</th><th>outside "
+          "tolerance</th><th>numbers</th><th>replay</th></tr></thead>\n<tbody>\n";
+  for (size_t i = 0; i < scenes.size() && i < evs.size(); ++i) {
+    const std::string name = evs[i].family + "/" + scenes[i].name;
+    const std::string slug = scene_slug(evs[i].family, scenes[i].file);
+    std::string checks, bad;
+    for (const std::string& c : scenes[i].check_names()) checks += (checks.empty() ? "" : ", ") + c;
+    for (const std::string& b : outside[slug]) bad += (bad.empty() ? "" : ", ") + b;
+    // details.html's heading of the scene is its md_escape'd name: the same anchor.
+    body << "<tr><td>" << html_escape(name) << "</td><td>" << html_escape(scenes[i].description)
+         << "</td><td>" << html_escape(checks) << "</td><td>"
+         << html_escape(bad.empty() ? "none" : bad) << "</td><td><a href=\"details.html#"
+         << html_escape(heading_anchor(md_escape(name))) << "\">numbers</a></td><td>"
+         << (views_ok ? "<a href=\"views/" + html_escape(slug) + ".html\">replay</a>" : "-")
+         << "</td></tr>\n";
+  }
+  body << "</tbody>\n</table>\n";
+  write_text((fs::path(dir) / "index.html").string(), html_page("rbx accuracy report", body.str()));
+  write_text((fs::path(dir) / "details.html").string(),
+             html_page("rbx accuracy report: every table", markdown_to_html(details_md)));
+}
+
+}  // namespace rbx

@@ -1,0 +1,38 @@
+// The report a reader opens first: report.md, a summary of at most a few hundred lines (what
+// answers "which backend is most accurate, which is fastest, at what cost"), and index.html, the
+// same summary as a page with its figures inline and every scene one click away (its numbers in
+// details.html, its 3-D replay in views/).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "comparisons/eval/harness.h"
+#include "engine/scene.h"
+
+namespace rbx {
+
+/// What the summary needs beside the evaluations.
+struct SummaryInputs {
+  double total_s = 0.0;      // the evaluation's wall time
+  bool figures_ok = false;   // the figures were drawn
+  std::string figures_msg;   // why not, when they were not
+  bool views_ok = false;     // the replay pages were written
+  std::string tosses;        // the real tosses' sections (Markdown), "" when none
+};
+
+/// report.md: at a glance (per family, the most accurate backend and the fastest, each with
+/// its error, scenes within tolerance and run time), the ranked scorecard, the measured causes
+/// of failures (a few scenes each), error against run time, the real tosses, and links to the
+/// full tables.
+std::string report_summary_markdown(const std::vector<Scene>& scenes,
+                                    const std::vector<SceneEvaluation>& evs,
+                                    const SummaryInputs& in);
+
+/// index.html (the summary, then every scene: family, checks, backends outside tolerance,
+/// links to its numbers and replay) and details.html (`details_md` as a page) into `dir`.
+void write_report_pages(const std::string& dir, const std::vector<Scene>& scenes,
+                        const std::vector<SceneEvaluation>& evs, const std::string& summary_md,
+                        const std::string& details_md, bool views_ok);
+
+}  // namespace rbx

@@ -1,0 +1,179 @@
+// The report a reader opens first: report.md and index.html (output/report_pages.h), their
+// Markdown-to-HTML rendering (output/markdown_html.h) and the ranked scorecard
+// (output/scorecard.h): every link and image resolves, the unit of a row follows what it
+// measures, scene text never becomes markup.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "comparisons/output/markdown_html.h"
+
+namespace fs = std::filesystem;
+
+namespace rbx {
+namespace {
+
+std::string read(const fs::path& p) {
+  std::stringstream s;
+  s << std::ifstream(p).rdbuf();
+  return s.str();
+}
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("rbx_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+// `rbx report ARGS` from the source folder; the exit code.
+int report(const std::string& args) {
+  const std::string cmd = "cd '" RBX_SOURCE_DIR "' && '" RBX_BINARY_DIR
+                          "/comparisons/rbx' report " +
+                          args + " > /dev/null 2>&1";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A folder mixing a contact scene and dynamics scenes (one family, two measures), one of them
+// with a description that is markup.
+fs::path mixed_folder(const fs::path& dir) {
+  const fs::path mixed = dir / "mixed";
+  fs::create_directories(mixed);
+  fs::copy_file(RBX_SOURCE_DIR "/scenes/contact/axis_x.toml", mixed / "axis_x.toml");
+  fs::copy_file(RBX_SOURCE_DIR "/scenes/analytic/headon_e05.toml", mixed / "headon_e05.toml");
+  std::string text = read(RBX_SOURCE_DIR "/scenes/analytic/headon_e1.toml");
+  text = std::regex_replace(text, std::regex("\ndescription = \"[^\"]*\""),
+                            "\ndescription = \"<b>bold</b> *x* [l](javascript:alert(1))\"");
+  std::ofstream(mixed / "markup.toml") << text;
+  return mixed;
+}
+
+// Every local target of href="..." and src="..." in an HTML page exists, and every "#id" it
+// names is an id of the target page.
+void expect_html_links_resolve(const fs::path& page) {
+  const std::string html = read(page);
+  const std::regex attr("(href|src)=\"([^\"]*)\"");
+  int checked = 0;
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), attr); it != std::sregex_iterator();
+       ++it) {
+    const std::string target = (*it)[2];
+    ASSERT_EQ(target.find("://"), std::string::npos) << page << ": not offline: " << target;
+    ASSERT_NE(target.rfind("javascript:", 0), 0u) << page << ": " << target;
+    const size_t hash = target.find('#');
+    const std::string file = target.substr(0, hash);
+    const fs::path path = file.empty() ? page : page.parent_path() / file;
+    EXPECT_TRUE(fs::exists(path)) << page << " links " << target;
+    if (hash != std::string::npos && fs::exists(path)) {
+      EXPECT_NE(read(path).find("id=\"" + target.substr(hash + 1) + "\""), std::string::npos)
+          << page << " links " << target;
+    }
+    ++checked;
+  }
+  EXPECT_GT(checked, 0) << page;
+}
+
+// Every local target of ](...) in a Markdown file exists.
+void expect_markdown_links_resolve(const fs::path& md_file) {
+  const std::string md = read(md_file);
+  // An escaped "\]" is text (a scene's), not the end of a link.
+  const std::regex link("(^|[^\\\\])\\]\\(([^)#]+)[^)]*\\)");
+  int checked = 0;
+  for (auto it = std::sregex_iterator(md.begin(), md.end(), link); it != std::sregex_iterator();
+       ++it) {
+    EXPECT_TRUE(fs::exists(md_file.parent_path() / (*it)[2].str())) << md_file << ": " << (*it)[2];
+    ++checked;
+  }
+  EXPECT_GT(checked, 0) << md_file;
+}
+
+class ReportPages : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(temp_dir("report_pages"));
+    const fs::path mixed = mixed_folder(*dir_);
+    code_ = report("'" + mixed.string() + "' scenes/mass/box_1x2x3.toml --out '" +
+                   (*dir_ / "out").string() + "'");
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+  }
+  static fs::path out() { return *dir_ / "out"; }
+  static fs::path* dir_;
+  static int code_;
+};
+fs::path* ReportPages::dir_ = nullptr;
+int ReportPages::code_ = -1;
+
+TEST_F(ReportPages, EveryLinkAndImageExists) {
+  ASSERT_EQ(code_, 0);
+  for (const char* page : {"index.html", "details.html"}) expect_html_links_resolve(out() / page);
+  for (const char* md : {"report.md", "details.md"}) expect_markdown_links_resolve(out() / md);
+  // The figures are inline in the page, and each scene links its numbers and its replay.
+  const std::string index = read(out() / "index.html");
+  EXPECT_NE(index.find("<img src=\"figures/error_vs_runtime_"), std::string::npos);
+  EXPECT_NE(index.find("href=\"details.html#mixed-headon_e05"), std::string::npos) << index;
+  EXPECT_NE(index.find("href=\"views/mixed_headon_e05.html\""), std::string::npos);
+}
+
+TEST_F(ReportPages, TheScorecardUnitFollowsTheMetricOnAMixedFolder) {
+  ASSERT_EQ(code_, 0);
+  const std::string md = read(out() / "report.md");
+  // One family, two measures: one ranked table each, in its own unit.
+  const size_t contacts = md.find("### mixed — contacts:");
+  const size_t dynamics = md.find("### mixed — dynamics:");
+  ASSERT_NE(contacts, std::string::npos) << md;
+  ASSERT_NE(dynamics, std::string::npos) << md;
+  auto table_after = [&](size_t at) {
+    const size_t start = md.find("\n|", at);
+    return md.substr(start, md.find("\n\n", start) - start);
+  };
+  const std::string c = table_after(contacts), d = table_after(dynamics);
+  EXPECT_NE(c.find("°"), std::string::npos) << c;
+  EXPECT_NE(c.find("µs/query"), std::string::npos) << c;
+  EXPECT_EQ(c.find("µs/step"), std::string::npos) << c;
+  // A velocity error is not an angle, and a step is not a query.
+  EXPECT_EQ(d.find("°"), std::string::npos) << d;
+  EXPECT_EQ(d.find("µs/query"), std::string::npos) << d;
+  EXPECT_NE(d.find("µs/step"), std::string::npos) << d;
+}
+
+TEST_F(ReportPages, SceneTextNeverBecomesMarkup) {
+  ASSERT_EQ(code_, 0);
+  for (const char* page : {"index.html", "details.html"}) {
+    const std::string html = read(out() / page);
+    EXPECT_EQ(html.find("<b>bold</b>"), std::string::npos) << page;
+    EXPECT_EQ(html.find("href=\"javascript:"), std::string::npos) << page;
+    EXPECT_NE(html.find("&lt;b&gt;bold&lt;/b&gt;"), std::string::npos) << page;
+  }
+}
+
+TEST(MarkdownHtml, RendersTheReportsSubsetAndEscapesText) {
+  const std::string html = markdown_to_html(
+      "# A \\<title\\>\n\nText with **bold**, _it_, `a<b`, a [link](x.html#y) and "
+      "![fig](f.png).\n\n| a | b\\|c |\n|---|---|\n| 1 | <i> |\n\n- one\n  - nested\n- two\n");
+  EXPECT_NE(html.find("<h1 id=\"a-title\">A &lt;title&gt;</h1>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<strong>bold</strong>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<em>it</em>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<code>a&lt;b</code>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<a href=\"x.html#y\">link</a>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<img src=\"f.png\" alt=\"fig\">"), std::string::npos) << html;
+  EXPECT_NE(html.find("<th>b|c</th>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<td>&lt;i&gt;</td>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<li>one</li>\n<ul>\n<li>nested</li>"), std::string::npos) << html;
+  // An escaped underscore in a name is text, not emphasis.
+  EXPECT_EQ(markdown_to_html("a\\_b\\_c"), "<p>a_b_c</p>\n");
+  EXPECT_EQ(heading_anchor("analytic/corner\\_drop\\_e05"), "analytic-corner_drop_e05");
+}
+
+}  // namespace
+}  // namespace rbx
