@@ -249,6 +249,29 @@ TEST_F(ViewBrowser, TossReplayShowsTheMeasuredGhost) {
   fs::remove_all(dir);
 }
 
+// A 0.1 m cube dropping onto a static 20 m floor: the camera frames the cube's fall (the moving
+// body, its trajectory and contacts), not the floor, so the cube is not a few pixels wide.
+TEST_F(ViewBrowser, TheCameraFramesTheMovingBodiesNotTheFloor) {
+  const fs::path dir = temp_dir("framing");
+  std::ofstream(dir / "drop.toml")
+      << "checks = [\"trajectory\"]\nbackends = [\"custom\"]\n[sim]\nduration = 0.3\n"
+         "dt = 0.001\n[[body]]\nname = \"floor\"\nshape = \"box\"\nsize = [20, 20, 1]\n"
+         "static = true\nposition = [0, 0, -0.5]\n[[body]]\nname = \"cube\"\nshape = \"box\"\n"
+         "size = [0.1, 0.1, 0.1]\nposition = [0, 0, 0.2]\n";
+  const Scene scene = load_scene((dir / "drop.toml").string());
+  HarnessOptions opt;
+  opt.sweep = false;
+  std::ofstream(dir / "drop.html")
+      << view_page(view_data(scene, evaluate_scene(scene, opt).json), three_js());
+  const nlohmann::json st = page_state(dir / "drop.html", "", 2000);
+  ASSERT_TRUE(st.is_object() && st.contains("framed")) << st.dump();
+  // The cube's fall spans about 0.3 m (from z = 0.25 to the floor at 0); the floor is 20 m.
+  const double size = st["framed"]["size"].get<double>();
+  EXPECT_GT(size, 0.1);
+  EXPECT_LT(size, 1.0);
+  fs::remove_all(dir);
+}
+
 TEST_F(ViewBrowser, FailsOnABrokenPage) {
   const fs::path dir = temp_dir("broken");
   const nlohmann::json d = data_of("scenes/analytic/headon_e05.toml");

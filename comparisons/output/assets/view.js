@@ -27,11 +27,15 @@
   function grow(p) { for (var i = 0; i < 3; ++i) { lo[i] = Math.min(lo[i], p[i]); hi[i] = Math.max(hi[i], p[i]); } }
   var radius = data.shapes.map(function (s) {
     var r = 0; s.vertices.forEach(function (v) { r = Math.max(r, Math.hypot(v[0], v[1], v[2])); }); return r; });
-  // With a measured ghost the view frames the measurement and the moving bodies (a toss's floor
-  // is 40 cube widths wide).
+  // The view frames the moving bodies, their trajectories and contacts (and a measured ghost),
+  // not the static ones: a floor 40 cube widths wide would leave a small body a few pixels.
+  // Only a scene with nothing moving frames its static bodies.
+  var anyMoving = data.bodies.some(function (b) { return !b.static; });
+  var staticName = {};
+  data.bodies.forEach(function (b) { if (b.static && anyMoving) staticName[b.name] = true; });
   if (ghost) Object.keys(ghost.frames || {}).forEach(function (b) { ghost.frames[b].forEach(grow); });
   data.bodies.forEach(function (b) {
-    if (ghost && b.static) return;
+    if (staticName[b.name]) return;
     var r = radius[b.shape];
     grow([b.position[0] - r, b.position[1] - r, b.position[2] - r]);
     grow([b.position[0] + r, b.position[1] + r, b.position[2] + r]);
@@ -43,8 +47,10 @@
   var s0 = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-6);
   names.forEach(function (n) {
     var fr = data.backends[n].frames || {};
-    Object.keys(fr).forEach(function (b) { fr[b].forEach(function (f) {
+    Object.keys(fr).forEach(function (b) { if (staticName[b]) return; fr[b].forEach(function (f) {
       if (Math.hypot(f[0] - c0[0], f[1] - c0[1], f[2] - c0[2]) < 3 * s0) grow(f); }); });
+    (data.backends[n].events || []).forEach(function (e) {
+      if (Math.hypot(e.point[0] - c0[0], e.point[1] - c0[1], e.point[2] - c0[2]) < 3 * s0) grow(e.point); });
   });
   var centre = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
   var size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-6);
@@ -59,6 +65,7 @@
     cps.forEach(function (e) { centre.x += e.point[0] / cps.length; centre.y += e.point[1] / cps.length; centre.z += e.point[2] / cps.length; });
     size = Math.min(size, 3 * rmin);
   }
+  state.framed = {size: size, centre: [centre.x, centre.y, centre.z]};
 
   var canvas = document.getElementById("view");
   var renderer;
