@@ -107,6 +107,9 @@ struct ExpectContact {
 /// The [expect] block: closed-form ground truth with an absolute tolerance (SI).
 struct Expect {
   double tolerance = 1e-6;
+  /// What the block holds: "analytic" (a closed form) or "exact" (the exact oracle's answer,
+  /// as `rbx explore` writes into the scenes it shrinks); metrics name it as their truth.
+  std::string truth = "analytic";
   std::string known_failure;  // non-empty: the custom engine is known to miss this, and why
   std::vector<ExpectBody> bodies;
   std::optional<ExpectContact> contact;

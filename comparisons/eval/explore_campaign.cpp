@@ -81,7 +81,7 @@ std::string expect_block(const std::string& text) {
   o << "# Truth: the exact oracle (separating axes over faces and edge pairs), not a closed form.\n"
        "# Tolerance: 1e-6 of the smaller body (round-off of exact methods is ~1e-15 relative;\n"
        "# the disagreements explore looks for are above 1 degree or 1 % of that size).\n";
-  o << "[expect]\n";
+  o << "[expect]\ntruth = \"exact\"\n";
   o << "tolerance = " << fmt_num(std::max(1e-12, 1e-6 * size), 3) << "\n[expect.contact]\n"
     << "touching = " << (sat.touching ? "true" : "false") << "\n";
   if (sat.touching) {

@@ -251,6 +251,13 @@ Expect read_expect(const Reader& r, const toml::table& t, const std::vector<Body
       r.fail(line_of(n), "expect.tolerance", "must be > 0, got " + num(e.tolerance),
              "write an absolute tolerance in SI units, e.g. tolerance = 1e-6");
   }
+  if (const toml::node* n = t.get("truth")) {
+    e.truth = r.string(*n, "expect.truth", "expect.truth");
+    if (e.truth != "analytic" && e.truth != "exact")
+      r.fail(line_of(n), "expect.truth",
+             "must be \"analytic\" or \"exact\", got \"" + e.truth + "\"",
+             "write truth = \"analytic\" for a closed form, \"exact\" for the oracle's answer");
+  }
   // A closed form the custom engine is known to miss (a documented limitation): kept as the
   // truth, reported as known, and pinned by the tests so a fix is noticed.
   if (const toml::node* n = t.get("known_failure")) {

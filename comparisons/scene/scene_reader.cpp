@@ -49,6 +49,7 @@ const KeyInfo kKeys[] = {
     {"body.velocity", "[0, 0, 0]"},
     {"body.angular_velocity", "[0, 0, 0]"},
     {"expect.tolerance", "1e-6"},
+    {"expect.truth", "\"analytic\""},
     {"expect.known_failure",
      "\"custom: no resting contact (seed correction 12 (what the seed admits it lacks))\""},
     {"expect.body.position", "[0, 0, 0]"},

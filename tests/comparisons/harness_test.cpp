@@ -203,5 +203,29 @@ TEST(HarnessExpect, AStatedContactPointMustLieInTheTrueContactRegion) {
   }
 }
 
+TEST(HarnessExpect, MetricsNameTheTruthTheExpectBlockHolds) {
+  // The same stated contact, as a closed form and as the oracle's answer written down (what
+  // `rbx explore` writes into a shrunk scene): each metric names that truth.
+  for (const std::string truth : {"analytic", "exact"}) {
+    const Scene scene = parse_scene(
+        "checks = [\"contact\"]\n[sim]\nduration = 0\n[[body]]\nname = \"A\"\n"
+        "[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n[expect]\ntruth = \"" +
+            truth + "\"\n[expect.contact]\ntouching = true\nnormal = [-1, 0, 0]\ndepth = 0.1\n",
+        "truth.toml");
+    HarnessOptions opt;
+    opt.backends = "custom";
+    opt.sweep = false;
+    const SceneEvaluation ev = evaluate_scene(scene, opt);
+    int named = 0;
+    for (const Metric& m : ev.metrics)
+      if (m.backend == "custom" &&
+          (m.name == "normal_err_deg" || m.name == "depth_err" || m.name == "touching_err")) {
+        EXPECT_EQ(m.against, truth) << m.name;
+        ++named;
+      }
+    EXPECT_EQ(named, 3) << truth;
+  }
+}
+
 }  // namespace
 }  // namespace rbx
