@@ -46,7 +46,7 @@ struct ReportOptions {
   bool update = false;              // check --update: merge this run into the baseline
   bool accept_worse = false;        // check --update --accept-worse: record worse metrics too
   bool no_cache = false;            // check --no-cache: rerun every reference library
-  // check: also run explore's fixed random samples (always when no scene is named).
+  // check, report: also run explore's fixed random samples (always when no scene is named).
   bool explore = false;
   /// Backends to choose from (nullptr: the registry); tests pass a table with a broken engine.
   const std::vector<Backend>* registry = nullptr;

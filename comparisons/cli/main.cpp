@@ -58,6 +58,9 @@ void add_library_commands(CLI::App& app, Options& o) {
   report->add_option("--out", o.report.out, "output folder");
   report->add_option("--backends", o.report.backends, "comma-separated backend names");
   report->add_option("--threads", o.report.threads, "threads per rank (default: every core)");
+  report->add_flag("--explore", o.report.explore,
+                   "also summarise explore's fixed random samples (contact and impact kinds, seed "
+                   "1): the default when no scene is named");
   app.add_subcommand("scenes", "the scene library as a markdown table (scenes/README.md)")
       ->add_option("inputs", o.scenes_inputs, "scene files or folders (default: scenes/)");
   CLI::App* check = app.add_subcommand("check", "regression check against reports/baseline.json");

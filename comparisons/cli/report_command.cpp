@@ -2,12 +2,14 @@
 // report.md, results.json, CSV files and figures into one folder, atomically.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <mutex>
 
 #include "comparisons/cli/commands.h"
+#include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/parallel.h"
 #include "comparisons/eval/scene_batch.h"
 #include "comparisons/eval/tosses.h"
@@ -66,6 +68,22 @@ int report_command(const ReportOptions& opt) {
     progress.show(++finished, scenes.size(), scenes[i].file, clock.seconds());
   });
   progress.done();
+  // Explore's fixed random samples (the whole library, or --explore), on every rank.
+  SummaryInputs in;
+  if (opt.explore || opt.inputs.empty()) {
+    const std::vector<std::string> chosen = opt.backends.empty() || opt.backends == "all"
+                                                ? std::vector<std::string>{}
+                                                : parse_backend_list(opt.backends);
+    std::vector<std::string> contact, impact;
+    for (const Backend& b : backends()) {
+      if (b.name == "exact" ||
+          (!chosen.empty() && std::find(chosen.begin(), chosen.end(), b.name) == chosen.end()))
+        continue;
+      if (b.contact) contact.push_back(b.name);
+      if (b.dynamics) impact.push_back(b.name);
+    }
+    in.explore = explore_check_metrics(contact, impact, in.explore_set, nullptr, &par);
+  }
   if (!par.root()) return 0;  // rank 0 writes everything
   // The contact pictures draw the bodies at t = 0.
   for (size_t i = 0; i < scenes.size(); ++i)
@@ -92,7 +110,7 @@ int report_command(const ReportOptions& opt) {
     // --- end replay pages ---
     // report.md is the summary (with the real tosses), details.md every table; index.html and
     // details.html are the same as pages.
-    SummaryInputs in;
+    in.report_dir = tmp.string();
     in.total_s = clock.seconds();
     in.figures_ok = figures_ok;
     in.figures_msg = figures_msg;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/explore_campaign.h"
@@ -50,9 +51,11 @@ void tally(const std::string& scene, const std::vector<std::string>& encoded,
 std::vector<ExploreCheckMetric> explore_check_metrics(
     const std::vector<std::string>& contact_backends,
     const std::vector<std::string>& impact_backends, const ExploreCheckSet& set,
-    const std::vector<Backend>* table) {
+    const std::vector<Backend>* table, const ParallelRun* given) {
   std::vector<ExploreCheckMetric> out;
-  const ParallelRun run;
+  std::optional<ParallelRun> own;
+  if (!given) own.emplace();
+  const ParallelRun& run = given ? *given : *own;
   if (!contact_backends.empty() && set.contact > 0)
     tally("explore/contact",
           run.map(static_cast<size_t>(set.contact),

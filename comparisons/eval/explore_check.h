@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "comparisons/eval/harness.h"
+#include "comparisons/eval/parallel.h"
 #include "reference/backend.h"
 
 namespace rbx {
@@ -27,10 +28,12 @@ struct ExploreCheckMetric {
 
 /// Per backend: the disagreement rate and the median and 90th percentile of its errors (contact:
 /// normal_err_deg, depth_err_rel; impact: velocity_err_ke), over the samples, exactly as `rbx
-/// explore` classifies them. Backends are looked up in `table` (null: the registry).
+/// explore` classifies them. Backends are looked up in `table` (null: the registry). The samples
+/// run on `run`'s ranks and threads (null: a run of its own); every rank must call it, the
+/// metrics come back on rank 0.
 std::vector<ExploreCheckMetric> explore_check_metrics(
     const std::vector<std::string>& contact_backends,
     const std::vector<std::string>& impact_backends, const ExploreCheckSet& set,
-    const std::vector<Backend>* table = nullptr);
+    const std::vector<Backend>* table = nullptr, const ParallelRun* run = nullptr);
 
 }  // namespace rbx

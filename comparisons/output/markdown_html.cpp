@@ -187,12 +187,13 @@ std::string markdown_to_html(const std::string& md) {
       const size_t level = l.find_first_not_of('#');
       const std::string text = l.substr(std::min(l.size(), level + 1));
       const std::string tag = "h" + std::to_string(std::min<size_t>(level, 6));
-      html += "<" + tag + " id=\"" + html_escape(heading_anchor(text)) + "\">" +
-              inline_html(text) + "</" + tag + ">\n";
+      html += "<" + tag + " id=\"" + html_escape(heading_anchor(text)) + "\">" + inline_html(text) +
+              "</" + tag + ">\n";
       ++i;
     } else if (l[0] == '|') {
       std::vector<std::string> rows;
-      while (i < lines.size() && !lines[i].empty() && lines[i][0] == '|') rows.push_back(lines[i++]);
+      while (i < lines.size() && !lines[i].empty() && lines[i][0] == '|')
+        rows.push_back(lines[i++]);
       html += rows.size() >= 2 ? table_html(rows) : "<p>" + inline_html(rows[0]) + "</p>\n";
     } else if (is_list_line(l)) {
       std::vector<std::string> items;
@@ -221,7 +222,8 @@ std::string html_page(const std::string& title, const std::string& body) {
          "th,td{border:1px solid #ccc;padding:.2em .5em;text-align:left;vertical-align:top}\n"
          "th{background:#f0f0f0}tbody tr:nth-child(even){background:#fafafa}\n"
          "img{max-width:100%;height:auto;display:block;margin:.5em 0}\n"
-         "code{background:#f3f3f3;padding:0 .2em}h2{border-bottom:1px solid #ddd;margin-top:1.6em}\n"
+         "code{background:#f3f3f3;padding:0 .2em}h2{border-bottom:1px solid "
+         "#ddd;margin-top:1.6em}\n"
          "nav a{margin-right:1em}\n"
          "</style></head><body>\n" +
          body + "</body></html>\n";

@@ -68,7 +68,8 @@ std::string glance_markdown(const std::vector<ScoreRow>& rows) {
       if (!best && !row.error.empty()) best = &row;
       bool pre = false;
       const double tr = best_time(row, pre);
-      if (tr >= 0 && (!fastest || tr < fastest_t)) fastest = &row, fastest_t = tr, fastest_pre = pre;
+      if (tr >= 0 && (!fastest || tr < fastest_t))
+        fastest = &row, fastest_t = tr, fastest_pre = pre;
     }
     const std::string unit = rows[k].measure == Measure::Contact ? " µs/query" : " µs/step";
     auto within = [](const ScoreRow& r) {
@@ -94,6 +95,58 @@ std::string glance_markdown(const std::vector<ScoreRow>& rows) {
   return md.str();
 }
 
+// Explore's fixed samples: per family (contact pairs, impacts) one table, backends by their
+// disagreement rate, with the median and 90th percentile of their errors.
+std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
+                             const ExploreCheckSet& set) {
+  if (metrics.empty()) return "";
+  std::ostringstream md;
+  md << "## Random poses and impacts\n\n"
+        "What no scene of the library shows: `rbx explore`'s fixed samples (seed "
+     << set.seed << "; the ones `rbx check` compares), " << set.contact
+     << " random convex pairs against the `exact` oracle and " << set.impact
+     << " random vertex-on-face impacts at a random phase against their closed form. "
+        "*Disagreement*: a sample a backend answers clearly wrong (normal > 1°, depth > 1 % of "
+        "the smaller body, velocity error > 0.1 %, a missed or false contact, an error). Errors "
+        "are the median and 90th percentile over the samples where both touch. "
+        "`rbx explore` shrinks every disagreement to a scene.\n\n";
+  struct Family {
+    const char* scene;
+    const char* title;
+    std::vector<std::pair<std::string, std::string>> errors;  // metric stem, column
+  };
+  const std::vector<Family> families = {
+      {"explore/contact",
+       "contact pairs",
+       {{"normal_err_deg", "normal error (deg) p50 / p90"},
+        {"depth_err_rel", "depth error / smaller size p50 / p90"}}},
+      {"explore/impact", "impacts", {{"velocity_err_ke", "velocity error (KE norm) p50 / p90"}}}};
+  for (const Family& f : families) {
+    std::map<std::string, std::map<std::string, double>> by;  // backend -> metric -> value
+    for (const ExploreCheckMetric& m : metrics)
+      if (m.scene == f.scene) by[m.metric.backend][m.metric.name] = m.metric.value;
+    if (by.empty()) continue;
+    std::vector<std::string> names;
+    for (const auto& [b, v] : by) names.push_back(b);
+    std::stable_sort(names.begin(), names.end(), [&](const std::string& a, const std::string& b) {
+      return by[a]["disagreement_rate_err"] < by[b]["disagreement_rate_err"];
+    });
+    std::vector<std::string> header = {"backend", "disagreements"};
+    for (const auto& e : f.errors) header.push_back(e.second);
+    Table t(header);
+    for (const std::string& b : names) {
+      std::vector<std::string> row = {"**" + md_escape(b) + "**",
+                                      fmt_num(100 * by[b]["disagreement_rate_err"], 3) + " %"};
+      for (const auto& e : f.errors)
+        row.push_back(fmt_num(by[b][e.first + "_p50"], 2) + " / " +
+                      fmt_num(by[b][e.first + "_p90"], 2));
+      t.add(row);
+    }
+    md << "### " << f.title << "\n\n" << t.markdown() << "\n";
+  }
+  return md.str();
+}
+
 }  // namespace
 
 std::string report_summary_markdown(const std::vector<Scene>& scenes,
@@ -116,9 +169,10 @@ std::string report_summary_markdown(const std::vector<Scene>& scenes,
         "[sweep.csv](sweep.csv), [stability.csv](stability.csv), "
         "[results.json](results.json).\n\n";
   md << glance_markdown(rows);
-  // The causes name a few scenes each here; details.md names every one.
-  md << scorecard_markdown(rows, causes, 4, in.views_ok);
-  md << error_vs_runtime_markdown(evs, in.figures_ok, in.figures_msg);
+  // The causes name one scene each here; details.md names every one.
+  md << scorecard_markdown(rows) << causes_markdown(causes, true, in.views_ok);
+  md << error_vs_runtime_markdown(evs, in.report_dir, in.figures_ok, in.figures_msg);
+  md << explore_markdown(in.explore, in.explore_set);
   md << in.tosses;
   return md.str();
 }
@@ -133,8 +187,7 @@ void write_report_pages(const std::string& dir, const std::vector<Scene>& scenes
   for (const FailureCause& f : causes)
     for (const SceneRef& s : f.scenes) {
       std::vector<std::string>& list = outside[s.slug];
-      if (std::find(list.begin(), list.end(), f.backend) == list.end())
-        list.push_back(f.backend);
+      if (std::find(list.begin(), list.end(), f.backend) == list.end()) list.push_back(f.backend);
     }
   std::ostringstream body;
   body << markdown_to_html(summary_md);

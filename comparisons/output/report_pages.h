@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/harness.h"
 #include "engine/scene.h"
 
@@ -14,17 +15,21 @@ namespace rbx {
 
 /// What the summary needs beside the evaluations.
 struct SummaryInputs {
-  double total_s = 0.0;      // the evaluation's wall time
-  bool figures_ok = false;   // the figures were drawn
-  std::string figures_msg;   // why not, when they were not
-  bool views_ok = false;     // the replay pages were written
-  std::string tosses;        // the real tosses' sections (Markdown), "" when none
+  std::string report_dir;   // where the report is written (figures/ in it)
+  double total_s = 0.0;     // the evaluation's wall time
+  bool figures_ok = false;  // the figures were drawn
+  std::string figures_msg;  // why not, when they were not
+  bool views_ok = false;    // the replay pages were written
+  std::string tosses;       // the real tosses' sections (Markdown), "" when none
+  /// Explore's fixed random samples (explore_check_metrics), empty when not run.
+  std::vector<ExploreCheckMetric> explore;
+  ExploreCheckSet explore_set;  // the sample set they come from
 };
 
 /// report.md: at a glance (per family, the most accurate backend and the fastest, each with
 /// its error, scenes within tolerance and run time), the ranked scorecard, the measured causes
-/// of failures (a few scenes each), error against run time, the real tosses, and links to the
-/// full tables.
+/// of failures (one scene each), error against run time, random poses and impacts (explore's
+/// fixed samples, when run), the real tosses, and links to the full tables.
 std::string report_summary_markdown(const std::vector<Scene>& scenes,
                                     const std::vector<SceneEvaluation>& evs,
                                     const SummaryInputs& in);

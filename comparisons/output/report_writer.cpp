@@ -393,7 +393,8 @@ std::vector<std::string> report_columns(const std::vector<SceneEvaluation>& evs)
   return cols;
 }
 
-std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs, bool figures_ok,
+std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs,
+                                      const std::string& report_dir, bool figures_ok,
                                       const std::string& figures_msg) {
   std::ostringstream md;
   md << "## Error against run time\n\n";
@@ -412,13 +413,19 @@ std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs, b
         "1e-15 "
         "in the grey band. The dashed line is the Pareto front over backends. Numbers: "
         "`sweep.csv`, `metrics.csv`.\n\n";
+  // A family's figure is named for its kind of sweep point (plots.py): contact queries (timed
+  // per call or prebuilt) "-contact"; only figures plots.py drew are linked (a dynamics family
+  // with no closed form has none).
   std::set<std::string> families;
   for (const SceneEvaluation& ev : evs)
     for (const SweepPoint& p : ev.sweep)
-      families.insert(ev.family + (p.kind == "contact" ? "-contact" : ""));
+      families.insert(ev.family + (p.kind.rfind("contact", 0) == 0 ? "-contact" : ""));
   if (!figures_ok) md << "_Figures were not drawn: " << figures_msg << "_\n\n";
-  for (const std::string& f : families)
-    md << "![error against run time, " << f << "](figures/error_vs_runtime_" << f << ".png)\n\n";
+  for (const std::string& f : families) {
+    const std::string file = "figures/error_vs_runtime_" + f + ".png";
+    if (figures_ok && std::filesystem::exists(std::filesystem::path(report_dir) / file))
+      md << "![error against run time, " << f << "](" << file << ")\n\n";
+  }
 
   return md.str();
 }
@@ -449,7 +456,7 @@ std::string report_details_markdown(const std::vector<Scene>& scenes,
         "[stability.csv](stability.csv).\n\n";
   std::vector<FailureCause> causes;
   const std::vector<ScoreRow> rows = score_rows(scenes, evs, cols, &causes);
-  md << scorecard_markdown(rows, causes, 0, views_ok);
+  md << scorecard_markdown(rows) << causes_markdown(causes, false, views_ok);
   md << summary_section(scenes, evs, cols, views_ok) << contact_phase_section(scenes, evs, cols)
      << disagreement_section(scenes, evs, cols);
   if (const std::string q = query_time_markdown(evs, cols); !q.empty())

@@ -18,8 +18,10 @@ Json geometry_json(const Scene& scene);
 /// Backends that appear anywhere in the evaluations, in registry order (the report's columns).
 std::vector<std::string> report_columns(const std::vector<SceneEvaluation>& evs);
 
-/// The error-against-run-time figures (linked; when `figures_ok` is false, why they are not).
-std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs, bool figures_ok,
+/// The error-against-run-time figures that exist in `report_dir`/figures, linked (when
+/// `figures_ok` is false, why they are not there).
+std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs,
+                                      const std::string& report_dir, bool figures_ok,
                                       const std::string& figures_msg);
 
 /// details.md: the scorecard with every failing scene named, the summary of every scene for

@@ -258,9 +258,7 @@ std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
   return rows;
 }
 
-std::string scorecard_markdown(const std::vector<ScoreRow>& rows,
-                               const std::vector<FailureCause>& causes, size_t max_scenes,
-                               bool views) {
+std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
   std::ostringstream md;
   md << "## Scorecard\n\n"
         "One table per scene family, backends ranked by their median error against the truth "
@@ -286,18 +284,32 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows,
     md << t.markdown() << "\n";
     k = end;
   }
+  return md.str();
+}
+
+std::string causes_markdown(const std::vector<FailureCause>& causes, bool compact, bool views) {
+  std::ostringstream md;
   md << "### Causes of the failures, measured\n\n";
   if (causes.empty()) md << "Every backend is within tolerance on every scene it ran.\n";
-  for (const FailureCause& f : causes) {
+  auto link = [&](const SceneRef& s) {
+    const std::string name = md_escape(s.name);
+    return views ? "[" + name + "](views/" + s.slug + ".html)" : name;
+  };
+  for (size_t k = 0; k < causes.size(); ++k) {
+    const FailureCause& f = causes[k];
+    if (compact) {
+      // One line per backend: each cause, its count and one scene; details.md names them all.
+      if (k > 0 && causes[k - 1].backend == f.backend) continue;
+      md << "- **" << md_escape(f.backend) << "**: ";
+      for (size_t j = k; j < causes.size() && causes[j].backend == f.backend; ++j)
+        md << (j > k ? "; " : "") << md_escape(causes[j].cause) << ", " << causes[j].scenes.size()
+           << " (e.g. " << link(causes[j].scenes.front()) << ")";
+      md << "\n";
+      continue;
+    }
     md << "- **" << md_escape(f.backend) << "**: " << md_escape(f.cause) << " — " << f.scenes.size()
        << ": ";
-    const size_t shown = max_scenes == 0 ? f.scenes.size() : std::min(max_scenes, f.scenes.size());
-    for (size_t k = 0; k < shown; ++k) {
-      const std::string name = md_escape(f.scenes[k].name);
-      md << (k ? ", " : "")
-         << (views ? "[" + name + "](views/" + f.scenes[k].slug + ".html)" : name);
-    }
-    if (shown < f.scenes.size()) md << " and " << f.scenes.size() - shown << " more";
+    for (size_t j = 0; j < f.scenes.size(); ++j) md << (j ? ", " : "") << link(f.scenes[j]);
     md << "\n";
   }
   md << "\n";

@@ -62,11 +62,13 @@ std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
 /// The heading of a row's group: the family, and the measure with its unit.
 std::string group_title(const ScoreRow& row);
 
-/// The scorecard in Markdown: one ranked table per group, then the causes of the failures with
-/// at most `max_scenes` scenes each (0: all), linked to their replay pages when `views`.
-std::string scorecard_markdown(const std::vector<ScoreRow>& rows,
-                               const std::vector<FailureCause>& causes, size_t max_scenes,
-                               bool views);
+/// The scorecard in Markdown: one ranked table per group.
+std::string scorecard_markdown(const std::vector<ScoreRow>& rows);
+
+/// The measured causes of the failures: every cause with every scene, or `compact`, one line
+/// per backend with each cause's count and one scene; scenes link their replay pages when
+/// `views`.
+std::string causes_markdown(const std::vector<FailureCause>& causes, bool compact, bool views);
 
 /// The contact query times in Markdown: per backend, the median over the scenes' queries of the
 /// time per query with the library's shapes built in the query (as the backend runs), with them

@@ -49,6 +49,9 @@ fs::path mixed_folder(const fs::path& dir) {
   const fs::path mixed = dir / "mixed";
   fs::create_directories(mixed);
   fs::copy_file(RBX_SOURCE_DIR "/scenes/contact/axis_x.toml", mixed / "axis_x.toml");
+  // A family of contact scenes only: its figure is the "-contact" one.
+  fs::create_directories(dir / "touch");
+  fs::copy_file(RBX_SOURCE_DIR "/scenes/contact/axis_y.toml", dir / "touch/axis_y.toml");
   fs::copy_file(RBX_SOURCE_DIR "/scenes/analytic/headon_e05.toml", mixed / "headon_e05.toml");
   std::string text = read(RBX_SOURCE_DIR "/scenes/analytic/headon_e1.toml");
   text = std::regex_replace(text, std::regex("\ndescription = \"[^\"]*\""),
@@ -100,8 +103,8 @@ class ReportPages : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new fs::path(temp_dir("report_pages"));
     const fs::path mixed = mixed_folder(*dir_);
-    code_ = report("'" + mixed.string() + "' scenes/mass/box_1x2x3.toml --out '" +
-                   (*dir_ / "out").string() + "'");
+    code_ = report("'" + mixed.string() + "' '" + (*dir_ / "touch").string() +
+                   "' scenes/mass/box_1x2x3.toml --out '" + (*dir_ / "out").string() + "'");
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);
