@@ -7,32 +7,13 @@ marker still tells them apart. The colours start from Okabe & Ito's colour-blind
 A name not listed (a new backend) gets a grey shade and a marker of its own, by its position in
 the sorted list of unlisted names it is drawn with.
 """
+import json
+import os
 
-# name: (colour, marker)
-STYLE = {
-    "custom": ("#0072B2", "o"),
-    "custom-seed": ("#56B4E9", "s"),
-    "custom (accelerated)": ("#0072B2", "o"),
-    "custom (faithful)": ("#00436B", "D"),
-    "exact": ("#000000", "*"),
-    "fcl": ("#E69F00", "o"),
-    "fcl-hull": ("#A35F00", "s"),
-    "fcl-epa": ("#F3C363", "^"),
-    "fcl-indep": ("#6B4E16", "D"),
-    "fcl-box": ("#FFB347", "v"),
-    "libccd-mpr": ("#CC79A7", "o"),
-    "libccd-epa": ("#882255", "^"),
-    "libccd": ("#CC79A7", "P"),
-    "bullet": ("#009E73", "o"),
-    "bullet-hull": ("#00543D", "s"),
-    "bullet-sat": ("#7FD4B6", "D"),
-    "mujoco": ("#D55E00", "o"),
-    "mujoco-hull": ("#7A2E00", "s"),
-    "ode": ("#6A3D9A", "o"),
-    "ode-hull": ("#B39DDB", "s"),
-    "dart": ("#999933", "o"),
-    "dart-hull": ("#5C5C1F", "s"),
-}
+# name: (colour, marker), in assets/backend_style.json, which the report's pages read too.
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "assets",
+                       "backend_style.json")) as _f:
+    STYLE = {name: tuple(pair) for name, pair in json.load(_f).items()}
 ORDER = list(STYLE)
 _GREYS = ["#777777", "#AAAAAA", "#444444", "#CCCCCC"]
 _MARKERS = "hpX<>dH8"

@@ -5,6 +5,7 @@
 #include <map>
 #include <sstream>
 
+#include "comparisons/output/backend_style.h"
 #include "comparisons/output/markdown_html.h"
 #include "comparisons/output/report_writer.h"
 #include "comparisons/output/scorecard.h"
@@ -190,7 +191,12 @@ void write_report_pages(const std::string& dir, const std::vector<Scene>& scenes
       if (std::find(list.begin(), list.end(), f.backend) == list.end()) list.push_back(f.backend);
     }
   std::ostringstream body;
-  body << markdown_to_html(summary_md);
+  // The colour key goes under the figures' heading (the page's top when there are none).
+  std::string summary = markdown_to_html(summary_md);
+  const size_t figures = summary.find("<h2 id=\"error-against-run-time\">");
+  summary.insert(figures == std::string::npos ? 0 : summary.find('\n', figures) + 1,
+                 backend_legend_html(report_columns(evs)));
+  body << summary;
   body << "<h2 id=\"scenes\">Every scene</h2>\n<p>Each scene's numbers (every backend, every "
           "metric) are in details.html"
        << (views_ok ? "; its replay plays every backend's run side by side in 3-D" : "")

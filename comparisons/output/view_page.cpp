@@ -11,6 +11,7 @@
 #include "asset_view_js.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/trajectory.h"
+#include "comparisons/output/backend_style.h"
 #include "comparisons/output/scorecard.h"
 #include "comparisons/output/table.h"
 #include "comparisons/scene/scene_file.h"
@@ -187,6 +188,16 @@ std::string three_js_path() {
       "three.js not found under /usr/share/javascript/three/ (install Debian's libjs-three)");
 }
 
+namespace {
+
+// The data with each backend's colour (its panel label shows it, as the figures do).
+Json with_colours(Json data) {
+  for (auto& [name, b] : data["backends"].items()) b["colour"] = backend_colour(name);
+  return data;
+}
+
+}  // namespace
+
 std::string view_page(const Json& data, const std::string& three_js, const std::string& three_src) {
   const std::string title = data.value("family", "") + "/" + data.value("scene", "");
   const Json& ref = data["reference"];
@@ -222,7 +233,7 @@ std::string view_page(const Json& data, const std::string& three_js, const std::
        "id=\"toggles\"></span></div>\n"
        "</header>\n<div id=\"stage\"><canvas id=\"view\"></canvas><div id=\"labels\"></div></div>\n"
        "<pre id=\"rbx-state\">{}</pre>\n<script id=\"rbx-data\" type=\"application/json\">"
-    << script_safe_json(data) << "</script>\n<script>\n"
+    << script_safe_json(with_colours(data)) << "</script>\n<script>\n"
     << kViewScript << "</script>\n</body></html>\n";
   return h.str();
 }

@@ -43,6 +43,7 @@ std::string three_js_path();
 /// The page. `three_js` is the library's source, inlined; or, when `three_src` is non-empty, the
 /// page loads it from that relative path instead (the report shares one copy among its pages).
 /// Every text from the scene is escaped (HTML and the embedded JSON), never parsed as markup.
+/// Each backend's colour (backend_style.h) is added to the data: its toggle shows it.
 std::string view_page(const Json& data, const std::string& three_js,
                       const std::string& three_src = "");
 

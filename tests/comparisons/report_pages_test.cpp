@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string>
 
+#include "comparisons/output/backend_style.h"
 #include "comparisons/output/markdown_html.h"
 
 namespace fs = std::filesystem;
@@ -126,6 +127,13 @@ TEST_F(ReportPages, EveryLinkAndImageExists) {
   EXPECT_NE(index.find("<img src=\"figures/error_vs_runtime_"), std::string::npos);
   EXPECT_NE(index.find("href=\"details.html#mixed-headon_e05"), std::string::npos) << index;
   EXPECT_NE(index.find("href=\"views/mixed_headon_e05.html\""), std::string::npos);
+  // The colour key of the figures names each backend in its colour (assets/backend_style.json),
+  // and a replay page's data carries the same colour for its panel.
+  EXPECT_NE(index.find("background:" + backend_colour("custom") + "\"></span> custom<"),
+            std::string::npos);
+  EXPECT_NE(read(out() / "views/mixed_headon_e05.html")
+                .find("\"colour\":\"" + backend_colour("custom") + "\""),
+            std::string::npos);
 }
 
 TEST_F(ReportPages, TheScorecardUnitFollowsTheMetricOnAMixedFolder) {

@@ -178,7 +178,15 @@
     var l = document.createElement("label"), c = document.createElement("input");
     c.type = "checkbox"; c.checked = true;
     c.addEventListener("change", function () { p.visible = c.checked; layout(); render(); });
-    l.appendChild(c); l.appendChild(document.createTextNode(" " + p.name)); toggles.appendChild(l);
+    l.appendChild(c);
+    // The backend's colour, as in the report's figures (in the header, off the drawing).
+    var colour = data.backends[p.name].colour;
+    if (colour) {
+      var sw = document.createElement("span");
+      sw.style.cssText = "display:inline-block;width:.8em;height:.8em;margin-left:.3em;background:" + colour;
+      l.appendChild(sw);
+    }
+    l.appendChild(document.createTextNode(" " + p.name)); toggles.appendChild(l);
   });
   var showRef = true;
   var rc = document.getElementById("ref");
