@@ -99,31 +99,19 @@ void expect_markdown_links_resolve(const fs::path& md_file) {
   EXPECT_GT(checked, 0) << md_file;
 }
 
-class ReportPages : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    dir_ = new fs::path(temp_dir("report_pages"));
-    const fs::path mixed = mixed_folder(*dir_);
-    code_ = report("'" + mixed.string() + "' '" + (*dir_ / "touch").string() +
-                   "' scenes/mass/box_1x2x3.toml --out '" + (*dir_ / "out").string() + "'");
-  }
-  static void TearDownTestSuite() {
-    fs::remove_all(*dir_);
-    delete dir_;
-  }
-  static fs::path out() { return *dir_ / "out"; }
-  static fs::path* dir_;
-  static int code_;
-};
-fs::path* ReportPages::dir_ = nullptr;
-int ReportPages::code_ = -1;
-
-TEST_F(ReportPages, EveryLinkAndImageExists) {
-  ASSERT_EQ(code_, 0);
-  for (const char* page : {"index.html", "details.html"}) expect_html_links_resolve(out() / page);
-  for (const char* md : {"report.md", "details.md"}) expect_markdown_links_resolve(out() / md);
+// One report (a report costs tens of seconds under the sanitizers) of a folder mixing contact
+// and dynamics scenes, a contact-only folder and a mass scene, judged three ways.
+TEST(ReportPages, LinksResolveUnitsFollowTheMetricAndSceneTextStaysText) {
+  const fs::path dir = temp_dir("report_pages");
+  const fs::path mixed = mixed_folder(dir), out = dir / "out";
+  ASSERT_EQ(report("'" + mixed.string() + "' '" + (dir / "touch").string() +
+                   "' scenes/mass/box_1x2x3.toml --out '" + out.string() + "'"),
+            0);
+  // Every link and image resolves.
+  for (const char* page : {"index.html", "details.html"}) expect_html_links_resolve(out / page);
+  for (const char* md : {"report.md", "details.md"}) expect_markdown_links_resolve(out / md);
   // The figures are inline in the page, and each scene links its numbers and its replay.
-  const std::string index = read(out() / "index.html");
+  const std::string index = read(out / "index.html");
   EXPECT_NE(index.find("<img src=\"figures/error_vs_runtime_"), std::string::npos);
   EXPECT_NE(index.find("href=\"details.html#mixed-headon_e05"), std::string::npos) << index;
   EXPECT_NE(index.find("href=\"views/mixed_headon_e05.html\""), std::string::npos);
@@ -131,14 +119,12 @@ TEST_F(ReportPages, EveryLinkAndImageExists) {
   // and a replay page's data carries the same colour for its panel.
   EXPECT_NE(index.find("background:" + backend_colour("custom") + "\"></span> custom<"),
             std::string::npos);
-  EXPECT_NE(read(out() / "views/mixed_headon_e05.html")
+  EXPECT_NE(read(out / "views/mixed_headon_e05.html")
                 .find("\"colour\":\"" + backend_colour("custom") + "\""),
             std::string::npos);
-}
 
-TEST_F(ReportPages, TheScorecardUnitFollowsTheMetricOnAMixedFolder) {
-  ASSERT_EQ(code_, 0);
-  const std::string md = read(out() / "report.md");
+  // The unit of a row follows what it measures.
+  const std::string md = read(out / "report.md");
   // One family, two measures: one ranked table each, in its own unit.
   const size_t contacts = md.find("### mixed — contacts:");
   const size_t dynamics = md.find("### mixed — dynamics:");
@@ -156,16 +142,15 @@ TEST_F(ReportPages, TheScorecardUnitFollowsTheMetricOnAMixedFolder) {
   EXPECT_EQ(d.find("°"), std::string::npos) << d;
   EXPECT_EQ(d.find("µs/query"), std::string::npos) << d;
   EXPECT_NE(d.find("µs/step"), std::string::npos) << d;
-}
 
-TEST_F(ReportPages, SceneTextNeverBecomesMarkup) {
-  ASSERT_EQ(code_, 0);
+  // Scene text never becomes markup.
   for (const char* page : {"index.html", "details.html"}) {
-    const std::string html = read(out() / page);
+    const std::string html = read(out / page);
     EXPECT_EQ(html.find("<b>bold</b>"), std::string::npos) << page;
     EXPECT_EQ(html.find("href=\"javascript:"), std::string::npos) << page;
     EXPECT_NE(html.find("&lt;b&gt;bold&lt;/b&gt;"), std::string::npos) << page;
   }
+  fs::remove_all(dir);
 }
 
 TEST(MarkdownHtml, RendersTheReportsSubsetAndEscapesText) {
