@@ -47,21 +47,31 @@ constexpr long kMaxSupportCalls = 4 * static_cast<long>(kMaxIterations) + 16;
 // limit the answer and still far above round-off of unit-scale coordinates (~1e-16 m).
 constexpr ccd_real_t kTolerance = 1e-10;
 
-/// A posed hull as libccd sees it: the body-frame polyhedron and the body-to-world transform.
+/// A posed body as libccd sees it: the body-frame polyhedron, the box it is (when it is one)
+/// and the body-to-world transform.
 struct CcdBody {
   const ConvexPolyhedron* hull;
+  bool box = false;     // a box body (is_native_box): libccd's own box support
+  Vec3 half_size;       // m, the box's half extents (body axes)
   Mat3 rotation;        // body to world
   Vec3 position;        // m, world position of the body origin (the centre of mass)
   long* support_calls;  // calls so far in the current query, shared by the pair
 };
 
-/// libccd support function, the one rbx gives every library that takes one: the world-frame
-/// vertex of the posed hull furthest along `dir`, R * support_local(R^T dir) + p, where
-/// support_local is the body-frame hull's support_index (among vertices tied on the dot
-/// product, the first in the hull's vertex order). A box's vertex order puts -x before +x (and
-/// likewise y, z), so at a zero component of `dir` it returns the corner on the minus side,
-/// where libccd's test-suite box support returns the face centre (sign 0): both are support
-/// points, and only tie-sensitive algorithms (MPR) can tell them apart.
+/// The pose and shape of `body` for libccd, sharing the pair's support-call count.
+CcdBody ccd_body(const RigidBody& body, long* calls) {
+  return {body.shape.get(),       is_native_box(body), 0.5 * body.box_size,
+          body.pose().rotation(), body.position,       calls};
+}
+
+/// libccd support function. A box gets the support libccd documents for boxes (its README's
+/// example and its test suite's, testsuites/support.c): ccdSign(d) * half size in the box
+/// frame, a component of d within libccd's epsilon of zero giving the centre of that face or
+/// edge. Every other body: the vertex
+/// of the posed hull furthest along `dir`, R * support_local(R^T dir) + p, support_local being
+/// the hull's support_index (among tied vertices the first in the hull's order). Both are
+/// support points; only where `dir` has a zero component can they differ, and libccd's MPR and
+/// EPA can tell them apart there (tests/reference/libccd_test.cpp).
 void support(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* vec) {
   const auto* body = static_cast<const CcdBody*>(obj);
   if (++*body->support_calls > kMaxSupportCalls) {  // over budget: see kMaxSupportCalls
@@ -70,7 +80,13 @@ void support(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* vec) {
   }
   const Vec3 dir_world(ccdVec3X(dir), ccdVec3Y(dir), ccdVec3Z(dir));
   const Vec3 dir_local = body->rotation.transpose() * dir_world;
-  const Vec3& v_local = body->hull->vertices()[body->hull->support_index(dir_local)];
+  Vec3 v_local;
+  if (body->box)
+    v_local = Vec3(ccdSign(dir_local.x()) * body->half_size.x(),
+                   ccdSign(dir_local.y()) * body->half_size.y(),
+                   ccdSign(dir_local.z()) * body->half_size.z());
+  else
+    v_local = body->hull->vertices()[body->hull->support_index(dir_local)];
   const Vec3 v_world = body->rotation * v_local + body->position;
   ccdVec3Set(vec, v_world.x(), v_world.y(), v_world.z());
 }
@@ -128,8 +144,8 @@ template <class Query>
 ContactResult penetration(const RigidBody& a, const RigidBody& b, const char* name,
                           const char* feature, Query&& run) {
   long support_calls = 0;
-  const CcdBody body_a{a.shape.get(), a.pose().rotation(), a.position, &support_calls};
-  const CcdBody body_b{b.shape.get(), b.pose().rotation(), b.position, &support_calls};
+  const CcdBody body_a = ccd_body(a, &support_calls);
+  const CcdBody body_b = ccd_body(b, &support_calls);
   const ccd_t ccd = make_ccd();
   ccd_real_t depth = 0.0;
   ccd_vec3_t dir, pos;

@@ -1,4 +1,5 @@
-// libccd 2.1 called directly on our support function: MPR and GJK + EPA, each its own backend.
+// libccd 2.1 called directly: MPR and GJK + EPA, each its own backend, on libccd's documented box
+// support for boxes and the hull's vertex support otherwise (reference/libccd.cpp).
 #pragma once
 
 #include "reference/backend.h"

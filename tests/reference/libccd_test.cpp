@@ -214,37 +214,90 @@ TEST(Libccd, EpaUnderestimatesPinned) {
   EXPECT_GT(depth_along(a, b, epa.normal), truth);
 }
 
-TEST(Libccd, BoxBoxLargeEpaIsStoppedAndSaysSoMprAnswers) {
+TEST(Libccd, BoxBoxLargeEpaConvergesOnTheBoxSupportAndIsStoppedOnTheHulls) {
   // MuJoCo's BoxBoxLarge (engine_collision_gjk_test.cc): a 100 x 100 x 0.5 m slab and a 0.2 m
-  // cube resting on it, faces parallel to ~1e-10 rad, 0.754 mm deep. libccd 2.1's EPA never
-  // returns here (it swaps between the two diagonals of the flat face of the Minkowski
-  // difference); the support-call budget stops it: libccd-epa is an error that says so, at
-  // once, and MPR answers right.
+  // cube resting on it, faces parallel to ~1e-10 rad, 0.754 mm deep.
   Mat3 r;
   r << 1.0, -0.000000000004566, -0.000000000167641,  //
       0.000000000004566, 1.0, -0.000000000017877,    //
       0.000000000167641, 0.000000000017877, 1.0;
-  const RigidBody a = box_at("geom1", Vec3(100, 100, 0.5), Vec3(0, 0, 0.25));
-  const RigidBody b =
+  RigidBody a = box_at("geom1", Vec3(100, 100, 0.5), Vec3(0, 0, 0.25));
+  RigidBody b =
       box_at("geom2", Vec3(0.2, 0.2, 0.2),
              Vec3(-0.000000000043537, -0.000000000012973, 0.599245786666870), Quat(r).normalized());
   const double truth = sat_depth(a, b);  // 0.000754213351681798 m
-  const Both res = both(a, b);
-  EXPECT_EQ(res.epa.status, Status::Error);
-  EXPECT_NE(res.epa.message.find("ccdGJKPenetration did not converge"), std::string::npos)
-      << res.epa.message;
-  ASSERT_EQ(res.mpr.status, Status::Ok) << res.mpr.message;
-  ASSERT_EQ(res.mpr.contacts.size(), 1u);
-  // MPR converges to 1e-10 m (the adapter's tolerance); its answer here is 1.8e-12 off.
-  EXPECT_NEAR(res.mpr.contacts[0].depth, truth, 1e-10);
-  EXPECT_NEAR(res.mpr.contacts[0].normal.z(), -1.0, 1e-12);
+  // Boxes, with libccd's own box support: both algorithms answer, to the adapter's tolerance
+  // (1e-10 m) on the depth and round-off on the normal.
+  const Both boxes = both(a, b);
+  for (const ContactResult* res : {&boxes.mpr, &boxes.epa}) {
+    ASSERT_EQ(res->status, Status::Ok) << res->message;
+    ASSERT_EQ(res->contacts.size(), 1u);
+    EXPECT_NEAR(res->contacts[0].depth, truth, 1e-10);
+    EXPECT_NEAR(res->contacts[0].normal.z(), -1.0, 1e-12);
+  }
+  // The same boxes as plain hulls (vertex support): libccd 2.1's EPA never returns (it swaps
+  // between the two diagonals of the flat face of the Minkowski difference); the support-call
+  // budget stops it: libccd-epa is an error that says so, at once, and MPR still answers.
+  a.shape_kind = b.shape_kind = ShapeKind::Convex;
+  const Both hulls = both(a, b);
+  EXPECT_EQ(hulls.epa.status, Status::Error);
+  EXPECT_NE(hulls.epa.message.find("ccdGJKPenetration did not converge"), std::string::npos)
+      << hulls.epa.message;
+  ASSERT_EQ(hulls.mpr.status, Status::Ok) << hulls.mpr.message;
+  ASSERT_EQ(hulls.mpr.contacts.size(), 1u);
+  EXPECT_NEAR(hulls.mpr.contacts[0].depth, truth, 1e-10);
 }
 
-TEST(Libccd, OurBoxSupportIsASupportPointWhereverTheTestSuitesIs) {
-  // libccd's test suite gives boxes a support of its own (testsuites/support.c): the corner
-  // sign(d) * half size, with a zero component of d giving the face centre. Ours is the first
-  // hull vertex of maximal d . v. Along every direction (zeros included) both are support
-  // points: equal d . v; and where no component is zero, the same point.
+// The setting measured: libccd's own box support (its README's and test suite's) reproduces the
+// values libccd's test suite publishes (regressions/TSBoxBox.out, TSMPRBoxBox.out, printed with
+// 6 decimals: 5e-7 is half the last digit), where the hull's vertex support does not.
+TEST(Libccd, ItsOwnBoxSupportReproducesItsPublishedCases) {
+  const Quat turned_45(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()));
+  RigidBody pen3_a = unit_cube("A", Vec3(0.1, 0, 0.1), turned_45);
+  RigidBody pen3_b = unit_cube("B", Vec3(0.1, 0, 0));
+  RigidBody sep5_a = unit_cube("A", Vec3(-0.5, 0, 0), turned_45);
+  RigidBody sep5_b = unit_cube("B", Vec3::Zero());
+  RigidBody pen7_a = unit_cube(
+      "A", Vec3(-0.5, 0.1, 0.4),
+      Quat(0.7339802347242237, 0.2041241452319315, 0.5139107231664566, 0.39433756729740643));
+  RigidBody pen7_b = unit_cube("B", Vec3(0.1, 0, 0));
+  constexpr double kPrinted = 5e-7;
+  // "Pen 3" (EPA): depth 0.900000, dir (0, 0, -1); "Separate 5" (EPA): (0.707107, 0, 0).
+  const ContactResult pen3 = libccd_epa_contact(pen3_a, pen3_b);
+  ASSERT_EQ(pen3.contacts.size(), 1u) << pen3.message;
+  EXPECT_NEAR(pen3.contacts[0].depth, 0.9, kPrinted);
+  EXPECT_NEAR(pen3.contacts[0].normal.z(), 1.0, kPrinted);
+  const ContactResult sep5 = libccd_epa_contact(sep5_a, sep5_b);
+  ASSERT_EQ(sep5.contacts.size(), 1u) << sep5.message;
+  EXPECT_NEAR(sep5.contacts[0].depth, 0.707107, kPrinted);
+  EXPECT_NEAR(sep5.contacts[0].normal.x(), -1.0, kPrinted);
+  // "Pen 7" (MPR): depth 0.622928, dir (0.999509, 0.028016, -0.014008); our normal is -dir.
+  const ContactResult pen7 = libccd_mpr_contact(pen7_a, pen7_b);
+  ASSERT_EQ(pen7.contacts.size(), 1u) << pen7.message;
+  EXPECT_NEAR(pen7.contacts[0].depth, 0.622928, kPrinted);
+  EXPECT_NEAR((pen7.contacts[0].normal - Vec3(-0.999509, -0.028016, 0.014008)).norm(), 0.0,
+              2 * kPrinted);
+  // The same boxes as plain hulls: EPA stops at a depth of round-off on Pen 3 and Separate 5
+  // (a degenerate polytope at the tied vertices), MPR takes another portal on Pen 7.
+  for (RigidBody* body : {&pen3_a, &pen3_b, &sep5_a, &sep5_b, &pen7_a, &pen7_b})
+    body->shape_kind = ShapeKind::Convex;
+  const ContactResult pen3_hull = libccd_epa_contact(pen3_a, pen3_b);
+  ASSERT_EQ(pen3_hull.contacts.size(), 1u) << pen3_hull.message;
+  EXPECT_LT(pen3_hull.contacts[0].depth, 1e-12);
+  const ContactResult sep5_hull = libccd_epa_contact(sep5_a, sep5_b);
+  ASSERT_EQ(sep5_hull.contacts.size(), 1u) << sep5_hull.message;
+  EXPECT_LT(sep5_hull.contacts[0].depth, 1e-12);
+  const ContactResult pen7_hull = libccd_mpr_contact(pen7_a, pen7_b);
+  ASSERT_EQ(pen7_hull.contacts.size(), 1u) << pen7_hull.message;
+  EXPECT_GT(std::abs(pen7_hull.contacts[0].depth - 0.622928), 0.01);
+}
+
+TEST(Libccd, OurHullSupportIsASupportPointWhereverItsBoxSupportIs) {
+  // libccd's box support (its README's, testsuites/support.c), which the adapter gives boxes:
+  // the corner sign(d) * half size, with a zero component of d giving the face centre. The hull
+  // support every other body gets is the first hull vertex of maximal d . v. Along every
+  // direction (zeros included) both are support points: equal d . v; and where no component is
+  // zero, the same point.
   const Vec3 half(0.3, 0.5, 0.7);
   const RigidBody box = box_at("A", 2.0 * half, Vec3::Zero());
   auto ccd_suite_support = [&](const Vec3& d) {
