@@ -1,6 +1,7 @@
 #include "comparisons/output/scorecard.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -44,7 +45,7 @@ std::string cause(const SceneEvaluation& ev, const std::string& backend) {
   const Json& bj = ev.json["backends"][backend];
   if (bj["status"] == "error" || bj["status"] == "timeout") {
     std::string msg = bj["message"].get<std::string>();
-    if (msg.size() > 70) msg = msg.substr(0, 67) + "...";
+    if (msg.size() > 120) msg = msg.substr(0, msg.rfind(' ', 117)) + " ...";
     return bj["status"].get<std::string>() + ": " + msg;
   }
   if (truth_metric(ev, backend, "touching_err") > 0)
@@ -117,19 +118,27 @@ void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, con
     row.time.push_back(bj["runtime_s"].get<double>() / static_cast<double>(steps));
 }
 
-// Errors below this are round-off, as the error-against-time figures draw them (plots.py), so
-// they rank as equal: 4e-15 deg is not worse than 0 deg.
-constexpr double kRankRoundOff = 1e-13;
+// Errors below this rank as equal: round-off and the iterative methods' stopping tolerances
+// (1e-10 in the adapters) are not a difference in accuracy, and 3e-13 deg is not worse than 0.
+constexpr double kRankNoise = 1e-9;
 
-// Ranking within a group: rows with an error first, by median error (contact: angle, then
-// depth), then most scenes within tolerance, then worst error, then run time.
+// A value as the tables show it (2 significant digits), noise as 0: rows that read the same
+// rank by the next criterion.
+double as_shown(double x) {
+  if (x < kRankNoise) return 0.0;
+  const double scale = std::pow(10.0, std::floor(std::log10(x)) - 1);
+  return std::round(x / scale) * scale;
+}
+
+// Ranking within a group: rows with an error first, by median error as shown (contact: angle,
+// then depth), then most scenes within tolerance, then worst error, then run time.
 bool ranks_before(const ScoreRow& a, const ScoreRow& b) {
   auto key = [](const ScoreRow& r) {
     const double none = std::numeric_limits<double>::infinity();
     auto rank_value = [&](const std::vector<double>& v, bool worst) {
       if (v.empty()) return none;
       const double x = worst ? max_of(v) : median_of(v);
-      return x < kRankRoundOff ? 0.0 : x;
+      return as_shown(x);
     };
     return std::make_tuple(r.error.empty(), rank_value(r.error, false),
                            rank_value(r.depth_error, false), -r.within, rank_value(r.error, true),
@@ -142,13 +151,14 @@ bool ranks_before(const ScoreRow& a, const ScoreRow& b) {
 const char* measure_title(Measure m) {
   switch (m) {
     case Measure::Contact:
-      return "contacts: normal angle / depth error (m) against the truth, time per query";
+      return "contacts: normal angle (deg) / depth error (m) against the truth, time per query";
     case Measure::Mass:
       return "mass properties: worst relative error of mass, centre of mass and inertia";
     case Measure::Dynamics:
       break;
   }
-  return "dynamics: post-impact velocity error (kinetic-energy norm), time per step";
+  return "dynamics: post-impact velocity error, relative (kinetic-energy norm; 0.001 is 0.1 %), "
+         "time per step";
 }
 
 }  // namespace
@@ -263,9 +273,11 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
   md << "## Scorecard\n\n"
         "One table per scene family, backends ranked by their median error against the truth "
         "(the closed form, the `exact` oracle or the exact solid; self-consistency errors are "
-        "not counted), then by scenes within tolerance, worst error and run time. *Within "
+        "not counted) as shown, errors under 1e-9 (round-off, iteration tolerances) counting "
+        "as equal; then by scenes within tolerance, worst error and run time. *Within "
         "tolerance*: scenes with no ✗ and no ~ in the full tables (details.md); `unsupported` "
-        "scenes are not counted. (n): scenes with an error against the truth. Run time: median, "
+        "scenes are not counted. *Median error (n)*: the median over the n scenes that have a "
+        "truth to compare with (the others have none). Run time: median, "
         "wall clock; a library builds its shapes inside each query, custom reuses its hulls; "
         "in brackets the same query with the library's shapes prebuilt, the fair comparison "
         "with custom.\n\n";
