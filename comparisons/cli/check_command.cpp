@@ -43,6 +43,8 @@ int check_command(const ReportOptions& opt) {
   if (opt.backends != "all") set.only = parse_backend_list(opt.backends, table);
   set.explore = opt.explore || opt.inputs.empty();
   set.explore_samples = opt.explore_samples;
+  // The measured tosses when the whole library is checked.
+  set.tosses = opt.tosses || opt.inputs.empty();
   set.use_cache = !opt.no_cache;
   set.registry = opt.registry;
 

@@ -52,6 +52,7 @@ struct ReportOptions {
   const std::vector<Backend>* registry = nullptr;
   /// check: explore's fixed sample set; tests narrow it (the sanitizer build is ~15x slower).
   ExploreCheckSet explore_samples;
+  bool tosses = false;   // check: also the measured tosses (always when no scene is named)
   std::string backends;  // --backends LIST
   bool quiet = false;    // no progress line
   int threads = 0;       // report: threads per rank (0: the cores of the node, divided among ranks)

@@ -7,15 +7,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 
 #include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/result_cache.h"
 #include "comparisons/eval/select_backends.h"
+#include "comparisons/eval/tosses.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/format.h"
 
 namespace rbx {
+
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -102,6 +106,35 @@ void measure_explore(const CheckSettings& set, CheckRun& run) {
   }
 }
 
+// The measured cube tosses' test split of every data set under scenes/: per dynamics backend at
+// its stored (fitted) parameters, as the report's first toss table, the median and 90th
+// percentile of the position error per toss and the median angle error, under the pseudo-scene
+// "tosses/FOLDER". The simulations are deterministic, so the metrics are exact repeats.
+void measure_tosses(const CheckSettings& set, CheckRun& run) {
+  const std::vector<Backend>& table = set.registry ? *set.registry : backends();
+  for (const std::string& dir : find_toss_datasets({})) {
+    const std::vector<Toss> tosses = read_tosses(toss_test_split(dir));
+    const auto stored = read_params_file((fs::path(dir) / "params.json").string());
+    const std::string scene = "tosses/" + fs::path(dir).filename().string();
+    run.scene_in_run.insert(scene);
+    for (const Backend& b : table) {
+      if (!b.dynamics || !set.selected(b.name)) continue;
+      const BackendTosses r = evaluate_backend(b, tosses, stored_params(stored, b.name));
+      if (r.status != Status::Ok) continue;  // a failed toss: its metrics go missing (worse)
+      std::vector<double> position, angle;
+      for (const TossErrors& e : r.tosses) {
+        position.push_back(e.position);
+        angle.push_back(e.orientation_deg);
+      }
+      const Spread p = spread_of(position), a = spread_of(angle);
+      for (const auto& [name, value] :
+           {std::pair{"position_err_p50", p.median}, std::pair{"position_err_p90", p.p90},
+            std::pair{"angle_err_deg_p50", a.median}})
+        run.now[key_of(scene, {"tosses", b.name, "", name, value, "measured"})] = value;
+    }
+  }
+}
+
 }  // namespace
 
 bool CheckSettings::selected(const std::string& backend) const {
@@ -136,6 +169,7 @@ CheckRun measure_check(const std::vector<Scene>& scenes, const CheckSettings& se
     if (known_failure_passes(s, ev, subject)) run.now_passing.push_back({scene, s.file, subject});
   }
   if (set.explore) measure_explore(set, run);
+  if (set.tosses) measure_tosses(set, run);
   run.runtime_s = clock.seconds();
   return run;
 }

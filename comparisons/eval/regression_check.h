@@ -18,6 +18,7 @@ struct CheckSettings {
   std::vector<std::string> only;    // backends compared (and merged); empty: every one
   bool explore = false;             // also explore's fixed random samples
   ExploreCheckSet explore_samples;  // which samples (the baseline's set unless a test narrows it)
+  bool tosses = false;              // also the measured cube tosses' test split (scenes/)
   bool use_cache = true;            // reference results from the cache
   /// Backends to choose from (nullptr: the registry); tests pass a table with a broken engine.
   const std::vector<Backend>* registry = nullptr;
@@ -40,7 +41,8 @@ struct CheckRun {
   double runtime_s = 0.0;
 };
 
-/// Runs every scene (and, with `set.explore`, explore's fixed samples).
+/// Runs every scene (and, with `set.explore`, explore's fixed samples; with `set.tosses`, the
+/// measured tosses).
 CheckRun measure_check(const std::vector<Scene>& scenes, const CheckSettings& set);
 
 /// The baseline file (InputError when unreadable or malformed; an absent one is an empty

@@ -18,18 +18,6 @@ namespace rbx {
 
 namespace {
 
-// The stored parameters of `name`, or the published ones (params_source says which).
-ContactParams stored_params(const std::vector<std::pair<std::string, ContactParams>>& stored,
-                            const std::string& name, std::string* source) {
-  for (const auto& [n, p] : stored)
-    if (n == name) {
-      *source = "fitted";
-      return p;
-    }
-  *source = "published (none stored)";
-  return kPublishedParams;
-}
-
 Json model_json(const CubeTossModel& m) {
   return {{"cube_width_m", 2.0 * m.half_width},
           {"mass_kg", m.mass},
@@ -42,6 +30,22 @@ Json model_json(const CubeTossModel& m) {
 }
 
 }  // namespace
+
+ContactParams stored_params(const std::vector<std::pair<std::string, ContactParams>>& stored,
+                            const std::string& name, std::string* source) {
+  for (const auto& [n, p] : stored)
+    if (n == name) {
+      if (source) *source = "fitted";
+      return p;
+    }
+  if (source) *source = "published (none stored)";
+  return kPublishedParams;
+}
+
+std::string toss_test_split(const std::string& dir) {
+  const fs::path d(dir);
+  return (fs::exists(d / "test.csv.gz") ? d / "test.csv.gz" : d / "test.csv").string();
+}
 
 std::vector<const Backend*> select_toss_backends(const std::string& list) {
   std::vector<const Backend*> out;

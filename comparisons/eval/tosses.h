@@ -188,4 +188,12 @@ Json updated_params_json(const std::string& path, const std::string& data,
 /// params.json beside test.csv or test.csv.gz. Sorted.
 std::vector<std::string> find_toss_datasets(const std::vector<std::string>& inputs);
 
+/// The test split of a data set folder: DIR/test.csv.gz, else DIR/test.csv.
+std::string toss_test_split(const std::string& dir);
+
+/// A backend's stored (fitted) parameters, or the published ones when it has none; `source`
+/// (when given) gets "fitted" or "published (none stored)".
+ContactParams stored_params(const std::vector<std::pair<std::string, ContactParams>>& stored,
+                            const std::string& name, std::string* source = nullptr);
+
 }  // namespace rbx

@@ -188,8 +188,7 @@ std::string error_over_time_table(const TossEvaluation& ev, const std::vector<si
 std::string tosses_report_section(const std::string& dir, const std::string& out_dir,
                                   const std::string& backend_list) {
   const fs::path d(dir);
-  const std::string data =
-      (fs::exists(d / "test.csv.gz") ? d / "test.csv.gz" : d / "test.csv").string();
+  const std::string data = toss_test_split(dir);
   const std::vector<Toss> tosses = read_tosses(data);
   const std::string params_path = (d / "params.json").string();
   const auto stored = read_params_file(params_path);

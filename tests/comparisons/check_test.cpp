@@ -232,5 +232,32 @@ TEST(Check, AChangeThatOnlyBreaksRandomPosesIsNamedByTheExploreSamples) {
   fs::remove_all(dir);
 }
 
+TEST(Check, AChangeThatOnlyBreaksTheMeasuredTossesIsNamed) {
+  // The broken copy simulates with the seed's frictionless impulse: axis_x (a contact query)
+  // cannot see it; the measured tosses, where the real cube slides to rest by friction, do.
+  std::vector<Backend> broken = backends();
+  for (Backend& b : broken)
+    if (b.name == "custom") b.dynamics = custom_seed_dynamics;
+  const fs::path dir = temp_dir("check_tosses");
+  ReportOptions opt;
+  opt.inputs = {RBX_SOURCE_DIR "/scenes/contact/axis_x.toml"};
+  opt.backends = "custom";
+  opt.tosses = true;
+  opt.baseline = (dir / "baseline.json").string();
+  opt.update = true;
+  ASSERT_EQ(run_check(opt).code, 0);
+
+  ReportOptions check = opt;
+  check.update = false;
+  check.registry = &broken;
+  const CheckRun r = run_check(check);
+  EXPECT_EQ(r.code, 1) << r.out;
+  const size_t at = r.out.find("tosses/cube_toss\n  custom\n");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("worse   tosses position_err_p50: ", at), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("contact/axis_x\n"), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace rbx
