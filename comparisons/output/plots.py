@@ -16,6 +16,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 # One (colour, marker) per backend, the same in every figure (backend_style.py).
@@ -137,6 +138,7 @@ def error_vs_runtime(report, out):
         ax.set_title(f"{family}: error against run time, closed-form scenes\n"
                      "one point per time step; large open marker: the coarsest step", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
+        readable_log_ticks(ax.xaxis)
         # Below the axes: the legend hides no point.
         ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3)
         save(fig, out, f"error_vs_runtime_{family}")
@@ -189,11 +191,25 @@ def error_vs_runtime(report, out):
                           "filled: shapes built in each query; hollow, dotted: shapes prebuilt")
             ax.set_ylabel(f"{label}: median over scenes,\nbar 25-75 %; small hollow: worst scene")
             ax.grid(True, which="both", alpha=0.3)
-            # Between the round-off band and the worst scenes, where no point lies.
-            ax.legend(fontsize=6.5, loc="center left")
+            readable_log_ticks(ax.xaxis)
+        # One legend for both panels, below them: it hides no point.
+        handles, labels = axes[0].get_legend_handles_labels()
+        fig.legend(handles, [lab.split(" (worst")[0] for lab in labels], fontsize=7,
+                   loc="lower center", ncol=6, bbox_to_anchor=(0.5, 0.0))
         fig.suptitle(f"{family}: contact error against query time (one point per backend; "
                      "truth: closed form, else the exact oracle)", fontsize=10)
-        save(fig, out, f"error_vs_runtime_{family}-contact")
+        fig.tight_layout(rect=(0, 0.04 + 0.035 * ((len(labels) + 5) // 6), 1, 1))
+        for ext in ("png", "svg"):
+            fig.savefig(os.path.join(out, f"error_vs_runtime_{family}-contact.{ext}"), dpi=110)
+        plt.close(fig)
+
+
+def readable_log_ticks(axis):
+    """Labels at 1, 2 and 5 times each power of ten: a log axis spanning less than a decade
+    otherwise shows one number or none."""
+    axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    axis.set_major_formatter(FormatStrFormatter("%g"))
+    axis.set_minor_formatter(NullFormatter())
 
 
 def slug(scene):
