@@ -18,12 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // A row's best run time: the library's prebuilt variant where it has one (how a user holding
 // the shapes runs it), else the time as it runs; negative when the row has no time.
 double best_time(const ScoreRow& r, bool& prebuilt) {

@@ -15,12 +15,6 @@ namespace rbx {
 
 namespace {
 
-double median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // True when one of the lines is about backend `name` (lines start "NAME " or "NAME:").
 bool about(const std::vector<std::string>& lines, const std::string& name) {
   for (const std::string& d : lines)
@@ -195,6 +189,12 @@ std::string ScoreRow::time_text() const {
 
 std::string group_title(const ScoreRow& row) {
   return row.family + " — " + measure_title(row.measure);
+}
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 std::string scene_slug(const std::string& family, const std::string& file) {
