@@ -21,6 +21,7 @@
 #include <utility>
 
 #include "engine/format.h"
+#include "reference/result_codec.h"
 
 namespace rbx {
 
@@ -32,216 +33,20 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// -- bytes: plain values in host order, strings and vectors length-prefixed ---------------------
+// -- bytes: a record as reference/result_codec.h encodes it (a mass call has no run time) ---
 
-struct Writer {
-  std::string out;
-  template <class T>
-  void pod(const T& v) {
-    out.append(reinterpret_cast<const char*>(&v), sizeof v);
-  }
-  void str(const std::string& s) {
-    pod<uint64_t>(s.size());
-    out += s;
-  }
-  void vec(const Vec3& v) {
-    for (int k = 0; k < 3; ++k) pod(v[k]);
-  }
-  void quat(const Quat& q) {
-    const double c[4] = {q.w(), q.x(), q.y(), q.z()};
-    pod(c);
-  }
-};
-
-struct Reader {
-  const std::string& in;
-  size_t pos = 0;
-  bool ok = true;
-  template <class T>
-  T pod() {
-    T v{};
-    if (pos + sizeof v > in.size()) {
-      ok = false;
-      return v;
-    }
-    std::memcpy(&v, in.data() + pos, sizeof v);
-    pos += sizeof v;
-    return v;
-  }
-  std::string str() {
-    const uint64_t n = pod<uint64_t>();
-    if (!ok || pos + n > in.size()) {
-      ok = false;
-      return {};
-    }
-    std::string s = in.substr(pos, n);
-    pos += n;
-    return s;
-  }
-  Vec3 vec() {
-    Vec3 v;
-    for (int k = 0; k < 3; ++k) v[k] = pod<double>();
-    return v;
-  }
-  Quat quat() {
-    const double w = pod<double>(), x = pod<double>(), y = pod<double>(), z = pod<double>();
-    return Quat(w, x, y, z);
-  }
-  // A count read from the stream, refused when it claims more items than bytes are left.
-  uint64_t count() {
-    const uint64_t n = pod<uint64_t>();
-    if (n > in.size()) ok = false;
-    return ok ? n : 0;
-  }
-};
-
-void put(Writer& w, const ContactPoint& c) {
-  w.vec(c.point);
-  w.vec(c.normal);
-  w.pod(c.depth);
-  w.str(c.feature);
-}
-ContactPoint get_contact(Reader& r) {
-  ContactPoint c;
-  c.point = r.vec();
-  c.normal = r.vec();
-  c.depth = r.pod<double>();
-  c.feature = r.str();
-  return c;
-}
-
-void put(Writer& w, const BodyFinal& b) {
-  w.str(b.name);
-  w.vec(b.position);
-  w.quat(b.orientation);
-  w.vec(b.velocity);
-  w.vec(b.angular_velocity);
-}
-BodyFinal get_final(Reader& r) {
-  BodyFinal b;
-  b.name = r.str();
-  b.position = r.vec();
-  b.orientation = r.quat();
-  b.velocity = r.vec();
-  b.angular_velocity = r.vec();
-  return b;
-}
-
-std::string encode(const TimedContact& t) {
-  Writer w;
-  w.pod(static_cast<int32_t>(t.result.status));
-  w.str(t.result.message);
-  w.pod(t.runtime_s);
-  w.pod<uint64_t>(t.result.contacts.size());
-  for (const ContactPoint& c : t.result.contacts) put(w, c);
-  return w.out;
-}
+std::string encode(const TimedContact& t) { return encode_result(t.result, t.runtime_s); }
 bool decode(const std::string& bytes, TimedContact& t) {
-  Reader r{bytes};
-  t.result.status = static_cast<Status>(r.pod<int32_t>());
-  t.result.message = r.str();
-  t.runtime_s = r.pod<double>();
-  const uint64_t n = r.count();
-  for (uint64_t i = 0; i < n && r.ok; ++i) t.result.contacts.push_back(get_contact(r));
-  return r.ok && r.pos == bytes.size();
+  return decode_result(bytes, t.result, t.runtime_s);
 }
-
-std::string encode(const TimedDynamics& t) {
-  const DynamicsResult& d = t.result;
-  Writer w;
-  w.pod(static_cast<int32_t>(d.status));
-  w.str(d.message);
-  w.pod(t.runtime_s);
-  w.pod<uint64_t>(d.events.size());
-  for (const CollisionEvent& e : d.events) {
-    w.pod(e.time);
-    w.pod(e.step);
-    w.str(e.body_a);
-    w.str(e.body_b);
-    put(w, e.contact);
-    w.pod(e.impulse);
-  }
-  w.pod<uint64_t>(d.finals.size());
-  for (const BodyFinal& b : d.finals) put(w, b);
-  w.pod<uint64_t>(d.samples.size());
-  for (const StateSample& s : d.samples) {
-    w.pod(s.time);
-    w.pod<uint64_t>(s.bodies.size());
-    for (const BodyFinal& b : s.bodies) put(w, b);
-  }
-  const FirstImpulse& f = d.first_impulse;
-  w.pod<uint8_t>(f.seen);
-  w.str(f.body_a);
-  w.str(f.body_b);
-  w.pod(f.step);
-  w.pod(f.contact_points);
-  w.vec(f.normal);
-  w.vec(f.point);
-  w.pod(f.depth);
-  w.pod(f.impulse);
-  w.pod(f.approach_speed);
-  w.pod(f.entry_phase);
-  return w.out;
-}
+std::string encode(const TimedDynamics& t) { return encode_result(t.result, t.runtime_s); }
 bool decode(const std::string& bytes, TimedDynamics& t) {
-  DynamicsResult& d = t.result;
-  Reader r{bytes};
-  d.status = static_cast<Status>(r.pod<int32_t>());
-  d.message = r.str();
-  t.runtime_s = r.pod<double>();
-  for (uint64_t i = 0, n = r.count(); i < n && r.ok; ++i) {
-    CollisionEvent e;
-    e.time = r.pod<double>();
-    e.step = r.pod<long>();
-    e.body_a = r.str();
-    e.body_b = r.str();
-    e.contact = get_contact(r);
-    e.impulse = r.pod<double>();
-    d.events.push_back(std::move(e));
-  }
-  for (uint64_t i = 0, n = r.count(); i < n && r.ok; ++i) d.finals.push_back(get_final(r));
-  for (uint64_t i = 0, n = r.count(); i < n && r.ok; ++i) {
-    StateSample s;
-    s.time = r.pod<double>();
-    for (uint64_t k = 0, m = r.count(); k < m && r.ok; ++k) s.bodies.push_back(get_final(r));
-    d.samples.push_back(std::move(s));
-  }
-  FirstImpulse& f = d.first_impulse;
-  f.seen = r.pod<uint8_t>() != 0;
-  f.body_a = r.str();
-  f.body_b = r.str();
-  f.step = r.pod<long>();
-  f.contact_points = r.pod<int>();
-  f.normal = r.vec();
-  f.point = r.vec();
-  f.depth = r.pod<double>();
-  f.impulse = r.pod<double>();
-  f.approach_speed = r.pod<double>();
-  f.entry_phase = r.pod<double>();
-  return r.ok && r.pos == bytes.size();
+  return decode_result(bytes, t.result, t.runtime_s);
 }
-
-std::string encode(const MassResult& m) {
-  Writer w;
-  w.pod(static_cast<int32_t>(m.status));
-  w.str(m.message);
-  w.pod(m.mass);
-  w.pod(m.volume);
-  w.vec(m.center_of_mass);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) w.pod(m.inertia(i, j));
-  return w.out;
-}
+std::string encode(const MassResult& m) { return encode_result(m, 0.0); }
 bool decode(const std::string& bytes, MassResult& m) {
-  Reader r{bytes};
-  m.status = static_cast<Status>(r.pod<int32_t>());
-  m.message = r.str();
-  m.mass = r.pod<double>();
-  m.volume = r.pod<double>();
-  m.center_of_mass = r.vec();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) m.inertia(i, j) = r.pod<double>();
-  return r.ok && r.pos == bytes.size();
+  double no_runtime;
+  return decode_result(bytes, m, no_runtime);
 }
 
 // -- frames, child -> parent, and the call state the child shares with its parent -------------
@@ -261,10 +66,10 @@ void write_all(int fd, const std::string& s) {
 }
 
 void send(int fd, char type, const std::string& payload) {
-  Writer w;
-  w.pod(type);
-  w.str(payload);
-  write_all(fd, w.out);
+  ByteWriter w;
+  w.put(static_cast<long>(type));
+  w.put(payload);
+  write_all(fd, w.str());
 }
 
 // The call a child is in, written by the child, read by its parent (a sequence lock: `seq` is
@@ -435,18 +240,23 @@ struct StderrRelay {
 template <class OnFrame>
 void read_frames(std::string& inbox, ChildEnd& end, const OnFrame& on_frame) {
   for (;;) {
-    Reader r{inbox};
-    const char type = r.pod<char>();
-    const std::string payload = r.str();
-    if (!r.ok) break;
-    inbox.erase(0, r.pos);
+    long type = 0;
+    std::string payload;
+    try {
+      ByteReader r(inbox);
+      r.get(type);
+      r.get(payload);
+      inbox.erase(0, r.position());
+    } catch (const std::runtime_error&) {
+      break;  // the frame is not complete yet
+    }
     if (type == 'X') {
       end.threw = payload;
     } else if (type == 'C') {
       end.has_answer = true;
       end.answer = payload;
     } else {
-      on_frame(type, payload);
+      on_frame(static_cast<char>(type), payload);
     }
   }
 }
@@ -600,18 +410,22 @@ std::vector<std::string> run_items_isolated(size_t lo, size_t hi,
               send(fd, 'X', "a non-standard exception");
               return;
             }
-            Writer w;
-            w.pod<uint64_t>(i);
-            w.out += bytes;
-            send(fd, 'R', w.out);
+            ByteWriter w;
+            w.put(static_cast<long>(i));
+            send(fd, 'R', w.str() + bytes);
           }
         },
         [&](char type, const std::string& payload) {
           if (type != 'R') return;
-          Reader r{payload};
-          const uint64_t i = r.pod<uint64_t>();
-          if (!r.ok || i != next) throw std::runtime_error("isolated items: result out of order");
-          results[i - lo] = payload.substr(sizeof(uint64_t));
+          long i = -1;
+          try {
+            ByteReader r(payload);
+            r.get(i);
+          } catch (const std::runtime_error&) {
+          }
+          if (i < 0 || static_cast<size_t>(i) != next)
+            throw std::runtime_error("isolated items: result out of order");
+          results[static_cast<size_t>(i) - lo] = payload.substr(sizeof(std::int64_t));
           ++next;
           if (done) done(i);
         });
