@@ -187,43 +187,54 @@ std::string shrink_contact_group(const Json& g, uint64_t seed, long count, int b
                       {"point_err_rel", found.point_err_rel}});
 }
 
-// One impact group's shrink: the scene carries its closed form ([expect]) already.
-std::string shrink_impact_group(const Json& g, uint64_t seed, long count, int budget) {
-  const ImpactSample start = make_impact_sample(seed, g["first_sample"].get<uint64_t>());
+// One closed-form group's shrink (impact, landing kinds): the scene carries its closed form
+// ([expect]) already. `make` and `shrink` are the kind's sampler and shrinker; `how` says how
+// the shrink went and `numbers` are the kind's measures in the record, both from its result.
+template <class Make, class Shrink, class How, class Numbers>
+std::string shrink_closed_form_group(const char* kind, const Json& g, uint64_t seed, long count,
+                                     int budget, Make make, Shrink shrink, How how,
+                                     Numbers numbers) {
+  const auto start = make(seed, g["first_sample"].get<uint64_t>());
   const std::string backend = g["backend"], sig = g["signature"];
-  const ImpactShrinkResult r = shrink_impact(start, backend, sig, budget);
+  const auto r = shrink(start, backend, sig, budget);
   const BackendOutcome found = outcome_of(r.outcome, backend);
   if (found.error.empty()) return Json{{"ok", false}}.dump();
-  const std::string shrunk =
-      points_shrunk(r.vertices_before, r.vertices_after, r.steps_accepted, r.evaluations);
   return shrunk_json(
-      closed_form_header("impact", seed, count, start.index, g, found, shrunk) + r.sample.text,
-      found,
-      {{"points_before", r.vertices_before},
-       {"points_after", r.vertices_after},
-       {"evaluations", r.evaluations},
-       {"phase", r.sample.phase},
-       {"velocity_err_ke", found.velocity_err_ke},
-       {"momentum_err_ke", found.momentum_err_ke}});
+      closed_form_header(kind, seed, count, start.index, g, found, how(r)) + r.sample.text, found,
+      numbers(r, found));
 }
 
-// One landing group's shrink, as the impact kind's (a landing's box keeps its 8 points).
+std::string shrink_impact_group(const Json& g, uint64_t seed, long count, int budget) {
+  return shrink_closed_form_group(
+      "impact", g, seed, count, budget, make_impact_sample, shrink_impact,
+      [](const ImpactShrinkResult& r) {
+        return points_shrunk(r.vertices_before, r.vertices_after, r.steps_accepted, r.evaluations);
+      },
+      [](const ImpactShrinkResult& r, const BackendOutcome& found) {
+        return Json{{"points_before", r.vertices_before},
+                    {"points_after", r.vertices_after},
+                    {"evaluations", r.evaluations},
+                    {"phase", r.sample.phase},
+                    {"velocity_err_ke", found.velocity_err_ke},
+                    {"momentum_err_ke", found.momentum_err_ke}};
+      });
+}
+
+// A landing's box keeps its 8 points: its shrink moves numbers toward round ones.
 std::string shrink_landing_group(const Json& g, uint64_t seed, long count, int budget) {
-  const LandingSample start = make_landing_sample(seed, g["first_sample"].get<uint64_t>());
-  const std::string backend = g["backend"], sig = g["signature"];
-  const LandingShrinkResult r = shrink_landing(start, backend, sig, budget);
-  const BackendOutcome found = outcome_of(r.outcome, backend);
-  if (found.error.empty()) return Json{{"ok", false}}.dump();
-  const std::string shrunk = "toward round numbers (" + std::to_string(r.steps_accepted) +
-                             " simplifications kept, " + std::to_string(r.evaluations) + " tried)";
-  return shrunk_json(
-      closed_form_header("landing", seed, count, start.index, g, found, shrunk) + r.sample.text,
-      found,
-      {{"evaluations", r.evaluations},
-       {"phase", r.sample.phase},
-       {"position_err_m", found.position_err_m},
-       {"turn_rad", found.turn_rad},
-       {"rest_time_err_s", found.rest_time_err_s}});
+  return shrink_closed_form_group(
+      "landing", g, seed, count, budget, make_landing_sample, shrink_landing,
+      [](const LandingShrinkResult& r) {
+        return "toward round numbers (" + std::to_string(r.steps_accepted) +
+               " simplifications kept, " + std::to_string(r.evaluations) + " tried)";
+      },
+      [](const LandingShrinkResult& r, const BackendOutcome& found) {
+        return Json{{"evaluations", r.evaluations},
+                    {"phase", r.sample.phase},
+                    {"position_err_m", found.position_err_m},
+                    {"turn_rad", found.turn_rad},
+                    {"rest_time_err_s", found.rest_time_err_s}};
+      });
 }
 
 // Every sample, spread over ranks and threads; encoded outcomes in index order on rank 0.

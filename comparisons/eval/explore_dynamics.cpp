@@ -263,6 +263,21 @@ std::string impact_expect(const ImpactSample& s, double speed, const SinglePoint
   return x.str();
 }
 
+// The first of up to `attempts` draws from the sample's own stream that `draw` realizes (draw
+// fills the sample and says whether it is valid); throws when none is.
+template <class Sample, class Draw>
+Sample first_realized(uint64_t seed, uint64_t index, int attempts, const char* what, Draw draw) {
+  SampleRng r(seed, index);
+  for (int attempt = 0; attempt < attempts; ++attempt) {
+    Sample s;
+    s.seed = seed;
+    s.index = index;
+    if (draw(r, s)) return s;
+  }
+  throw std::runtime_error(std::string("no valid ") + what + " found in " +
+                           std::to_string(attempts) + " attempts");
+}
+
 }  // namespace
 
 bool realize_impact(ImpactSample& s) {
@@ -366,55 +381,51 @@ bool realize_impact(ImpactSample& s) {
 }
 
 ImpactSample make_impact_sample(uint64_t seed, uint64_t index) {
-  SampleRng r(seed, index);
-  for (int attempt = 0; attempt < 30; ++attempt) {
-    ImpactSample s;
-    s.seed = seed;
-    s.index = index;
-    s.b_static = r.uniform() < 0.4;
-    const double scale = std::pow(10.0, r.uniform(-0.3, 0.3));
-    // A: a box or a hull of 4 to 60 points (a sliver's lowest vertex is rarely unique).
-    do {
-      s.a = random_body(r, scale);
-    } while (s.a.shape_class == "sliver" || s.a.points.size() > 60);
-    s.a.orientation = r.rotation();
-    // B: a box, a slab under A when static, else up to 3 times A's size.
-    s.b.shape_class = "box";
-    if (s.b_static)
-      s.b.box_size = Vec3(4 * scale, 4 * scale, scale);
-    else
-      for (int k = 0; k < 3; ++k) s.b.box_size[k] = scale * r.uniform(1.0, 3.0);
-    s.b.orientation = r.rotation();
-    s.mass_a = std::pow(10.0, r.uniform(-0.5, 0.5));
-    s.mass_b = s.b_static ? 1.0 : std::pow(10.0, r.uniform(-0.5, 0.5));
-    s.restitution = r.uniform(0.2, 1.0);
-    s.dt = 1e-3;
-    s.face = s.b_static ? 2 : r.integer(0, 5);
-    s.face_u = r.uniform(-0.3, 0.3);
-    s.face_v = r.uniform(-0.3, 0.3);
-    // Relative velocity: against the face normal, tilted up to 30 degrees; 0.5 to 3 m/s.
-    Vec3 local_n = Vec3::Zero();
-    local_n[s.face % 3] = s.face < 3 ? 1.0 : -1.0;
-    const Vec3 n = s.b.orientation.normalized() * local_n;
-    const Vec3 t = n.cross(r.direction()).normalized();
-    const double tilt = r.uniform(0.0, 30.0) * M_PI / 180.0;
-    const Vec3 v_rel = r.uniform(0.5, 3.0) * (-std::cos(tilt) * n + std::sin(tilt) * t);
-    if (s.b_static) {
-      s.velocity_a = v_rel;
-    } else {
-      // Centre-of-mass velocity up to 1 m/s, split by the masses.
-      const Vec3 vcm = r.uniform(0.0, 1.0) * r.direction();
-      const double m = s.mass_a + s.mass_b;
-      s.velocity_a = vcm + v_rel * (s.mass_b / m);
-      s.velocity_b = vcm - v_rel * (s.mass_a / m);
-    }
-    // First contact 2 to 5 steps ahead, at a random phase of its step; then at least 50 ms of
-    // flight, to a whole number of steps (a scene's duration is one).
-    s.contact_time = (r.integer(2, 5) + r.uniform(0.02, 0.98)) * s.dt;
-    s.duration = std::ceil((s.contact_time + 0.05) / s.dt) * s.dt;
-    if (realize_impact(s)) return s;
-  }
-  throw std::runtime_error("no single-point impact found in 30 attempts");
+  return first_realized<ImpactSample>(
+      seed, index, 30, "single-point impact", [](SampleRng& r, ImpactSample& s) {
+        s.b_static = r.uniform() < 0.4;
+        const double scale = std::pow(10.0, r.uniform(-0.3, 0.3));
+        // A: a box or a hull of 4 to 60 points (a sliver's lowest vertex is rarely unique).
+        do {
+          s.a = random_body(r, scale);
+        } while (s.a.shape_class == "sliver" || s.a.points.size() > 60);
+        s.a.orientation = r.rotation();
+        // B: a box, a slab under A when static, else up to 3 times A's size.
+        s.b.shape_class = "box";
+        if (s.b_static)
+          s.b.box_size = Vec3(4 * scale, 4 * scale, scale);
+        else
+          for (int k = 0; k < 3; ++k) s.b.box_size[k] = scale * r.uniform(1.0, 3.0);
+        s.b.orientation = r.rotation();
+        s.mass_a = std::pow(10.0, r.uniform(-0.5, 0.5));
+        s.mass_b = s.b_static ? 1.0 : std::pow(10.0, r.uniform(-0.5, 0.5));
+        s.restitution = r.uniform(0.2, 1.0);
+        s.dt = 1e-3;
+        s.face = s.b_static ? 2 : r.integer(0, 5);
+        s.face_u = r.uniform(-0.3, 0.3);
+        s.face_v = r.uniform(-0.3, 0.3);
+        // Relative velocity: against the face normal, tilted up to 30 degrees; 0.5 to 3 m/s.
+        Vec3 local_n = Vec3::Zero();
+        local_n[s.face % 3] = s.face < 3 ? 1.0 : -1.0;
+        const Vec3 n = s.b.orientation.normalized() * local_n;
+        const Vec3 t = n.cross(r.direction()).normalized();
+        const double tilt = r.uniform(0.0, 30.0) * M_PI / 180.0;
+        const Vec3 v_rel = r.uniform(0.5, 3.0) * (-std::cos(tilt) * n + std::sin(tilt) * t);
+        if (s.b_static) {
+          s.velocity_a = v_rel;
+        } else {
+          // Centre-of-mass velocity up to 1 m/s, split by the masses.
+          const Vec3 vcm = r.uniform(0.0, 1.0) * r.direction();
+          const double m = s.mass_a + s.mass_b;
+          s.velocity_a = vcm + v_rel * (s.mass_b / m);
+          s.velocity_b = vcm - v_rel * (s.mass_a / m);
+        }
+        // First contact 2 to 5 steps ahead, at a random phase of its step; then at least 50 ms of
+        // flight, to a whole number of steps (a scene's duration is one).
+        s.contact_time = (r.integer(2, 5) + r.uniform(0.02, 0.98)) * s.dt;
+        s.duration = std::ceil((s.contact_time + 0.05) / s.dt) * s.dt;
+        return realize_impact(s);
+      });
 }
 
 SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<std::string>& names,
@@ -664,29 +675,25 @@ bool realize_landing(LandingSample& s) {
 }
 
 LandingSample make_landing_sample(uint64_t seed, uint64_t index) {
-  SampleRng r(seed, index);
-  for (int attempt = 0; attempt < 10; ++attempt) {
-    LandingSample s;
-    s.seed = seed;
-    s.index = index;
-    s.friction = r.uniform(0.1, 1.0);
-    // Footprint sides 0.2 to 2 m; height up to 3 footprints, kept clear of tipping.
-    s.size.x() = std::pow(10.0, r.uniform(-0.7, 0.3));
-    s.size.y() = std::pow(10.0, r.uniform(-0.7, 0.3));
-    const double footprint = std::min(s.size.x(), s.size.y());
-    s.size.z() = footprint * r.uniform(0.1, std::min(3.0, kNoTipMargin / s.friction));
-    s.mass = std::pow(10.0, r.uniform(-1.0, 1.0));
-    s.yaw_deg = r.uniform(0.0, 90.0);  // a box's yaw repeats every 90 degrees
-    // Slide speeds to 1.5 m/s (kLandingPositionMark says why), falls of 0.2 to 2 m/s.
-    s.slide_speed = r.uniform(0.05, 1.5);
-    s.heading_deg = r.uniform(0.0, 360.0);
-    s.fall_speed = r.uniform(0.2, 2.0);
-    s.dt = 1e-3;
-    s.steps_before = r.integer(2, 5);
-    s.phase = r.uniform(0.02, 0.98);
-    if (realize_landing(s)) return s;
-  }
-  throw std::runtime_error("no valid landing found in 10 attempts");
+  return first_realized<LandingSample>(
+      seed, index, 10, "landing", [](SampleRng& r, LandingSample& s) {
+        s.friction = r.uniform(0.1, 1.0);
+        // Footprint sides 0.2 to 2 m; height up to 3 footprints, kept clear of tipping.
+        s.size.x() = std::pow(10.0, r.uniform(-0.7, 0.3));
+        s.size.y() = std::pow(10.0, r.uniform(-0.7, 0.3));
+        const double footprint = std::min(s.size.x(), s.size.y());
+        s.size.z() = footprint * r.uniform(0.1, std::min(3.0, kNoTipMargin / s.friction));
+        s.mass = std::pow(10.0, r.uniform(-1.0, 1.0));
+        s.yaw_deg = r.uniform(0.0, 90.0);  // a box's yaw repeats every 90 degrees
+        // Slide speeds to 1.5 m/s (kLandingPositionMark says why), falls of 0.2 to 2 m/s.
+        s.slide_speed = r.uniform(0.05, 1.5);
+        s.heading_deg = r.uniform(0.0, 360.0);
+        s.fall_speed = r.uniform(0.2, 2.0);
+        s.dt = 1e-3;
+        s.steps_before = r.integer(2, 5);
+        s.phase = r.uniform(0.02, 0.98);
+        return realize_landing(s);
+      });
 }
 
 SampleOutcome evaluate_landing_sample(const LandingSample& s,
