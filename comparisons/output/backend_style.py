@@ -6,6 +6,8 @@ marker, so two neighbours in a legend never share both colour and marker, and in
 marker still tells them apart. The colours start from Okabe & Ito's colour-blind-safe set.
 A name not listed (a new backend) gets a grey shade and a marker of its own, by its position in
 the sorted list of unlisted names it is drawn with.
+
+save() is how every figure is written: PNG for the pages, SVG for print, at one resolution.
 """
 import json
 import os
@@ -37,3 +39,16 @@ def colour(name, others=()):
 def order(names):
     """Names in the registry's order, unlisted ones last, sorted."""
     return sorted(names, key=lambda b: (ORDER.index(b) if b in ORDER else len(ORDER), b))
+
+
+def save(fig, out, name, rect=None):
+    """Lays `fig` out (inside `rect`, figure fractions, when given), writes out/name.png and
+    out/name.svg, and closes it."""
+    import matplotlib.pyplot as plt
+    if rect is None:
+        fig.tight_layout()
+    else:
+        fig.tight_layout(rect=rect)
+    for ext in ("png", "svg"):
+        fig.savefig(os.path.join(out, f"{name}.{ext}"), dpi=110)
+    plt.close(fig)

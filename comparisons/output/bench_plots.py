@@ -21,13 +21,6 @@ METHOD_STYLE = {"all-pairs": ("tab:red", "o"), "sweep-and-prune": ("tab:orange",
                 "tree": ("tab:blue", "^")}
 
 
-def save(fig, out, name):
-    fig.tight_layout()
-    for ext in ("png", "svg"):
-        fig.savefig(os.path.join(out, f"{name}.{ext}"), dpi=110)
-    plt.close(fig)
-
-
 def narrowphase(rows, out):
     """Time per query against hull vertices, log-log; the box drawn as a separate marker at N=8."""
     by_pose = defaultdict(lambda: defaultdict(list))
@@ -59,7 +52,7 @@ def narrowphase(rows, out):
         ax.set_title(f"Narrow phase, {pose} poses")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8, ncol=2)
-        save(fig, out, f"perf_narrowphase_{pose}")
+        backend_style.save(fig, out, f"perf_narrowphase_{pose}")
 
 
 def broadphase(rows, out):
@@ -87,7 +80,7 @@ def broadphase(rows, out):
     ax.set_title("Broad phase (same pairs from every method)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=9)
-    save(fig, out, "perf_broadphase")
+    backend_style.save(fig, out, "perf_broadphase")
 
 
 def step(rows, out):
@@ -105,7 +98,7 @@ def step(rows, out):
     ax.set_ylabel("µs per body per step")
     ax.set_title("Whole step, scenes/many/")
     ax.grid(True, axis="y", which="both", alpha=0.3)
-    save(fig, out, "perf_step")
+    backend_style.save(fig, out, "perf_step")
 
 
 def main():

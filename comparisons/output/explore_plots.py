@@ -42,9 +42,7 @@ def main(out):
     axes[0].set_ylabel("fraction of samples with both touching")
     axes[-1].legend(fontsize=7, loc="lower right")
     fig.suptitle(f"rbx explore: {j['count']} samples, seed {j['seed']}, errors against the exact oracle")
-    fig.tight_layout()
-    for ext in ("png", "svg"):
-        fig.savefig(os.path.join(out, f"explore_errors.{ext}"), dpi=110)
+    backend_style.save(fig, out, "explore_errors")
 
 
 if __name__ == "__main__":

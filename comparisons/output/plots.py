@@ -20,7 +20,7 @@ from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter  # n
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 # One (colour, marker) per backend, the same in every figure (backend_style.py).
-from backend_style import order, style  # noqa: E402,F401
+from backend_style import order, save, style  # noqa: E402,F401
 
 
 # Errors below ROUNDOFF are round-off (a few ulps of double precision on unit-sized numbers) and
@@ -50,13 +50,6 @@ def quartiles(values):
 
 def floored(x):
     return max(x, FLOOR) if x >= ROUNDOFF else FLOOR
-
-
-def save(fig, out, name):
-    fig.tight_layout()
-    for ext in ("png", "svg"):
-        fig.savefig(os.path.join(out, f"{name}.{ext}"), dpi=110)
-    plt.close(fig)
 
 
 def pareto(points):
@@ -198,10 +191,8 @@ def error_vs_runtime(report, out):
                    loc="lower center", ncol=6, bbox_to_anchor=(0.5, 0.0))
         fig.suptitle(f"{family}: contact error against query time (one point per backend; "
                      "truth: closed form, else the exact oracle)", fontsize=10)
-        fig.tight_layout(rect=(0, 0.04 + 0.035 * ((len(labels) + 5) // 6), 1, 1))
-        for ext in ("png", "svg"):
-            fig.savefig(os.path.join(out, f"error_vs_runtime_{family}-contact.{ext}"), dpi=110)
-        plt.close(fig)
+        save(fig, out, f"error_vs_runtime_{family}-contact",
+             rect=(0, 0.04 + 0.035 * ((len(labels) + 5) // 6), 1, 1))
 
 
 def readable_log_ticks(axis):

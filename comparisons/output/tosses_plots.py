@@ -30,13 +30,6 @@ def colour_of(names):
     return {n: backend_style.colour(n, names) for n in names}
 
 
-def save(fig, out, name):
-    fig.tight_layout()
-    for ext in ("png", "svg"):
-        fig.savefig(os.path.join(out, f"{name}.{ext}"), dpi=110)
-    plt.close(fig)
-
-
 def error_figure(report, out):
     """Per-toss position error distribution (box plots) and the median error over time."""
     per = rows(os.path.join(report, "tosses_per_toss.csv"))
@@ -86,7 +79,7 @@ def error_figure(report, out):
     bx.set_title("error over time, fitted parameters")
     bx.grid(True, alpha=0.3)
     bx.legend(fontsize=8)
-    save(fig, out, "tosses_errors")
+    backend_style.save(fig, out, "tosses_errors")
 
 
 def trajectory_figure(report, out):
@@ -119,7 +112,7 @@ def trajectory_figure(report, out):
             a.grid(True, alpha=0.3)
             a.set_xlabel("time after release (s)")
     axes[0][0].legend(fontsize=8)
-    save(fig, out, "tosses_trajectories")
+    backend_style.save(fig, out, "tosses_trajectories")
 
 
 def main():
