@@ -14,7 +14,7 @@ struct SatResult {
   Vec3 normal = Vec3::UnitZ();  // unit, world, from B toward A: minimum-translation direction
   double depth = 0.0;          // m: minimum translation distance (negative: separation lower bound)
   std::string axis_kind;       // "face_a" | "face_b" | "edge_edge"
-  std::vector<Vec3> manifold;  // contact polygon (world): clipped reference/incident faces
+  std::vector<Vec3> manifold;  // contact polygon (world): clipped reference and incident faces
 };
 
 namespace exact_detail {

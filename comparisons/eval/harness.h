@@ -22,7 +22,7 @@ struct HarnessOptions {
   /// Backends to choose from; nullptr: the registry (reference/registry.cpp). Tests pass their
   /// own table to add a failing backend without touching the registry.
   const std::vector<Backend>* registry = nullptr;
-  /// Reference-result cache folder (comparisons/result_cache.h); "" : no cache. Results are
+  /// Reference-result cache folder (comparisons/eval/result_cache.h); "" : no cache. Results are
   /// byte-identical either way; a cached backend's JSON says "cached": true (its timings are
   /// those of the run that filled the cache).
   std::string cache_dir;

@@ -5,7 +5,7 @@
 // backends match the closed form, the `-hull` variants keep the one-point hull's errors.
 //
 // Error measure: the report's velocity error in the kinetic-energy norm,
-// sqrt(sum m|dv|^2 + dw.I.dw) / sqrt(2 E_ref) (comparisons/metrics.h), recomputed here so that
+// sqrt(sum m|dv|^2 + dw.I.dw) / sqrt(2 E_ref) (comparisons/eval/metrics.h), recomputed here so that
 // this test needs the reference layer only. Thresholds: "exact" means below 1e-9 (a
 // sequential-impulse or LCP solve of a few contact rows in double rounds to ~1e-15; ODE's
 // CFM = 1e-10 softens each row by ~1e-7, hence its own bound); "clearly wrong" means above
@@ -135,7 +135,7 @@ std::vector<Case> box_cases() {
 }
 
 /// Velocity error in the kinetic-energy norm against the closed form; E_ref falls back to the
-/// initial kinetic energy when the reference is at rest (as comparisons/metrics.cpp does).
+/// initial kinetic energy when the reference is at rest (as comparisons/eval/metrics.cpp does).
 double ke_error(const Case& c, const DynamicsResult& r) {
   if (r.status != Status::Ok || r.finals.size() != c.scene.bodies.size()) return INFINITY;
   double num = 0, e_ref = 0, e0 = 0;
