@@ -1,5 +1,6 @@
 // A scene as plain data: simulation settings, body specifications and optional closed-form
-// expectations. Parsing lives in comparisons/scene/scene_file.h; the engine only consumes this struct.
+// expectations. Parsing lives in comparisons/scene/scene_file.h; the engine only consumes this
+// struct.
 #pragma once
 
 #include <memory>
