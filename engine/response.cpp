@@ -28,8 +28,12 @@ double impulse_magnitude(const RigidBody& a, const RigidBody& b, const ContactPo
 double apply_impulse(RigidBody& a, RigidBody& b, const ContactPoint& c, double restitution) {
   const double j = impulse_magnitude(a, b, c, restitution);
   if (j <= 0.0) return 0.0;
-  const Vec3 impulse = j * c.normal;
-  const Vec3 ra = c.point - a.position, rb = c.point - b.position;
+  apply_impulse_at(a, b, c.point, j * c.normal);
+  return j;
+}
+
+void apply_impulse_at(RigidBody& a, RigidBody& b, const Vec3& point, const Vec3& impulse) {
+  const Vec3 ra = point - a.position, rb = point - b.position;
   // seed correction 4 (velocity update signs): the seed subtracts on both bodies and writes J x r,
   // which does not conserve momentum; A (pushed along n, away from B) gains, B loses, and the
   // torque is r x J.
@@ -37,7 +41,6 @@ double apply_impulse(RigidBody& a, RigidBody& b, const ContactPoint& c, double r
   b.velocity -= b.inverse_mass * impulse;
   a.angular_velocity += a.inverse_inertia_world() * ra.cross(impulse);
   b.angular_velocity -= b.inverse_inertia_world() * rb.cross(impulse);
-  return j;
 }
 
 }  // namespace rbx

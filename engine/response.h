@@ -2,6 +2,8 @@
 // (impulse, velocity updates, world inertia)).
 #pragma once
 
+#include <functional>
+
 #include "engine/body.h"
 #include "engine/contact.h"
 
@@ -21,5 +23,15 @@ double impulse_magnitude(const RigidBody& a, const RigidBody& b, const ContactPo
 /// w_b -= Ib^-1 (r_b x j n) (seed correction 4 (velocity update signs)). Returns j (0: nothing
 /// applied).
 double apply_impulse(RigidBody& a, RigidBody& b, const ContactPoint& c, double restitution);
+
+/// Applies the impulse vector `impulse` (N s) at world point `point`: +impulse on A, -impulse on
+/// B, linear and angular (the velocity updates of apply_impulse).
+void apply_impulse_at(RigidBody& a, RigidBody& b, const Vec3& point, const Vec3& impulse);
+
+/// A response in place of the seed's impulse: the impulse vector (N s, applied +J on A, -J on B at
+/// the contact point) for a contact found by the seed's tests, from the bodies' states before it
+/// and the restitution.
+using ResponseFn = std::function<Vec3(const RigidBody& a, const RigidBody& b,
+                                      const ContactPoint& contact, double restitution)>;
 
 }  // namespace rbx

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
+#include <stdexcept>
 
 #include "engine/bounding.h"
 #include "engine/format.h"
@@ -53,6 +54,16 @@ void World::collide_pair(int i, int j, bool bounded) {
   for (Feature feature : {Feature::Face, Feature::Vertex, Feature::Edge}) {
     const auto contact = detection_.test(feature);
     if (!contact) continue;
+    if (response_) {
+      // A researcher's response (set_response): its impulse vector, applied as given.
+      const Vec3 impulse = response_(a, b, *contact, sim_.restitution);
+      if (!impulse.allFinite())
+        throw std::runtime_error("the response returned a non-finite impulse");
+      if (impulse.isZero(0.0)) continue;
+      apply_impulse_at(a, b, contact->point, impulse);
+      events_.push_back({time_, step_, a.name, b.name, *contact, impulse.dot(contact->normal)});
+      continue;
+    }
     const double j_mag = apply_impulse(a, b, *contact, sim_.restitution);
     if (j_mag > 0.0) events_.push_back({time_, step_, a.name, b.name, *contact, j_mag});
   }

@@ -12,6 +12,7 @@
 #include "engine/contact_solver.h"
 #include "engine/detect.h"
 #include "engine/integrate.h"
+#include "engine/response.h"
 #include "engine/scene.h"
 #include "engine/separation.h"
 #include "engine/settings.h"
@@ -71,6 +72,11 @@ class World {
   /// Chooses the response (default Seed: the seed's single-point impulse). Extended: manifolds,
   /// friction, resting contact, time of impact (engine/contact_solver.h, world_extended.cpp).
   void set_contact_model(ContactModel model) { contact_model_ = model; }
+  /// Seed model only: each hit is resolved by `response` instead of the seed's single-point
+  /// impulse (a researcher's own response, engine/response.h); an empty function restores it.
+  /// An event is recorded for every non-zero impulse, with its normal component as `impulse`;
+  /// a non-finite impulse throws std::runtime_error (step() and run() pass it on).
+  void set_response(ResponseFn response) { response_ = std::move(response); }
 
   /// The bodies in their current state, in scene order.
   const std::vector<RigidBody>& bodies() const { return bodies_; }
@@ -114,6 +120,7 @@ class World {
   DetectorVariant variant_;
   DetectionCache detection_;  // the pair being resolved: placed once per pair per step
   ContactModel contact_model_ = ContactModel::Seed;
+  ResponseFn response_;     // empty: the seed's impulse
   WorldSettings tunables_;  // before the broad phases, which are built from it
   BroadPhase broad_phase_;
   // The extended step's second broad phase, on the poses at the step's end (new contacts).

@@ -135,7 +135,8 @@ Vec3 vec_of(const py::handle& x, const std::string& what) {
   } catch (const py::cast_error&) {
     throw std::runtime_error(what + " is not a sequence of 3 numbers");
   }
-  if (v.size() != 3) throw std::runtime_error(what + " has " + std::to_string(v.size()) + " numbers, not 3");
+  if (v.size() != 3)
+    throw std::runtime_error(what + " has " + std::to_string(v.size()) + " numbers, not 3");
   const Vec3 r(v[0], v[1], v[2]);
   if (!r.allFinite()) throw std::runtime_error(what + " is not finite");
   return r;
@@ -261,8 +262,8 @@ PYBIND11_MODULE(_rbx, m) {
   m.def("command_line", &rbx::command_line_in_process, py::arg("args"),
         "Runs `rbx ARGS...` in this process: (exit code, stdout text, stderr text).");
   m.def("backends", &rbx::backend_rows, "Every registry row as a dict.");
-  m.def("register_contact_backend", &rbx::register_contact, py::arg("name"),
-        py::arg("description"), py::arg("fn"), "Adds a Python contact function as a backend.");
+  m.def("register_contact_backend", &rbx::register_contact, py::arg("name"), py::arg("description"),
+        py::arg("fn"), "Adds a Python contact function as a backend.");
   m.def("register_response_backend", &rbx::register_response, py::arg("name"),
         py::arg("description"), py::arg("fn"), "Adds a Python collision response as a backend.");
 }

@@ -50,13 +50,15 @@ BodyFinal final_of(const RigidBody& b) {
   return {b.name, b.position, b.orientation, b.velocity, b.angular_velocity};
 }
 
-DynamicsResult run_dynamics(const Scene& scene, const DynamicsOptions& opt, ContactModel model) {
+DynamicsResult run_dynamics(const Scene& scene, const DynamicsOptions& opt, ContactModel model,
+                            const ResponseFn& response = {}) {
   DynamicsResult r;
   try {
     SimSettings sim = scene.sim;
     if (opt.dt > 0) sim.dt = opt.dt;
     World world(sim, make_bodies(scene));
     world.set_contact_model(model);
+    world.set_response(response);
     const long steps = sim.steps();
     DynamicsRecorder recorder(r, opt, [&] {
       std::vector<BodyFinal> states;
@@ -92,6 +94,11 @@ DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt) {
 
 DynamicsResult custom_seed_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   return run_dynamics(scene, opt, ContactModel::Seed);
+}
+
+DynamicsResult custom_seed_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+                                         const ResponseFn& response) {
+  return run_dynamics(scene, opt, ContactModel::Seed, response);
 }
 
 }  // namespace rbx

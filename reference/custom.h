@@ -1,6 +1,7 @@
 // The custom engine behind the backend interface.
 #pragma once
 
+#include "engine/response.h"
 #include "reference/backend.h"
 
 namespace rbx {
@@ -17,5 +18,9 @@ DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt);
 /// Whole-scene run with the seed's algorithm and its corrections only: first hit, single-point
 /// frictionless impulse, no time of impact (the `custom-seed` backend).
 DynamicsResult custom_seed_dynamics(const Scene& scene, const DynamicsOptions& opt);
+/// custom_seed_dynamics with each hit resolved by `response` (World::set_response): a
+/// researcher's own collision response over the seed's contacts.
+DynamicsResult custom_seed_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+                                         const ResponseFn& response);
 
 }  // namespace rbx

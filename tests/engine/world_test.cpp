@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "engine/response.h"
 #include "tests/common/fixtures.h"
 
 namespace rbx {
@@ -92,6 +93,46 @@ TEST(World, RunsAreBitwiseDeterministic) {
         std::memcmp(r1.bodies[i].velocity.data(), r2.bodies[i].velocity.data(), 3 * sizeof(double)),
         0);
   }
+}
+
+// A response given as a function (World::set_response, the hook behind a researcher's own
+// response backend) replaces the seed's impulse: handed the seed's own impulse it reproduces the
+// seed's run bit for bit; handed e = 1 on an e = 0.5 scene it bounces elastically.
+TEST(World, AResponseFunctionReplacesTheSeedsImpulse) {
+  std::vector<RigidBody> bodies;
+  for (int i = 0; i < 6; ++i)
+    bodies.push_back(box_body("b" + std::to_string(i), Vec3(0.5, 0.6, 0.7), 1 + i,
+                              Vec3(0.8 * i, 0.1 * (i % 2), 0),
+                              Quat(Eigen::AngleAxisd(0.3 * i, Vec3(1, 1, 0).normalized())),
+                              Vec3(i % 2 ? -1 : 1, 0.1, 0), Vec3(0, 0, 0.5 * i)));
+  World seed(sim_with(1e-3, 0.5, 0.8), bodies), hooked(sim_with(1e-3, 0.5, 0.8), bodies);
+  hooked.set_response([](const RigidBody& a, const RigidBody& b, const ContactPoint& c,
+                         double e) -> Vec3 { return impulse_magnitude(a, b, c, e) * c.normal; });
+  const RunResult r1 = seed.run(), r2 = hooked.run();
+  ASSERT_EQ(r1.events.size(), r2.events.size());
+  EXPECT_GT(r1.events.size(), 0u);
+  for (size_t i = 0; i < r1.bodies.size(); ++i) {
+    EXPECT_EQ(
+        std::memcmp(r1.bodies[i].velocity.data(), r2.bodies[i].velocity.data(), 3 * sizeof(double)),
+        0);
+    EXPECT_EQ(std::memcmp(r1.bodies[i].angular_velocity.data(),
+                          r2.bodies[i].angular_velocity.data(), 3 * sizeof(double)),
+              0);
+  }
+  std::vector<RigidBody> pair = {
+      box_body("A", Vec3::Ones(), 1, Vec3(-0.75, 0, 0), Quat::Identity(), Vec3(1, 0, 0)),
+      box_body("B", Vec3::Ones(), 1, Vec3(0.75, 0, 0), Quat::Identity(), Vec3(-1, 0, 0))};
+  World elastic(sim_with(1e-3, 0.6, 0.5), pair);
+  elastic.set_response([](const RigidBody& a, const RigidBody& b, const ContactPoint& c,
+                          double) -> Vec3 { return impulse_magnitude(a, b, c, 1.0) * c.normal; });
+  const RunResult r = elastic.run();
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_LT((r.bodies[0].velocity - Vec3(-1, 0, 0)).norm(), 1e-12);  // e = 1's exchange
+  World broken(sim_with(1e-3, 0.6, 0.5), pair);
+  broken.set_response([](const RigidBody&, const RigidBody&, const ContactPoint&, double) {
+    return Vec3(NAN, 0, 0);
+  });
+  EXPECT_THROW(broken.run(), std::runtime_error);
 }
 
 TEST(World, NonFiniteStateStopsTheRunNamingBodyAndQuantity) {

@@ -1,0 +1,266 @@
+"""The Python module rbx: the same documents as the command line, numpy where arrays belong, a
+researcher's contact and response functions as backends, and clear errors.
+
+Run by ctest (tests/CMakeLists.txt) as `python3 -m pytest tests/python`, with the module on
+PYTHONPATH and RBX_EXECUTABLE naming the command-line rbx of the same build.
+"""
+import glob
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import rbx
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+EXE = os.environ.get("RBX_EXECUTABLE", os.path.join(ROOT, "build", "comparisons", "rbx"))
+sys.path.insert(0, os.path.join(ROOT, "examples"))
+from sat_backend import sat_contact  # noqa: E402
+
+
+def without_timings(x):
+    """The document with every run time removed (the only thing allowed to differ)."""
+    if isinstance(x, dict):
+        return {k: without_timings(v) for k, v in x.items() if "runtime" not in k}
+    if isinstance(x, list):
+        return [without_timings(v) for v in x]
+    return x
+
+
+def cli_json(*args):
+    out = subprocess.run([EXE, *args, "--json", "-"], capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode in (0, 1), out.stderr
+    return json.loads(out.stdout)
+
+
+# -- the same answers as the command line ----------------------------------------------------
+
+def same_documents(scenes, backends):
+    cli = cli_json("compare", *scenes, *(["--backends", backends] if backends else []))
+    py = rbx.compare(scenes, backends=backends)
+    assert len(py["scenes"]) == len(scenes)
+    for a, b in zip(cli["scenes"], py["scenes"]):
+        assert without_timings(a) == without_timings(b), a["scene"]
+
+
+def test_compare_is_the_command_lines_document_on_every_scene():
+    # Every scene, through a contact library, a dynamics library, the custom engine and the
+    # oracle (the scene's own backends among them where it names some) ...
+    scenes = sorted(glob.glob(os.path.join(ROOT, "scenes", "*", "*.toml")))
+    assert len(scenes) > 100
+    same_documents(scenes, "exact,fcl,bullet,custom-seed")
+    # ... and every backend the scene uses on the first scene of each family (all of them on
+    # every scene would take minutes for no other path: the document is built the same way).
+    firsts = {}
+    for path in scenes:
+        firsts.setdefault(os.path.basename(os.path.dirname(path)), path)
+    same_documents(sorted(firsts.values()), None)
+
+
+@pytest.mark.parametrize("scene", ["seed/face_face.toml", "analytic/headon_vertex_e05.toml",
+                                   "friction/incline_slide.toml"])
+def test_run_is_the_command_lines_document(scene):
+    path = os.path.join(ROOT, "scenes", scene)
+    backends = "custom,bullet,ode"
+    assert without_timings(cli_json("run", path, "--backends", backends)) == \
+        without_timings(rbx.run(path, backends=backends.split(",")))
+
+
+def test_contacts_is_the_command_lines_document_and_a_dict_scene_is_a_file():
+    path = os.path.join(ROOT, "scenes", "contact", "fcl_rotated_45.toml")
+    assert without_timings(cli_json("contacts", path)) == without_timings(rbx.contacts(path))
+    scene = {"name": "tilted", "description": "a cube turned 45 deg on a slab",
+             "checks": ["contact"], "sim": {"duration": 0},
+             "body": [{"name": "A", "rotation": [0, 45, 0]},
+                      {"name": "B", "size": [3, 3, 3], "position": [0, 0, -1.5]}],
+             "expect": {"tolerance": 1e-6, "contact": {"normal": [0, 0, 1],
+                                                       "depth": 0.7071067811865476}}}
+    doc = rbx.contacts(scene, backends=["exact"])
+    c = doc["backends"]["exact"]["contacts"][0]
+    assert np.allclose(c["normal"], [0, 0, 1]) and abs(c["depth"] - 0.5 ** 0.5) < 1e-12
+
+
+def test_backends_lists_every_registry_row_with_its_kind():
+    rows = {b["name"]: b for b in rbx.backends()}
+    assert rows["exact"]["kind"] == ["contact"]
+    assert rows["custom-seed"]["kind"] == ["dynamics"]
+    assert rows["bullet"]["kind"] == ["contact", "dynamics"]
+    assert all(b["description"] for b in rows.values())
+
+
+# -- numpy -----------------------------------------------------------------------------------
+
+def test_one_contact_query_returns_numpy_arrays():
+    cube = {"size": [1, 1, 1], "position": [0, 0, 0.4]}
+    slab = {"vertices": np.array([[x, y, z] for x in (-2, 2) for y in (-2, 2) for z in (-1, 0)],
+                                 dtype=float)}
+    for backend in ("exact", "fcl"):
+        cs = rbx.contact(cube, slab, backend=backend)
+        assert len(cs) >= 1
+        for c in cs:
+            assert c["point"].shape == (3,) and c["point"].dtype == np.float64
+            assert c["normal"].shape == (3,) and c["normal"].dtype == np.float64
+            assert isinstance(c["depth"], float)
+        deepest = max(cs, key=lambda c: c["depth"])
+        # The cube's bottom at z = -0.1, the slab's top at 0: 0.1 deep, normal +z (B toward A).
+        assert np.allclose(deepest["normal"], [0, 0, 1], atol=1e-6)
+        assert abs(deepest["depth"] - 0.1) < 1e-6
+    assert rbx.contact(cube, {"size": [1, 1, 1], "position": [5, 0, 0]}) == []
+
+
+def test_a_contact_function_agrees_with_the_oracle_and_is_listed():
+    rbx.register_contact_backend("py-sat", sat_contact)
+    path = os.path.join(ROOT, "scenes", "contact", "fcl_rotated_45.toml")
+    doc = rbx.contacts(path, backends=["py-sat", "exact"])
+    ours = doc["backends"]["py-sat"]
+    assert ours["status"] == "ok", ours["message"]
+    assert np.allclose(ours["contacts"][0]["normal"], [0, 0, 1], atol=1e-9)
+    assert abs(ours["contacts"][0]["depth"] - 0.5 ** 0.5) < 1e-9
+    row = [b for b in rbx.backends() if b["name"] == "py-sat"][0]
+    assert row["user"] and row["kind"] == ["contact"]
+
+
+def test_the_arguments_a_contact_function_gets():
+    shapes = {}
+
+    def probe(a, b):
+        for name, body in (("a", a), ("b", b)):
+            shapes[name] = {k: (v.shape, str(v.dtype)) for k, v in body.items()
+                            if isinstance(v, np.ndarray)}
+        if shapes["a"]["vertices"] != ((8, 3), "float64") or \
+           shapes["a"]["faces"] != ((12, 3), "int64") or \
+           shapes["a"]["position"] != ((3,), "float64") or \
+           shapes["a"]["orientation"] != ((4,), "float64"):
+            raise AssertionError(f"unexpected arguments {shapes['a']}")
+        # World-frame vertices: the box of size 1 at (0, 0, 0.4) spans z 0.4 +- 0.5.
+        if abs(a["vertices"][:, 2].min() + 0.1) > 1e-12:
+            raise AssertionError("vertices are not in the world frame")
+        return [{"point": [0, 0, 0], "normal": [0, 0, 1], "depth": 0.1}]
+
+    rbx.register_contact_backend("py-probe", probe)
+    cs = rbx.contact({"size": [1, 1, 1], "position": [0, 0, 0.4]},
+                     {"size": [4, 4, 1], "position": [0, 0, -0.5]}, backend="py-probe")
+    assert len(cs) == 1 and cs[0]["depth"] == 0.1
+
+
+# -- a wrong function is found, and shrunk to a scene ----------------------------------------
+
+def flipped_sat(a, b):
+    """sat_contact with the normal reversed: wrong on every touching pose."""
+    return [dict(c, normal=-np.asarray(c["normal"])) for c in sat_contact(a, b)]
+
+
+def test_a_wrong_normal_is_flagged_and_explore_shrinks_it_to_a_scene(tmp_path):
+    rbx.register_contact_backend("py-flipped", flipped_sat)
+    path = os.path.join(ROOT, "scenes", "contact", "axis_z.toml")
+    rbx.register_contact_backend("py-sat-2", sat_contact)
+    doc = rbx.compare(path, backends=["py-flipped", "py-sat-2", "exact"])
+    metrics = {(m["backend"], m["name"]): m["value"] for m in doc["scenes"][0]["metrics"]}
+    assert metrics[("py-flipped", "normal_err_deg")] > 179
+    assert metrics[("py-sat-2", "normal_err_deg")] < 1e-6
+    ex = rbx.explore(count=60, seed=3, backends=["py-flipped", "py-sat-2"], out=tmp_path,
+                     figure=False, shrink_budget=40)
+    b = ex["backends"]["py-flipped"]
+    # Every touching sample shows the flip (separated ones cannot); the same SAT unflipped has
+    # its normals right (its disagreements, if any, are about the point it places).
+    assert b["rate"] > 0.2 and all(g["signature"].endswith(" normal") for g in b["groups"])
+    assert not any(g["signature"].endswith(" normal")
+                   for g in ex["backends"]["py-sat-2"]["groups"])
+    scenes = [g["scene"] for g in b["groups"] if g["scene"]]
+    assert scenes, b["groups"]
+    shrunk = os.path.join(tmp_path, "scenes", os.path.basename(scenes[0]))
+    # The shrunk scene reproduces the disagreement through the harness.
+    again = rbx.compare(shrunk, backends=["py-flipped", "exact"])
+    flags = again["scenes"][0]["disagreements"] + \
+        [m for m in again["scenes"][0]["metrics"]
+         if m["backend"] == "py-flipped" and m["name"] == "normal_err_deg" and m["value"] > 90]
+    assert flags
+
+
+# -- a response function ---------------------------------------------------------------------
+
+def seed_response(a, b, contact, e):
+    """The seed's single-point impulse in numpy: the closed forms hold."""
+    n, p = contact["normal"], contact["point"]
+    ra, rb = p - a["position"], p - b["position"]
+    v = (a["velocity"] + np.cross(a["angular_velocity"], ra)) - \
+        (b["velocity"] + np.cross(b["angular_velocity"], rb))
+    vn = v @ n
+    if vn >= 0:
+        return np.zeros(3)
+    k = a["inverse_mass"] + b["inverse_mass"] + \
+        np.cross(ra, n) @ a["inverse_inertia"] @ np.cross(ra, n) + \
+        np.cross(rb, n) @ b["inverse_inertia"] @ np.cross(rb, n)
+    return -(1 + e) * vn / k * n
+
+
+def elastic_always(a, b, contact, e):
+    """Ignores the restitution: every impact perfectly elastic."""
+    return seed_response(a, b, contact, 1.0)
+
+
+def test_a_response_that_ignores_restitution_fails_the_closed_forms():
+    rbx.register_response_backend("py-seed-response", seed_response)
+    rbx.register_response_backend("py-elastic", elastic_always)
+    for scene in ("analytic/headon_vertex_e05.toml", "analytic/corner_drop_e05.toml"):
+        path = os.path.join(ROOT, "scenes", scene)
+        doc = rbx.compare(path, backends=["py-seed-response", "py-elastic", "custom-seed"])
+        s = doc["scenes"][0]
+        flagged = " ".join(s["expect"]["failures"] + s["disagreements"])
+        assert "py-elastic" in flagged, s
+        assert "py-seed-response" not in flagged, s
+        # The seed's impulse written in numpy gives custom-seed's numbers, to round-off (numpy
+        # sums the products in another order than Eigen).
+        ours = {(m["check"], m["pair"], m["name"]): m["value"] for m in s["metrics"]
+                if m["backend"] == "py-seed-response"}
+        theirs = {(m["check"], m["pair"], m["name"]): m["value"] for m in s["metrics"]
+                  if m["backend"] == "custom-seed"}
+        assert ours.keys() == theirs.keys() and ours
+        for k, v in theirs.items():
+            assert abs(ours[k] - v) <= 1e-9 * max(1.0, abs(v)), (k, ours[k], v)
+
+
+# -- errors ----------------------------------------------------------------------------------
+
+def test_an_exception_or_a_wrong_return_type_is_that_backends_error():
+    rbx.register_contact_backend("py-raises", lambda a, b: 1 / 0)
+    rbx.register_contact_backend("py-returns-int", lambda a, b: 7)
+    rbx.register_contact_backend("py-no-depth", lambda a, b: [{"point": [0, 0, 0],
+                                                              "normal": [0, 0, 1]}])
+    path = os.path.join(ROOT, "scenes", "contact", "axis_z.toml")
+    doc = rbx.contacts(path, backends=["py-raises", "py-returns-int", "py-no-depth", "exact"])
+    bs = doc["backends"]
+    assert bs["py-raises"]["status"] == "error"
+    assert "ZeroDivisionError: division by zero" in bs["py-raises"]["message"]
+    assert bs["py-returns-int"]["status"] == "error"
+    assert "returned int" in bs["py-returns-int"]["message"]
+    assert 'no "depth"' in bs["py-no-depth"]["message"]
+    assert bs["exact"]["status"] == "ok"  # the run went on
+
+
+def test_bad_arguments_raise_with_one_line():
+    with pytest.raises(TypeError, match="scene: a path or a dict"):
+        rbx.compare(42)
+    with pytest.raises(ValueError) as e:
+        rbx.compare(os.path.join(ROOT, "no_such_scene.toml"))
+    assert "no_such_scene.toml" in str(e.value) and "\n" not in str(e.value)
+    with pytest.raises(ValueError, match="empty"):
+        rbx.compare(os.path.join(ROOT, "scenes", "contact", "axis_z.toml"), backends=[])
+    with pytest.raises(ValueError, match="unknown"):
+        rbx.compare(os.path.join(ROOT, "scenes", "contact", "axis_z.toml"),
+                    backends=["no-such-backend"])
+    with pytest.raises(TypeError, match="fn: a function"):
+        rbx.register_contact_backend("py-not-callable", 3)
+    with pytest.raises(ValueError, match="taken"):
+        rbx.register_contact_backend("exact", sat_contact)
+    with pytest.raises(ValueError, match="vertices must be N x 3"):
+        rbx.contact({"vertices": [[0, 0, 0]]}, {"size": [1, 1, 1]})
+    with pytest.raises(ValueError, match="unknown key 'mass'"):
+        rbx.contact({"size": [1, 1, 1], "mass": 2}, {"size": [1, 1, 1]})
+    bad_scene = {"name": "bad", "checks": ["contact"], "sim": {"duration": 0},
+                 "body": [{"name": "A", "mass": -1}, {"name": "B", "position": [0, 0, -1]}]}
+    with pytest.raises(ValueError, match="mass"):
+        rbx.compare(bad_scene)
