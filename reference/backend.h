@@ -191,10 +191,17 @@ struct Backend {
   MassFn mass = nullptr;    // empty: the library computes no mass properties of a hull
   bool library = true;      // an outside library's code: isolated with a deadline per call
   bool friction = true;     // its dynamics apply Coulomb friction (false: mu is ignored)
+  bool user = false;        // registered at run time (register_backend): never cached
 };
 
-/// Every backend, in report order.
+/// Every backend, in report order; those added by register_backend last.
 const std::vector<Backend>& backends();
+/// Adds a backend to the registry for the rest of the process (a researcher's own, from Python):
+/// it is marked `user` (its results are never cached: its code is not hashed). Throws
+/// std::invalid_argument on an empty or taken name, a name with a comma or a space, or a
+/// backend with neither a contact query nor dynamics. Call it before any run starts: pointers
+/// to registry rows (find_backend) may move.
+void register_backend(Backend b);
 /// The backend called `name`, or nullptr.
 const Backend* find_backend(const std::string& name);
 /// The backend called `name` in `table` (null: the registry), or nullptr.

@@ -1,4 +1,6 @@
 // The backend registry: one line per backend, readable at a glance.
+#include <stdexcept>
+
 #include "reference/backend.h"
 #include "reference/bullet.h"
 #include "reference/custom.h"
@@ -26,12 +28,14 @@ const char* to_string(Status s) {
   return "error";
 }
 
-const std::vector<Backend>& backends() {
+namespace {
+
+std::vector<Backend>& registry_table() {
   // name, description, contact query, dynamics run, mass properties, library (isolated).
   // Plain names: the library as its experts use it (native primitives where a body is one);
   // `-hull`: every body the same convex hull the custom engine gets. The former `fcl-box`
   // (Box-Box only) is what `fcl` runs on two boxes, so it is gone as a duplicate.
-  static const std::vector<Backend> table = {
+  static std::vector<Backend> table = {
       {"custom",
        "rbx engine, extended: Moore & Wilhelms tests with the plane of least overlap, contact "
        "manifolds, Coulomb friction, resting contact, time of impact for every new contact",
@@ -67,6 +71,21 @@ const std::vector<Backend>& backends() {
        ode_hull_contact, ode_hull_dynamics},
   };
   return table;
+}
+
+}  // namespace
+
+const std::vector<Backend>& backends() { return registry_table(); }
+
+void register_backend(Backend b) {
+  if (b.name.empty() || b.name.find_first_of(", \t\n") != std::string::npos)
+    throw std::invalid_argument("backend name '" + b.name +
+                                "': one word without commas or spaces, please");
+  if (find_backend(b.name)) throw std::invalid_argument("backend name '" + b.name + "' is taken");
+  if (!b.contact && !b.dynamics)
+    throw std::invalid_argument("backend '" + b.name + "' has neither contact nor dynamics");
+  b.user = true;
+  registry_table().push_back(std::move(b));
 }
 
 const Backend* find_backend(const std::string& name) { return find_backend(name, nullptr); }

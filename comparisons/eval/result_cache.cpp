@@ -69,6 +69,8 @@ std::optional<CachedResult<Result>> decode(const std::optional<std::string>& byt
 }  // namespace
 
 bool ResultCache::caches(const std::string& backend) {
+  const Backend* b = find_backend(backend);
+  if (b && b->user) return false;  // a registered function's code is not in the key
   return backend != "exact" && backend.rfind("custom", 0) != 0;
 }
 

@@ -36,7 +36,8 @@ class ResultCache {
   explicit ResultCache(std::string dir = "", std::string code = code_fingerprint())
       : dir_(std::move(dir)), code_(std::move(code)) {}
 
-  /// True when results of `backend` may be cached: every backend except ours (custom*, exact).
+  /// True when results of `backend` may be cached: every backend except ours (custom*, exact) and
+  /// those registered at run time (Backend::user).
   static bool caches(const std::string& backend);
   /// The folder used by `rbx check` unless --no-cache: build/cache in the build tree.
   static std::string default_dir();
