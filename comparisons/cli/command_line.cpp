@@ -1,5 +1,6 @@
-// The `rbx` command: parses arguments, dispatches to a subcommand, maps failures to exit codes
-// (0 success, 1 a check failed, 2 bad input or usage, with one line on stderr).
+// The `rbx` command line: parses arguments, dispatches to a subcommand, maps failures to exit
+// codes (0 success, 1 a check failed, 2 bad input or usage, with one line on stderr). The `rbx`
+// executable (main.cpp) and the Python module (python/rbx_module.cpp) both run it.
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <filesystem>
@@ -185,7 +186,7 @@ int dispatch(CLI::App& app, const Options& o) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int rbx::command_line(int argc, char** argv) {
   CLI::App app{"rbx: rigid-body collision detection and response testbed"};
   app.require_subcommand(1);
   Options o;

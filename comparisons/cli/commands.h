@@ -12,6 +12,10 @@
 
 namespace rbx {
 
+/// The whole `rbx` command line (argv[0] is the program's name): parses, runs the subcommand,
+/// prints as the executable does and returns its exit code (0, 1 a check failed, 2 bad input).
+int command_line(int argc, char** argv);
+
 /// Options shared by the scene commands.
 struct SceneCommandOptions {
   std::vector<std::string> scenes;  // scene files (compare takes several)
