@@ -2,6 +2,7 @@
 # rbx: one entry point. First use installs missing Debian packages, configures CMake (Release,
 # build/), builds incrementally, then runs the compiled `rbx` with the same arguments.
 # `./rbx test [--sanitize]` builds and runs the whole test suite with ctest.
+# `./rbx python [ARGS...]` builds the Python module and runs python3 with `import rbx` working.
 # `./rbx format [--check]` applies (or checks) clang-format on every tracked C++ source.
 # `./rbx fuzz [SECONDS]` builds the libFuzzer targets (tests/fuzz) with clang, ASan and UBSan in
 # build-fuzz/ and runs each for SECONDS (default 60) from its seed corpus.
@@ -15,7 +16,10 @@ cd "$here"
 packages=(cmake g++ pkg-config libeigen3-dev libbullet-dev libfcl-dev libccd-dev libgtest-dev
           libbenchmark-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libmujoco-dev
           libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib zlib1g-dev
-          libjs-three chromium python3-pil libopenmpi-dev openmpi-bin)
+          libjs-three chromium python3-pil libopenmpi-dev openmpi-bin python3-dev pybind11-dev
+          python3-numpy python3-pytest)
+# python3-dev, pybind11-dev, python3-numpy, python3-pytest: the Python module (`./rbx python`,
+# python/) and its tests.
 # libjs-three: three.js for the replay pages (`rbx view`, report views/); chromium and python3-pil:
 # the browser test of those pages (headless screenshots read with PIL).
 # `./rbx format [--check]` needs clang-format (Debian's `clang-format`, version 14 here).
@@ -34,7 +38,7 @@ fi
 # queries, no build check); anything else takes the full path below.
 stamp=build/.rbx-packages-found
 case "${1:-}" in
-  test | format | fuzz) ;;
+  test | format | fuzz | python) ;;
   *)
     if [ -x build/comparisons/rbx ] && [ -f "$stamp" ] && [ "$stamp" -nt /var/lib/dpkg/status ] &&
        [ "$(cat "$stamp")" = "${packages[*]}" ] &&
@@ -138,6 +142,9 @@ fi
 build_dir=build
 cmake_flags=(-DCMAKE_BUILD_TYPE=Release)
 targets=(--target rbx)  # the scene commands need the rbx executable only; `test` builds everything
+if [ "${1:-}" = "python" ]; then
+  targets=(--target _rbx)
+fi
 if [ "${1:-}" = "test" ]; then
   targets=()
   if [ "${2:-}" = "--sanitize" ]; then
@@ -186,4 +193,11 @@ if [ "${1:-}" = "test" ]; then
   exec ctest --output-on-failure -j "$jobs"
 fi
 cd "$caller"
+# `./rbx python [ARGS...]`: Debian's python3 (its numpy and matplotlib) with the module rbx
+# importable from this tree; nothing is installed.
+if [ "${1:-}" = "python" ]; then
+  shift
+  export PYTHONPATH="$here/python:$here/$build_dir/python${PYTHONPATH:+:$PYTHONPATH}"
+  exec /usr/bin/python3 "$@"
+fi
 exec "$here/$build_dir/comparisons/rbx" "$@"
