@@ -4,7 +4,7 @@ over the size limit.
 
 Usage: citations.py ROOT [MAX_LINES]
 Reads the comments of the C++ sources, scripts and CMake files under engine/, reference/,
-comparisons/, tests/ and examples/ (a path in a string literal is a program's input, not a
+comparisons/, tests/, examples/, python/ and scenes/ (a path in a string literal is a program's input, not a
 citation), and the Markdown files at the top and under docs/. A citation is a path that
 starts at one of the repository's top folders ("engine/world.h", "docs/style.md:12") or a
 Markdown file named in capitals (such as the README); each must name a file or folder of the
@@ -17,7 +17,8 @@ import os
 import re
 import sys
 
-TOP = ("engine", "reference", "comparisons", "tests", "docs", "scenes", "reports", "examples")
+TOP = ("engine", "reference", "comparisons", "tests", "docs", "scenes", "reports", "examples",
+       "python")
 # Paths the program writes or the user supplies, named in the text as such, not files of ours.
 GENERATED = ("reports/latest", "reports/perf.md", "reports/explore", "build", "scenes/x.toml")
 CITATION = re.compile(r"(?<![\w./-])((?:%s)/[\w./-]*[\w])" % "|".join(TOP))
@@ -27,10 +28,11 @@ CAPITAL_MD = re.compile(r"(?<![\w/.-])([A-Z][A-Z_]+\.md)\b")
 def sources(root):
     """The files read, relative to root."""
     patterns = []
-    for top in ("engine", "reference", "comparisons", "tests", "examples"):
+    for top in ("engine", "reference", "comparisons", "tests", "examples", "python"):
         for ext in ("h", "cpp", "py", "sh", "js", "txt", "toml"):
             patterns.append(f"{top}/**/*.{ext}")
-    patterns += ["*.md", "docs/*.md", "rbx", ".ci/run", "CMakeLists.txt"]
+    patterns += ["*.md", "docs/*.md", "rbx", ".ci/run", "CMakeLists.txt", "scenes/**/*.toml",
+                 "scenes/**/*.md", "python/**/*.py", "python/**/*.cpp", "python/CMakeLists.txt"]
     found = set()
     for p in patterns:
         found.update(glob.glob(os.path.join(root, p), recursive=True))
