@@ -37,8 +37,11 @@ struct Options {
 
 // run, contacts, compare: the commands on scene files.
 void add_scene_commands(CLI::App& app, Options& o) {
-  scene_options(app.add_subcommand("run", "custom engine only: collision events and final state"),
-                o.run, false, true);
+  CLI::App* run = app.add_subcommand("run", "custom engine only: collision events and final state");
+  scene_options(run, o.run, false, true);
+  run->add_option("--sample-every", o.run.sample_every,
+                  "with --json: each backend's trajectory, every N steps")
+      ->check(CLI::PositiveNumber);
   CLI::App* contacts =
       app.add_subcommand("contacts", "contact query at the t=0 poses, every backend");
   scene_options(contacts, o.contacts, false, true);

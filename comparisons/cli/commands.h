@@ -24,6 +24,7 @@ struct SceneCommandOptions {
   std::string backends;             // --backends LIST ("" : the scene's, or every one)
   bool force = false;               // --force: accept absurd step counts
   std::string at;                   // contacts --at: "" (t = 0) | "first-contact"
+  long sample_every = 0;            // run --sample-every N: the trajectory, every N steps
 };
 
 /// Loads a scene applying --set and --force (InputError on bad input).

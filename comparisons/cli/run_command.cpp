@@ -62,7 +62,7 @@ int run_command(const SceneCommandOptions& opt) {
       r.status = Status::Unsupported;
       r.message = name + " has no dynamics (contact queries only)";
     } else {
-      TimedDynamics t = run_dynamics_isolated(*b, scene, DynamicsOptions{});
+      TimedDynamics t = run_dynamics_isolated(*b, scene, DynamicsOptions{0.0, opt.sample_every});
       r = std::move(t.result);
       runtime = t.runtime_s;
     }

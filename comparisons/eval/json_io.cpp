@@ -81,6 +81,22 @@ Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsRe
   j["contacts"] = events;
   j["bodies"] = bodies_json(inputs, &r.finals);
   j["first_impulse"] = first_impulse_json(r.first_impulse);
+  // The sampled states (DynamicsOptions::sample_every), frame by frame: one row per body of
+  // position (centre of mass) and orientation (w, x, y, z).
+  if (!r.samples.empty()) {
+    Json time = Json::array(), states = Json::array();
+    for (const StateSample& s : r.samples) {
+      time.push_back(s.time);
+      Json frame = Json::array();
+      for (const BodyFinal& b : s.bodies)
+        frame.push_back({b.position.x(), b.position.y(), b.position.z(), b.orientation.w(),
+                         b.orientation.x(), b.orientation.y(), b.orientation.z()});
+      states.push_back(frame);
+    }
+    Json names = Json::array();
+    for (const BodyFinal& b : r.samples.front().bodies) names.push_back(b.name);
+    j["trajectory"] = {{"time", time}, {"bodies", names}, {"states", states}};
+  }
   return j;
 }
 

@@ -37,7 +37,9 @@ Json final_json(const BodyFinal& f);
 Json settings_json(const Scene& scene);
 
 /// One backend's dynamics result in the contract's shape: status, message, runtime_s,
-/// contacts (collision events), bodies (inputs at t = 0 and final state), first_impulse.
+/// contacts (collision events), bodies (inputs at t = 0 and final state), first_impulse, and
+/// when states were sampled, trajectory {time: [t], bodies: [names, in scene order],
+/// states: [frame][body][px, py, pz, qw, qx, qy, qz]}.
 Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsResult& r,
                           double runtime_s);
 

@@ -22,7 +22,7 @@ import numpy as np
 
 import _rbx
 
-__all__ = ["backends", "compare", "run", "contacts", "contact", "explore", "tosses", "check",
+__all__ = ["backends", "compare", "run", "trajectory", "contacts", "contact", "explore", "tosses", "check",
            "report", "register_contact_backend", "register_response_backend", "scene_toml"]
 
 
@@ -181,11 +181,29 @@ def compare(scene, backends=None, sets=None, force=False):
                           (["--force"] if force else []))
 
 
-def run(scene, backends=None, sets=None, force=False):
-    """`rbx run SCENE --json`: collision events and final states (custom, plus `backends`)."""
+def run(scene, backends=None, sets=None, force=False, sample_every=None):
+    """`rbx run SCENE --json`: collision events and final states (custom, plus `backends`);
+    with `sample_every` N, each backend's trajectory every N steps (see trajectory())."""
+    extra = ["--force"] if force else []
+    if sample_every is not None:
+        if not isinstance(sample_every, int) or sample_every <= 0:
+            raise ValueError("sample_every: a positive number of steps")
+        extra += ["--sample-every", sample_every]
     with _SceneFiles(scene) as paths:
-        return _with_json(["run", *paths[:1], *_names(backends), *_sets(sets)] +
-                          (["--force"] if force else []))
+        return _with_json(["run", *paths[:1], *_names(backends), *_sets(sets)] + extra)
+
+
+def trajectory(doc, backend):
+    """A backend's sampled trajectory from run(..., sample_every=N) as numpy arrays: "time"
+    (frames,), "bodies" (names, scene order), "states" (frames x bodies x 7: position of the
+    centre of mass, then the orientation quaternion w, x, y, z)."""
+    result = doc["backends"][backend]
+    if "trajectory" not in result:
+        raise ValueError(f"{backend}: no trajectory in this document (run with sample_every)")
+    t = result["trajectory"]
+    states = np.asarray(t["states"], dtype=np.float64).reshape(len(t["time"]), len(t["bodies"]), 7)
+    return {"time": np.asarray(t["time"], dtype=np.float64), "bodies": list(t["bodies"]),
+            "states": states}
 
 
 def contacts(scene, backends=None, sets=None, at=None):

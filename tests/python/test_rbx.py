@@ -93,6 +93,22 @@ def test_backends_lists_every_registry_row_with_its_kind():
 
 # -- numpy -----------------------------------------------------------------------------------
 
+def test_a_trajectory_is_frames_by_bodies_by_seven():
+    path = os.path.join(ROOT, "scenes", "analytic", "headon_e05.toml")
+    doc = rbx.run(path, backends=["custom", "bullet"], sample_every=10)
+    assert without_timings(doc) == without_timings(
+        cli_json("run", path, "--backends", "custom,bullet", "--sample-every", "10"))
+    for backend in ("custom", "bullet"):
+        t = rbx.trajectory(doc, backend)
+        assert t["states"].dtype == np.float64 and t["states"].ndim == 3
+        assert t["states"].shape == (len(t["time"]), 2, 7) and len(t["time"]) > 2
+        assert t["bodies"] == ["A", "B"]
+        # The orientation columns are unit quaternions (the column order is right).
+        assert np.allclose(np.linalg.norm(t["states"][:, :, 3:], axis=2), 1.0, atol=1e-9)
+    with pytest.raises(ValueError, match="sample_every"):
+        rbx.trajectory(rbx.run(path), "custom")
+
+
 def test_one_contact_query_returns_numpy_arrays():
     cube = {"size": [1, 1, 1], "position": [0, 0, 0.4]}
     slab = {"vertices": np.array([[x, y, z] for x in (-2, 2) for y in (-2, 2) for z in (-1, 0)],
