@@ -300,11 +300,14 @@ def tosses(data, params=None, fit=False, backends=None):
     return _with_json(args)
 
 
-def check(inputs=None, baseline=None, backends=None, explore=False, no_cache=False):
+def check(inputs=None, baseline=None, backends=None, explore=False, no_cache=False,
+          update=False):
     """`rbx check`: every accuracy metric against the baseline (default reports/baseline.json).
     Returns {"passed", "exit_code", "output"} (output: the lines the command prints, which name
-    every changed metric)."""
+    every changed metric). `update` merges this run into the baseline (`--update`)."""
     args = ["check", *[os.fspath(i) for i in (inputs or [])], *_names(backends)]
+    if update:
+        args.append("--update")
     if baseline is not None:
         args += ["--baseline", os.fspath(baseline)]
     if explore:

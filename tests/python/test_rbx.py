@@ -7,6 +7,7 @@ PYTHONPATH and RBX_EXECUTABLE naming the command-line rbx of the same build.
 import glob
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -194,6 +195,38 @@ def test_a_wrong_normal_is_flagged_and_explore_shrinks_it_to_a_scene(tmp_path):
         [m for m in again["scenes"][0]["metrics"]
          if m["backend"] == "py-flipped" and m["name"] == "normal_err_deg" and m["value"] > 90]
     assert flags
+
+
+MODE = {"flip": False}
+
+
+def toggled_sat(a, b):
+    """sat_contact, flipped while MODE["flip"] (read in the backend's process, forked after the
+    flag is set)."""
+    return flipped_sat(a, b) if MODE["flip"] else sat_contact(a, b)
+
+
+def test_check_names_a_registered_backend_that_got_worse_and_a_report_shows_it(tmp_path):
+    rbx.register_contact_backend("py-toggled", toggled_sat, "sat_contact, flipped on demand")
+    scenes = [os.path.join(ROOT, "scenes", "contact", f) for f in ("axis_z.toml",
+                                                                    "fcl_rotated_45.toml")]
+    baseline = tmp_path / "baseline.json"
+    first = rbx.check(scenes, baseline=baseline, backends=["py-toggled"], update=True)
+    assert first["passed"] and baseline.exists(), first["output"]
+    assert rbx.check(scenes, baseline=baseline, backends=["py-toggled"])["passed"]
+    MODE["flip"] = True
+    try:
+        worse = rbx.check(scenes, baseline=baseline, backends=["py-toggled"])
+    finally:
+        MODE["flip"] = False
+    assert not worse["passed"] and worse["exit_code"] == 1
+    assert "py-toggled" in worse["output"] and "normal_err_deg" in worse["output"]
+    # A report written from Python ranks it and lists it with its description, like any backend.
+    out = rbx.report(scenes, out=tmp_path / "report", backends=["py-toggled", "fcl", "exact"])
+    summary = open(os.path.join(out, "report.md")).read()
+    assert "| **py-toggled** | sat\\_contact, flipped on demand |" in summary  # escaped
+    assert any(re.match(r"\| \d+ \| \*\*py-toggled\*\* \|", line)
+               for line in summary.splitlines())  # ranked in the scorecard
 
 
 # -- a response function ---------------------------------------------------------------------
