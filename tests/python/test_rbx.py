@@ -84,6 +84,12 @@ def test_contacts_is_the_command_lines_document_and_a_dict_scene_is_a_file():
     assert np.allclose(c["normal"], [0, 0, 1]) and abs(c["depth"] - 0.5 ** 0.5) < 1e-12
 
 
+def test_tosses_is_the_command_lines_document():
+    data = os.path.join(ROOT, "scenes", "real", "cube_toss", "test.csv.gz")
+    assert without_timings(cli_json("tosses", data, "--backends", "custom")) == \
+        without_timings(rbx.tosses(data, backends=["custom"]))
+
+
 def test_backends_lists_every_registry_row_with_its_kind():
     rows = {b["name"]: b for b in rbx.backends()}
     assert rows["exact"]["kind"] == ["contact"]
