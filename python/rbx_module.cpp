@@ -46,15 +46,16 @@ class TeeBuffer : public std::streambuf {
 };
 
 // `rbx ARGS...` in this process: (exit code, standard output, standard error). Standard output
-// is kept, not shown; standard error is shown and kept. The GIL is released: the commands run
-// their own threads and child processes, and a registered Python backend takes it back.
-py::tuple command_line_in_process(const std::vector<std::string>& args) {
+// is kept, not shown; standard error is kept, and shown as it comes when `show_stderr` (the
+// progress lines of long commands). The GIL is released: the commands run their own threads and
+// child processes, and a registered Python backend takes it back.
+py::tuple command_line_in_process(const std::vector<std::string>& args, bool show_stderr) {
   std::vector<std::string> argv_text = {"rbx"};
   argv_text.insert(argv_text.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& a : argv_text) argv.push_back(a.data());
   argv.push_back(nullptr);
-  TeeBuffer out(nullptr), err(std::cerr.rdbuf());
+  TeeBuffer out(nullptr), err(show_stderr ? std::cerr.rdbuf() : nullptr);
   int code = 0;
   {
     py::gil_scoped_release release;
@@ -260,6 +261,7 @@ void register_response(const std::string& name, const std::string& description, 
 PYBIND11_MODULE(_rbx, m) {
   m.doc() = "The C++ side of the rbx module (use `import rbx`).";
   m.def("command_line", &rbx::command_line_in_process, py::arg("args"),
+        py::arg("show_stderr") = false,
         "Runs `rbx ARGS...` in this process: (exit code, stdout text, stderr text).");
   m.def("backends", &rbx::backend_rows, "Every registry row as a dict.");
   m.def("register_contact_backend", &rbx::register_contact, py::arg("name"), py::arg("description"),

@@ -130,31 +130,43 @@ class _SceneFiles:
                 path = os.path.join(self.folder.name, f"{safe}.toml")
                 with open(path, "w") as f:
                     f.write(scene_toml(body))
+                _SCENE_LABELS[path] = f"scene dict {name!r}"
                 paths.append(path)
             else:
                 raise TypeError("scene: a path or a dict with the scene file's keys")
         return paths
 
     def __exit__(self, *exc):
+        for path in list(_SCENE_LABELS):
+            if self.folder is not None and path.startswith(self.folder.name):
+                del _SCENE_LABELS[path]
         if self.folder is not None:
             self.folder.cleanup()
 
 
-def _command(args):
+# Temporary scene files written for scene dicts, and how a message names them instead.
+_SCENE_LABELS = {}
+
+
+def _command(args, show_progress=False):
     """Runs `rbx ARGS...` in this process: (exit code, stdout); exit code 2 raises ValueError
-    with the command's message (its last line on stderr)."""
-    code, out, err = _rbx.command_line([str(a) for a in args])
+    with the command's message (its last line on stderr). `show_progress`: the command's stderr
+    is shown as it runs (long commands), else only its message in the exception."""
+    code, out, err = _rbx.command_line([str(a) for a in args], show_progress)
     if code == 2:
         lines = [ln for ln in err.splitlines() if ln.strip()]
-        raise ValueError(lines[-1] if lines else f"rbx {args[0]}: bad input")
+        message = lines[-1] if lines else f"rbx {args[0]}: bad input"
+        for path, label in _SCENE_LABELS.items():
+            message = message.replace(path, label)
+        raise ValueError(message)
     return code, out
 
 
-def _with_json(args):
+def _with_json(args, show_progress=False):
     """The document `rbx ARGS... --json FILE` writes."""
     with tempfile.TemporaryDirectory(prefix="rbx-") as d:
         path = os.path.join(d, "out.json")
-        _command(list(args) + ["--json", path])
+        _command(list(args) + ["--json", path], show_progress)
         with open(path) as f:
             return json.load(f)
 
@@ -280,7 +292,7 @@ def explore(count=20000, seed=1, kind="contact", backends=None, out=None, thread
         args += ["--baseline", os.fspath(baseline)]
     if not figure:
         args.append("--no-figure")
-    code, _ = _command(args)
+    code, _ = _command(args, show_progress=True)
     folder = os.fspath(out) if out is not None else os.path.join(_source_dir(), "reports",
                                                                     "explore")
     with open(os.path.join(folder, "explore.json")) as f:
@@ -297,7 +309,7 @@ def tosses(data, params=None, fit=False, backends=None):
         args += ["--params", os.fspath(params)]
     if fit:
         args.append("--fit")
-    return _with_json(args)
+    return _with_json(args, show_progress=fit)  # a fit reports its progress
 
 
 def check(inputs=None, baseline=None, backends=None, explore=False, no_cache=False,
@@ -314,7 +326,7 @@ def check(inputs=None, baseline=None, backends=None, explore=False, no_cache=Fal
         args.append("--explore")
     if no_cache:
         args.append("--no-cache")
-    code, out = _command(args)
+    code, out = _command(args, show_progress=True)
     return {"passed": code == 0, "exit_code": code, "output": out}
 
 
@@ -325,7 +337,7 @@ def report(inputs=None, out=None, backends=None, explore=False):
         args += ["--out", os.fspath(out)]
     if explore:
         args.append("--explore")
-    _command(args)
+    _command(args, show_progress=True)
     return os.fspath(out) if out is not None else os.path.join(_source_dir(), "reports", "latest")
 
 

@@ -317,5 +317,5 @@ def test_bad_arguments_raise_with_one_line():
         rbx.contact({"size": [1, 1, 1], "mass": 2}, {"size": [1, 1, 1]})
     bad_scene = {"name": "bad", "checks": ["contact"], "sim": {"duration": 0},
                  "body": [{"name": "A", "mass": -1}, {"name": "B", "position": [0, 0, -1]}]}
-    with pytest.raises(ValueError, match="mass"):
+    with pytest.raises(ValueError, match="scene dict 'bad':.*mass"):
         rbx.compare(bad_scene)
