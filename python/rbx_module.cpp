@@ -241,9 +241,12 @@ void register_response(const std::string& name, const std::string& description, 
     contact["depth"] = c.depth;
     contact["feature"] = c.feature;
     try {
-      return vec_of((*f)(state_dict(a), state_dict(bb), contact, restitution), "the impulse");
+      return vec_of((*f)(state_dict(a), state_dict(bb), contact, restitution),
+                    "the impulse it returned");
     } catch (py::error_already_set& e) {
       throw std::runtime_error(name + ": " + python_message(e));
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(name + ": " + e.what());
     }
   };
   b.dynamics = [response](const Scene& scene, const DynamicsOptions& opt) {

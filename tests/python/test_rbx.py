@@ -294,6 +294,16 @@ def test_an_exception_or_a_wrong_return_type_is_that_backends_error():
     assert "returned int" in bs["py-returns-int"]["message"]
     assert 'no "depth"' in bs["py-no-depth"]["message"]
     assert bs["exact"]["status"] == "ok"  # the run went on
+    # The same for response functions, in a dynamics run.
+    rbx.register_response_backend("py-response-raises", lambda a, b, c, e: 1 / 0)
+    rbx.register_response_backend("py-response-str", lambda a, b, c, e: "up")
+    run = rbx.run(os.path.join(ROOT, "scenes", "analytic", "headon_e05.toml"),
+                  backends=["py-response-raises", "py-response-str", "custom-seed"])["backends"]
+    assert run["py-response-raises"]["message"] == \
+        "py-response-raises: ZeroDivisionError: division by zero"
+    assert run["py-response-str"]["message"] == \
+        "py-response-str: the impulse it returned is not a sequence of 3 numbers"
+    assert run["custom-seed"]["status"] == "ok"
 
 
 def test_bad_arguments_raise_with_one_line():
