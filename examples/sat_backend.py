@@ -26,7 +26,8 @@ def _unit_rows(v, eps=1e-12):
     n = np.linalg.norm(v, axis=1)
     v = v[n > eps] / n[n > eps, None]
     v = v * np.where(v[:, [0]] < 0, -1.0, 1.0)  # one sign per direction, for the merge
-    return np.unique(np.round(v, 9), axis=0)
+    _, first = np.unique(np.round(v, 9), axis=0, return_index=True)  # rounded keys only
+    return v[np.sort(first)]
 
 
 def _edges(body):

@@ -3,12 +3,10 @@
 #include <unistd.h>
 
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
-#include <type_traits>
 
 #include "evaluation_source_hash.h"  // generated at build time: RBX_EVALUATION_SOURCE_HASH
 #include "reference/result_codec.h"
