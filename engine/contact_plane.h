@@ -35,11 +35,19 @@ struct ContactPlane {
   PlaneAxis axis = PlaneAxis::FaceOfB;
 };
 
+/// How the candidate axes are found; every method gives the same plane (to round-off).
+enum class PlaneMethod {
+  Automatic,  ///< the scan on small pairs, the search on large ones (the faster of the two)
+  Scan,       ///< every face measured, every solid edge near the other shape paired: linear
+  Search      ///< branch and bound over the shapes' Gauss maps: skips whole cones of them
+};
+
 /// The direction of least overlap of A and B at their poses: over every distinct face normal of
 /// either shape and every pair of solid edges (one of each, not a flat face's diagonal) that forms
 /// a face of the Minkowski difference, the one along which A must move least to separate.
 /// Meant for shapes the detector found in contact; for separated shapes the depth is 0.
 ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
-                                  const ConvexPolyhedron& b, const Pose& pb);
+                                  const ConvexPolyhedron& b, const Pose& pb,
+                                  PlaneMethod method = PlaneMethod::Automatic);
 
 }  // namespace rbx

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/bvh.h"
+#include "engine/gauss_map.h"
 #include "engine/shape_hierarchy.h"
 
 namespace rbx {
@@ -166,6 +167,7 @@ void ConvexPolyhedron::build_hierarchy() {
   hierarchy_.reset();
   if (static_cast<int>(triangles_.size()) > kSmallTriangles)
     hierarchy_ = std::make_shared<const ShapeHierarchy>(ShapeHierarchy::build(*this));
+  gauss_map_ = std::make_shared<const GaussMap>(GaussMap::build(*this));
 }
 
 double ConvexPolyhedron::volume() const {

@@ -12,6 +12,7 @@
 namespace rbx {
 
 struct ShapeHierarchy;
+struct GaussMap;
 
 /// Raised when a mesh is not a valid closed convex polyhedron; the message names the feature.
 class GeometryError : public std::runtime_error {
@@ -80,6 +81,9 @@ class ConvexPolyhedron {
   /// The accelerated detector's trees over this shape (engine/shape_hierarchy.h), built with it;
   /// null for shapes of at most kSmallTriangles triangles, which are tested with plain loops.
   const ShapeHierarchy* hierarchy() const { return hierarchy_.get(); }
+  /// The Gauss map's cone trees over this shape (engine/gauss_map.h), built with it for every
+  /// shape: the contact plane's search.
+  const GaussMap& gauss_map() const { return *gauss_map_; }
 
   /// Enclosed volume (m^3), by the divergence theorem.
   double volume() const;
@@ -97,8 +101,10 @@ class ConvexPolyhedron {
   std::vector<unsigned char> new_plane_;
   Aabb bounds_;
   std::shared_ptr<const ShapeHierarchy> hierarchy_;  // shared by copies: the shape is immutable
+  std::shared_ptr<const GaussMap> gauss_map_;        // likewise
 
-  // Builds hierarchy_ from the shape's current geometry (or clears it for a small shape).
+  // Builds hierarchy_ (or clears it for a small shape) and gauss_map_ from the shape's current
+  // geometry.
   void build_hierarchy();
   // Throws GeometryError naming the first face with a vertex more than `tol` (m) outside its
   // plane.

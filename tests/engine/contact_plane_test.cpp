@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -94,12 +96,14 @@ TEST(ContactPlane, EitherBodyOrderGivesTheSameContactReversed) {
     const Pose &pa = r.pa, &pb = r.pb;
     if (!detect(a, pa, b, pb)) continue;
     ++touching;
-    const ContactPlane ab = choose_contact_plane(a, pa, b, pb);
-    const ContactPlane ba = choose_contact_plane(b, pb, a, pa);
-    // Round-off: a hierarchy's projections are climbed from different start vertices in the two
-    // orders, so overlaps may differ by a few ulps of coordinates of order 1 m.
-    EXPECT_NEAR((ab.normal + ba.normal).norm(), 0.0, 1e-9) << "trial " << trial;
-    EXPECT_NEAR(ab.depth, ba.depth, 1e-12) << "trial " << trial;
+    for (const PlaneMethod method : {PlaneMethod::Scan, PlaneMethod::Search}) {
+      const ContactPlane ab = choose_contact_plane(a, pa, b, pb, method);
+      const ContactPlane ba = choose_contact_plane(b, pb, a, pa, method);
+      // Round-off: projections are climbed from different start vertices in the two orders, so
+      // overlaps may differ by a few ulps of coordinates of order 1 m.
+      EXPECT_NEAR((ab.normal + ba.normal).norm(), 0.0, 1e-9) << "trial " << trial;
+      EXPECT_NEAR(ab.depth, ba.depth, 1e-12) << "trial " << trial;
+    }
   }
   EXPECT_GT(touching, 300);
 }
@@ -125,6 +129,98 @@ TEST(ContactPlane, NoDirectionSeparatesWithASmallerMove) {
     }
   }
   EXPECT_GT(touching, 100);
+}
+
+// An icosphere stretched along the axes: an ellipsoid-like hull whose face normals and edges
+// are in no special position (a linear map keeps faces flat and the shape convex).
+ConvexPolyhedron stretched_icosphere(int subdivisions, const Vec3& scale) {
+  const ConvexPolyhedron s = make_icosphere(0.5, subdivisions);
+  std::vector<Vec3> v;
+  for (const Vec3& p : s.vertices()) v.push_back(p.cwiseProduct(scale));
+  return ConvexPolyhedron::from_triangles(v, s.triangles());
+}
+
+// The least overlap by brute force, written without the chooser's search: along every face
+// normal of either shape and every cross product of an edge of A and an edge of B, both signs.
+// Every one of those directions overlaps by at least the least overlap, and the face normals of
+// the Minkowski difference are among them, so the minimum is the least overlap.
+double least_overlap_by_brute_force(const ConvexPolyhedron& a, const Pose& pa,
+                                    const ConvexPolyhedron& b, const Pose& pb) {
+  std::vector<Vec3> va, vb, axes;
+  for (const Vec3& v : a.vertices()) va.push_back(pa.apply(v));
+  for (const Vec3& v : b.vertices()) vb.push_back(pb.apply(v));
+  for (const Plane& p : a.planes()) axes.push_back(pa.rotation() * p.normal);
+  for (const Plane& p : b.planes()) axes.push_back(pb.rotation() * p.normal);
+  for (const Edge& ea : a.edges())
+    for (const Edge& eb : b.edges()) {
+      const Vec3 d = (va[ea.b] - va[ea.a]).cross(vb[eb.b] - vb[eb.a]);
+      if (d.norm() > 1e-9) axes.push_back(d.normalized());
+    }
+  // Along n, A must move max_b (b . n) - min_a (a . n) to clear B; along -n, the reverse.
+  double least = std::numeric_limits<double>::infinity();
+  for (const Vec3& n : axes) {
+    double a_lo = 1e300, a_hi = -1e300, b_lo = 1e300, b_hi = -1e300;
+    for (const Vec3& v : va) {
+      a_lo = std::min(a_lo, v.dot(n));
+      a_hi = std::max(a_hi, v.dot(n));
+    }
+    for (const Vec3& v : vb) {
+      b_lo = std::min(b_lo, v.dot(n));
+      b_hi = std::max(b_hi, v.dot(n));
+    }
+    least = std::min({least, b_hi - a_lo, a_hi - b_lo});
+  }
+  return std::max(least, 0.0);  // the chooser's depth is clamped at 0 likewise
+}
+
+TEST(ContactPlane, TheSearchFindsTheLeastOverlapOfEveryCandidate) {
+  // The scan skips faces and edges on bounds, the search whole cones of them; on shapes in no
+  // special position (stretched icospheres) and on ones full of ties (boxes, prisms, icospheres),
+  // deep and shallow, it must find the same least overlap as trying every candidate.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> stretch(0.5, 1.5);
+  // Shapes of at most 120 edges, so that every pair of edges can be tried.
+  std::vector<ConvexPolyhedron> all = {make_box(Vec3(1.0, 0.6, 0.3)),
+                                       make_box(Vec3(2.0, 2.0, 0.05)), make_prism(0.4, 1.2, 24),
+                                       make_icosphere(0.6, 1)};
+  for (int k = 0; k < 4; ++k)
+    all.push_back(stretched_icosphere(1, Vec3(stretch(rng), stretch(rng), stretch(rng))));
+  int touching = 0;
+  for (int trial = 0; trial < 800; ++trial) {
+    const RandomPair r = random_pair(all, rng);
+    if (!detect(*r.a, r.pa, *r.b, r.pb)) continue;
+    ++touching;
+    const double least = least_overlap_by_brute_force(*r.a, r.pa, *r.b, r.pb);
+    for (const PlaneMethod method : {PlaneMethod::Scan, PlaneMethod::Search}) {
+      const ContactPlane p = choose_contact_plane(*r.a, r.pa, *r.b, r.pb, method);
+      // Round-off: projections of coordinates of order 1 m, by the chooser in the body frames
+      // and here in the world frame.
+      EXPECT_NEAR(p.depth, least, 1e-12) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(touching, 300);
+}
+
+TEST(ContactPlane, TheScanAndTheSearchChooseTheSamePlane) {
+  // On shapes too large for the brute force (hulls of up to 2,562 vertices, stretched so that
+  // no two directions tie by symmetry), deep and shallow: the two methods, one linear and one a
+  // branch and bound, agree on the depth and the normal.
+  std::mt19937 rng(19);
+  const std::vector<ConvexPolyhedron> all = {
+      stretched_icosphere(2, Vec3(1.3, 0.7, 1.0)), stretched_icosphere(3, Vec3(0.6, 1.4, 0.9)),
+      stretched_icosphere(4, Vec3(1.0, 0.8, 1.2)), make_box(Vec3(0.9, 0.4, 0.7))};
+  int touching = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const RandomPair r = random_pair(all, rng);
+    if (!detect(*r.a, r.pa, *r.b, r.pb)) continue;
+    ++touching;
+    const ContactPlane scan = choose_contact_plane(*r.a, r.pa, *r.b, r.pb, PlaneMethod::Scan);
+    const ContactPlane search = choose_contact_plane(*r.a, r.pa, *r.b, r.pb, PlaneMethod::Search);
+    // Round-off: the two compute the same overlaps in the world and in the body frames.
+    EXPECT_NEAR(scan.depth, search.depth, 1e-12) << "trial " << trial;
+    EXPECT_NEAR((scan.normal - search.normal).norm(), 0.0, 1e-9) << "trial " << trial;
+  }
+  EXPECT_GT(touching, 60);
 }
 
 }  // namespace

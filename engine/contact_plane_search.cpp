@@ -1,0 +1,282 @@
+// The direction of least overlap of two convex polyhedra, by branch and bound over their Gauss
+// maps. Every candidate axis (a face normal, or the crossing of two edges' arcs) is a face normal
+// u of the Minkowski difference D = A - B, and its overlap is D's support h_D(u) = h_A(u) +
+// h_B(-u). Any point x of D bounds h_D(u) >= x . u from below for every u, so a cone of
+// directions whose bound (from the support point at its axis) exceeds the least overlap found
+// cannot hold the answer and is skipped with every face and edge in it. Any direction's h_D is
+// at least the least overlap, so it bounds the answer from above. docs/contact_plane.md derives
+// both and says why no candidate within the tie margin is ever skipped.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "engine/contact_plane_detail.h"
+#include "engine/gauss_map.h"
+
+namespace rbx::plane_detail {
+
+namespace {
+
+// One shape of the query: its Gauss map and its pose.
+struct Side {
+  const ConvexPolyhedron* shape = nullptr;
+  const GaussMap* map = nullptr;
+  Mat3 r = Mat3::Identity();
+  Mat3 rt = Mat3::Identity();
+  Vec3 p = Vec3::Zero();
+
+  // The support h(d) = max over the shape of x . d along a world direction, climbing from `at`
+  // (left on a vertex that reaches it).
+  double support(const Vec3& d, int& at) const {
+    double h = 0.0;
+    at = map->climb(shape->vertices(), rt * d, at, h);
+    return h + p.dot(d);
+  }
+  Vec3 world(int v) const { return r * shape->vertices()[v] + p; }
+};
+
+// The least of x . u over the unit vectors u of a cone (axis in the world): a lower bound on
+// h_D over the cone when x is a point of D.
+double cone_bound(const Vec3& x, const Vec3& axis, const DirectionCone& cone) {
+  const double size = x.norm();
+  if (cone.whole) return -size;
+  const double along = x.dot(axis);
+  // The cone reaches the direction opposite x (its angle to x plus the cone's is pi or more).
+  if (along <= -size * cone.cos_angle) return -size;
+  return along * cone.cos_angle - x.cross(axis).norm() * cone.sin_angle;
+}
+
+// The trees searched: the faces and the arcs of A and of B.
+enum Tree { kFacesA = 0, kFacesB = 1, kArcsA = 2, kArcsB = 3 };
+
+// A node waiting in the search: the lower bound it carries, and the vertices of A and B from
+// which its support climbs start (its parent's, near its axis).
+struct Pending {
+  double bound = -kInf;
+  int tree = 0, node = 0;
+  int at_a = 0, at_b = 0;
+  // The heap's order: the least bound on top; ties by tree and node (deterministic).
+  bool operator<(const Pending& o) const {
+    if (bound != o.bound) return bound > o.bound;
+    if (tree != o.tree) return tree > o.tree;
+    return node > o.node;
+  }
+};
+
+// An arc kept for pairing: its D-space endpoints and cone axis, and its edge.
+struct KeptArc {
+  double bound = -kInf;
+  Vec3 n0, n1, axis;
+  const DirectionCone* cone = nullptr;
+  int edge = 0;
+};
+
+// The state of one query.
+struct Query {
+  Side a, b;
+  double upper = kInf;  // m, an upper bound on the least overlap (h_D along some direction)
+  Vec3 upper_normal = Vec3::UnitZ();  // -u for the direction u that gave `upper`
+  double tie = 0.0;                   // m, overlaps closer than this are equal (round-off)
+  std::vector<Candidate> kept;
+  std::vector<Pending> heap;
+  std::vector<KeptArc> arcs[2];  // A's and B's arcs that may hold the answer
+
+  // Nothing whose lower bound exceeds this can be within the tie margin of the answer: twice
+  // the margin absorbs the round-off of the bounds themselves.
+  double threshold() const { return upper + 2.0 * tie; }
+  const Side& side(int tree) const { return tree % 2 == 0 ? a : b; }
+  // Directions of B's Gauss map are negated in D = A - B.
+  static double sign(int tree) { return tree % 2 == 0 ? 1.0 : -1.0; }
+
+  void keep(const Candidate& c) {
+    if (c.overlap < upper) {
+      upper = c.overlap;
+      upper_normal = c.normal;
+    }
+    kept.push_back(c);
+  }
+  void push(const Pending& p) {
+    heap.push_back(p);
+    std::push_heap(heap.begin(), heap.end());
+  }
+  void search();
+  void visit(const Pending& e);
+  void face(int tree, int f, int at_other);
+  void pair_arcs();
+  void edge_pair(const KeptArc& ka, const KeptArc& kb);
+};
+
+void Query::search() {
+  heap.clear();
+  for (int t = kFacesA; t <= kArcsB; ++t) {
+    const GaussMap& g = *side(t).map;
+    if (!(t < kArcsA ? g.face_tree : g.arc_tree).nodes.empty()) push({-kInf, t, 0, 0, 0});
+  }
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end());
+    const Pending e = heap.back();
+    heap.pop_back();
+    // Every node left has a bound at least this one's.
+    if (e.bound > threshold()) break;
+    visit(e);
+  }
+}
+
+// One node: the support point of D at its axis bounds the node from below (and the answer from
+// above); a leaf's faces are measured, a leaf's arcs kept for pairing, an inner node's children
+// queued with their bounds from the same point.
+void Query::visit(const Pending& e) {
+  const Side& own = side(e.tree);
+  const GaussMap& g = *own.map;
+  const bool faces = e.tree < kArcsA;
+  const Bvh& tree = faces ? g.face_tree : g.arc_tree;
+  const std::vector<DirectionCone>& cones = faces ? g.face_cones : g.arc_cones;
+  const double s = sign(e.tree);
+  const Vec3 axis = s * (own.r * cones[e.node].axis);
+  int at_a = e.at_a, at_b = e.at_b;
+  const double h = a.support(axis, at_a) + b.support(-axis, at_b);
+  if (std::max(h, 0.0) < upper) {
+    upper = std::max(h, 0.0);
+    upper_normal = -axis;
+  }
+  const Vec3 x = a.world(at_a) - b.world(at_b);
+  const double bound = std::max(e.bound, cone_bound(x, axis, cones[e.node]));
+  if (bound > threshold()) return;
+  const BvhNode& node = tree.nodes[e.node];
+  if (node.child >= 0) {
+    for (const int c : {node.child, node.child + 1}) {
+      const Vec3 c_axis = s * (own.r * cones[c].axis);
+      push({std::max(bound, cone_bound(x, c_axis, cones[c])), e.tree, c, at_a, at_b});
+    }
+    return;
+  }
+  for (int i = node.begin; i < node.end; ++i) {
+    const int item = tree.order[i];
+    if (faces) {
+      // x . u bounds this face's overlap before any climb.
+      const Vec3 u = s * (own.r * g.faces[item].normal);
+      if (x.dot(u) > threshold()) continue;
+      face(e.tree, item, e.tree == kFacesA ? at_b : at_a);
+      continue;
+    }
+    const GaussMap::Arc& arc = g.arcs[item];
+    KeptArc k;
+    k.axis = s * (own.r * arc.cone.axis);
+    k.bound = cone_bound(x, k.axis, arc.cone);
+    if (k.bound > threshold()) continue;
+    k.n0 = s * (own.r * arc.n0);
+    k.n1 = s * (own.r * arc.n1);
+    k.cone = &arc.cone;
+    k.edge = arc.edge;
+    arcs[e.tree - kArcsA].push_back(k);
+  }
+}
+
+// A face of one shape: pushing the other out of it along its normal n costs the face's height
+// plus the other's support along -n (its lowest point along n).
+void Query::face(int tree, int f, int at_other) {
+  const Side& own = side(tree);
+  const Side& other = side(tree + 1);
+  const GaussMap::Face& face = own.map->faces[f];
+  const Vec3 n = own.r * face.normal;
+  Candidate c;
+  c.overlap = (face.offset + n.dot(own.p)) + other.support(-n, at_other);
+  if (c.overlap > threshold()) return;
+  c.kind = 0;
+  c.axis = canonical(n);
+  // The other shape moves along n: the normal from B toward A is n when it is A, -n when B.
+  c.normal = tree == kFacesA ? Vec3(-n) : n;
+  c.source = tree == kFacesA ? PlaneAxis::FaceOfA : PlaneAxis::FaceOfB;
+  keep(c);
+}
+
+// The edge-pair axes: each kept arc of A against each kept arc of B whose cones meet and whose
+// arcs cross.
+void Query::pair_arcs() {
+  const double limit = threshold();
+  for (const KeptArc& ka : arcs[0]) {
+    if (ka.bound > limit) continue;
+    for (const KeptArc& kb : arcs[1]) {
+      if (kb.bound > limit) continue;
+      if (!ka.cone->whole && !kb.cone->whole) {
+        // Cones apart: the angle between their axes exceeds the sum of their angles.
+        const double cos_sum =
+            ka.cone->cos_angle * kb.cone->cos_angle - ka.cone->sin_angle * kb.cone->sin_angle;
+        const bool sum_below_pi =
+            ka.cone->sin_angle * kb.cone->cos_angle + ka.cone->cos_angle * kb.cone->sin_angle > 0.0;
+        if (sum_below_pi && ka.axis.dot(kb.axis) < cos_sum) continue;
+      }
+      if (!arcs_cross(ka.n0, ka.n1, kb.n0, kb.n1)) continue;
+      edge_pair(ka, kb);
+    }
+  }
+}
+
+// Two edges whose arcs cross: their cross product is a face normal of D, on the side of the
+// crossing (the side of either arc's midpoint).
+void Query::edge_pair(const KeptArc& ka, const KeptArc& kb) {
+  const Edge& ea = a.shape->edges()[ka.edge];
+  const Edge& eb = b.shape->edges()[kb.edge];
+  const Vec3 a0 = a.world(ea.a), b0 = b.world(eb.a);
+  const Vec3 da = a.world(ea.b) - a0, db = b.world(eb.b) - b0;
+  Vec3 d = da.cross(db);
+  // Parallel edges (sine below 1e-9) give no axis of their own: a face normal covers them.
+  if (!(d.squaredNorm() > 1e-18 * da.squaredNorm() * db.squaredNorm())) return;
+  d.normalize();
+  // The crossing's side: from the arc whose midpoint is further from the great circle of d's
+  // plane (both agree unless an arc is a half circle); both sides when neither decides.
+  const double on_a = d.dot(ka.n0 + ka.n1), on_b = d.dot(kb.n0 + kb.n1);
+  const double side = std::abs(on_a) >= std::abs(on_b) ? on_a : on_b;
+  // The pair's overlap when it is a face of D is the distance of the two edges' lines along its
+  // normal, so a pair beyond the threshold is skipped before any climb.
+  if (std::abs(side) > 1e-9 && (side > 0 ? 1.0 : -1.0) * d.dot(a0 - b0) > threshold()) return;
+  Candidate c;
+  c.kind = 1;
+  c.axis = canonical(d);
+  c.source = PlaneAxis::EdgeEdge;
+  for (const double sgn : {1.0, -1.0}) {
+    if (std::abs(side) > 1e-9 && sgn * side < 0) continue;
+    const Vec3 u = sgn * d;
+    int at_a = ea.a, at_b = eb.a;
+    const double overlap = a.support(u, at_a) + b.support(-u, at_b);
+    if (overlap < c.overlap) {
+      c.overlap = overlap;
+      c.normal = -u;
+    }
+  }
+  if (c.overlap <= threshold()) keep(c);
+}
+
+}  // namespace
+
+void search_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                       const Pose& pb, Candidates& out) {
+  // Scratch reused across queries on this thread (allocated once, as the detector's).
+  thread_local Query q;
+  auto set = [](Side& s, const ConvexPolyhedron& shape, const Pose& p) {
+    s.shape = &shape;
+    s.map = &shape.gauss_map();
+    s.r = p.rotation();
+    s.rt = s.r.transpose();
+    s.p = p.position;
+  };
+  set(q.a, a, pa);
+  set(q.b, b, pb);
+  q.upper = kInf;
+  q.kept.clear();
+  q.arcs[0].clear();
+  q.arcs[1].clear();
+  // Round-off of a projection difference is a few ulps of the largest coordinate; 1e-12 of it is
+  // ~10^3 times that, far below any depth a tolerance in the harness distinguishes.
+  const double scale = std::max(pa.position.cwiseAbs().maxCoeff() + q.a.map->radius,
+                                pb.position.cwiseAbs().maxCoeff() + q.b.map->radius);
+  q.tie = 1e-12 * scale;
+  q.search();
+  q.pair_arcs();
+  out.kept.swap(q.kept);
+  out.tie = q.tie;
+  out.upper = q.upper;
+  out.upper_normal = q.upper_normal;
+}
+
+}  // namespace rbx::plane_detail

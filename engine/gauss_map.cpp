@@ -1,0 +1,134 @@
+#include "engine/gauss_map.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/polyhedron.h"
+
+namespace rbx {
+
+namespace {
+
+// Faces or arcs per leaf of the cone trees.
+constexpr int kLeafSize = 4;
+// Added to every cone's angle (rad): the angles are computed with atan2 to ~1e-16 rad, so a
+// cone never misses a direction it should hold by round-off.
+constexpr double kConeSlack = 1e-9;
+
+// The angle between two unit vectors, accurate near 0 and pi (acos is not).
+double angle_between(const Vec3& p, const Vec3& q) {
+  return std::atan2(p.cross(q).norm(), p.dot(q));
+}
+
+DirectionCone cone_of(const Vec3& axis, double angle) {
+  DirectionCone c;
+  c.axis = axis;
+  c.whole = !(angle + kConeSlack < M_PI);
+  c.cos_angle = c.whole ? -1.0 : std::cos(angle + kConeSlack);
+  c.sin_angle = c.whole ? 0.0 : std::sin(angle + kConeSlack);
+  return c;
+}
+
+// The cone of a tree node: around the normalized sum of its items' axes, wide enough to hold
+// every item's cone; the whole sphere when the axes cancel.
+DirectionCone node_cone(const std::vector<int>& order, int begin, int end,
+                        const std::vector<DirectionCone>& items,
+                        const std::vector<double>& angles) {
+  Vec3 sum = Vec3::Zero();
+  for (int i = begin; i < end; ++i) sum += items[order[i]].axis;
+  if (sum.norm() < 1e-6) return cone_of(Vec3::UnitZ(), M_PI);
+  const Vec3 axis = sum.normalized();
+  double angle = 0.0;
+  for (int i = begin; i < end; ++i)
+    angle = std::max(angle, angle_between(axis, items[order[i]].axis) + angles[order[i]]);
+  return cone_of(axis, angle);
+}
+
+// A tree over item cones (split on their axes as points of the sphere) and the cone of each node.
+void build_tree(const std::vector<DirectionCone>& items, const std::vector<double>& angles,
+                Bvh& tree, std::vector<DirectionCone>& cones) {
+  std::vector<Vec3> at;
+  for (const DirectionCone& c : items) at.push_back(c.axis);
+  tree = Bvh::build(at, at, kLeafSize);
+  cones.clear();
+  for (const BvhNode& node : tree.nodes)
+    cones.push_back(node_cone(tree.order, node.begin, node.end, items, angles));
+}
+
+}  // namespace
+
+GaussMap GaussMap::build(const ConvexPolyhedron& s) {
+  GaussMap g;
+  const auto& planes = s.planes();
+  // Distinct face planes (consecutive coplanar triangles share one).
+  std::vector<DirectionCone> items;
+  std::vector<double> angles;
+  for (int f = 0; f < static_cast<int>(planes.size()); ++f) {
+    if (!s.new_plane()[f]) continue;
+    g.faces.push_back({planes[f].normal, planes[f].offset, f});
+    items.push_back(cone_of(planes[f].normal, 0.0));
+    angles.push_back(0.0);
+  }
+  build_tree(items, angles, g.face_tree, g.face_cones);
+  // Solid edges: a flat face's diagonal (1 - cos below 1e-12, the validation's convexity
+  // tolerance) has no arc and no axis of its own.
+  items.clear();
+  angles.clear();
+  for (int i = 0; i < static_cast<int>(s.edges().size()); ++i) {
+    const auto& f = s.edge_faces()[i];
+    const Vec3 &n0 = planes[f[0]].normal, &n1 = planes[f[1]].normal;
+    if (n0.dot(n1) > 1.0 - 1e-12) continue;
+    Arc arc;
+    arc.n0 = n0;
+    arc.n1 = n1;
+    arc.edge = i;
+    const Vec3 mid = n0 + n1;
+    // Faces nearly opposite (a sliver's rim): no useful centre, the whole sphere.
+    const double half = mid.norm() > 1e-6 ? 0.5 * angle_between(n0, n1) : M_PI;
+    arc.cone = cone_of(mid.norm() > 1e-6 ? Vec3(mid.normalized()) : n0, half);
+    g.arcs.push_back(arc);
+    items.push_back(arc.cone);
+    angles.push_back(half + kConeSlack);
+  }
+  build_tree(items, angles, g.arc_tree, g.arc_cones);
+  // Vertex adjacency from the edges (counting sort: each list in increasing order).
+  const int nv = static_cast<int>(s.vertices().size());
+  g.neighbor_start.assign(nv + 1, 0);
+  for (const Edge& e : s.edges()) {
+    ++g.neighbor_start[e.a + 1];
+    ++g.neighbor_start[e.b + 1];
+  }
+  for (int v = 0; v < nv; ++v) g.neighbor_start[v + 1] += g.neighbor_start[v];
+  g.neighbors.resize(g.neighbor_start.back());
+  std::vector<int> fill(g.neighbor_start.begin(), g.neighbor_start.end() - 1);
+  for (const Edge& e : s.edges()) {
+    g.neighbors[fill[e.a]++] = e.b;
+    g.neighbors[fill[e.b]++] = e.a;
+  }
+  for (const Vec3& v : s.vertices()) g.radius = std::max(g.radius, v.norm());
+  return g;
+}
+
+int GaussMap::climb(const std::vector<Vec3>& vertices, const Vec3& d, int start,
+                    double& height) const {
+  int at = start;
+  double best = vertices[at].dot(d);
+  for (;;) {
+    // The highest neighbour of `at`, if higher than it.
+    int next = at;
+    for (int k = neighbor_start[at]; k < neighbor_start[at + 1]; ++k) {
+      const int o = neighbors[k];
+      const double h = vertices[o].dot(d);
+      if (h > best) {
+        best = h;
+        next = o;
+      }
+    }
+    if (next == at) break;
+    at = next;
+  }
+  height = best;
+  return at;
+}
+
+}  // namespace rbx

@@ -1,0 +1,60 @@
+// The Gauss map of a convex polyhedron, in its body frame, for the contact plane's search
+// (engine/contact_plane.h): its distinct face normals (points of the unit sphere), its solid
+// edges (arcs between their two faces' normals) and a tree of cones over each, so that a search
+// over directions can skip every face and edge whose normals lie in a cone it has bounded.
+// Built once with the shape (which is immutable), for every shape.
+#pragma once
+
+#include <vector>
+
+#include "engine/bvh.h"
+
+namespace rbx {
+
+class ConvexPolyhedron;
+
+/// A cone of directions: every unit vector within `angle` (rad) of `axis`. An angle of pi or
+/// more holds the whole sphere (`whole`).
+struct DirectionCone {
+  Vec3 axis = Vec3::UnitZ();  // unit, body frame
+  double cos_angle = -1.0, sin_angle = 0.0;
+  bool whole = true;
+};
+
+/// The Gauss map of one shape, in its body frame.
+struct GaussMap {
+  /// A distinct face plane (the first triangle of each run of triangles sharing a normal).
+  struct Face {
+    Vec3 normal = Vec3::UnitZ();  // unit, outward
+    double offset = 0.0;          // m, normal . p for every point p of the face
+    int triangle = 0;
+  };
+  /// A solid edge (its two faces not coplanar): the short arc between their outward normals.
+  struct Arc {
+    Vec3 n0 = Vec3::UnitZ(), n1 = Vec3::UnitZ();  // unit: the normals of edge_faces()[edge]
+    DirectionCone cone;                           // holds the whole arc
+    int edge = 0;
+  };
+
+  std::vector<Face> faces;
+  std::vector<Arc> arcs;
+  /// Trees over faces (by normal) and arcs (by cone centre): node k of `face_tree` holds the
+  /// faces face_tree.order[begin, end) and `face_cones[k]` holds their normals; the same for
+  /// arcs, whose node cones hold every point of their arcs.
+  Bvh face_tree, arc_tree;
+  std::vector<DirectionCone> face_cones, arc_cones;
+  /// Vertex adjacency, compressed: the neighbours of vertex v are
+  /// neighbors[neighbor_start[v] .. neighbor_start[v + 1]).
+  std::vector<int> neighbor_start, neighbors;
+  double radius = 0.0;  // m, the largest distance of a vertex from the body origin
+
+  /// Builds the Gauss map of `shape` (its vertices, triangles, edges and planes must be set).
+  static GaussMap build(const ConvexPolyhedron& shape);
+
+  /// The vertex of `vertices` furthest along d (body frame), climbing the vertex graph from
+  /// `start` (a vertex with no higher neighbour is highest on a convex polyhedron); its
+  /// projection goes to `height`.
+  int climb(const std::vector<Vec3>& vertices, const Vec3& d, int start, double& height) const;
+};
+
+}  // namespace rbx
