@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "engine/contact_plane_detail.h"
+#include "engine/gauss_map.h"
 #include "engine/shape_hierarchy.h"
 
 namespace rbx::plane_detail {
@@ -62,8 +63,17 @@ void sample(Placed& x, const Vec3& toward) {
   x.samples.clear();
   const Vec3 dirs[7] = {Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY(),
                         Vec3::UnitZ(), -Vec3::UnitZ(), toward};
-  int at = 0;
+  const GaussMap& g = x.shape->gauss_map();
+  const Mat3 rt = x.r.transpose();
   for (const Vec3& d : dirs) {
+    // Climbs start from the Gauss map's start vertex nearest d, a few edges from the answer.
+    int at = 0;
+    double along = -2.0;
+    for (std::size_t k = 0; k < g.start_directions.size(); ++k)
+      if (g.start_directions[k].dot(rt * d) > along) {
+        along = g.start_directions[k].dot(rt * d);
+        at = g.start_vertices[k];
+      }
     x.max_along(d, at);
     x.samples.push_back(x.v[at]);
   }

@@ -50,7 +50,8 @@ double cone_bound(const Vec3& x, const Vec3& axis, const DirectionCone& cone) {
 enum Tree { kFacesA = 0, kFacesB = 1, kArcsA = 2, kArcsB = 3 };
 
 // A node waiting in the search: the lower bound it carries, and the vertices of A and B from
-// which its support climbs start (its parent's, near its axis).
+// which its support climbs start (its parent's, near its axis; -1 at a root: from the Gauss
+// map's start vertices).
 struct Pending {
   double bound = -kInf;
   int tree = 0, node = 0;
@@ -110,7 +111,7 @@ void Query::search() {
   heap.clear();
   for (int t = kFacesA; t <= kArcsB; ++t) {
     const GaussMap& g = *side(t).map;
-    if (!(t < kArcsA ? g.face_tree : g.arc_tree).nodes.empty()) push({-kInf, t, 0, 0, 0});
+    if (!(t < kArcsA ? g.face_tree : g.arc_tree).nodes.empty()) push({-kInf, t, 0, -1, -1});
   }
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end());

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "engine/detect.h"
@@ -317,6 +318,28 @@ void table_candidates(const AcceleratedView& x, Primitive kind, int n, std::vect
   }
 }
 
+// Puts a list of indices below n in increasing order without repeats, through a bitmap: linear
+// in the list plus n / 64 words, where a comparison sort of the thousands of primitives a deep
+// cap holds took a large share of the query. The bitmap is left cleared.
+void sort_unique(std::vector<int>& list, std::size_t n) {
+  thread_local std::vector<std::uint64_t> bits;
+  if (bits.size() < (n + 63) / 64) bits.assign((n + 63) / 64, 0);
+  if (list.empty()) return;
+  std::size_t lo = bits.size(), hi = 0;
+  for (const int i : list) {
+    const std::size_t w = static_cast<std::size_t>(i) / 64;
+    bits[w] |= std::uint64_t{1} << (i % 64);
+    lo = std::min(lo, w);
+    hi = std::max(hi, w);
+  }
+  list.clear();
+  for (std::size_t w = lo; w <= hi; ++w) {
+    for (std::uint64_t b = bits[w]; b != 0; b &= b - 1)
+      list.push_back(static_cast<int>(w * 64 + static_cast<std::size_t>(__builtin_ctzll(b))));
+    bits[w] = 0;
+  }
+}
+
 // x's cap against y's facing face plane (the first cull plane), for x with a hierarchy: every
 // vertex whose plane distance may be within tol + margin, found without visiting the rest.
 // The vertices of a convex polyhedron on one side of a plane are connected by its edges (from
@@ -376,7 +399,7 @@ bool find_cap(AcceleratedView& x, const Limits& lim, AcceleratedWorkspace& ws, i
       if (plane.local_distance(verts[w]) <= limit) cap.push_back(w);
     }
   }
-  std::sort(cap.begin(), cap.end());
+  sort_unique(cap, verts.size());
   return true;
 }
 
@@ -405,8 +428,7 @@ void cap_candidates(const AcceleratedView& x, Primitive kind, std::vector<int>& 
   const std::vector<int>& start = triangles ? h.triangle_start : h.edge_start;
   const std::vector<int>& list = triangles ? h.vertex_triangles : h.vertex_edges;
   for (int v : cap) out.insert(out.end(), list.begin() + start[v], list.begin() + start[v + 1]);
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+  sort_unique(out, triangles ? x.shape->triangles().size() : x.shape->edges().size());
   std::size_t kept = 0;
   for (int i : out) {
     bool culled_out;

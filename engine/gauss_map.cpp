@@ -106,12 +106,31 @@ GaussMap GaussMap::build(const ConvexPolyhedron& s) {
     g.neighbors[fill[e.b]++] = e.a;
   }
   for (const Vec3& v : s.vertices()) g.radius = std::max(g.radius, v.norm());
+  // The 26 start directions, each vertex found by a scan (once per shape).
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z) {
+        if (x == 0 && y == 0 && z == 0) continue;
+        const Vec3 d = Vec3(x, y, z).normalized();
+        g.start_directions.push_back(d);
+        g.start_vertices.push_back(s.support_index(d));
+      }
   return g;
 }
 
 int GaussMap::climb(const std::vector<Vec3>& vertices, const Vec3& d, int start,
                     double& height) const {
   int at = start;
+  if (at < 0) {
+    double along = -2.0;
+    for (std::size_t k = 0; k < start_directions.size(); ++k) {
+      const double c = start_directions[k].dot(d);
+      if (c > along) {
+        along = c;
+        at = start_vertices[k];
+      }
+    }
+  }
   double best = vertices[at].dot(d);
   for (;;) {
     // The highest neighbour of `at`, if higher than it.

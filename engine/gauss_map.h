@@ -47,13 +47,19 @@ struct GaussMap {
   /// neighbors[neighbor_start[v] .. neighbor_start[v + 1]).
   std::vector<int> neighbor_start, neighbors;
   double radius = 0.0;  // m, the largest distance of a vertex from the body origin
+  /// Start vertices for a climb with no vertex near its direction: the support vertex along each
+  /// of 26 directions (the faces, edges and corners of a cube), so that no climb starts more
+  /// than about 35 degrees from its answer.
+  std::vector<Vec3> start_directions;
+  std::vector<int> start_vertices;
 
   /// Builds the Gauss map of `shape` (its vertices, triangles, edges and planes must be set).
   static GaussMap build(const ConvexPolyhedron& shape);
 
   /// The vertex of `vertices` furthest along d (body frame), climbing the vertex graph from
-  /// `start` (a vertex with no higher neighbour is highest on a convex polyhedron); its
-  /// projection goes to `height`.
+  /// `start` (a vertex with no higher neighbour is highest on a convex polyhedron), or from the
+  /// start vertex of the nearest start direction when `start` is negative; its projection goes
+  /// to `height`.
   int climb(const std::vector<Vec3>& vertices, const Vec3& d, int start, double& height) const;
 };
 
