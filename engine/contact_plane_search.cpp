@@ -1,15 +1,11 @@
 // The direction of least overlap of two convex polyhedra, by branch and bound over their Gauss
 // maps. Every candidate axis (a face normal, or the crossing of two edges' arcs) is a face normal
-// u of the Minkowski difference D = A - B, and its overlap is D's support h_D(u) = h_A(u) +
-// h_B(-u). Any point x of D bounds h_D(u) >= x . u from below for every u, so a cone of
-// directions whose bound (from the support point at its axis) exceeds the least overlap found
-// cannot hold the answer and is skipped with every face and edge in it. Any direction's h_D is
-// at least the least overlap, so it bounds the answer from above. docs/contact_plane.md derives
-// both and says why no candidate within the tie margin is ever skipped.
-#include <algorithm>
-#include <cmath>
-#include <vector>
-
+// of the Minkowski difference D = A - B, and its overlap is h_A(n) + h_B(-n). Over a cone of one
+// shape's normals, its own support is at least the least face offset in the cone (plus its
+// position along n) and the other's is at least that of any one of its points, so a cone whose
+// bound exceeds the least overlap measured cannot hold the answer and is skipped with every face
+// and edge in it. docs/contact_plane.md derives the bound and says why no candidate within the tie
+// margin is ever skipped.
 #include "engine/contact_plane_detail.h"
 #include "engine/gauss_map.h"
 
@@ -49,13 +45,13 @@ double cone_bound(const Vec3& x, const Vec3& axis, const DirectionCone& cone) {
 // The trees searched: the faces and the arcs of A and of B.
 enum Tree { kFacesA = 0, kFacesB = 1, kArcsA = 2, kArcsB = 3 };
 
-// A node waiting in the search: the lower bound it carries, and the vertices of A and B from
-// which its support climbs start (its parent's, near its axis; -1 at a root: from the Gauss
-// map's start vertices).
+// A node waiting in the search: the lower bound it carries, and the vertex of the other shape
+// from which its climb starts (its parent's, near its axis; -1 at a root: from the Gauss map's
+// start vertices).
 struct Pending {
   double bound = -kInf;
   int tree = 0, node = 0;
-  int at_a = 0, at_b = 0;
+  int at_other = -1;
   // The heap's order: the least bound on top; ties by tree and node (deterministic).
   bool operator<(const Pending& o) const {
     if (bound != o.bound) return bound > o.bound;
@@ -75,8 +71,8 @@ struct KeptArc {
 // The state of one query.
 struct Query {
   Side a, b;
-  double upper = kInf;  // m, an upper bound on the least overlap (h_D along some direction)
-  Vec3 upper_normal = Vec3::UnitZ();  // -u for the direction u that gave `upper`
+  double upper = kInf;  // m, the least overlap measured so far: an upper bound on the answer
+  Vec3 upper_normal = Vec3::UnitZ();  // the normal of the candidate that gave `upper`
   double tie = 0.0;                   // m, overlaps closer than this are equal (round-off)
   std::vector<Candidate> kept;
   std::vector<Pending> heap;
@@ -111,7 +107,7 @@ void Query::search() {
   heap.clear();
   for (int t = kFacesA; t <= kArcsB; ++t) {
     const GaussMap& g = *side(t).map;
-    if (!(t < kArcsA ? g.face_tree : g.arc_tree).nodes.empty()) push({-kInf, t, 0, -1, -1});
+    if (!(t < kArcsA ? g.face_tree : g.arc_tree).nodes.empty()) push({-kInf, t, 0, -1});
   }
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end());
@@ -123,48 +119,50 @@ void Query::search() {
   }
 }
 
-// One node: the support point of D at its axis bounds the node from below (and the answer from
-// above); a leaf's faces are measured, a leaf's arcs kept for pairing, an inner node's children
-// queued with their bounds from the same point.
+// One node of the own shape's faces or arcs, whose normals n lie in the node's cone. Each
+// overlap there is h_D = h_own(n) + h_other(-n) >= low + (p_own - y) . n for the node's least
+// own support `low` and any point y of the other shape; y is the other's lowest point along the
+// node's axis (one climb), and the least of (p_own - y) . n over the cone is cone_bound. A leaf's
+// faces are then measured, a leaf's arcs kept for pairing, an inner node's children queued with
+// their bounds from the same point.
 void Query::visit(const Pending& e) {
   const Side& own = side(e.tree);
+  const Side& other = side(e.tree + 1);
   const GaussMap& g = *own.map;
   const bool faces = e.tree < kArcsA;
   const Bvh& tree = faces ? g.face_tree : g.arc_tree;
   const std::vector<DirectionCone>& cones = faces ? g.face_cones : g.arc_cones;
-  const double s = sign(e.tree);
-  const Vec3 axis = s * (own.r * cones[e.node].axis);
-  int at_a = e.at_a, at_b = e.at_b;
-  const double h = a.support(axis, at_a) + b.support(-axis, at_b);
-  if (std::max(h, 0.0) < upper) {
-    upper = std::max(h, 0.0);
-    upper_normal = -axis;
-  }
-  const Vec3 x = a.world(at_a) - b.world(at_b);
-  const double bound = std::max(e.bound, cone_bound(x, axis, cones[e.node]));
+  const std::vector<double>& lows = faces ? g.face_lows : g.arc_lows;
+  const Vec3 axis = own.r * cones[e.node].axis;
+  int at = e.at_other;
+  other.support(-axis, at);
+  const Vec3 y = own.p - other.world(at);
+  const double bound = std::max(e.bound, lows[e.node] + cone_bound(y, axis, cones[e.node]));
   if (bound > threshold()) return;
   const BvhNode& node = tree.nodes[e.node];
   if (node.child >= 0) {
-    for (const int c : {node.child, node.child + 1}) {
-      const Vec3 c_axis = s * (own.r * cones[c].axis);
-      push({std::max(bound, cone_bound(x, c_axis, cones[c])), e.tree, c, at_a, at_b});
-    }
+    for (const int c : {node.child, node.child + 1})
+      push({std::max(bound, lows[c] + cone_bound(y, own.r * cones[c].axis, cones[c])), e.tree, c,
+            at});
     return;
   }
+  const double s = sign(e.tree);
   for (int i = node.begin; i < node.end; ++i) {
     const int item = tree.order[i];
     if (faces) {
-      // x . u bounds this face's overlap before any climb.
-      const Vec3 u = s * (own.r * g.faces[item].normal);
-      if (x.dot(u) > threshold()) continue;
-      face(e.tree, item, e.tree == kFacesA ? at_b : at_a);
+      // The same bound at the face's own normal, before its climb.
+      const GaussMap::Face& f = g.faces[item];
+      if (f.offset + y.dot(own.r * f.normal) > threshold()) continue;
+      face(e.tree, item, at);
       continue;
     }
     const GaussMap::Arc& arc = g.arcs[item];
     KeptArc k;
-    k.axis = s * (own.r * arc.cone.axis);
-    k.bound = cone_bound(x, k.axis, arc.cone);
+    const Vec3 arc_axis = own.r * arc.cone.axis;
+    k.bound = arc.low + cone_bound(y, arc_axis, arc.cone);
     if (k.bound > threshold()) continue;
+    // For pairing, the arc on D's Gauss map (B's negated).
+    k.axis = s * arc_axis;
     k.n0 = s * (own.r * arc.n0);
     k.n1 = s * (own.r * arc.n1);
     k.cone = &arc.cone;

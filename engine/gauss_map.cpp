@@ -86,11 +86,30 @@ GaussMap GaussMap::build(const ConvexPolyhedron& s) {
     // Faces nearly opposite (a sliver's rim): no useful centre, the whole sphere.
     const double half = mid.norm() > 1e-6 ? 0.5 * angle_between(n0, n1) : M_PI;
     arc.cone = cone_of(mid.norm() > 1e-6 ? Vec3(mid.normalized()) : n0, half);
+    // Along the arc the support is v . n for the edge's vertex v, a sinusoid in the arc's angle
+    // that equals the two faces' offsets at the ends. An arc shorter than a half circle with
+    // both ends at or above 0 holds no trough of it, so its least is at an end; otherwise
+    // -|v| is below it everywhere.
+    const double o0 = planes[f[0]].offset, o1 = planes[f[1]].offset;
+    arc.low = o0 >= 0 && o1 >= 0 && half < 0.5 * M_PI ? std::min(o0, o1)
+                                                      : -s.vertices()[s.edges()[i].a].norm();
     g.arcs.push_back(arc);
     items.push_back(arc.cone);
     angles.push_back(half + kConeSlack);
   }
   build_tree(items, angles, g.arc_tree, g.arc_cones);
+  // The least support per node.
+  auto lows = [](const Bvh& tree, auto low_of, std::vector<double>& out) {
+    for (const BvhNode& node : tree.nodes) {
+      double low = low_of(tree.order[node.begin]);
+      for (int i = node.begin; i < node.end; ++i) low = std::min(low, low_of(tree.order[i]));
+      out.push_back(low);
+    }
+  };
+  lows(
+      g.face_tree, [&](int k) { return g.faces[k].offset; }, g.face_lows);
+  lows(
+      g.arc_tree, [&](int k) { return g.arcs[k].low; }, g.arc_lows);
   // Vertex adjacency from the edges (counting sort: each list in increasing order).
   const int nv = static_cast<int>(s.vertices().size());
   g.neighbor_start.assign(nv + 1, 0);

@@ -33,6 +33,7 @@ struct GaussMap {
   struct Arc {
     Vec3 n0 = Vec3::UnitZ(), n1 = Vec3::UnitZ();  // unit: the normals of edge_faces()[edge]
     DirectionCone cone;                           // holds the whole arc
+    double low = 0.0;  // m, at most the shape's support h(n) = max_p p . n at every n of the arc
     int edge = 0;
   };
 
@@ -43,6 +44,9 @@ struct GaussMap {
   /// arcs, whose node cones hold every point of their arcs.
   Bvh face_tree, arc_tree;
   std::vector<DirectionCone> face_cones, arc_cones;
+  /// Per node, the least support h(n) over its faces' normals (their offsets) or over its arcs
+  /// (their `low`), in the body frame.
+  std::vector<double> face_lows, arc_lows;
   /// Vertex adjacency, compressed: the neighbours of vertex v are
   /// neighbors[neighbor_start[v] .. neighbor_start[v + 1]).
   std::vector<int> neighbor_start, neighbors;
