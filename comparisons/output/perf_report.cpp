@@ -61,10 +61,9 @@ double find_time(const std::vector<NarrowRow>& rows, const std::string& backend,
 // search; hulls of random points on a sphere), each a measured cause.
 constexpr const char* kDetectorProfile =
     "touching, the contact plane costs more than the tests: at N = 2048 its search is about 3/4 "
-    "of the query, half of it the vertex climbs that find the support point at each cone's axis "
-    "(a few hundred cones opened per query); at N = 32 the scan is about 3/4 (its per-query "
-    "placing and sampling of both shapes, then every face's bound). The tests alone are about "
-    "1x FCL (prebuilt).";
+    "of the query, a third of it the vertex climbs (one per cone opened, a few hundred per "
+    "query); at N = 32 the scan is about 3/4 (its per-query placing and sampling of both shapes, "
+    "then every face's bound). The tests alone are about 1x FCL (prebuilt).";
 constexpr const char* kDeepProfile =
     "deep, the tests cost more than the plane: at N = 8192 the seed's point-in-mesh tests on the "
     "cap's candidates are about 40 % of the query and finding the cap (a fifth of the vertices "
