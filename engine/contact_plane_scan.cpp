@@ -7,7 +7,6 @@
 
 #include "engine/contact_plane_detail.h"
 #include "engine/gauss_map.h"
-#include "engine/shape_hierarchy.h"
 
 namespace rbx::plane_detail {
 
@@ -25,33 +24,18 @@ struct Placed {
   std::vector<Vec3> samples;
 
   // The furthest projection of the shape along d, and in `at` a vertex that reaches it. With a
-  // hierarchy, climbs the vertex graph from `at` (a vertex with no higher neighbour is highest
-  // on a convex polyhedron); otherwise scans every vertex.
+  // hierarchy, climbs the vertex graph from `at`; otherwise scans every vertex.
   double max_along(const Vec3& d, int& at) const {
-    const ShapeHierarchy* h = shape->hierarchy();
-    if (!h) {
-      double best = -kInf;
-      for (int i = 0; i < static_cast<int>(v.size()); ++i) {
-        const double s = v[i].dot(d);
-        if (s > best) {
-          best = s;
-          at = i;
-        }
-      }
+    double best = -kInf;
+    if (shape->hierarchy()) {
+      at = shape->gauss_map().climb(v, d, at, best);
       return best;
     }
-    double best = v[at].dot(d);
-    for (bool moved = true; moved;) {
-      moved = false;
-      for (int k = h->edge_start[at]; k < h->edge_start[at + 1]; ++k) {
-        const Edge& e = shape->edges()[h->vertex_edges[k]];
-        const int o = e.a == at ? e.b : e.a;
-        const double s = v[o].dot(d);
-        if (s > best) {
-          best = s;
-          at = o;
-          moved = true;
-        }
+    for (int i = 0; i < static_cast<int>(v.size()); ++i) {
+      const double s = v[i].dot(d);
+      if (s > best) {
+        best = s;
+        at = i;
       }
     }
     return best;
@@ -67,13 +51,7 @@ void sample(Placed& x, const Vec3& toward) {
   const Mat3 rt = x.r.transpose();
   for (const Vec3& d : dirs) {
     // Climbs start from the Gauss map's start vertex nearest d, a few edges from the answer.
-    int at = 0;
-    double along = -2.0;
-    for (std::size_t k = 0; k < g.start_directions.size(); ++k)
-      if (g.start_directions[k].dot(rt * d) > along) {
-        along = g.start_directions[k].dot(rt * d);
-        at = g.start_vertices[k];
-      }
+    int at = g.start_for(rt * d);
     x.max_along(d, at);
     x.samples.push_back(x.v[at]);
   }

@@ -137,19 +137,22 @@ GaussMap GaussMap::build(const ConvexPolyhedron& s) {
   return g;
 }
 
-int GaussMap::climb(const std::vector<Vec3>& vertices, const Vec3& d, int start,
-                    double& height) const {
-  int at = start;
-  if (at < 0) {
-    double along = -2.0;
-    for (std::size_t k = 0; k < start_directions.size(); ++k) {
-      const double c = start_directions[k].dot(d);
-      if (c > along) {
-        along = c;
-        at = start_vertices[k];
-      }
+int GaussMap::start_for(const Vec3& d) const {
+  int at = 0;
+  double along = -2.0;
+  for (std::size_t k = 0; k < start_directions.size(); ++k) {
+    const double c = start_directions[k].dot(d);
+    if (c > along) {
+      along = c;
+      at = start_vertices[k];
     }
   }
+  return at;
+}
+
+int GaussMap::climb(const std::vector<Vec3>& vertices, const Vec3& d, int start,
+                    double& height) const {
+  int at = start < 0 ? start_for(d) : start;
   double best = vertices[at].dot(d);
   for (;;) {
     // The highest neighbour of `at`, if higher than it.

@@ -60,10 +60,14 @@ struct GaussMap {
   /// Builds the Gauss map of `shape` (its vertices, triangles, edges and planes must be set).
   static GaussMap build(const ConvexPolyhedron& shape);
 
+  /// The start vertex of the start direction nearest d (body frame).
+  int start_for(const Vec3& d) const;
   /// The vertex of `vertices` furthest along d (body frame), climbing the vertex graph from
   /// `start` (a vertex with no higher neighbour is highest on a convex polyhedron), or from the
   /// start vertex of the nearest start direction when `start` is negative; its projection goes
-  /// to `height`.
+  /// to `height`. `vertices` may be the shape's body-frame vertices or the same placed in the
+  /// world (with d in the same frame; then `start` must not be negative): only the vertex graph
+  /// is the map's.
   int climb(const std::vector<Vec3>& vertices, const Vec3& d, int start, double& height) const;
 };
 

@@ -186,7 +186,7 @@ TEST(ContactPlane, TheSearchFindsTheLeastOverlapOfEveryCandidate) {
   for (int k = 0; k < 4; ++k)
     all.push_back(stretched_icosphere(1, Vec3(stretch(rng), stretch(rng), stretch(rng))));
   int touching = 0;
-  for (int trial = 0; trial < 800; ++trial) {
+  for (int trial = 0; trial < 500; ++trial) {
     const RandomPair r = random_pair(all, rng);
     if (!detect(*r.a, r.pa, *r.b, r.pb)) continue;
     ++touching;
@@ -198,7 +198,7 @@ TEST(ContactPlane, TheSearchFindsTheLeastOverlapOfEveryCandidate) {
       EXPECT_NEAR(p.depth, least, 1e-12) << "trial " << trial;
     }
   }
-  EXPECT_GT(touching, 300);
+  EXPECT_GT(touching, 200);
 }
 
 TEST(ContactPlane, TheScanAndTheSearchChooseTheSamePlane) {
@@ -210,7 +210,7 @@ TEST(ContactPlane, TheScanAndTheSearchChooseTheSamePlane) {
       stretched_icosphere(2, Vec3(1.3, 0.7, 1.0)), stretched_icosphere(3, Vec3(0.6, 1.4, 0.9)),
       stretched_icosphere(4, Vec3(1.0, 0.8, 1.2)), make_box(Vec3(0.9, 0.4, 0.7))};
   int touching = 0;
-  for (int trial = 0; trial < 200; ++trial) {
+  for (int trial = 0; trial < 120; ++trial) {
     const RandomPair r = random_pair(all, rng);
     if (!detect(*r.a, r.pa, *r.b, r.pb)) continue;
     ++touching;
@@ -220,7 +220,7 @@ TEST(ContactPlane, TheScanAndTheSearchChooseTheSamePlane) {
     EXPECT_NEAR(scan.depth, search.depth, 1e-12) << "trial " << trial;
     EXPECT_NEAR((scan.normal - search.normal).norm(), 0.0, 1e-9) << "trial " << trial;
   }
-  EXPECT_GT(touching, 60);
+  EXPECT_GT(touching, 40);
 }
 
 }  // namespace
