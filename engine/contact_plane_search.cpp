@@ -6,6 +6,10 @@
 // bound exceeds the least overlap measured cannot hold the answer and is skipped with every face
 // and edge in it. docs/contact_plane.md derives the bound and says why no candidate within the tie
 // margin is ever skipped.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 #include "engine/contact_plane_detail.h"
 #include "engine/gauss_map.h"
 
@@ -31,8 +35,8 @@ struct Side {
   Vec3 world(int v) const { return r * shape->vertices()[v] + p; }
 };
 
-// The least of x . u over the unit vectors u of a cone (axis in the world): a lower bound on
-// h_D over the cone when x is a point of D.
+// The least of x . u over the unit vectors u of a cone (axis in the world): |x| cos(theta + r)
+// for theta the angle of x to the axis and r the cone's, or -|x| once theta + r reaches pi.
 double cone_bound(const Vec3& x, const Vec3& axis, const DirectionCone& cone) {
   const double size = x.norm();
   if (cone.whole) return -size;
