@@ -527,6 +527,10 @@ bool AcceleratedView::inside(const Vec3& p) const {
   }
   const Vec3 pl = to_local(p);
   const double certified = tol - margin, outside = tol + margin;
+  // Within the inscribed ball grown by `certified`: every face's body-frame plane distance is
+  // at most `certified`, the rule the tree's leaves apply face by face.
+  const double reach = accel->ball_radius + certified;
+  if (reach > 0 && (pl - accel->ball_centre).squaredNorm() <= reach * reach) return true;
   const Bvh& tree = accel->triangles;
   if (linear) {
     const int n = num_triangles();

@@ -99,6 +99,12 @@ ShapeHierarchy ShapeHierarchy::build(const ConvexPolyhedron& s) {
       }
     }
   }
+  // The inscribed ball about the vertex mean.
+  for (const Vec3& p : v) h.ball_centre += p;
+  h.ball_centre /= static_cast<double>(v.size());
+  h.ball_radius = std::numeric_limits<double>::infinity();
+  for (const Plane& plane : planes)
+    h.ball_radius = std::min(h.ball_radius, plane.offset - plane.normal.dot(h.ball_centre));
   return h;
 }
 

@@ -46,6 +46,11 @@ struct ShapeHierarchy {
   Bvh vertices;                     // over vertices
   Bvh edges;                        // over edges (boxes of their two ends)
   std::array<int, 6> axis_faces{};  // the face whose normal is most along +x, -x, +y, ... -z
+  // A ball inside the shape: around the vertex mean, as far as its nearest face plane (m, body
+  // frame; <= 0 when the mean is on or beyond a face plane). Every face's plane distance of a
+  // point within it is at most |p - centre| - radius, so inside() certifies it without a search.
+  Vec3 ball_centre = Vec3::Zero();
+  double ball_radius = 0.0;
   // Incidence, compressed by vertex: the edges of vertex v are
   // vertex_edges[edge_start[v] .. edge_start[v + 1]), its triangles likewise.
   std::vector<int> edge_start, vertex_edges;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "comparisons/scene/mesh_io.h"
+#include "engine/contact_plane.h"
 #include "engine/detect.h"
 #include "tests/fuzz/byte_reader.h"
 #include "tests/fuzz/targets.h"
@@ -48,6 +49,20 @@ Aabb world_box(const ConvexPolyhedron& s, const Pose& pose) {
     box.max = box.max.cwiseMax(w);
   }
   return box;
+}
+
+std::string describe_vec(const Vec3& v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v.transpose();
+  return s.str();
+}
+
+std::string describe_num(double x) {
+  std::ostringstream s;
+  s.precision(17);
+  s << x;
+  return s.str();
 }
 
 std::string describe(const ContactPoint& c) {
@@ -121,6 +136,30 @@ void convex_detect(const uint8_t* data, size_t size) {
                 std::abs(faithful->depth - accelerated->depth) <= tol,
             "Accelerated and Faithful disagree: " + describe(*faithful) + " vs " +
                 describe(*accelerated));
+  }
+
+  // The contact plane of a touching pair (engine/contact_plane.h), by both of its methods: a
+  // unit normal, a depth >= 0 that is the overlap along that normal, and the same least overlap
+  // from the scan and the search (on an exact tie they may name different axes of it). The
+  // same round-off room as above: projections of coordinates of order `reach`.
+  if (accelerated) {
+    const double tol = 1e-9 * reach;
+    double depth[2] = {0.0, 0.0};
+    for (const PlaneMethod method : {PlaneMethod::Scan, PlaneMethod::Search}) {
+      const ContactPlane p = choose_contact_plane(*a, pa, *b, pb, method);
+      const std::string what = std::string(method == PlaneMethod::Scan ? "scan" : "search") +
+                               " plane: normal (" + describe_vec(p.normal) + ") depth " +
+                               describe_num(p.depth);
+      require(p.normal.allFinite() && std::abs(p.normal.norm() - 1.0) < 1e-12,
+              "normal not unit: " + what);
+      require(std::isfinite(p.depth) && p.depth >= 0, "depth negative or non-finite: " + what);
+      require(std::abs(overlap_along(*a, pa, *b, pb, p.normal) - p.depth) <= tol,
+              "depth is not the overlap along the normal: " + what);
+      depth[method == PlaneMethod::Scan ? 0 : 1] = p.depth;
+    }
+    require(std::abs(depth[0] - depth[1]) <= tol,
+            "scan and search disagree on the depth: " + describe_num(depth[0]) + " vs " +
+                describe_num(depth[1]));
   }
 }
 
