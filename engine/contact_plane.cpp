@@ -35,10 +35,11 @@ ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
   const std::size_t features = ga.faces.size() + ga.arcs.size() + gb.faces.size() + gb.arcs.size();
   if (method == PlaneMethod::Automatic)
     method = features <= kScanFeatures ? PlaneMethod::Scan : PlaneMethod::Search;
-  if (method == PlaneMethod::Scan)
-    plane_detail::scan_candidates(a, pa, b, pb, found);
-  else
+  // The scan answers only for shapes it proves to overlap; the search for every pair.
+  if (method != PlaneMethod::Scan || !plane_detail::scan_candidates(a, pa, b, pb, found)) {
+    found.kept.clear();
     plane_detail::search_candidates(a, pa, b, pb, found);
+  }
 
   // Among the candidates within the tie margin of the least overlap: faces first, then the
   // smaller sign-free axis, then the smaller overlap. Every key is the geometry's, not the slot's.

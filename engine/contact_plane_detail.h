@@ -55,8 +55,10 @@ inline bool arcs_cross(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec
 }
 
 /// The scan: every face measured (with a bound that skips the hopeless) and every solid edge near
-/// the other shape paired (engine/contact_plane_scan.cpp).
-void scan_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+/// the other shape paired (engine/contact_plane_scan.cpp). Its edge filters hold for shapes that
+/// overlap; it returns false, keeping nothing, when it cannot prove that they do (then the search
+/// answers).
+bool scan_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                      const Pose& pb, Candidates& out);
 
 /// The search: branch and bound over both shapes' Gauss maps

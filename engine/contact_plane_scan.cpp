@@ -88,6 +88,12 @@ struct Query {
   Placed a, b;
   double best = kInf;  // m, least overlap so far
   double tie = 0.0;    // m, overlaps closer than this are equal (round-off)
+  // A point that may lie inside both shapes, to prove they overlap: the witness of the candidate
+  // of least overlap (face_axes, edge_axes). When it is a vertex of one shape, `witness_in` is
+  // the other (the only one it must be inside); null: it must be inside both.
+  Vec3 witness = Vec3::Zero();
+  const Placed* witness_in = nullptr;
+  double witness_overlap = kInf;
   std::vector<Candidate> kept;
   std::vector<std::pair<double, int>> bounds;  // scratch: (lower bound, face)
   std::vector<int> edges_a, edges_b;           // scratch: solid edges near the other shape
@@ -144,6 +150,13 @@ void face_axes(Query& q, const Placed& x, const Placed& y, bool x_is_a) {
     const double low = -y.max_along(-n, at);
     Candidate c;
     c.overlap = height - low;
+    // The lowest point of y along the face of least overlap so far (a vertex of y): inside x, it
+    // proves the shapes overlap (overlaps).
+    if (c.overlap < q.witness_overlap) {
+      q.witness_overlap = c.overlap;
+      q.witness = y.v[at];
+      q.witness_in = &x;
+    }
     c.kind = 0;
     c.axis = canonical(n);
     // y is pushed along n: the normal from B toward A is n when y is A, -n when y is B.
@@ -153,6 +166,31 @@ void face_axes(Query& q, const Placed& x, const Placed& y, bool x_is_a) {
     // x's face planes of least overlap: every point within that overlap of x lies below them.
     q.keep_plane(x_is_a ? q.planes_a : q.planes_b, {n, height}, c.overlap);
   }
+}
+
+// Whether p lies inside x by more than `margin` below every face plane.
+bool strictly_inside(const Placed& x, const Vec3& p, double margin) {
+  const ConvexPolyhedron& s = *x.shape;
+  const auto& tris = s.triangles();
+  for (int f = 0; f < static_cast<int>(tris.size()); ++f)
+    if (s.new_plane()[f] && (x.r * s.planes()[f].normal).dot(p - x.v[tris[f][0]]) > -margin)
+      return false;
+  return true;
+}
+
+// Whether the shapes are proved to overlap: a point strictly inside both (the witness of the
+// candidate of least overlap, or either shape's vertex mean inside the other). The edge filters
+// (near_edges, the lines' distance in edge_axes) assume it: for overlapping shapes every
+// candidate's overlap is positive and its two edges pass within it of each other, while shapes
+// apart by a hair (which the tests may call touching) have a negative least overlap that two
+// edges can give from any distance.
+bool overlaps(const Query& q) {
+  if (q.witness_overlap < kInf) {
+    const bool in_a = q.witness_in == &q.b || strictly_inside(q.a, q.witness, q.tie);
+    const bool in_b = q.witness_in == &q.a || strictly_inside(q.b, q.witness, q.tie);
+    if (in_a && in_b) return true;
+  }
+  return strictly_inside(q.a, q.b.centre, q.tie) || strictly_inside(q.b, q.a.centre, q.tie);
 }
 
 // The solid edges of x (not a flat face's diagonal) that come within `reach` of the other
@@ -246,13 +284,27 @@ void edge_axes(Query& q) {
       k.overlap = std::min(up, down);
       k.normal = up <= down ? c : Vec3(-c);
       q.keep(k);
+      // The midpoint of the two edges' closest points: inside both shapes, it proves the
+      // overlap of a pair whose least overlap is this edge pair's.
+      if (k.overlap < q.witness_overlap) {
+        const double aa = da.dot(da), bb = db.dot(db), ab = da.dot(db);
+        const Vec3 r = a.v[ea.a] - b.v[eb.a];
+        const double denom = aa * bb - ab * ab;  // > 0: the edges are not parallel (above)
+        const double u = (ab * db.dot(r) - bb * da.dot(r)) / denom;
+        const double w = (aa * db.dot(r) - ab * da.dot(r)) / denom;
+        if (u >= 0 && u <= 1 && w >= 0 && w <= 1) {
+          q.witness_overlap = k.overlap;
+          q.witness = 0.5 * ((a.v[ea.a] + u * da) + (b.v[eb.a] + w * db));
+          q.witness_in = nullptr;  // inside both
+        }
+      }
     }
   }
 }
 
 }  // namespace
 
-void scan_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+bool scan_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                      const Pose& pb, Candidates& out) {
   // Scratch reused across queries on this thread (allocated once, as the detector's).
   thread_local Query q;
@@ -270,11 +322,15 @@ void scan_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPoly
                                  q.b.lo.cwiseAbs().maxCoeff(), q.b.hi.cwiseAbs().maxCoeff()});
   q.tie = 1e-12 * scale;
 
+  q.witness_in = nullptr;
+  q.witness_overlap = kInf;
   face_axes(q, q.a, q.b, true);
   face_axes(q, q.b, q.a, false);
   edge_axes(q);
+  if (!overlaps(q)) return false;
   out.kept.swap(q.kept);
   out.tie = q.tie;
+  return true;
 }
 
 }  // namespace rbx::plane_detail

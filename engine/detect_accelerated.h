@@ -16,7 +16,8 @@
 //     plane are connected by edges, as in the simplex method), so the rest are never visited;
 //     the candidates are the cap's vertices and the triangles and edges that have one. The
 //     survivors are sorted by index, so "the first" is the seed's first.
-//   - Point in mesh. The seed checks every face; here B's triangle tree bounds the plane
+//   - Point in mesh. The seed checks every face; here a point within B's inscribed ball (grown
+//     by tol - margin) is inside at once, and otherwise B's triangle tree bounds the plane
 //     distance of a whole cluster of faces at once (the range of their normals' components
 //     and of their plane offsets), certifying the cluster without visiting it. In a leaf, the
 //     face's plane distance in B's body frame (within round-off of the seed's) decides unless
