@@ -66,9 +66,11 @@ constexpr const char* kDetectorProfile =
     "then every face's bound). The tests alone are about 1x FCL (prebuilt).";
 constexpr const char* kDeepProfile =
     "deep, the tests cost more than the plane: at N = 8192 the seed's point-in-mesh tests on the "
-    "cap's candidates are about 40 % of the query and finding the cap (a fifth of the vertices "
-    "lie within the other shape) about 17 %; the first hit must be the seed's, in index order, "
-    "so the cap is walked whole. The contact plane's search is about a quarter.";
+    "cap's candidates are about 45 % of the query (points deep inside the other shape are "
+    "certified by its inscribed ball; those near its surface take its tree) and finding the cap "
+    "(a fifth of the vertices lie within the other shape) about 18 %: the seed's face test "
+    "averages the centroids of every triangle inside, so the cap is walked whole. The contact "
+    "plane's search is about a sixth.";
 
 std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& results) {
   std::vector<PerfGoal> goals;
