@@ -14,8 +14,8 @@ namespace {
 using plane_detail::Candidate;
 
 // Pairs with at most this many faces and solid edges in all take the scan, larger ones the
-// search: the crossover measured on hulls of random points on a sphere (perf.md). The sum is the
-// same in either body order, so both orders take the same path.
+// search: the crossover measured on hulls of random points on a sphere (docs/contact_plane.md).
+// The sum is the same in either body order, so both orders take the same path.
 constexpr std::size_t kScanFeatures = 600;
 
 bool lex_less(const Vec3& p, const Vec3& q) {

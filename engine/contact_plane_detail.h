@@ -5,7 +5,8 @@
 // difference D = A - B) whose overlap lies within the tie margin of the least, and
 // choose_contact_plane picks among those by keys of the geometry alone. The scan measures every
 // face and filters edges linearly and is the faster on small shapes; the search is a branch and
-// bound over the shapes' Gauss maps and is the faster from a few hundred faces (perf.md).
+// bound over the shapes' Gauss maps and is the faster from a few hundred faces
+// (docs/contact_plane.md has the timings).
 #pragma once
 
 #include <limits>
