@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -214,6 +215,27 @@ struct QueryVariant {
   std::string variant;      // e.g. "prebuilt"
   std::string description;  // one line: what differs
   ContactFn contact;
+};
+
+/// One library adapter as a table: the backends it provides and their query variants, each row
+/// with its name (as in the CLI and JSON), description and entry points. The registry is the
+/// adapters' rows in order; tests reach an entry point by the backend's own name.
+struct Adapter {
+  std::vector<Backend> backends;
+  std::vector<QueryVariant> variants;
+
+  /// The backend called `name`; throws std::invalid_argument when this adapter has none.
+  const Backend& backend(const std::string& name) const {
+    for (const Backend& b : backends)
+      if (b.name == name) return b;
+    throw std::invalid_argument("no backend '" + name + "' in this adapter");
+  }
+  /// The variant `variant` of backend `name`; throws std::invalid_argument when there is none.
+  const QueryVariant& variant(const std::string& name, const std::string& variant) const {
+    for (const QueryVariant& v : variants)
+      if (v.backend == name && v.variant == variant) return v;
+    throw std::invalid_argument("no variant '" + variant + "' of '" + name + "' in this adapter");
+  }
 };
 
 /// Every query variant, one line each (reference/registry.cpp).

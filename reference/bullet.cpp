@@ -461,12 +461,15 @@ ContactResult bullet_contact_with(const RigidBody& a, const RigidBody& b,
   return pair_query(a, b, settings);
 }
 
-ContactResult bullet_contact(const RigidBody& a, const RigidBody& b) {
-  return pair_query(a, b, bullet_native_settings());
+DynamicsResult bullet_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+                                    const BulletSettings& settings) {
+  return run_world(scene, opt, settings);
 }
 
-ContactResult bullet_hull_contact(const RigidBody& a, const RigidBody& b) {
-  return pair_query(a, b, bullet_hull_settings());
+DynamicsResult bullet_dynamics_default_world(const Scene& scene, const DynamicsOptions& opt) {
+  BulletSettings s = bullet_hull_settings();
+  s.fair_world = false;
+  return run_world(scene, opt, s);
 }
 
 namespace {
@@ -478,46 +481,27 @@ BulletSettings bullet_sat_settings() {
   return s;
 }
 
-}  // namespace
-
-ContactResult bullet_sat_contact(const RigidBody& a, const RigidBody& b) {
-  return pair_query(a, b, bullet_sat_settings());
+// The contact query, dynamics run and prebuilt query of one set-up. Prebuilt: each shape built
+// once and kept (reference/prebuilt_cache.h; polyhedral features included), the query without
+// the cost of building the shape, which the report shows apart; one cache per set-up and thread.
+template <BulletSettings (*Settings)()>
+ContactResult query(const RigidBody& a, const RigidBody& b) {
+  return pair_query(a, b, Settings());
 }
-
-ContactResult bullet_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+template <BulletSettings (*Settings)()>
+ContactResult prebuilt_query(const RigidBody& a, const RigidBody& b) {
   thread_local ShapeCache cache;
-  return pair_query(a, b, bullet_native_settings(), &cache);
+  return pair_query(a, b, Settings(), &cache);
+}
+template <BulletSettings (*Settings)()>
+DynamicsResult dynamics_run(const Scene& scene, const DynamicsOptions& opt) {
+  return run_world(scene, opt, Settings());
 }
 
-ContactResult bullet_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
-  thread_local ShapeCache cache;
-  return pair_query(a, b, bullet_hull_settings(), &cache);
-}
+MassResult bullet_hull_mass(const RigidBody& body);
 
-ContactResult bullet_sat_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
-  thread_local ShapeCache cache;
-  return pair_query(a, b, bullet_sat_settings(), &cache);
-}
-
-DynamicsResult bullet_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
-                                    const BulletSettings& settings) {
-  return run_world(scene, opt, settings);
-}
-
-DynamicsResult bullet_dynamics(const Scene& scene, const DynamicsOptions& opt) {
-  return run_world(scene, opt, bullet_native_settings());
-}
-
-DynamicsResult bullet_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
-  return run_world(scene, opt, bullet_hull_settings());
-}
-
-DynamicsResult bullet_dynamics_default_world(const Scene& scene, const DynamicsOptions& opt) {
-  BulletSettings s = bullet_hull_settings();
-  s.fair_world = false;
-  return run_world(scene, opt, s);
-}
-
+// `bullet` mass: btBoxShape::calculateLocalInertia for boxes (the solid box's, exact), the hull
+// routine below otherwise.
 MassResult bullet_mass(const RigidBody& body) {
   if (!is_native_box(body)) return bullet_hull_mass(body);
   MassResult r;
@@ -532,6 +516,9 @@ MassResult bullet_mass(const RigidBody& body) {
   return r;
 }
 
+// `bullet-hull` mass: btConvexHullShape::calculateLocalInertia with its default margin (0.04 m):
+// the inertia of the bounding box about the shape origin, each extent grown by 6 margins (the
+// cached AABB, getAabb and the routine each add one on both sides); no centre of mass.
 MassResult bullet_hull_mass(const RigidBody& body) {
   MassResult r;
   btConvexHullShape hull;
@@ -546,6 +533,33 @@ MassResult bullet_hull_mass(const RigidBody& body) {
   r.message = "calculateLocalInertia, default margin " + std::to_string(hull.getMargin()) +
               " m: bounding-box inertia about the shape origin";
   return r;
+}
+
+}  // namespace
+
+const Adapter& bullet_adapter() {
+  static const Adapter adapter = {
+      {
+          // Native boxes (btBoxShape, btBoxBoxDetector on two boxes), polyhedral hulls clipped
+          // about the GJK + EPA axis otherwise, zero hull margin, the fair world.
+          {"bullet", "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
+           query<bullet_native_settings>, dynamics_run<bullet_native_settings>, bullet_mass},
+          // Every body a zero-margin btConvexHullShape through GJK + EPA (one point).
+          {"bullet-hull", "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",
+           query<bullet_hull_settings>, dynamics_run<bullet_hull_settings>, bullet_hull_mass},
+          // Every body a polyhedral hull (boxes too), SAT + clipping; contact queries only.
+          {"bullet-sat", "Bullet 3.24 double: polyhedral hull SAT + clipping, boxes too",
+           query<bullet_sat_settings>, nullptr},
+      },
+      {
+          {"bullet", "prebuilt", "each btBoxShape or polyhedral hull built once and kept",
+           prebuilt_query<bullet_native_settings>},
+          {"bullet-hull", "prebuilt", "each btConvexHullShape built once and kept",
+           prebuilt_query<bullet_hull_settings>},
+          {"bullet-sat", "prebuilt", "each polyhedral hull built once and kept",
+           prebuilt_query<bullet_sat_settings>},
+      }};
+  return adapter;
 }
 
 }  // namespace rbx

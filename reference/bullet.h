@@ -27,33 +27,15 @@ BulletSettings bullet_native_settings();
 /// `bullet-hull`: every body a zero-margin btConvexHullShape through GJK + EPA, the fair world.
 BulletSettings bullet_hull_settings();
 
-/// `bullet`: contactPairTest on the native shapes (box-box: btBoxBoxDetector; otherwise the
-/// polyhedral hulls clipped against each other about the GJK + EPA axis).
-ContactResult bullet_contact(const RigidBody& a, const RigidBody& b);
-/// `bullet-hull`: btConvexHullShape (margin 0) pair through GJK + EPA, one point.
-ContactResult bullet_hull_contact(const RigidBody& a, const RigidBody& b);
-/// `bullet-sat`: every body a polyhedral hull (boxes too), SAT + clipping.
-ContactResult bullet_sat_contact(const RigidBody& a, const RigidBody& b);
-/// `bullet`, `bullet-hull` and `bullet-sat` with each shape built once and kept (reference/
-/// prebuilt_cache.h; polyhedral features included): variant "prebuilt", the same query without
-/// the cost of building the shape (the report shows that cost apart).
-ContactResult bullet_contact_prebuilt(const RigidBody& a, const RigidBody& b);
-ContactResult bullet_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b);
-ContactResult bullet_sat_contact_prebuilt(const RigidBody& a, const RigidBody& b);
+/// Bullet's backends: `bullet` (native boxes, polyhedral hulls clipped about the GJK + EPA axis),
+/// `bullet-hull` (every body a zero-margin GJK + EPA hull, one point) and `bullet-sat` (every
+/// body a polyhedral hull, SAT + clipping), each with its "prebuilt" variant; contact queries
+/// through contactPairTest, dynamics in btDiscreteDynamicsWorld with the fair settings.
+const Adapter& bullet_adapter();
+
 /// The contact query with explicit settings.
 ContactResult bullet_contact_with(const RigidBody& a, const RigidBody& b,
                                   const BulletSettings& settings);
-/// `bullet` mass: btBoxShape::calculateLocalInertia for boxes (the solid box's, exact), the
-/// hull routine below otherwise.
-MassResult bullet_mass(const RigidBody& body);
-/// `bullet-hull` mass: btConvexHullShape::calculateLocalInertia with its default margin (0.04 m):
-/// the inertia of the bounding box about the shape origin, each extent grown by 6 margins (the
-/// cached AABB, getAabb and the routine each add one on both sides); no centre of mass.
-MassResult bullet_hull_mass(const RigidBody& body);
-/// `bullet` dynamics: btDiscreteDynamicsWorld on the native shapes, fair settings.
-DynamicsResult bullet_dynamics(const Scene& scene, const DynamicsOptions& opt);
-/// `bullet-hull` dynamics: the same world, every body a zero-margin GJK + EPA hull.
-DynamicsResult bullet_hull_dynamics(const Scene& scene, const DynamicsOptions& opt);
 /// The world with explicit settings.
 DynamicsResult bullet_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
                                     const BulletSettings& settings);

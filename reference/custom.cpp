@@ -34,17 +34,17 @@ ContactResult chosen_plane_contact(const RigidBody& a, const RigidBody& b,
   return r;
 }
 
-}  // namespace
-
+// `custom`: the accelerated detector finds the contact and its point, the plane is the
+// direction of least overlap (engine/contact_plane.h), from either body order alike.
 ContactResult custom_contact(const RigidBody& a, const RigidBody& b) {
   return chosen_plane_contact(a, b, DetectorVariant::Accelerated);
 }
 
+// Variant "faithful" of `custom`: the seed's loops over every primitive (the accelerated
+// detector's oracle), then the same chosen plane; the same answer, slower.
 ContactResult custom_faithful_contact(const RigidBody& a, const RigidBody& b) {
   return chosen_plane_contact(a, b, DetectorVariant::Faithful);
 }
-
-namespace {
 
 BodyFinal final_of(const RigidBody& b) {
   return {b.name, b.position, b.orientation, b.velocity, b.angular_velocity};
@@ -86,19 +86,43 @@ DynamicsResult run_dynamics(const Scene& scene, const DynamicsOptions& opt, Cont
   return r;
 }
 
-}  // namespace
-
+// `custom`: the extended engine (manifolds, Coulomb friction, resting contact, time of impact).
 DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   return run_dynamics(scene, opt, ContactModel::Extended);
 }
 
+// `custom-seed`: the seed's algorithm and its corrections only (first hit, single-point
+// frictionless impulse, no time of impact).
 DynamicsResult custom_seed_dynamics(const Scene& scene, const DynamicsOptions& opt) {
   return run_dynamics(scene, opt, ContactModel::Seed);
 }
 
+}  // namespace
+
 DynamicsResult custom_seed_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
                                          const ResponseFn& response) {
   return run_dynamics(scene, opt, ContactModel::Seed, response);
+}
+
+const Adapter& custom_adapter() {
+  // The engine's own code: not isolated (library = false); the seed model has no friction.
+  static const Adapter adapter = {
+      {
+          {"custom",
+           "rbx engine, extended: Moore & Wilhelms tests with the plane of least overlap, contact "
+           "manifolds, Coulomb friction, resting contact, time of impact for every new contact",
+           custom_contact, custom_dynamics, nullptr, false},
+          {"custom-seed",
+           "rbx engine, the seed's algorithm: first hit, single-point frictionless impulse",
+           nullptr, custom_seed_dynamics, nullptr, false, false},
+      },
+      {
+          {"custom", "faithful",
+           "custom on the faithful detector: the seed's loops over every primitive (the "
+           "accelerated detector's oracle), the same chosen plane",
+           custom_faithful_contact},
+      }};
+  return adapter;
 }
 
 }  // namespace rbx

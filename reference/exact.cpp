@@ -717,4 +717,13 @@ ContactResult exact_contact(const RigidBody& a, const RigidBody& b) {
   return r;
 }
 
+const Adapter& exact_adapter() {
+  // Our own code, not isolated (library = false).
+  static const Adapter adapter = {
+      {{"exact", "rbx oracle: separating-axis test over faces and edge pairs, clipped manifold",
+        exact_contact, nullptr, nullptr, false}},
+      {}};
+  return adapter;
+}
+
 }  // namespace rbx

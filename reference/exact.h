@@ -46,5 +46,7 @@ SatResult sat_query(const SatShape& a, const Pose& pa, const SatShape& b, const 
 /// Backend `exact`: one contact per manifold point, each with the SAT normal and depth;
 /// the first contact is the manifold centroid.
 ContactResult exact_contact(const RigidBody& a, const RigidBody& b);
+/// The oracle as a backend: `exact` (exact_contact), contact queries only.
+const Adapter& exact_adapter();
 
 }  // namespace rbx

@@ -152,8 +152,8 @@ std::shared_ptr<fcl::CollisionGeometryd> native_geometry(const RigidBody& body,
   return std::make_shared<fcl::Boxd>(body.box_size);
 }
 
-}  // namespace
-
+// `fcl`: fcl::collide, GST_LIBCCD, on fcl::Box for box bodies and Convex otherwise (two boxes:
+// boxBoxIntersect, up to 4 points; otherwise libccd MPR).
 ContactResult fcl_contact(const RigidBody& a, const RigidBody& b) {
   // GST_LIBCCD: with two Box shapes both solvers dispatch to boxBoxIntersect (the table in
   // gjk_solver_libccd-inl.h); with a Convex in the pair it runs libccd MPR.
@@ -170,6 +170,7 @@ ContactResult fcl_contact(const RigidBody& a, const RigidBody& b) {
       "fcl::collide (GST_LIBCCD)");
 }
 
+// `fcl-hull`: fcl::collide on Convex shapes with GST_LIBCCD (libccd MPR), boxes included.
 ContactResult fcl_hull_contact(const RigidBody& a, const RigidBody& b) {
   // At depth below CCD_EPS libccd's MPR sets its direction to zero ("can be anything",
   // mpr.c findPenetr) and FCL copies it as the normal: labelled as no normal, not a 180 deg miss.
@@ -182,8 +183,9 @@ ContactResult fcl_hull_contact(const RigidBody& a, const RigidBody& b) {
                                   "fcl::collide (GST_LIBCCD, libccd MPR)");
 }
 
+// `fcl` with each shape's geometry (Box or Convex) built once per thread and kept (reference/
+// prebuilt_cache.h), as a user holding FCL objects across steps runs it: FCL without its set-up.
 ContactResult fcl_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
-  // fcl_contact with each shape's geometry (Box or Convex) built once per thread.
   // One cache for fcl::Box bodies, one for Convex ones: the key is the shape alone.
   thread_local PrebuiltCache<std::shared_ptr<fcl::CollisionGeometryd>> box_cache, convex_cache;
   auto cache_of = [&](const RigidBody& body) -> auto& {
@@ -221,6 +223,7 @@ ContactResult fcl_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) 
       "fcl::collide (GST_LIBCCD, libccd MPR)");
 }
 
+// `fcl-epa`: fcl::distance with signed distance (GJK + EPA).
 ContactResult fcl_epa_contact(const RigidBody& a, const RigidBody& b) {
   return guarded("fcl::distance (signed, GST_LIBCCD)", [&]() -> ContactResult {
     fcl::CollisionObjectd object_a(convex_geometry(a), to_fcl(a.pose()));
@@ -260,6 +263,7 @@ ContactResult fcl_epa_contact(const RigidBody& a, const RigidBody& b) {
   });
 }
 
+// `fcl-indep`: fcl::collide on Convex shapes with GST_INDEP, defects shown as they are.
 ContactResult fcl_indep_contact(const RigidBody& a, const RigidBody& b) {
   // Only collide() is called, in this process, without run_isolated: it cannot abort. INDEP's
   // *distance* can: fcl::distance's signed-distance workaround (narrowphase/distance-inl.h,
@@ -283,6 +287,10 @@ ContactResult fcl_indep_contact(const RigidBody& a, const RigidBody& b) {
   return r;
 }
 
+MassResult fcl_hull_mass(const RigidBody& body);
+
+// `fcl` mass: fcl::Box's volume and inertia for box bodies (unit density, scaled by mass /
+// volume), fcl_hull_mass otherwise.
 MassResult fcl_mass(const RigidBody& body) {
   if (!is_native_box(body)) return fcl_hull_mass(body);
   MassResult r;
@@ -296,6 +304,8 @@ MassResult fcl_mass(const RigidBody& body) {
   return r;
 }
 
+// `fcl-hull` mass: FCL's own Convex volume, centre of mass and inertia (computeVolume, computeCOM,
+// computeMomentofInertiaRelatedToCOM at uniform density mass / volume).
 MassResult fcl_hull_mass(const RigidBody& body) {
   MassResult r;
   try {
@@ -316,6 +326,29 @@ MassResult fcl_hull_mass(const RigidBody& body) {
     r.message = e.what();
   }
   return r;
+}
+
+}  // namespace
+
+const Adapter& fcl_adapter() {
+  static const Adapter adapter = {
+      {
+          {"fcl", "FCL 0.7: Box (boxBoxIntersect) or Convex (libccd MPR)", fcl_contact, nullptr,
+           fcl_mass},
+          {"fcl-hull", "FCL 0.7 Convex, GST_LIBCCD (libccd MPR)", fcl_hull_contact, nullptr,
+           fcl_hull_mass},
+          {"fcl-epa", "FCL 0.7 signed distance (GJK + EPA)", fcl_epa_contact, nullptr},
+          {"fcl-indep", "FCL 0.7 Convex, GST_INDEP (known defects shown)", fcl_indep_contact,
+           nullptr},
+      },
+      {
+          {"fcl", "prebuilt",
+           "each fcl::Box or Convex built once and kept, as a user holding FCL objects",
+           fcl_contact_prebuilt},
+          {"fcl-hull", "prebuilt", "each fcl::Convex built once and kept",
+           fcl_hull_contact_prebuilt},
+      }};
+  return adapter;
 }
 
 }  // namespace rbx

@@ -166,16 +166,30 @@ ContactResult penetration(const RigidBody& a, const RigidBody& b, const char* na
   return {Status::Ok, "", {p.contact}};
 }
 
-}  // namespace
-
+// `libccd-mpr`: one contact from ccdMPRPenetration (feature "mpr").
 ContactResult libccd_mpr_contact(const RigidBody& a, const RigidBody& b) {
   return penetration(a, b, "ccdMPRPenetration", "mpr",
                      [](auto... args) { return ccdMPRPenetration(args...); });
 }
 
+// `libccd-epa`: one contact from ccdGJKPenetration, GJK then EPA (feature "gjk-epa").
 ContactResult libccd_epa_contact(const RigidBody& a, const RigidBody& b) {
   return penetration(a, b, "ccdGJKPenetration", "gjk-epa",
                      [](auto... args) { return ccdGJKPenetration(args...); });
+}
+
+}  // namespace
+
+const Adapter& libccd_adapter() {
+  static const Adapter adapter = {
+      {
+          {"libccd-mpr", "libccd 2.1 MPR (ccdMPRPenetration); libccd's box support for boxes",
+           libccd_mpr_contact, nullptr},
+          {"libccd-epa", "libccd 2.1 GJK + EPA (ccdGJKPenetration); libccd's box support for boxes",
+           libccd_epa_contact, nullptr},
+      },
+      {}};
+  return adapter;
 }
 
 }  // namespace rbx

@@ -6,9 +6,8 @@
 
 namespace rbx {
 
-/// `libccd-mpr`: one contact from ccdMPRPenetration (feature "mpr").
-ContactResult libccd_mpr_contact(const RigidBody& a, const RigidBody& b);
-/// `libccd-epa`: one contact from ccdGJKPenetration, GJK then EPA (feature "gjk-epa").
-ContactResult libccd_epa_contact(const RigidBody& a, const RigidBody& b);
+/// libccd's backends, contact queries only: `libccd-mpr` (ccdMPRPenetration, feature "mpr") and
+/// `libccd-epa` (ccdGJKPenetration, GJK then EPA, feature "gjk-epa"), one contact each.
+const Adapter& libccd_adapter();
 
 }  // namespace rbx

@@ -490,25 +490,6 @@ MujocoSettings mujoco_hull_settings() {
   return s;
 }
 
-ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b) {
-  // Two boxes meet in MuJoCo's own box-box collider, as in its dynamics and as its own tests
-  // exercise it (its normals there are right where the meshes' MPR is not); 2.2.2 reports half
-  // the depth there, passed on and labelled (query_model). `mujoco-hull` keeps the meshes.
-  return mujoco_contact_with(a, b, mujoco_query_settings());
-}
-
-ContactResult mujoco_hull_contact(const RigidBody& a, const RigidBody& b) {
-  return mujoco_contact_with(a, b, mujoco_hull_settings());
-}
-
-DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
-  return mujoco_dynamics_with(scene, opt, MujocoSettings{});
-}
-
-DynamicsResult mujoco_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
-  return mujoco_dynamics_with(scene, opt, mujoco_hull_settings());
-}
-
 namespace {
 
 /// A compiled two-body model for contact queries (`error` set when it failed to build).
@@ -568,16 +549,6 @@ ContactResult mujoco_contact_with(const RigidBody& a, const RigidBody& b,
                                   const MujocoSettings& settings) {
   QueryModel q = make_query_model(a, b, settings);
   return query_model(q, a, b);
-}
-
-ContactResult mujoco_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
-  thread_local PrebuiltCache<QueryModel> cache;
-  return prebuilt_query(a, b, mujoco_query_settings(), cache);
-}
-
-ContactResult mujoco_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
-  thread_local PrebuiltCache<QueryModel> cache;
-  return prebuilt_query(a, b, mujoco_hull_settings(), cache);
 }
 
 namespace {
@@ -730,10 +701,74 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
   return r;
 }
 
+namespace {
+
+// `mujoco`: contacts from mj_forward on box geoms for two boxes, mesh geoms with multiccd
+// otherwise (boxes among hulls too).
+ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b) {
+  // Two boxes meet in MuJoCo's own box-box collider, as in its dynamics and as its own tests
+  // exercise it (its normals there are right where the meshes' MPR is not); 2.2.2 reports half
+  // the depth there, passed on and labelled (query_model). `mujoco-hull` keeps the meshes.
+  return mujoco_contact_with(a, b, mujoco_query_settings());
+}
+
+// `mujoco-hull`: contacts of mesh geoms from mj_forward (MPR, one point).
+ContactResult mujoco_hull_contact(const RigidBody& a, const RigidBody& b) {
+  return mujoco_contact_with(a, b, mujoco_hull_settings());
+}
+
+// `mujoco`: mj_step with e mapped to solref, native geoms.
+DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return mujoco_dynamics_with(scene, opt, MujocoSettings{});
+}
+
+// `mujoco-hull`: the same on mesh geoms.
+DynamicsResult mujoco_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return mujoco_dynamics_with(scene, opt, mujoco_hull_settings());
+}
+
+// `mujoco` and `mujoco-hull` with the pair's model compiled once and kept (reference/
+// prebuilt_cache.h), each query setting the poses and running mj_forward: variant "prebuilt".
+ContactResult mujoco_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local PrebuiltCache<QueryModel> cache;
+  return prebuilt_query(a, b, mujoco_query_settings(), cache);
+}
+
+ContactResult mujoco_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local PrebuiltCache<QueryModel> cache;
+  return prebuilt_query(a, b, mujoco_hull_settings(), cache);
+}
+
+MassResult mujoco_hull_mass(const RigidBody& body);
+
+// `mujoco` mass: MuJoCo's own inertia of a box geom for a box body (inertiafromgeom), of the
+// hull mesh otherwise.
 MassResult mujoco_mass(const RigidBody& body) {
   return is_native_box(body) ? mass_of_geom(body, true) : mujoco_hull_mass(body);
 }
 
+// `mujoco-hull` mass: a free body with one mesh geom of the body's mass, compiled with
+// inertiafromgeom; body_mass, body_ipos and body_inertia/body_iquat read back.
 MassResult mujoco_hull_mass(const RigidBody& body) { return mass_of_geom(body, false); }
+
+}  // namespace
+
+const Adapter& mujoco_adapter() {
+  static const Adapter adapter = {
+      {
+          {"mujoco",
+           "MuJoCo 2.2.2 box geoms (box-box) or mesh + multiccd; mj_step, negative solref",
+           mujoco_contact, mujoco_dynamics, mujoco_mass},
+          {"mujoco-hull", "MuJoCo 2.2.2 mesh geoms (MPR, one point); mj_step, negative solref",
+           mujoco_hull_contact, mujoco_hull_dynamics, mujoco_hull_mass},
+      },
+      {
+          {"mujoco", "prebuilt", "the pair's model compiled once and kept (poses set, mj_forward)",
+           mujoco_contact_prebuilt},
+          {"mujoco-hull", "prebuilt", "the pair's model compiled once and kept",
+           mujoco_hull_contact_prebuilt},
+      }};
+  return adapter;
+}
 
 }  // namespace rbx

@@ -18,28 +18,14 @@ struct MujocoSettings {
 /// `mujoco-hull`: every body a mesh geom, single-point MPR.
 MujocoSettings mujoco_hull_settings();
 
-/// `mujoco`: contacts from mj_forward on mesh geoms with multiccd (boxes too: MuJoCo 2.2.2's box
-/// geoms report half the depth).
-ContactResult mujoco_contact(const RigidBody& a, const RigidBody& b);
-/// `mujoco-hull`: contacts of mesh geoms from mj_forward.
-ContactResult mujoco_hull_contact(const RigidBody& a, const RigidBody& b);
-/// `mujoco` and `mujoco-hull` with the pair's model compiled once and kept (reference/
-/// prebuilt_cache.h), each query setting the poses and running mj_forward: variant "prebuilt".
-ContactResult mujoco_contact_prebuilt(const RigidBody& a, const RigidBody& b);
-ContactResult mujoco_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b);
+/// MuJoCo's backends: `mujoco` (box geoms for two boxes, mesh geoms with multiccd otherwise;
+/// mj_step with e mapped to a negative solref) and `mujoco-hull` (one mesh geom per hull, MPR,
+/// one point), each with its "prebuilt" variant and MuJoCo's own mass properties.
+const Adapter& mujoco_adapter();
+
 /// The contact query with explicit settings.
 ContactResult mujoco_contact_with(const RigidBody& a, const RigidBody& b,
                                   const MujocoSettings& settings);
-/// `mujoco` mass: MuJoCo's own inertia of a box geom for a box body (inertiafromgeom), of the
-/// hull mesh otherwise.
-MassResult mujoco_mass(const RigidBody& body);
-/// `mujoco-hull` mass: a free body with one mesh geom of the body's mass, compiled with
-/// inertiafromgeom; body_mass, body_ipos and body_inertia/body_iquat read back.
-MassResult mujoco_hull_mass(const RigidBody& body);
-/// `mujoco` dynamics: mj_step with e mapped to solref, native geoms.
-DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt);
-/// `mujoco-hull` dynamics: the same on mesh geoms.
-DynamicsResult mujoco_hull_dynamics(const Scene& scene, const DynamicsOptions& opt);
 /// The dynamics run with explicit settings.
 DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
                                     const MujocoSettings& settings);

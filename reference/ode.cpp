@@ -365,32 +365,6 @@ OdeSettings ode_hull_settings() {
   return s;
 }
 
-ContactResult ode_contact(const RigidBody& a, const RigidBody& b) {
-  return contact_query(a, b, true);
-}
-
-ContactResult ode_hull_contact(const RigidBody& a, const RigidBody& b) {
-  return contact_query(a, b, false);
-}
-
-ContactResult ode_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
-  thread_local PrebuiltCache<KeptGeom> cache;
-  return contact_query(a, b, true, &cache);
-}
-
-ContactResult ode_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
-  thread_local PrebuiltCache<KeptGeom> cache;
-  return contact_query(a, b, false, &cache);
-}
-
-DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
-  return ode_dynamics_with(scene, opt, OdeSettings{});
-}
-
-DynamicsResult ode_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
-  return ode_dynamics_with(scene, opt, ode_hull_settings());
-}
-
 namespace {
 
 // The scene's ODE world, space and contact group in `w`: gravity from the scene; ERP and CFM
@@ -581,6 +555,59 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
 
   recorder.finish("ODE");
   return r;
+}
+
+namespace {
+
+// `ode`: dCollide on dCreateBox geoms for boxes (dBoxBox), dCreateConvex otherwise.
+ContactResult ode_contact(const RigidBody& a, const RigidBody& b) {
+  return contact_query(a, b, true);
+}
+
+// `ode-hull`: dCollide on dCreateConvex geoms (libccd MPR in Debian's build, one point).
+ContactResult ode_hull_contact(const RigidBody& a, const RigidBody& b) {
+  return contact_query(a, b, false);
+}
+
+// `ode` and `ode-hull` with each shape's geom built once and kept (reference/prebuilt_cache.h),
+// placed at each query: variant "prebuilt".
+ContactResult ode_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local PrebuiltCache<KeptGeom> cache;
+  return contact_query(a, b, true, &cache);
+}
+
+ContactResult ode_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local PrebuiltCache<KeptGeom> cache;
+  return contact_query(a, b, false, &cache);
+}
+
+// `ode`: dWorldStep with dContactBounce on the native geoms.
+DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return ode_dynamics_with(scene, opt, OdeSettings{});
+}
+
+// `ode-hull`: the same world on convex geoms.
+DynamicsResult ode_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+  return ode_dynamics_with(scene, opt, ode_hull_settings());
+}
+
+}  // namespace
+
+const Adapter& ode_adapter() {
+  static const Adapter adapter = {
+      {
+          {"ode", "ODE 0.16.2 dCreateBox (dBoxBox) or dCreateConvex; dWorldStep, bounce = e",
+           ode_contact, ode_dynamics},
+          {"ode-hull", "ODE 0.16.2 dCreateConvex (libccd MPR); dWorldStep, bounce = e",
+           ode_hull_contact, ode_hull_dynamics},
+      },
+      {
+          {"ode", "prebuilt", "each dBox or dConvex geom built once and kept",
+           ode_contact_prebuilt},
+          {"ode-hull", "prebuilt", "each dConvex geom built once and kept",
+           ode_hull_contact_prebuilt},
+      }};
+  return adapter;
 }
 
 }  // namespace rbx

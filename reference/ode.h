@@ -17,18 +17,10 @@ struct OdeSettings {
 /// `ode-hull`: every body a dCreateConvex geom, ODE's default world.
 OdeSettings ode_hull_settings();
 
-/// `ode`: dCollide on dCreateBox geoms for boxes (dBoxBox), dCreateConvex otherwise.
-ContactResult ode_contact(const RigidBody& a, const RigidBody& b);
-/// `ode-hull`: dCollide on dCreateConvex geoms (libccd MPR in Debian's build, one point).
-ContactResult ode_hull_contact(const RigidBody& a, const RigidBody& b);
-/// `ode` and `ode-hull` with each shape's geom built once and kept (reference/prebuilt_cache.h),
-/// placed at each query: variant "prebuilt".
-ContactResult ode_contact_prebuilt(const RigidBody& a, const RigidBody& b);
-ContactResult ode_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b);
-/// `ode` dynamics: dWorldStep with dContactBounce on the native geoms.
-DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt);
-/// `ode-hull` dynamics: the same world on convex geoms.
-DynamicsResult ode_hull_dynamics(const Scene& scene, const DynamicsOptions& opt);
+/// ODE's backends: `ode` (dCreateBox for boxes, dBoxBox; dCreateConvex otherwise) and
+/// `ode-hull` (dCreateConvex for every body, libccd MPR in Debian's build, one point); dCollide,
+/// and dWorldStep with bounce = e; each with its "prebuilt" variant.
+const Adapter& ode_adapter();
 /// The dynamics run with explicit settings.
 DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
                                  const OdeSettings& settings);

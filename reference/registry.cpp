@@ -1,4 +1,4 @@
-// The backend registry: one line per backend, readable at a glance.
+// The backend registry: every adapter's rows (reference/<library>.cpp), in report order.
 #include <stdexcept>
 
 #include "reference/backend.h"
@@ -30,46 +30,21 @@ const char* to_string(Status s) {
 
 namespace {
 
+// Every adapter, in report order: our engine and oracle, then the libraries.
+std::vector<const Adapter*> adapters() {
+  return {&custom_adapter(), &exact_adapter(),  &fcl_adapter(), &libccd_adapter(),
+          &bullet_adapter(), &mujoco_adapter(), &ode_adapter()};
+}
+
 std::vector<Backend>& registry_table() {
-  // name, description, contact query, dynamics run, mass properties, library (isolated).
   // Plain names: the library as its experts use it (native primitives where a body is one);
-  // `-hull`: every body the same convex hull the custom engine gets. The former `fcl-box`
-  // (Box-Box only) is what `fcl` runs on two boxes, so it is gone as a duplicate.
-  static std::vector<Backend> table = {
-      {"custom",
-       "rbx engine, extended: Moore & Wilhelms tests with the plane of least overlap, contact "
-       "manifolds, Coulomb friction, resting contact, time of impact for every new contact",
-       custom_contact, custom_dynamics, nullptr, false},
-      {"custom-seed",
-       "rbx engine, the seed's algorithm: first hit, single-point frictionless impulse", nullptr,
-       custom_seed_dynamics, nullptr, false, false},
-      {"exact", "rbx oracle: separating-axis test over faces and edge pairs, clipped manifold",
-       exact_contact, nullptr, nullptr, false},
-      {"fcl", "FCL 0.7: Box (boxBoxIntersect) or Convex (libccd MPR)", fcl_contact, nullptr,
-       fcl_mass},
-      {"fcl-hull", "FCL 0.7 Convex, GST_LIBCCD (libccd MPR)", fcl_hull_contact, nullptr,
-       fcl_hull_mass},
-      {"fcl-epa", "FCL 0.7 signed distance (GJK + EPA)", fcl_epa_contact, nullptr},
-      {"fcl-indep", "FCL 0.7 Convex, GST_INDEP (known defects shown)", fcl_indep_contact, nullptr},
-      {"libccd-mpr", "libccd 2.1 MPR (ccdMPRPenetration); libccd's box support for boxes",
-       libccd_mpr_contact, nullptr},
-      {"libccd-epa", "libccd 2.1 GJK + EPA (ccdGJKPenetration); libccd's box support for boxes",
-       libccd_epa_contact, nullptr},
-      {"bullet", "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
-       bullet_contact, bullet_dynamics, bullet_mass},
-      {"bullet-hull", "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",
-       bullet_hull_contact, bullet_hull_dynamics, bullet_hull_mass},
-      {"bullet-sat", "Bullet 3.24 double: polyhedral hull SAT + clipping, boxes too",
-       bullet_sat_contact, nullptr},
-      {"mujoco", "MuJoCo 2.2.2 box geoms (box-box) or mesh + multiccd; mj_step, negative solref",
-       mujoco_contact, mujoco_dynamics, mujoco_mass},
-      {"mujoco-hull", "MuJoCo 2.2.2 mesh geoms (MPR, one point); mj_step, negative solref",
-       mujoco_hull_contact, mujoco_hull_dynamics, mujoco_hull_mass},
-      {"ode", "ODE 0.16.2 dCreateBox (dBoxBox) or dCreateConvex; dWorldStep, bounce = e",
-       ode_contact, ode_dynamics},
-      {"ode-hull", "ODE 0.16.2 dCreateConvex (libccd MPR); dWorldStep, bounce = e",
-       ode_hull_contact, ode_hull_dynamics},
-  };
+  // `-hull`: every body the same convex hull the custom engine gets.
+  static std::vector<Backend> table = [] {
+    std::vector<Backend> rows;
+    for (const Adapter* a : adapters())
+      rows.insert(rows.end(), a->backends.begin(), a->backends.end());
+    return rows;
+  }();
   return table;
 }
 
@@ -97,30 +72,12 @@ const Backend* find_backend(const std::string& name, const std::vector<Backend>*
 }
 
 const std::vector<QueryVariant>& query_variants() {
-  // backend, variant, what differs, contact query.
-  static const std::vector<QueryVariant> table = {
-      {"custom", "faithful",
-       "custom on the faithful detector: the seed's loops over every primitive (the "
-       "accelerated detector's oracle), the same chosen plane",
-       custom_faithful_contact},
-      {"fcl", "prebuilt",
-       "each fcl::Box or Convex built once and kept, as a user holding FCL "
-       "objects",
-       fcl_contact_prebuilt},
-      {"fcl-hull", "prebuilt", "each fcl::Convex built once and kept", fcl_hull_contact_prebuilt},
-      {"bullet", "prebuilt", "each btBoxShape or polyhedral hull built once and kept",
-       bullet_contact_prebuilt},
-      {"bullet-hull", "prebuilt", "each btConvexHullShape built once and kept",
-       bullet_hull_contact_prebuilt},
-      {"bullet-sat", "prebuilt", "each polyhedral hull built once and kept",
-       bullet_sat_contact_prebuilt},
-      {"ode", "prebuilt", "each dBox or dConvex geom built once and kept", ode_contact_prebuilt},
-      {"ode-hull", "prebuilt", "each dConvex geom built once and kept", ode_hull_contact_prebuilt},
-      {"mujoco", "prebuilt", "the pair's model compiled once and kept (poses set, mj_forward)",
-       mujoco_contact_prebuilt},
-      {"mujoco-hull", "prebuilt", "the pair's model compiled once and kept",
-       mujoco_hull_contact_prebuilt},
-  };
+  static const std::vector<QueryVariant> table = [] {
+    std::vector<QueryVariant> rows;
+    for (const Adapter* a : adapters())
+      rows.insert(rows.end(), a->variants.begin(), a->variants.end());
+    return rows;
+  }();
   return table;
 }
 

@@ -17,6 +17,10 @@
 namespace rbx {
 namespace {
 
+// The backends under test, by their registry names.
+const Backend& custom = custom_adapter().backend("custom");
+const Backend& custom_seed = custom_adapter().backend("custom-seed");
+
 namespace fs = std::filesystem;
 
 // The registry with `custom` replaced by a broken copy: its contact normals turned 2 degrees
@@ -27,13 +31,13 @@ std::vector<Backend> table_with_broken_engine() {
   for (Backend& b : table) {
     if (b.name != "custom") continue;
     b.contact = [](const RigidBody& a, const RigidBody& bb) {
-      ContactResult r = custom_contact(a, bb);
+      ContactResult r = custom.contact(a, bb);
       const Quat turn(Eigen::AngleAxisd(2.0 * M_PI / 180.0, Vec3::UnitZ()));
       for (ContactPoint& c : r.contacts) c.normal = turn * c.normal;
       return r;
     };
     b.dynamics = [](const Scene& s, const DynamicsOptions& o) {
-      DynamicsResult r = custom_dynamics(s, o);
+      DynamicsResult r = custom.dynamics(s, o);
       for (BodyFinal& f : r.finals) f.velocity.x() += 1e-3;
       return r;
     };
@@ -237,7 +241,7 @@ TEST(Check, AChangeThatOnlyBreaksTheMeasuredTossesIsNamed) {
   // cannot see it; the measured tosses, where the real cube slides to rest by friction, do.
   std::vector<Backend> broken = backends();
   for (Backend& b : broken)
-    if (b.name == "custom") b.dynamics = custom_seed_dynamics;
+    if (b.name == "custom") b.dynamics = custom_seed.dynamics;
   const fs::path dir = temp_dir("check_tosses");
   ReportOptions opt;
   opt.inputs = {RBX_SOURCE_DIR "/scenes/contact/axis_x.toml"};

@@ -16,6 +16,10 @@
 namespace rbx {
 namespace {
 
+// The backends under test, by their registry names.
+const Backend& bullet_hull = bullet_adapter().backend("bullet-hull");
+const Backend& bullet_sat = bullet_adapter().backend("bullet-sat");
+
 using test::box_spec;
 using test::unit_cube;
 
@@ -32,13 +36,7 @@ bool has_point(const std::vector<ContactPoint>& cs, const Vec3& p, double tol) {
                      [&](const ContactPoint& c) { return (c.point - p).norm() <= tol; });
 }
 
-using ContactQuery = ContactResult (*)(const RigidBody&, const RigidBody&);
-
-struct Backend {
-  const char* name;
-  ContactQuery query;
-};
-const Backend kBoth[] = {{"bullet-hull", bullet_hull_contact}, {"bullet-sat", bullet_sat_contact}};
+const Backend* const kBoth[] = {&bullet_hull, &bullet_sat};
 
 // ---------------------------------------------------------------------------------------------
 // Contact conventions
@@ -51,9 +49,9 @@ const Backend kBoth[] = {{"bullet-hull", bullet_hull_contact}, {"bullet-sat", bu
 TEST(BulletContact, FaceOverlapNormalDepthAndPoint) {
   const RigidBody a = unit_cube("A", Vec3::Zero());
   const RigidBody b = unit_cube("B", Vec3(0.9, 0.1, 0.2));
-  for (const Backend& be : kBoth) {
-    SCOPED_TRACE(be.name);
-    const ContactResult r = be.query(a, b);
+  for (const Backend* be : kBoth) {
+    SCOPED_TRACE(be->name);
+    const ContactResult r = be->contact(a, b);
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_FALSE(r.contacts.empty());
     for (const ContactPoint& c : r.contacts) {
@@ -67,8 +65,8 @@ TEST(BulletContact, FaceOverlapNormalDepthAndPoint) {
     }
   }
   // GJK + EPA: one point. Clipping: the four corners of the overlap rectangle.
-  EXPECT_EQ(bullet_hull_contact(a, b).contacts.size(), 1u);
-  const ContactResult sat = bullet_sat_contact(a, b);
+  EXPECT_EQ(bullet_hull.contact(a, b).contacts.size(), 1u);
+  const ContactResult sat = bullet_sat.contact(a, b);
   ASSERT_EQ(sat.contacts.size(), 4u);
   for (double y : {-0.4, 0.5})
     for (double z : {-0.3, 0.5}) EXPECT_TRUE(has_point(sat.contacts, Vec3(0.45, y, z), kRoundOff));
@@ -78,7 +76,7 @@ TEST(BulletContact, FaceOverlapNormalDepthAndPoint) {
 // clipped manifold the overlap face's corners (0.45, +-0.5, +-0.5).
 TEST(BulletContact, SatAlignedCubes) {
   const ContactResult r =
-      bullet_sat_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(0.9, 0, 0)));
+      bullet_sat.contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(0.9, 0, 0)));
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 4u);
   for (const ContactPoint& c : r.contacts) {
@@ -97,7 +95,7 @@ TEST(BulletContact, SatAlignedCubes) {
 // If Bullet gets fixed this test fails: update docs/references.md and the report.
 TEST(BulletContact, KnownDefectEpaCoplanarSides) {
   const ContactResult r =
-      bullet_hull_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(0.9, 0, 0)));
+      bullet_hull.contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(0.9, 0, 0)));
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   const ContactPoint& c = r.contacts[0];
@@ -121,12 +119,12 @@ TEST(BulletContact, KnownDefectSatDepthMeasuredToTheFirstBodysFace) {
         r.contacts.begin(), r.contacts.end(),
         [](const ContactPoint& x, const ContactPoint& y) { return x.depth < y.depth; });
   };
-  const ContactResult ab = bullet_sat_contact(a, b);
+  const ContactResult ab = bullet_sat.contact(a, b);
   ASSERT_EQ(ab.status, Status::Ok) << ab.message;
   ASSERT_FALSE(ab.contacts.empty());
   EXPECT_LT((deepest(ab).normal - Vec3(0, 0, 1)).norm(), kRoundOff);  // the normal is right
   EXPECT_NEAR(deepest(ab).depth, 1.0, kRoundOff) << "SAT depth now exact: defect fixed?";
-  const ContactResult ba = bullet_sat_contact(b, a);
+  const ContactResult ba = bullet_sat.contact(b, a);
   ASSERT_EQ(ba.status, Status::Ok) << ba.message;
   ASSERT_FALSE(ba.contacts.empty());
   EXPECT_NEAR(deepest(ba).depth, std::sqrt(0.5), kRoundOff);
@@ -142,13 +140,13 @@ TEST(BulletContact, KnownDefectZeroDepthNormal) {
   const Quat q = Quat(rotation_from_euler_deg(Vec3(30, 30, 0)));
   const double corner = 0.8415063509461096;  // lowest corner's depth below the centre
   const RigidBody slab = make_body(box_spec("B", Vec3(4, 4, 1), Vec3(0, 0, -0.5)));
-  const ContactResult touching = bullet_hull_contact(unit_cube("A", Vec3(0, 0, corner), q), slab);
+  const ContactResult touching = bullet_hull.contact(unit_cube("A", Vec3(0, 0, corner), q), slab);
   ASSERT_EQ(touching.status, Status::Ok) << touching.message;
   ASSERT_EQ(touching.contacts.size(), 1u);
   EXPECT_LT(touching.contacts[0].normal.z(), std::cos(5 * kPi / 180))
       << "zero-depth normal now right: defect fixed?";
   const ContactResult deeper =
-      bullet_hull_contact(unit_cube("A", Vec3(0, 0, corner - 1e-9), q), slab);
+      bullet_hull.contact(unit_cube("A", Vec3(0, 0, corner - 1e-9), q), slab);
   ASSERT_EQ(deeper.status, Status::Ok) << deeper.message;
   ASSERT_EQ(deeper.contacts.size(), 1u);
   EXPECT_LT((deeper.contacts[0].normal - Vec3(0, 0, 1)).norm(), 1e-6);
@@ -158,10 +156,10 @@ TEST(BulletContact, KnownDefectZeroDepthNormal) {
 TEST(BulletContact, BothOrdersFlipTheNormal) {
   const RigidBody a = unit_cube("A", Vec3::Zero());
   const RigidBody b = unit_cube("B", Vec3(0.9, 0.1, 0.2));
-  for (const Backend& be : kBoth) {
-    SCOPED_TRACE(be.name);
-    const ContactResult ab = be.query(a, b);
-    const ContactResult ba = be.query(b, a);
+  for (const Backend* be : kBoth) {
+    SCOPED_TRACE(be->name);
+    const ContactResult ab = be->contact(a, b);
+    const ContactResult ba = be->contact(b, a);
     ASSERT_EQ(ba.status, Status::Ok) << ba.message;
     ASSERT_EQ(ab.contacts.size(), ba.contacts.size());
     for (const ContactPoint& c : ba.contacts) {
@@ -181,9 +179,9 @@ TEST(BulletContact, RotatedPairWorldNormal) {
   const RigidBody a = unit_cube("A", Vec3::Zero(), q);
   const RigidBody b = unit_cube("B", q * Vec3(0.9, 0.2, 0.1), q);
   const Vec3 n(-std::cos(0.3), -std::sin(0.3), 0);
-  for (const Backend& be : kBoth) {
-    SCOPED_TRACE(be.name);
-    const ContactResult r = be.query(a, b);
+  for (const Backend* be : kBoth) {
+    SCOPED_TRACE(be->name);
+    const ContactResult r = be->contact(a, b);
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_FALSE(r.contacts.empty());
     for (const ContactPoint& c : r.contacts) {
@@ -192,7 +190,7 @@ TEST(BulletContact, RotatedPairWorldNormal) {
       EXPECT_NEAR((q.conjugate() * c.point).x(), 0.45, kRoundOff);
     }
   }
-  const ContactResult sat = bullet_sat_contact(a, b);
+  const ContactResult sat = bullet_sat.contact(a, b);
   ASSERT_EQ(sat.contacts.size(), 4u);
   for (double y : {-0.3, 0.5})
     for (double z : {-0.4, 0.5})
@@ -204,9 +202,9 @@ TEST(BulletContact, RotatedPairWorldNormal) {
 // depth-0 contacts (GJK distance <= 1e-9, the adapter's tolerance), which is what we accept.
 TEST(BulletContact, TouchingCounts) {
   const RigidBody a = unit_cube("A", Vec3::Zero());
-  for (const Backend& be : kBoth) {
-    SCOPED_TRACE(be.name);
-    const ContactResult r = be.query(a, unit_cube("B", Vec3(1.0, 0, 0)));
+  for (const Backend* be : kBoth) {
+    SCOPED_TRACE(be->name);
+    const ContactResult r = be->contact(a, unit_cube("B", Vec3(1.0, 0, 0)));
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_FALSE(r.contacts.empty());
     for (const ContactPoint& c : r.contacts) {
@@ -215,7 +213,7 @@ TEST(BulletContact, TouchingCounts) {
       EXPECT_NEAR(c.point.x(), 0.5, kRoundOff);
     }
   }
-  EXPECT_FALSE(bullet_hull_contact(a, unit_cube("B", Vec3(1.0 + 1e-12, 0, 0))).contacts.empty());
+  EXPECT_FALSE(bullet_hull.contact(a, unit_cube("B", Vec3(1.0 + 1e-12, 0, 0))).contacts.empty());
 }
 
 // Separated: no contacts. 1.01 leaves a gap of 0.01 m, inside Bullet's contact breaking
@@ -223,10 +221,10 @@ TEST(BulletContact, TouchingCounts) {
 // Bullet does report a point with positive distance; the adapter must drop it. 3.0 is far.
 TEST(BulletContact, SeparatedHasNoContacts) {
   const RigidBody a = unit_cube("A", Vec3::Zero());
-  for (const Backend& be : kBoth) {
-    SCOPED_TRACE(be.name);
+  for (const Backend* be : kBoth) {
+    SCOPED_TRACE(be->name);
     for (double x : {1.001, 1.01, 3.0}) {
-      const ContactResult r = be.query(a, unit_cube("B", Vec3(x, 0, 0)));
+      const ContactResult r = be->contact(a, unit_cube("B", Vec3(x, 0, 0)));
       EXPECT_EQ(r.status, Status::Ok) << r.message;
       EXPECT_TRUE(r.contacts.empty()) << "x = " << x;
     }
@@ -275,7 +273,7 @@ Scene head_on(double m1, double v1, double m2, double v2, double e) {
 //   x1 = -1 + t* v1 + (T - t*) v1' = -1.125,  x2 = 0.5 + t* v2 + (T - t*) v2' = 0.375.
 TEST(BulletDynamics, HeadOnUnequalMasses) {
   const Scene s = head_on(1, 1, 3, -0.5, 0.5);
-  const DynamicsResult r = bullet_hull_dynamics(s, {});
+  const DynamicsResult r = bullet_hull.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.finals.size(), 2u);
   EXPECT_EQ(r.finals[0].name, "A");
@@ -301,7 +299,7 @@ TEST(BulletDynamics, HeadOnUnequalMasses) {
   EXPECT_NEAR(r.finals[0].position.x(), -1.125, 2.82e-3);
   EXPECT_NEAR(r.finals[1].position.x(), 0.375, 0.94e-3);
   // Determinism: the same scene gives bit-identical finals.
-  const DynamicsResult again = bullet_hull_dynamics(s, {});
+  const DynamicsResult again = bullet_hull.dynamics(s, {});
   ASSERT_EQ(again.status, Status::Ok);
   for (size_t i = 0; i < 2; ++i) {
     EXPECT_EQ(again.finals[i].position, r.finals[i].position);
@@ -349,7 +347,7 @@ TEST(BulletDynamics, CubeCornerOnStaticSlab) {
     const Vec3 v1 = v0 + j * n;
     const Vec3 w1 = 6.0 * r.cross(j * n);
 
-    const DynamicsResult res = bullet_hull_dynamics(s, {});
+    const DynamicsResult res = bullet_hull.dynamics(s, {});
     ASSERT_EQ(res.status, Status::Ok) << res.message;
     ASSERT_EQ(res.events.size(), 1u);
     EXPECT_EQ(res.events[0].body_a, "cube");
@@ -382,7 +380,7 @@ TEST(BulletDynamics, DefaultWorldDefectAndFairFix) {
   EXPECT_NEAR(def.finals[1].velocity.x(), 0.5, kRoundOff);
   EXPECT_NEAR(kinetic_energy(s, def), 0.25, kRoundOff);
 
-  const DynamicsResult fair = bullet_hull_dynamics(s, {});
+  const DynamicsResult fair = bullet_hull.dynamics(s, {});
   ASSERT_EQ(fair.status, Status::Ok) << fair.message;
   EXPECT_NEAR((fair.finals[0].velocity - Vec3(0, 0, 0)).norm(), 0.0, kRoundOff);
   EXPECT_NEAR((fair.finals[1].velocity - Vec3(1, 0, 0)).norm(), 0.0, kRoundOff);
@@ -399,7 +397,7 @@ TEST(BulletDynamics, DefaultWorldDefectAndFairFix) {
 TEST(BulletDynamics, KnownDefectAlignedFaceFaceSpins) {
   Scene s = head_on(1, 1, 1, 0, 1.0);
   s.bodies[1].orientation = Quat::Identity();
-  const DynamicsResult r = bullet_hull_dynamics(s, {});
+  const DynamicsResult r = bullet_hull.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   EXPECT_GT(r.finals[0].angular_velocity.norm(), 0.1) << "aligned face-face now spin-free: fixed?";
 }
@@ -437,7 +435,7 @@ TEST(BulletDynamics, NonDiagonalInertiaPrincipalFrame) {
   const RigidBody b0 = make_body(spec);
   ASSERT_GT(std::abs(b0.inertia_body(0, 1)), 0.01);  // really non-diagonal
 
-  const DynamicsResult r = bullet_hull_dynamics(s, {});
+  const DynamicsResult r = bullet_hull.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   const BodyFinal& f = r.finals[0];
   const Quat expected = Quat(Eigen::AngleAxisd(2.0 * s.sim.duration, axis)) * b0.orientation;
@@ -467,7 +465,7 @@ TEST(BulletDynamics, GyroscopicImplicitBodyConservesAngularMomentum) {
   auto drift = [&](double dt, double* energy) {
     DynamicsOptions opt;
     opt.dt = dt;
-    const DynamicsResult r = bullet_hull_dynamics(s, opt);
+    const DynamicsResult r = bullet_hull.dynamics(s, opt);
     EXPECT_EQ(r.status, Status::Ok) << r.message;
     RigidBody b = b0;
     b.orientation = r.finals[0].orientation;
@@ -504,7 +502,7 @@ TEST(BulletDynamics, SamplesAndErrors) {
   DynamicsOptions opt;
   opt.dt = 1e-3;  // 1000 steps
   opt.sample_every = 100;
-  const DynamicsResult r = bullet_hull_dynamics(s, opt);
+  const DynamicsResult r = bullet_hull.dynamics(s, opt);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.samples.size(), 11u);
   for (size_t k = 0; k < r.samples.size(); ++k) {
@@ -516,7 +514,7 @@ TEST(BulletDynamics, SamplesAndErrors) {
 
   Scene bad = s;
   bad.sim.dt = 0;
-  const DynamicsResult err = bullet_hull_dynamics(bad, {});
+  const DynamicsResult err = bullet_hull.dynamics(bad, {});
   EXPECT_EQ(err.status, Status::Error);
   EXPECT_FALSE(err.message.empty());
 }

@@ -28,6 +28,16 @@
 namespace rbx {
 namespace {
 
+// The backends under test, by their registry names.
+const Backend& bullet = bullet_adapter().backend("bullet");
+const Backend& bullet_hull = bullet_adapter().backend("bullet-hull");
+const Backend& fcl = fcl_adapter().backend("fcl");
+const Backend& fcl_hull = fcl_adapter().backend("fcl-hull");
+const Backend& mujoco = mujoco_adapter().backend("mujoco");
+const Backend& mujoco_hull = mujoco_adapter().backend("mujoco-hull");
+const Backend& ode = ode_adapter().backend("ode");
+const Backend& ode_hull = ode_adapter().backend("ode-hull");
+
 constexpr double kPi = 3.14159265358979323846;
 // Round-off bound of an exact impulse solve (measured ~1e-15; far above it, far below 1e-6).
 constexpr double kExact = 1e-9;
@@ -206,10 +216,10 @@ TEST(BulletSettingsMeasured, BoxShapeIsExactWhereTheHullIsWrong) {
   // the hull's single point off the face centre, and EPA's diagonal normal on coplanar sides,
   // spin the cubes (0.33 on headon_e05, 0.40 face_face, 1.05 offcentre_vertex).
   for (const Case& c : {box_cases()[0], box_cases()[1], box_cases()[2]}) {
-    EXPECT_LT(measured("bullet btBoxShape", c, ke_error(c, bullet_dynamics(c.scene, {}))), kExact)
+    EXPECT_LT(measured("bullet btBoxShape", c, ke_error(c, bullet.dynamics(c.scene, {}))), kExact)
         << c.name;
     EXPECT_GT(
-        measured("bullet-hull (GJK+EPA hull)", c, ke_error(c, bullet_hull_dynamics(c.scene, {}))),
+        measured("bullet-hull (GJK+EPA hull)", c, ke_error(c, bullet_hull.dynamics(c.scene, {}))),
         kWrong)
         << c.name;
   }
@@ -220,7 +230,7 @@ TEST(BulletSettingsMeasured, BoxMarginZeroOrDefaultMakesNoDifference) {
   // ignores it: margin 0 and Bullet's default (0.04 m, a tenth of the smallest half extent for
   // small boxes) both give the closed form, so the adapter leaves Bullet's default alone.
   for (const Case& c : box_cases()) {
-    const double with_default = ke_error(c, bullet_dynamics(c.scene, {}));
+    const double with_default = ke_error(c, bullet.dynamics(c.scene, {}));
     const double with_zero =
         ke_error(c, bullet_dynamics_with(
                         c.scene, {}, bullet_with([](BulletSettings& s) { s.box_margin = 0.0; })));
@@ -237,12 +247,12 @@ TEST(BulletSettingsMeasured, PolyhedralHullsClippedAboutTheGjkAxisNotSat) {
   BulletSettings sat = bullet_native_settings();
   sat.sat_convex = true;
   EXPECT_LT(
-      measured("bullet polyhedral hull, GJK axis", c, ke_error(c, bullet_dynamics(c.scene, {}))),
+      measured("bullet polyhedral hull, GJK axis", c, ke_error(c, bullet.dynamics(c.scene, {}))),
       kExact);
   EXPECT_GT(measured("bullet polyhedral hull, SAT axis", c,
                      ke_error(c, bullet_dynamics_with(c.scene, {}, sat))),
             kWrong);
-  EXPECT_LT(measured("bullet-hull GJK+EPA hull", c, ke_error(c, bullet_hull_dynamics(c.scene, {}))),
+  EXPECT_LT(measured("bullet-hull GJK+EPA hull", c, ke_error(c, bullet_hull.dynamics(c.scene, {}))),
             kExact);
 }
 
@@ -253,9 +263,9 @@ TEST(BulletSettingsMeasured, PolyhedralFeaturesMendACoplanarSidedHull) {
   Case c = box_cases()[0];
   for (BodySpec& b : c.scene.bodies) b.shape_kind = ShapeKind::Convex;
   const double polyhedral = measured("bullet polyhedral hull (cube as convex)", c,
-                                     ke_error(c, bullet_dynamics(c.scene, {})));
+                                     ke_error(c, bullet.dynamics(c.scene, {})));
   const double plain =
-      measured("bullet-hull (cube as convex)", c, ke_error(c, bullet_hull_dynamics(c.scene, {})));
+      measured("bullet-hull (cube as convex)", c, ke_error(c, bullet_hull.dynamics(c.scene, {})));
   EXPECT_GT(plain, kWrong);
   EXPECT_LT(polyhedral, plain);
 }
@@ -269,7 +279,7 @@ TEST(BulletSettingsMeasured, HullMarginZero) {
   BulletSettings inflated = bullet_native_settings();
   inflated.hull_margin = 0.04;
   const double zero =
-      measured("bullet hull margin 0", c, ke_error(c, bullet_dynamics(c.scene, {})));
+      measured("bullet hull margin 0", c, ke_error(c, bullet.dynamics(c.scene, {})));
   const double with_margin = measured("bullet hull margin 0.04", c,
                                       ke_error(c, bullet_dynamics_with(c.scene, {}, inflated)));
   EXPECT_LT(zero, kExact);
@@ -284,7 +294,7 @@ TEST(BulletSettingsMeasured, SplitImpulseAtEveryDepth) {
   const Case c = headon_off_step(0.5);
   BulletSettings baumgarte = bullet_native_settings();
   baumgarte.split_impulse_threshold = -0.04;
-  EXPECT_LT(measured("bullet split impulse always", c, ke_error(c, bullet_dynamics(c.scene, {}))),
+  EXPECT_LT(measured("bullet split impulse always", c, ke_error(c, bullet.dynamics(c.scene, {}))),
             kExact);
   EXPECT_GT(measured("bullet split impulse below -0.04 m (default)", c,
                      ke_error(c, bullet_dynamics_with(c.scene, {}, baumgarte))),
@@ -302,7 +312,7 @@ TEST(BulletSettingsMeasured, RestitutionAtAnyApproachSpeed) {
   BulletSettings default_threshold = bullet_native_settings();
   default_threshold.restitution_threshold = 0.2;
   EXPECT_LT(
-      measured("bullet restitution threshold 0", c, ke_error(c, bullet_dynamics(c.scene, {}))),
+      measured("bullet restitution threshold 0", c, ke_error(c, bullet.dynamics(c.scene, {}))),
       kExact);
   EXPECT_GT(measured("bullet restitution threshold 0.2 (default)", c,
                      ke_error(c, bullet_dynamics_with(c.scene, {}, default_threshold))),
@@ -317,7 +327,7 @@ TEST(BulletSettingsMeasured, ContactsSolvedOnlyOnceTheyOverlap) {
   const Case c = headon_off_step(0.5);
   BulletSettings early = bullet_native_settings();
   early.processing_threshold = 1e30;
-  EXPECT_LT(measured("bullet processing threshold 0", c, ke_error(c, bullet_dynamics(c.scene, {}))),
+  EXPECT_LT(measured("bullet processing threshold 0", c, ke_error(c, bullet.dynamics(c.scene, {}))),
             kExact);
   EXPECT_LT(measured("bullet processing threshold default", c,
                      ke_error(c, bullet_dynamics_with(c.scene, {}, early))),
@@ -325,7 +335,7 @@ TEST(BulletSettingsMeasured, ContactsSolvedOnlyOnceTheyOverlap) {
   BulletSettings hull_early = bullet_hull_settings();
   hull_early.processing_threshold = 1e30;
   const double hull_zero = measured("bullet-hull processing threshold 0", c,
-                                    ke_error(c, bullet_hull_dynamics(c.scene, {})));
+                                    ke_error(c, bullet_hull.dynamics(c.scene, {})));
   const double hull_default = measured("bullet-hull processing threshold default", c,
                                        ke_error(c, bullet_dynamics_with(c.scene, {}, hull_early)));
   EXPECT_LT(hull_zero, hull_default);
@@ -338,9 +348,9 @@ TEST(OdeSettingsMeasured, BoxGeomIsExactToCfmWhereTheConvexIsWrong) {
   // dCreateBox (dBoxBox, up to 4 points) against dCreateConvex (libccd MPR in Debian's build,
   // one point): 3.7e-8 / 2.5e-8 / 1.4e-7 against 0.22 / 0.0026 / 0.0006.
   for (const Case& c : {box_cases()[0], box_cases()[1], box_cases()[2]}) {
-    EXPECT_LT(measured("ode dCreateBox", c, ke_error(c, ode_dynamics(c.scene, {}))), kOdeSoft)
+    EXPECT_LT(measured("ode dCreateBox", c, ke_error(c, ode.dynamics(c.scene, {}))), kOdeSoft)
         << c.name;
-    EXPECT_GT(measured("ode-hull dCreateConvex", c, ke_error(c, ode_hull_dynamics(c.scene, {}))),
+    EXPECT_GT(measured("ode-hull dCreateConvex", c, ke_error(c, ode_hull.dynamics(c.scene, {}))),
               10 * kOdeSoft)
         << c.name;
   }
@@ -357,7 +367,7 @@ TEST(OdeSettingsMeasured, DefaultCfmAgainstHardAndSoft) {
   soft.cfm = 1e-5;
   for (const Case& c : {box_cases()[0], box_cases()[1]}) {
     const double e_default =
-        measured("ode CFM 1e-10 (default)", c, ke_error(c, ode_dynamics(c.scene, {})));
+        measured("ode CFM 1e-10 (default)", c, ke_error(c, ode.dynamics(c.scene, {})));
     const double e_hard =
         measured("ode CFM 0", c, ke_error(c, ode_dynamics_with(c.scene, {}, hard)));
     const double e_soft =
@@ -366,7 +376,7 @@ TEST(OdeSettingsMeasured, DefaultCfmAgainstHardAndSoft) {
     EXPECT_LT(e_hard, kExact) << c.name;
     EXPECT_GT(e_soft, kWrong) << c.name;
   }
-  const double drift_default = stack_drift(ode_dynamics(resting_stack(), {}));
+  const double drift_default = stack_drift(ode.dynamics(resting_stack(), {}));
   const double drift_hard = stack_drift(ode_dynamics_with(resting_stack(), {}, hard));
   std::printf("[measured] ode resting stack drift: CFM 1e-10 %.3g m, CFM 0 %.3g m\n", drift_default,
               drift_hard);
@@ -382,14 +392,14 @@ TEST(OdeSettingsMeasured, DefaultErpKeepsAStackUpAtAKnownCostForInelasticImpacts
   // (0.23 against 2e-24 with ERP 0), documented in ode.cpp. The stack decides: ERP stays.
   OdeSettings no_erp;
   no_erp.erp = 0.0;
-  const double drift_default = stack_drift(ode_dynamics(resting_stack(), {}));
+  const double drift_default = stack_drift(ode.dynamics(resting_stack(), {}));
   const double drift_no_erp = stack_drift(ode_dynamics_with(resting_stack(), {}, no_erp));
   std::printf("[measured] ode resting stack drift: ERP 0.2 %.3g m, ERP 0 %.3g m\n", drift_default,
               drift_no_erp);
   EXPECT_LT(drift_default, 1e-9);
   EXPECT_GT(drift_no_erp, 0.1);
   const Case c = headon_off_step(0.0);
-  EXPECT_GT(measured("ode ERP 0.2 (default)", c, ke_error(c, ode_dynamics(c.scene, {}))), 0.1);
+  EXPECT_GT(measured("ode ERP 0.2 (default)", c, ke_error(c, ode.dynamics(c.scene, {}))), 0.1);
   EXPECT_LT(measured("ode ERP 0", c, ke_error(c, ode_dynamics_with(c.scene, {}, no_erp))),
             kOdeSoft);
 }
@@ -416,7 +426,7 @@ TEST(MujocoSettingsMeasured, BoxGeomsWithDoubledStiffnessAgainstMeshes) {
   double log_box2 = 0, log_box1 = 0, log_multi = 0, log_mesh = 0;
   for (const Case& c : box_cases()) {
     const double box2 =
-        measured("mujoco box geoms, stiffness x2", c, ke_error(c, mujoco_dynamics(c.scene, {})));
+        measured("mujoco box geoms, stiffness x2", c, ke_error(c, mujoco.dynamics(c.scene, {})));
     log_box2 += std::log(box2);
     log_box1 += std::log(measured("mujoco box geoms, stiffness x1", c,
                                   ke_error(c, mujoco_dynamics_with(c.scene, {}, box_x1))));
@@ -436,9 +446,9 @@ TEST(MujocoSettingsMeasured, MulticcdOnNonBoxMeshes) {
   // plain mesh's single MPR point.
   const Case c = prism_headon();
   const double multi =
-      measured("mujoco mesh + multiccd", c, ke_error(c, mujoco_dynamics(c.scene, {})));
+      measured("mujoco mesh + multiccd", c, ke_error(c, mujoco.dynamics(c.scene, {})));
   const double one =
-      measured("mujoco-hull mesh (one point)", c, ke_error(c, mujoco_hull_dynamics(c.scene, {})));
+      measured("mujoco-hull mesh (one point)", c, ke_error(c, mujoco_hull.dynamics(c.scene, {})));
   EXPECT_LT(multi, kMujocoSoftLimit);
   EXPECT_LE(multi, one);
 }
@@ -448,19 +458,19 @@ TEST(MujocoSettingsMeasured, MulticcdOnNonBoxMeshes) {
 
 TEST(FairReferences, PlainBackendsMatchTheClosedFormHullVariantsDoNot) {
   for (const Case& c : box_cases()) {
-    EXPECT_LT(measured("bullet", c, ke_error(c, bullet_dynamics(c.scene, {}))), kExact) << c.name;
-    EXPECT_LT(measured("ode", c, ke_error(c, ode_dynamics(c.scene, {}))), kOdeSoft) << c.name;
-    EXPECT_LT(measured("mujoco", c, ke_error(c, mujoco_dynamics(c.scene, {}))), kMujocoSoftLimit)
+    EXPECT_LT(measured("bullet", c, ke_error(c, bullet.dynamics(c.scene, {}))), kExact) << c.name;
+    EXPECT_LT(measured("ode", c, ke_error(c, ode.dynamics(c.scene, {}))), kOdeSoft) << c.name;
+    EXPECT_LT(measured("mujoco", c, ke_error(c, mujoco.dynamics(c.scene, {}))), kMujocoSoftLimit)
         << c.name;
-    measured("bullet-hull", c, ke_error(c, bullet_hull_dynamics(c.scene, {})));
-    measured("ode-hull", c, ke_error(c, ode_hull_dynamics(c.scene, {})));
-    measured("mujoco-hull", c, ke_error(c, mujoco_hull_dynamics(c.scene, {})));
+    measured("bullet-hull", c, ke_error(c, bullet_hull.dynamics(c.scene, {})));
+    measured("ode-hull", c, ke_error(c, ode_hull.dynamics(c.scene, {})));
+    measured("mujoco-hull", c, ke_error(c, mujoco_hull.dynamics(c.scene, {})));
   }
   // The hull variants keep today's one-point errors on the first scene.
   const Case c = box_cases()[0];
-  EXPECT_GT(ke_error(c, bullet_hull_dynamics(c.scene, {})), 0.1);
-  EXPECT_GT(ke_error(c, ode_hull_dynamics(c.scene, {})), 0.1);
-  EXPECT_GT(ke_error(c, mujoco_hull_dynamics(c.scene, {})), 0.1);
+  EXPECT_GT(ke_error(c, bullet_hull.dynamics(c.scene, {})), 0.1);
+  EXPECT_GT(ke_error(c, ode_hull.dynamics(c.scene, {})), 0.1);
+  EXPECT_GT(ke_error(c, mujoco_hull.dynamics(c.scene, {})), 0.1);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -478,7 +488,7 @@ TEST(FairReferences, NativeBoxQueriesGiveTheFourCornerFaceManifold) {
   // y = z = 0.46, its box margin in from a corner: passed on, it is inside the overlap.)
   const RigidBody a = cube("A", Vec3::Zero()), b = cube("B", Vec3(0.9, 0, 0));
   for (auto [name, query] :
-       {std::pair{"bullet", bullet_contact}, {"ode", ode_contact}, {"fcl", fcl_contact}}) {
+       {std::pair{"bullet", bullet.contact}, {"ode", ode.contact}, {"fcl", fcl.contact}}) {
     const ContactResult r = query(a, b);
     ASSERT_EQ(r.status, Status::Ok) << name << ": " << r.message;
     for (const ContactPoint& c : r.contacts) {
@@ -503,7 +513,7 @@ TEST(FairReferences, NativeBoxQueriesGiveTheFourCornerFaceManifold) {
   // defect), passed on with a message that says so. The multiccd meshes, the alternative, give
   // the full depth (float vertices: 1e-6) but find their extra points by MPR on slightly rotated
   // geoms, whose normals keep that tilt (measured 1e-3 rad): 2e-3.
-  const ContactResult boxes = mujoco_contact(a, b);
+  const ContactResult boxes = mujoco.contact(a, b);
   ASSERT_EQ(boxes.status, Status::Ok) << boxes.message;
   ASSERT_FALSE(boxes.contacts.empty());
   EXPECT_NE(boxes.message.find("half"), std::string::npos);
@@ -521,9 +531,9 @@ TEST(FairReferences, NativeBoxQueriesGiveTheFourCornerFaceManifold) {
     EXPECT_NEAR(c.depth, 0.1, 1e-6);
   }
   // The -hull variants keep their one-point answer.
-  EXPECT_EQ(ode_hull_contact(a, b).contacts.size(), 1u);
-  EXPECT_EQ(fcl_hull_contact(a, b).contacts.size(), 1u);
-  EXPECT_EQ(mujoco_hull_contact(a, b).contacts.size(), 1u);
+  EXPECT_EQ(ode_hull.contact(a, b).contacts.size(), 1u);
+  EXPECT_EQ(fcl_hull.contact(a, b).contacts.size(), 1u);
+  EXPECT_EQ(mujoco_hull.contact(a, b).contacts.size(), 1u);
 }
 
 TEST(FairReferences, NativeBoxMassRoutinesAreTheSolidBox) {
@@ -535,9 +545,9 @@ TEST(FairReferences, NativeBoxMassRoutinesAreTheSolidBox) {
     const char* name;
     MassResult r;
     double tol;
-  } rows[] = {{"bullet", bullet_mass(body), 1e-7},
-              {"fcl", fcl_mass(body), 1e-12},
-              {"mujoco", mujoco_mass(body), 1e-12}};
+  } rows[] = {{"bullet", bullet.mass(body), 1e-7},
+              {"fcl", fcl.mass(body), 1e-12},
+              {"mujoco", mujoco.mass(body), 1e-12}};
   for (const auto& row : rows) {
     ASSERT_EQ(row.r.status, Status::Ok) << row.name << ": " << row.r.message;
     EXPECT_NEAR(row.r.mass, 6.0, 1e-12) << row.name;
@@ -545,8 +555,8 @@ TEST(FairReferences, NativeBoxMassRoutinesAreTheSolidBox) {
     EXPECT_LT((row.r.inertia - truth).norm(), row.tol * truth.norm()) << row.name;
   }
   // The hull routines keep their known answers (bounding box grown by margins; per unit mass).
-  EXPECT_GT((bullet_hull_mass(body).inertia - truth).norm(), 0.05 * truth.norm());
-  EXPECT_GT((fcl_hull_mass(body).inertia - truth).norm(), 0.5 * truth.norm());
+  EXPECT_GT((bullet_hull.mass(body).inertia - truth).norm(), 0.05 * truth.norm());
+  EXPECT_GT((fcl_hull.mass(body).inertia - truth).norm(), 0.5 * truth.norm());
 }
 
 TEST(FairReferences, OneHelperDecidesWhatIsABox) {
@@ -573,12 +583,12 @@ TEST(FairReferences, FirstImpulseRecordsWhatEachLibrarySaw) {
     int min_points, max_points;
   };
   const Row rows[] = {{"custom", find_backend("custom")->dynamics(c.scene, {}), 1, 1},
-                      {"bullet", bullet_dynamics(c.scene, {}), 4, 5},
-                      {"bullet-hull", bullet_hull_dynamics(c.scene, {}), 1, 1},
-                      {"ode", ode_dynamics(c.scene, {}), 4, 4},
-                      {"ode-hull", ode_hull_dynamics(c.scene, {}), 1, 1},
-                      {"mujoco", mujoco_dynamics(c.scene, {}), 2, 8},
-                      {"mujoco-hull", mujoco_hull_dynamics(c.scene, {}), 1, 1}};
+                      {"bullet", bullet.dynamics(c.scene, {}), 4, 5},
+                      {"bullet-hull", bullet_hull.dynamics(c.scene, {}), 1, 1},
+                      {"ode", ode.dynamics(c.scene, {}), 4, 4},
+                      {"ode-hull", ode_hull.dynamics(c.scene, {}), 1, 1},
+                      {"mujoco", mujoco.dynamics(c.scene, {}), 2, 8},
+                      {"mujoco-hull", mujoco_hull.dynamics(c.scene, {}), 1, 1}};
   for (const Row& row : rows) {
     const FirstImpulse& f = row.r.first_impulse;
     std::printf(

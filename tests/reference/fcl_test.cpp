@@ -23,6 +23,12 @@
 namespace rbx {
 namespace {
 
+// The backends under test, by their registry names.
+const Backend& fcl = fcl_adapter().backend("fcl");
+const Backend& fcl_epa = fcl_adapter().backend("fcl-epa");
+const Backend& fcl_hull = fcl_adapter().backend("fcl-hull");
+const Backend& fcl_indep = fcl_adapter().backend("fcl-indep");
+
 using test::box_at;
 using test::cube_symmetries;
 using test::depth_along;
@@ -69,7 +75,7 @@ constexpr double kMidPlaneX = 0.45;
 /// Runs `query` on the face pair in both orders and, rotated as a whole by a generic R, in
 /// both orders again; each must give the expected normal (R * n, flipped when swapped), depth
 /// 0.1 and points on the overlap's mid-plane.
-void check_face_pair(ContactResult (*query)(const RigidBody&, const RigidBody&), double tolerance) {
+void check_face_pair(const ContactFn& query, double tolerance) {
   for (const Quat& q : {Quat::Identity(), generic_rotation()}) {
     const RigidBody a = unit_cube("A", Vec3::Zero(), q);
     const RigidBody b = unit_cube("B", q * kFaceOffset, q);
@@ -118,7 +124,7 @@ bool is_negative_axis(const Vec3& n, double tol) {
 
 TEST(FclMpr, FacePairConventionBothOrdersAndRotated) {
   // MPR's portal lands on the exact hull face here: only round-off remains.
-  check_face_pair(fcl_hull_contact, kRoundOff);
+  check_face_pair(fcl_hull.contact, kRoundOff);
 }
 
 TEST(FclMpr, ExactTouchingOffCentreHasNoNormalAndIsTouching) {
@@ -128,7 +134,7 @@ TEST(FclMpr, ExactTouchingOffCentreHasNoNormalAndIsTouching) {
   // Pinned: the adapter labels that as touching with no normal (status Touching, the library's
   // convention at zero depth), not a 180 deg miss and not an error.
   const ContactResult r =
-      fcl_hull_contact(unit_cube("A", Vec3(0.3, 0.2, 1)), unit_cube("B", Vec3::Zero()));
+      fcl_hull.contact(unit_cube("A", Vec3(0.3, 0.2, 1)), unit_cube("B", Vec3::Zero()));
   EXPECT_EQ(r.status, Status::Touching);
   EXPECT_NE(r.message.find("touching"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("no normal"), std::string::npos) << r.message;
@@ -136,7 +142,7 @@ TEST(FclMpr, ExactTouchingOffCentreHasNoNormalAndIsTouching) {
 
 TEST(FclMpr, OneContactLabelledMpr) {
   const ContactResult r =
-      fcl_hull_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
+      fcl_hull.contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
   ASSERT_EQ(r.contacts.size(), 1u);  // Convex-Convex through MPR yields a single point
   EXPECT_EQ(r.contacts[0].feature, "mpr");
 }
@@ -145,10 +151,10 @@ TEST(FclMpr, TouchingIsNoContactAndSeparatedIsNoContact) {
   // Pinned: at gap 0 libccd's MPR classifies the origin on the Minkowski boundary as outside
   // (ccdMPRPenetration returns -1), so FCL reports no collision. Truth is "touching, depth 0";
   // the difference is a boundary convention, not a depth error.
-  const ContactResult touching = fcl_hull_contact(unit_cube("A", Vec3::Zero()), touching_b());
+  const ContactResult touching = fcl_hull.contact(unit_cube("A", Vec3::Zero()), touching_b());
   EXPECT_EQ(touching.status, Status::Ok);
   EXPECT_TRUE(touching.contacts.empty());
-  const ContactResult separated = fcl_hull_contact(unit_cube("A", Vec3::Zero()), separated_b());
+  const ContactResult separated = fcl_hull.contact(unit_cube("A", Vec3::Zero()), separated_b());
   EXPECT_EQ(separated.status, Status::Ok);
   EXPECT_TRUE(separated.contacts.empty());
 }
@@ -157,7 +163,7 @@ TEST(FclMpr, DiagonalCubeKnownWrongAnswerPinned) {
   // Known wrong answer (FCL issue 545), derived above: MPR gives n = -(1,1,1)/sqrt(3) and depth
   // 0.15 sqrt(3) where the truth is an axis and 0.15. MPR stops exactly at the corner of the
   // Minkowski difference, so the pin holds to round-off.
-  const ContactResult r = fcl_hull_contact(diagonal_big(), diagonal_small());
+  const ContactResult r = fcl_hull.contact(diagonal_big(), diagonal_small());
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   const ContactPoint& c = r.contacts[0];
@@ -168,7 +174,7 @@ TEST(FclMpr, DiagonalCubeKnownWrongAnswerPinned) {
               1e-9);  // degrees; round-off of acos near 0.577 is ~1e-14 rad
   EXPECT_FALSE(is_negative_axis(c.normal, 0.1));
   // Swapping the order flips the (wrong) normal and keeps the depth.
-  const ContactResult swapped = fcl_hull_contact(diagonal_small(), diagonal_big());
+  const ContactResult swapped = fcl_hull.contact(diagonal_small(), diagonal_big());
   ASSERT_EQ(swapped.contacts.size(), 1u);
   EXPECT_NEAR((swapped.contacts[0].normal - Vec3::Ones().normalized()).norm(), 0.0, kRoundOff);
   EXPECT_NEAR(swapped.contacts[0].depth, kDiagonalDepth * std::sqrt(3.0), kRoundOff);
@@ -178,11 +184,11 @@ TEST(FclMpr, DiagonalCubeKnownWrongAnswerPinned) {
 // fcl-epa: signed distance, GJK + EPA.
 
 TEST(FclEpa, FacePairConventionBothOrdersAndRotated) {
-  check_face_pair(fcl_epa_contact, kEpaTolerance);
+  check_face_pair(fcl_epa.contact, kEpaTolerance);
 }
 
 TEST(FclEpa, SeparatedIsNoContact) {
-  const ContactResult r = fcl_epa_contact(unit_cube("A", Vec3::Zero()), separated_b());
+  const ContactResult r = fcl_epa.contact(unit_cube("A", Vec3::Zero()), separated_b());
   EXPECT_EQ(r.status, Status::Ok);
   EXPECT_TRUE(r.contacts.empty());
 }
@@ -191,7 +197,7 @@ TEST(FclEpa, TouchingHasNoNormalAndIsReportedAsTouching) {
   // Pinned: at gap 0 FCL returns min_distance 0 and two coincident nearest points, and 0.7's
   // DistanceResult carries no normal; the adapter says so (status Touching) instead of
   // inventing a direction.
-  const ContactResult r = fcl_epa_contact(unit_cube("A", Vec3::Zero()), touching_b());
+  const ContactResult r = fcl_epa.contact(unit_cube("A", Vec3::Zero()), touching_b());
   EXPECT_EQ(r.status, Status::Touching);
   EXPECT_NE(r.message.find("no normal"), std::string::npos) << r.message;
   EXPECT_TRUE(r.contacts.empty());
@@ -199,13 +205,13 @@ TEST(FclEpa, TouchingHasNoNormalAndIsReportedAsTouching) {
 
 TEST(FclEpa, DiagonalCubeGetsTheMinimumPenetration) {
   // Truth derived above: an axis among -x, -y, -z and depth 0.15, in both orders.
-  const ContactResult r = fcl_epa_contact(diagonal_big(), diagonal_small());
+  const ContactResult r = fcl_epa.contact(diagonal_big(), diagonal_small());
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   EXPECT_TRUE(is_negative_axis(r.contacts[0].normal, kEpaTolerance))
       << r.contacts[0].normal.transpose();
   EXPECT_NEAR(r.contacts[0].depth, kDiagonalDepth, kEpaTolerance);
-  const ContactResult swapped = fcl_epa_contact(diagonal_small(), diagonal_big());
+  const ContactResult swapped = fcl_epa.contact(diagonal_small(), diagonal_big());
   ASSERT_EQ(swapped.contacts.size(), 1u);
   EXPECT_TRUE(is_negative_axis(-swapped.contacts[0].normal, kEpaTolerance));
   EXPECT_NEAR(swapped.contacts[0].depth, kDiagonalDepth, kEpaTolerance);
@@ -216,7 +222,7 @@ TEST(FclEpa, DiagonalCubeGetsTheMinimumPenetration) {
 
 TEST(FclIndep, CarriesTheDefectNote) {
   const ContactResult r =
-      fcl_indep_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(0.9, 0.2, 0.1)));
+      fcl_indep.contact(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(0.9, 0.2, 0.1)));
   EXPECT_EQ(r.status, Status::Ok);
   EXPECT_NE(r.message.find("local frame"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("negative"), std::string::npos) << r.message;
@@ -233,7 +239,7 @@ TEST(FclIndep, RotatedPairNormalInLocalFrameAndNegativeDepthPinned) {
   const RigidBody a = unit_cube("A", Vec3::Zero(), q);
   const RigidBody b = unit_cube("B", q * Vec3(0.9, 0.2, 0.1), q);
   const Vec3 truth = q * Vec3(-1, 0, 0);
-  const ContactResult r = fcl_indep_contact(a, b);
+  const ContactResult r = fcl_indep.contact(a, b);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   const ContactPoint& c = r.contacts[0];
@@ -250,7 +256,7 @@ TEST(FclIndep, PublicBoxCaseNormalIsRotatedBackIntoALocalFrame) {
   // about y, truth n = +z, depth sqrt(2)/2. The local-frame defect gives R_y(45)^T z =
   // (-sin 45, 0, cos 45); the depth is negated.
   const Quat q(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY()));
-  const ContactResult r = fcl_indep_contact(unit_cube("A", Vec3::Zero(), q),
+  const ContactResult r = fcl_indep.contact(unit_cube("A", Vec3::Zero(), q),
                                             box_at("B", Vec3::Constant(3), Vec3(0, 0, -1.5)));
   ASSERT_EQ(r.contacts.size(), 1u);
   const double s = std::sqrt(0.5);
@@ -265,7 +271,7 @@ TEST(FclIndep, AlignedFacePairWrongEpaFacePinned) {
   // (negated). Ours (A -> B flipped): n = (-1, 1, 1)/sqrt(3), depth -0.1/sqrt(3). Depends on
   // EPA's tie-breaking on a degenerate (axis-aligned) pair: pinned so that a change is seen.
   const ContactResult r =
-      fcl_indep_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
+      fcl_indep.contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
   ASSERT_EQ(r.contacts.size(), 1u);
   EXPECT_NEAR((r.contacts[0].normal - Vec3(-1, 1, 1).normalized()).norm(), 0.0, kRoundOff);
   EXPECT_NEAR(r.contacts[0].depth, -0.1 / std::sqrt(3.0), kRoundOff);
@@ -281,7 +287,7 @@ TEST(FclIndep, RotatedPairBothOrdersNormalInTheFirstBodysFramePinned) {
   const RigidBody a = unit_cube("A", Vec3::Zero(), q);
   const RigidBody b = unit_cube("B", q * Vec3(0.9, 0.2, 0.1), q);
   for (bool swapped : {false, true}) {
-    const ContactResult r = swapped ? fcl_indep_contact(b, a) : fcl_indep_contact(a, b);
+    const ContactResult r = swapped ? fcl_indep.contact(b, a) : fcl_indep.contact(a, b);
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_EQ(r.contacts.size(), 1u);
     const ContactPoint& c = r.contacts[0];
@@ -311,14 +317,14 @@ TEST(FclIndep, PublicBoxCaseBothOrdersAndSymmetriesPinned) {
   const std::vector<Quat> syms = cube_symmetries();
   for (size_t k = 0; k < syms.size(); ++k) {
     const RigidBody b = box_at("B", Vec3::Constant(3), Vec3(0, 0, -1.5), syms[k]);
-    const ContactResult ba = fcl_indep_contact(b, a);
+    const ContactResult ba = fcl_indep.contact(b, a);
     ASSERT_EQ(ba.contacts.size(), 1u) << "symmetry " << k;
     EXPECT_NEAR((ba.contacts[0].normal + syms[k].conjugate() * Vec3::UnitZ()).norm(), 0.0,
                 kRoundOff)
         << "symmetry " << k << ": " << ba.contacts[0].normal.transpose();
     EXPECT_NEAR(ba.contacts[0].depth, -s, kRoundOff) << "symmetry " << k;
 
-    const ContactResult ab = fcl_indep_contact(a, b);
+    const ContactResult ab = fcl_indep.contact(a, b);
     ASSERT_EQ(ab.contacts.size(), 1u) << "symmetry " << k;
     const bool wrong_face = k == 1;  // 180 deg about x
     const Vec3 n = wrong_face ? Vec3(0, -1, 0) : Vec3(-s, 0, s);
@@ -333,7 +339,7 @@ TEST(FclIndep, AlignedFacePairSwappedGivesAnotherWrongFacePinned) {
   // diagonal (1, -1, -1)/sqrt(3) but another one: FCL's A -> B normal (-1, -1, -1)/sqrt(3),
   // ours (1, 1, 1)/sqrt(3), same depth -0.1/sqrt(3). Truth: (1, 0, 0), 0.1.
   const ContactResult r =
-      fcl_indep_contact(unit_cube("B", kFaceOffset), unit_cube("A", Vec3::Zero()));
+      fcl_indep.contact(unit_cube("B", kFaceOffset), unit_cube("A", Vec3::Zero()));
   ASSERT_EQ(r.contacts.size(), 1u);
   EXPECT_NEAR((r.contacts[0].normal - Vec3(1, 1, 1).normalized()).norm(), 0.0, kRoundOff)
       << r.contacts[0].normal.transpose();
@@ -349,7 +355,7 @@ TEST(FclIndep, TouchingGivesAMinusZeroDepthContactPinned) {
   const RigidBody a = unit_cube("A", Vec3::Zero());
   for (bool swapped : {false, true}) {
     const ContactResult r =
-        swapped ? fcl_indep_contact(touching_b(), a) : fcl_indep_contact(a, touching_b());
+        swapped ? fcl_indep.contact(touching_b(), a) : fcl_indep.contact(a, touching_b());
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_EQ(r.contacts.size(), 1u) << "swapped " << swapped;
     const ContactPoint& c = r.contacts[0];
@@ -367,8 +373,8 @@ TEST(FclIndep, DiagonalCubeGetsTheMinimumPenetrationWithTheSignDefect) {
   // negated. A is not rotated, so the local-frame defect does not show; the normal, ours -z,
   // flips with the order.
   for (bool swapped : {false, true}) {
-    const ContactResult r = swapped ? fcl_indep_contact(diagonal_small(), diagonal_big())
-                                    : fcl_indep_contact(diagonal_big(), diagonal_small());
+    const ContactResult r = swapped ? fcl_indep.contact(diagonal_small(), diagonal_big())
+                                    : fcl_indep.contact(diagonal_big(), diagonal_small());
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_EQ(r.contacts.size(), 1u);
     EXPECT_NEAR((r.contacts[0].normal - Vec3(0, 0, swapped ? 1 : -1)).norm(), 0.0, kRoundOff)
@@ -378,7 +384,7 @@ TEST(FclIndep, DiagonalCubeGetsTheMinimumPenetrationWithTheSignDefect) {
 }
 
 TEST(FclIndep, SeparatedIsNoContact) {
-  const ContactResult r = fcl_indep_contact(unit_cube("A", Vec3::Zero()), separated_b());
+  const ContactResult r = fcl_indep.contact(unit_cube("A", Vec3::Zero()), separated_b());
   EXPECT_EQ(r.status, Status::Ok);
   EXPECT_TRUE(r.contacts.empty());
 }
@@ -386,12 +392,12 @@ TEST(FclIndep, SeparatedIsNoContact) {
 // ---------------------------------------------------------------------------------------------
 // fcl on two boxes: fcl::Box, boxBoxIntersect (the former fcl-box).
 
-TEST(FclBox, FacePairConventionBothOrdersAndRotated) { check_face_pair(fcl_contact, kRoundOff); }
+TEST(FclBox, FacePairConventionBothOrdersAndRotated) { check_face_pair(fcl.contact, kRoundOff); }
 
 TEST(FclBox, FacePairGivesTheFourCornersOfTheOverlapFace) {
   // B's -x face clipped by A's +x face is the whole unit square: 4 corners (0.45, +-0.5, +-0.5)
   // on the mid-plane, each at depth 0.1.
-  const ContactResult r = fcl_contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
+  const ContactResult r = fcl.contact(unit_cube("A", Vec3::Zero()), unit_cube("B", kFaceOffset));
   ASSERT_EQ(r.contacts.size(), 4u);
   for (const ContactPoint& c : r.contacts) {
     EXPECT_NEAR(std::abs(c.point.y()), 0.5, kRoundOff);
@@ -403,9 +409,9 @@ TEST(FclBox, FacePairGivesTheFourCornersOfTheOverlapFace) {
 TEST(FclBox, TouchingGivesDepthZeroAndSeparatedNone) {
   // At gap 0 the face test passes with zero overlap: 4 contacts at x = 0.5, depth 0, n = -x
   // (the truth: touching).
-  const ContactResult touching = fcl_contact(unit_cube("A", Vec3::Zero()), touching_b());
+  const ContactResult touching = fcl.contact(unit_cube("A", Vec3::Zero()), touching_b());
   expect_all_contacts(touching, kFaceNormal, 0.0, kRoundOff);
-  const ContactResult separated = fcl_contact(unit_cube("A", Vec3::Zero()), separated_b());
+  const ContactResult separated = fcl.contact(unit_cube("A", Vec3::Zero()), separated_b());
   EXPECT_EQ(separated.status, Status::Ok);
   EXPECT_TRUE(separated.contacts.empty());
 }
@@ -416,7 +422,7 @@ TEST(FclBox, VertexMassModelGivesTheSameBoxFrame) {
   const RigidBody a =
       box_at("A", Vec3::Ones(), Vec3::Zero(), Quat::Identity(), MassModel::Vertices);
   const RigidBody b = box_at("B", Vec3::Ones(), kFaceOffset, Quat::Identity(), MassModel::Vertices);
-  expect_all_contacts(fcl_contact(a, b), kFaceNormal, kFaceDepth, kRoundOff);
+  expect_all_contacts(fcl.contact(a, b), kFaceNormal, kFaceDepth, kRoundOff);
 }
 
 TEST(FclBox, ABoxAgainstAGeneralConvexRunsMpr) {
@@ -424,7 +430,7 @@ TEST(FclBox, ABoxAgainstAGeneralConvexRunsMpr) {
   // libccd MPR (one point), not boxBoxIntersect; the face overlap still gives n = -x, depth 0.1.
   RigidBody hull = unit_cube("B", kFaceOffset);
   hull.shape_kind = ShapeKind::Convex;
-  const ContactResult r = fcl_contact(unit_cube("A", Vec3::Zero()), hull);
+  const ContactResult r = fcl.contact(unit_cube("A", Vec3::Zero()), hull);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   EXPECT_EQ(r.contacts[0].feature, "mpr");
@@ -433,7 +439,7 @@ TEST(FclBox, ABoxAgainstAGeneralConvexRunsMpr) {
 
 TEST(FclBox, DiagonalCubeGetsTheMinimumPenetration) {
   // Truth derived above: an axis among -x, -y, -z, depth 0.15 (SAT picks one of the tie).
-  const ContactResult r = fcl_contact(diagonal_big(), diagonal_small());
+  const ContactResult r = fcl.contact(diagonal_big(), diagonal_small());
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_FALSE(r.contacts.empty());
   for (const ContactPoint& c : r.contacts) {
@@ -454,7 +460,7 @@ TEST(FclBox, PublicCaseUnitCubeOnEdgeIntoBigCube) {
   for (const Quat& sym : cube_symmetries()) {
     const RigidBody b = box_at("B", Vec3::Constant(3), Vec3(0, 0, -1.5), sym);
     for (bool swapped : {false, true}) {
-      const ContactResult r = swapped ? fcl_contact(b, a) : fcl_contact(a, b);
+      const ContactResult r = swapped ? fcl.contact(b, a) : fcl.contact(a, b);
       ASSERT_EQ(r.status, Status::Ok) << r.message;
       ASSERT_FALSE(r.contacts.empty());
       const Vec3 n = swapped ? Vec3(0, 0, -1) : Vec3(0, 0, 1);
@@ -488,7 +494,7 @@ TEST(FclBox, PublicCaseTiltedCubeOnRotatedCubeCullsToFour) {
   const RigidBody b =
       unit_cube("B", Vec3(0, 0, -0.75), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ())));
   for (bool swapped : {false, true}) {
-    const ContactResult r = swapped ? fcl_contact(b, a) : fcl_contact(a, b);
+    const ContactResult r = swapped ? fcl.contact(b, a) : fcl.contact(a, b);
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_EQ(r.contacts.size(), 4u);
     double deepest = 0.0;
@@ -513,10 +519,10 @@ TEST(FclConvexBackends, PublicCasesThroughMprAndEpa) {
       unit_cube("B", Vec3(0, 0, -0.75), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ())));
   const double depth1 = std::sqrt(2.0) / 2;
   const double depth2 = std::sqrt(2.0) / 2 * std::cos(M_PI / 4 - theta) - 0.25;
-  expect_all_contacts(fcl_hull_contact(a1, b1), Vec3::UnitZ(), depth1, kRoundOff);
-  expect_all_contacts(fcl_hull_contact(a2, b2), Vec3::UnitZ(), depth2, kRoundOff);
-  expect_all_contacts(fcl_epa_contact(a1, b1), Vec3::UnitZ(), depth1, kEpaTolerance);
-  expect_all_contacts(fcl_epa_contact(a2, b2), Vec3::UnitZ(), depth2, kEpaTolerance);
+  expect_all_contacts(fcl_hull.contact(a1, b1), Vec3::UnitZ(), depth1, kRoundOff);
+  expect_all_contacts(fcl_hull.contact(a2, b2), Vec3::UnitZ(), depth2, kRoundOff);
+  expect_all_contacts(fcl_epa.contact(a1, b1), Vec3::UnitZ(), depth1, kEpaTolerance);
+  expect_all_contacts(fcl_epa.contact(a2, b2), Vec3::UnitZ(), depth2, kEpaTolerance);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -558,9 +564,9 @@ TEST(FclRandomBoxes, AgainstSeparatingAxes) {
     const RigidBody b = box_at("B", size_b, centre_b, q_b);
     const double truth = sat_depth(a, b);
     if (std::abs(truth) < 1e-6) continue;
-    const ContactResult mpr = fcl_hull_contact(a, b);
-    const ContactResult epa = fcl_epa_contact(a, b);
-    const ContactResult box = fcl_contact(a, b);
+    const ContactResult mpr = fcl_hull.contact(a, b);
+    const ContactResult epa = fcl_epa.contact(a, b);
+    const ContactResult box = fcl.contact(a, b);
     ASSERT_EQ(mpr.status, Status::Ok) << "sample " << k << ": " << mpr.message;
     ASSERT_EQ(epa.status, Status::Ok) << "sample " << k << ": " << epa.message;
     ASSERT_EQ(box.status, Status::Ok) << "sample " << k << ": " << box.message;
@@ -602,7 +608,7 @@ TEST(FclEpa, PairWhereLibccdEpaUnderestimatesIsRight) {
       Vec3(0.55841869342978101, 0.040565343341065541, -0.45090973054194416),
       Quat(0.31812010099052296, -0.8985848754636705, 0.28341090204507841, 0.10499087358296565)
           .normalized());
-  const ContactResult r = fcl_epa_contact(a, b);
+  const ContactResult r = fcl_epa.contact(a, b);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   EXPECT_NEAR(r.contacts[0].depth, sat_depth(a, b), kEpaTolerance);

@@ -21,6 +21,10 @@
 namespace rbx {
 namespace {
 
+// The backends under test, by their registry names.
+const Backend& libccd_epa = libccd_adapter().backend("libccd-epa");
+const Backend& libccd_mpr = libccd_adapter().backend("libccd-mpr");
+
 using test::box_at;
 using test::depth_along;
 using test::generic_rotation;
@@ -36,7 +40,7 @@ struct Both {
   ContactResult mpr, epa;
 };
 Both both(const RigidBody& a, const RigidBody& b) {
-  return {libccd_mpr_contact(a, b), libccd_epa_contact(a, b)};
+  return {libccd_mpr.contact(a, b), libccd_epa.contact(a, b)};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -202,7 +206,7 @@ TEST(Libccd, EpaUnderestimatesPinned) {
       Quat(0.31812010099052296, -0.8985848754636705, 0.28341090204507841, 0.10499087358296565)
           .normalized());
   const double truth = sat_depth(a, b);  // ~0.8124 m, exact by the separating-axis theorem
-  const ContactResult r = libccd_epa_contact(a, b);
+  const ContactResult r = libccd_epa.contact(a, b);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   const ContactPoint& epa = r.contacts[0];
@@ -263,16 +267,16 @@ TEST(Libccd, ItsOwnBoxSupportReproducesItsPublishedCases) {
   RigidBody pen7_b = unit_cube("B", Vec3(0.1, 0, 0));
   constexpr double kPrinted = 5e-7;
   // "Pen 3" (EPA): depth 0.900000, dir (0, 0, -1); "Separate 5" (EPA): (0.707107, 0, 0).
-  const ContactResult pen3 = libccd_epa_contact(pen3_a, pen3_b);
+  const ContactResult pen3 = libccd_epa.contact(pen3_a, pen3_b);
   ASSERT_EQ(pen3.contacts.size(), 1u) << pen3.message;
   EXPECT_NEAR(pen3.contacts[0].depth, 0.9, kPrinted);
   EXPECT_NEAR(pen3.contacts[0].normal.z(), 1.0, kPrinted);
-  const ContactResult sep5 = libccd_epa_contact(sep5_a, sep5_b);
+  const ContactResult sep5 = libccd_epa.contact(sep5_a, sep5_b);
   ASSERT_EQ(sep5.contacts.size(), 1u) << sep5.message;
   EXPECT_NEAR(sep5.contacts[0].depth, 0.707107, kPrinted);
   EXPECT_NEAR(sep5.contacts[0].normal.x(), -1.0, kPrinted);
   // "Pen 7" (MPR): depth 0.622928, dir (0.999509, 0.028016, -0.014008); our normal is -dir.
-  const ContactResult pen7 = libccd_mpr_contact(pen7_a, pen7_b);
+  const ContactResult pen7 = libccd_mpr.contact(pen7_a, pen7_b);
   ASSERT_EQ(pen7.contacts.size(), 1u) << pen7.message;
   EXPECT_NEAR(pen7.contacts[0].depth, 0.622928, kPrinted);
   EXPECT_NEAR((pen7.contacts[0].normal - Vec3(-0.999509, -0.028016, 0.014008)).norm(), 0.0,
@@ -281,13 +285,13 @@ TEST(Libccd, ItsOwnBoxSupportReproducesItsPublishedCases) {
   // (a degenerate polytope at the tied vertices), MPR takes another portal on Pen 7.
   for (RigidBody* body : {&pen3_a, &pen3_b, &sep5_a, &sep5_b, &pen7_a, &pen7_b})
     body->shape_kind = ShapeKind::Convex;
-  const ContactResult pen3_hull = libccd_epa_contact(pen3_a, pen3_b);
+  const ContactResult pen3_hull = libccd_epa.contact(pen3_a, pen3_b);
   ASSERT_EQ(pen3_hull.contacts.size(), 1u) << pen3_hull.message;
   EXPECT_LT(pen3_hull.contacts[0].depth, 1e-12);
-  const ContactResult sep5_hull = libccd_epa_contact(sep5_a, sep5_b);
+  const ContactResult sep5_hull = libccd_epa.contact(sep5_a, sep5_b);
   ASSERT_EQ(sep5_hull.contacts.size(), 1u) << sep5_hull.message;
   EXPECT_LT(sep5_hull.contacts[0].depth, 1e-12);
-  const ContactResult pen7_hull = libccd_mpr_contact(pen7_a, pen7_b);
+  const ContactResult pen7_hull = libccd_mpr.contact(pen7_a, pen7_b);
   ASSERT_EQ(pen7_hull.contacts.size(), 1u) << pen7_hull.message;
   EXPECT_GT(std::abs(pen7_hull.contacts[0].depth - 0.622928), 0.01);
 }

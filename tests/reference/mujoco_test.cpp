@@ -30,6 +30,9 @@
 namespace rbx {
 namespace {
 
+// The backends under test, by their registry names.
+const Backend& mujoco_hull = mujoco_adapter().backend("mujoco-hull");
+
 using test::box_spec;
 using test::diagonal_along_x;
 using test::pyramid_spec;
@@ -45,7 +48,7 @@ TEST(MujocoContact, OverlapAlongXGivesNormalFromBTowardA) {
   // pushing A out of B is along -x.
   const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3(0.9, 0, 0)));
-  const ContactResult r = mujoco_hull_contact(a, b);
+  const ContactResult r = mujoco_hull.contact(a, b);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);  // mesh-mesh in 2.2.2: MPR, one point
   const ContactPoint& c = r.contacts[0];
@@ -64,7 +67,7 @@ TEST(MujocoContact, SwappingTheBodiesFlipsTheNormal) {
   // Same pair as above with B first: now B is pushed out of A along +x; same depth.
   const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3(0.9, 0, 0)));
-  const ContactResult r = mujoco_hull_contact(b, a);
+  const ContactResult r = mujoco_hull.contact(b, a);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   EXPECT_NEAR(r.contacts[0].normal.x(), 1.0, kFloatGeometry);
@@ -80,7 +83,7 @@ TEST(MujocoContact, RotatedPairGivesWorldFrameNormal) {
   const Quat q(Eigen::AngleAxisd(0.3, Vec3::UnitZ()));
   const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero(), 1.0, q));
   const RigidBody b = make_body(box_spec("B", Vec3::Ones(), q * Vec3(0.9, 0.2, 0.1), 1.0, q));
-  const ContactResult r = mujoco_hull_contact(a, b);
+  const ContactResult r = mujoco_hull.contact(a, b);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   EXPECT_NEAR(r.contacts[0].normal.x(), -std::cos(0.3), kFloatGeometry);
@@ -93,12 +96,12 @@ TEST(MujocoContact, TouchingAndSeparatedPairs) {
   const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   // Faces exactly touching (B at x = 1): no penetration; a zero-depth contact would be allowed.
   const ContactResult touching =
-      mujoco_hull_contact(a, make_body(box_spec("B", Vec3::Ones(), Vec3(1, 0, 0))));
+      mujoco_hull.contact(a, make_body(box_spec("B", Vec3::Ones(), Vec3(1, 0, 0))));
   ASSERT_EQ(touching.status, Status::Ok) << touching.message;
   for (const ContactPoint& c : touching.contacts) EXPECT_LE(c.depth, kFloatGeometry);
   // 1 mm apart: nothing.
   const ContactResult apart =
-      mujoco_hull_contact(a, make_body(box_spec("B", Vec3::Ones(), Vec3(1.001, 0, 0))));
+      mujoco_hull.contact(a, make_body(box_spec("B", Vec3::Ones(), Vec3(1.001, 0, 0))));
   ASSERT_EQ(apart.status, Status::Ok) << apart.message;
   EXPECT_TRUE(apart.contacts.empty());
 }
@@ -115,7 +118,7 @@ TEST(MujocoContact, RecentredMeshStaysOnOurPose) {
   const RigidBody pyramid = make_body(p);
   ASSERT_NEAR(pyramid.position.z(), 0.2, 1e-12);  // our centre of mass
   const RigidBody table = make_body(box_spec("T", Vec3(2, 2, 1), Vec3(0, 0, -0.48)));
-  const ContactResult r = mujoco_hull_contact(pyramid, table);
+  const ContactResult r = mujoco_hull.contact(pyramid, table);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   EXPECT_NEAR(r.contacts[0].normal.z(), 1.0, kFloatGeometry);
@@ -146,7 +149,7 @@ TEST(MujocoKnownWrongAnswer, SmallCubeOnTheDiagonalPinned) {
   // Pinned as the adapter returns it. Ours: normal from B toward A = -(1, 1, 1)/sqrt(3) (MuJoCo's
   // frame, geom1 -> geom2, is the diagonal toward the small cube), depth 0.15 sqrt(3). MuJoCo
   // stores the vertices as float (0.05 -> 0.0500000007), hence kFloatGeometry.
-  const ContactResult r = mujoco_hull_contact(diagonal_big(), diagonal_small(Vec3::Constant(0.4)));
+  const ContactResult r = mujoco_hull.contact(diagonal_big(), diagonal_small(Vec3::Constant(0.4)));
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   const ContactPoint& c = r.contacts[0];
@@ -157,7 +160,7 @@ TEST(MujocoKnownWrongAnswer, SmallCubeOnTheDiagonalPinned) {
   EXPECT_GT(c.depth - 0.15, 0.1);
   // Swapped (the scene's order, small cube first): the same wrong answer, flipped.
   const ContactResult swapped =
-      mujoco_hull_contact(diagonal_small(Vec3::Constant(0.4)), diagonal_big());
+      mujoco_hull.contact(diagonal_small(Vec3::Constant(0.4)), diagonal_big());
   ASSERT_EQ(swapped.status, Status::Ok) << swapped.message;
   ASSERT_EQ(swapped.contacts.size(), 1u);
   EXPECT_NEAR((swapped.contacts[0].normal - Vec3::Ones().normalized()).norm(), 0.0, kFloatGeometry)
@@ -178,8 +181,8 @@ TEST(MujocoKnownWrongAnswer, SmallCubeNearTheDiagonalPinned) {
   const double measured_depth = 0.17233688105783818;
   for (bool swapped : {false, true}) {
     const RigidBody small = diagonal_small(Vec3(0.4, 0.39, 0.39));
-    const ContactResult r = swapped ? mujoco_hull_contact(diagonal_big(), small)
-                                    : mujoco_hull_contact(small, diagonal_big());
+    const ContactResult r = swapped ? mujoco_hull.contact(diagonal_big(), small)
+                                    : mujoco_hull.contact(small, diagonal_big());
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_EQ(r.contacts.size(), 1u);
     const ContactPoint& c = r.contacts[0];
@@ -290,7 +293,7 @@ AllocationProfile profile_contact_query(const RigidBody& a, const RigidBody& b) 
   std::set<long> all;  // keep everything: nothing is freed after a clean query
   for (long k = 1; k <= 1000; ++k) all.insert(k);
   FailingAllocator count(0, all);
-  EXPECT_EQ(mujoco_hull_contact(a, b).status, Status::Ok);
+  EXPECT_EQ(mujoco_hull.contact(a, b).status, Status::Ok);
   out.calls = FailingAllocator::calls;
   for (const auto& [p, call] : count.blocks) out.kept.insert(call);
   return out;
@@ -310,14 +313,14 @@ TEST(MujocoErrors, MjuErrorInMakeDataIsAStatusErrorWithItsMessage) {
   ASSERT_LT(n, 1000);
   {
     FailingAllocator fail_last(n, clean.kept);
-    const ContactResult r = mujoco_hull_contact(a, b);
+    const ContactResult r = mujoco_hull.contact(a, b);
     EXPECT_EQ(FailingAllocator::calls, n);  // it did reach the failing allocation
     EXPECT_EQ(r.status, Status::Error);
     EXPECT_EQ(r.message, "MuJoCo mj_makeData: Could not allocate memory");
     EXPECT_TRUE(r.contacts.empty());
   }
   // Still alive, and MuJoCo still answers (the face pair above: one contact, depth 0.1).
-  const ContactResult again = mujoco_hull_contact(a, b);
+  const ContactResult again = mujoco_hull.contact(a, b);
   ASSERT_EQ(again.status, Status::Ok) << again.message;
   ASSERT_EQ(again.contacts.size(), 1u);
   EXPECT_NEAR(again.contacts[0].depth, 0.1, kFloatGeometry);
@@ -344,7 +347,7 @@ TEST(MujocoErrors, EveryFailedAllocationIsAStatusError) {
 #endif
   for (long k = 1; k <= n; ++k) {
     FailingAllocator fail(k, clean.kept);
-    const ContactResult r = mujoco_hull_contact(a, b);
+    const ContactResult r = mujoco_hull.contact(a, b);
     EXPECT_EQ(r.status, Status::Error) << "allocation " << k;
     EXPECT_NE(r.message.find("Could not allocate memory"), std::string::npos)
         << "allocation " << k << ": " << r.message;
@@ -391,7 +394,7 @@ TEST(MujocoDynamics, HeadOnImpactAtTheCalibratedEntryPhase) {
   // calibrated at. The remaining model error is the impedance d = 0.9999 (the solver reaches
   // aref to 1e-4 relative), so velocities and impulse agree to 1e-4.
   for (const HeadOnAnswer& want : kHeadOn) {
-    const DynamicsResult r = mujoco_hull_dynamics(head_on(want.e, 0.003, 1e-3), {});
+    const DynamicsResult r = mujoco_hull.dynamics(head_on(want.e, 0.003, 1e-3), {});
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_EQ(r.finals.size(), 2u);
     EXPECT_NEAR(r.finals[0].velocity.x(), want.v1, 1e-4) << "e = " << want.e;
@@ -415,7 +418,7 @@ TEST(MujocoDynamics, HeadOnImpactAtAnotherEntryPhase) {
   // and 0.517 over entry phases 0..1 for a target of 0.5, so |e - 0.5| <= 0.018 and the
   // velocities move by at most m2/(m1+m2) |de| |v1 - v2| = 0.75 * 0.018 * 2 = 0.027 (A) and
   // m1/(m1+m2) |de| 2 = 0.009 (B). This is the price of detecting contact at step starts.
-  const DynamicsResult r = mujoco_hull_dynamics(head_on(0.5, 0.004 - 1e-6, 1e-3), {});
+  const DynamicsResult r = mujoco_hull.dynamics(head_on(0.5, 0.004 - 1e-6, 1e-3), {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   EXPECT_NEAR(r.finals[0].velocity.x(), -1.25, 0.027);
   EXPECT_NEAR(r.finals[1].velocity.x(), -0.25, 0.009);
@@ -447,7 +450,7 @@ TEST(MujocoDynamics, CubeCornerOnStaticSlab) {
   s.bodies.back().velocity = Vec3(0, 0, -1);
   s.bodies.push_back(box_spec("slab", Vec3(4, 4, 1), Vec3(0, 0, rz - 0.5 - 1.5 * dt)));
   s.bodies.back().is_static = true;
-  const DynamicsResult r = mujoco_hull_dynamics(s, {});
+  const DynamicsResult r = mujoco_hull.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   // Tolerance: a soft contact is not an instantaneous impulse. Over its ~25 steps (2.5 ms) the
   // cube turns by about |w'| T / 2 = 1.8 * 2.5e-3 / 2 = 2.3e-3 rad, moving the lever r_x by
@@ -473,7 +476,7 @@ TEST(MujocoDynamics, FreeRotationStaysInTheWorldFrame) {
   s.sim.duration = 0.1;
   s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero(), 1.0, q0));
   s.bodies.back().angular_velocity = w;
-  const DynamicsResult r = mujoco_hull_dynamics(s, {});
+  const DynamicsResult r = mujoco_hull.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   // Round-off over 100 steps of an exact quaternion update.
   EXPECT_LT((r.finals[0].angular_velocity - w).norm(), 1e-9);
@@ -492,7 +495,7 @@ TEST(MujocoDynamics, FreeFallSamples) {
   s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3(0, 0, 5)));
   DynamicsOptions opt;
   opt.sample_every = 10;
-  const DynamicsResult r = mujoco_hull_dynamics(s, opt);
+  const DynamicsResult r = mujoco_hull.dynamics(s, opt);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.samples.size(), 11u);
   for (size_t k = 0; k < r.samples.size(); ++k) {
@@ -510,7 +513,7 @@ TEST(MujocoDynamics, NonFiniteStateIsAnError) {
   s.sim.duration = 0.01;
   s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   s.bodies.back().velocity = Vec3(std::nan(""), 0, 0);
-  const DynamicsResult r = mujoco_hull_dynamics(s, {});
+  const DynamicsResult r = mujoco_hull.dynamics(s, {});
   EXPECT_EQ(r.status, Status::Error);
   EXPECT_NE(r.message.find("MuJoCo"), std::string::npos) << r.message;
 }

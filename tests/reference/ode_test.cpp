@@ -13,6 +13,9 @@
 namespace rbx {
 namespace {
 
+// The backends under test, by their registry names.
+const Backend& ode_hull = ode_adapter().backend("ode-hull");
+
 using test::box_spec;
 using test::diagonal_along_x;
 using test::pyramid_spec;
@@ -26,7 +29,7 @@ TEST(OdeContact, OverlapAlongXGivesNormalFromBTowardA) {
   // Unit cubes, B centred at x = 0.9: faces x = 0.5 (A) and x = 0.4 (B) overlap by 0.1.
   const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3(0.9, 0, 0)));
-  const ContactResult r = ode_hull_contact(a, b);
+  const ContactResult r = ode_hull.contact(a, b);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_FALSE(r.contacts.empty());
   for (const ContactPoint& c : r.contacts) {
@@ -45,7 +48,7 @@ TEST(OdeContact, OverlapAlongXGivesNormalFromBTowardA) {
 TEST(OdeContact, SwappingTheBodiesFlipsTheNormal) {
   const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3(0.9, 0, 0)));
-  const ContactResult r = ode_hull_contact(b, a);
+  const ContactResult r = ode_hull.contact(b, a);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_FALSE(r.contacts.empty());
   for (const ContactPoint& c : r.contacts) {
@@ -60,7 +63,7 @@ TEST(OdeContact, RotatedPairGivesWorldFrameNormal) {
   const Quat q(Eigen::AngleAxisd(0.3, Vec3::UnitZ()));
   const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero(), 1.0, q));
   const RigidBody b = make_body(box_spec("B", Vec3::Ones(), q * Vec3(0.9, 0.2, 0.1), 1.0, q));
-  const ContactResult r = ode_hull_contact(a, b);
+  const ContactResult r = ode_hull.contact(a, b);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_FALSE(r.contacts.empty());
   for (const ContactPoint& c : r.contacts) {
@@ -75,12 +78,12 @@ TEST(OdeContact, TouchingAndSeparatedPairs) {
   const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   // Faces exactly touching: no penetration (a zero-depth contact would be allowed).
   const ContactResult touching =
-      ode_hull_contact(a, make_body(box_spec("B", Vec3::Ones(), Vec3(1, 0, 0))));
+      ode_hull.contact(a, make_body(box_spec("B", Vec3::Ones(), Vec3(1, 0, 0))));
   ASSERT_EQ(touching.status, Status::Ok) << touching.message;
   for (const ContactPoint& c : touching.contacts) EXPECT_LE(c.depth, kRoundOff);
   // 1 mm apart: nothing.
   const ContactResult apart =
-      ode_hull_contact(a, make_body(box_spec("B", Vec3::Ones(), Vec3(1.001, 0, 0))));
+      ode_hull.contact(a, make_body(box_spec("B", Vec3::Ones(), Vec3(1.001, 0, 0))));
   ASSERT_EQ(apart.status, Status::Ok) << apart.message;
   EXPECT_TRUE(apart.contacts.empty());
 }
@@ -93,7 +96,7 @@ TEST(OdeKnownBehaviour, ExactTouchingOffCentreHasNoNormalAndIsTouching) {
   // scoring (0, 0, 0).
   const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3(0.3, 0.2, 1)));
   const RigidBody b = make_body(box_spec("B", Vec3::Ones(), Vec3::Zero()));
-  const ContactResult r = ode_hull_contact(a, b);
+  const ContactResult r = ode_hull.contact(a, b);
   EXPECT_EQ(r.status, Status::Touching);
   EXPECT_NE(r.message.find("no normal"), std::string::npos) << r.message;
 }
@@ -106,7 +109,7 @@ TEST(OdeContact, MergedFacesOfAPyramidOnABox) {
   p.mass_model = MassModel::Vertices;
   const RigidBody pyramid = make_body(p);
   const RigidBody table = make_body(box_spec("T", Vec3(2, 2, 1), Vec3(0, 0, -0.48)));
-  const ContactResult r = ode_hull_contact(pyramid, table);
+  const ContactResult r = ode_hull.contact(pyramid, table);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_FALSE(r.contacts.empty());
   for (const ContactPoint& c : r.contacts) {
@@ -125,7 +128,7 @@ TEST(OdeKnownBehaviour, ConvexConvexReturnsOnePoint) {
   // changed and the reports' notes must too.
   const RigidBody a = make_body(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   const RigidBody b = make_body(box_spec("B", Vec3(0.5, 0.5, 0.5), Vec3(0.7, 0.1, 0.05)));
-  const ContactResult r = ode_hull_contact(a, b);
+  const ContactResult r = ode_hull.contact(a, b);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
   EXPECT_NEAR(r.contacts[0].normal.x(), -1.0, kRoundOff);
@@ -160,7 +163,7 @@ TEST(OdeDynamics, HeadOnImpactMatchesTheClosedForm) {
   // dWorldStep solves the contact exactly, up to ODE's default CFM = 1e-10, which softens the
   // impulse by a relative CFM / (dt * (1/m1 + 1/m2)) = 1e-10 / (1e-3 * 4/3) = 7.5e-8: 1e-6 m/s.
   for (const HeadOnAnswer& want : kHeadOn) {
-    const DynamicsResult r = ode_hull_dynamics(head_on(want.e), {});
+    const DynamicsResult r = ode_hull.dynamics(head_on(want.e), {});
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     ASSERT_EQ(r.finals.size(), 2u);
     EXPECT_NEAR(r.finals[0].velocity.x(), want.v1, 1e-6) << "e = " << want.e;
@@ -181,7 +184,7 @@ TEST(OdeDynamics, PositionCorrectionSeparatesAfterAnInelasticImpact) {
   // centre-of-mass velocity (-2 / 4 = -0.5) that gives v1' = -0.5 - (3/4) 0.2 = -0.65 and
   // v2' = -0.5 + (1/4) 0.2 = -0.45: an effective e of 0.1 instead of 0 (kept visible; see
   // ode.cpp on why the default ERP stays). CFM: 1e-6 as above.
-  const DynamicsResult r = ode_hull_dynamics(head_on(0.0), {});
+  const DynamicsResult r = ode_hull.dynamics(head_on(0.0), {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   EXPECT_NEAR(r.finals[0].velocity.x(), -0.65, 1e-6);
   EXPECT_NEAR(r.finals[1].velocity.x(), -0.45, 1e-6);
@@ -197,7 +200,7 @@ TEST(OdeDynamics, FaceFaceImpactConservesMomentum) {
   Scene s = head_on(0.5);
   s.bodies[0].orientation = Quat::Identity();
   s.bodies[0].position = Vec3(-0.5 - 0.003, 0, 0);
-  const DynamicsResult r = ode_hull_dynamics(s, {});
+  const DynamicsResult r = ode_hull.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   const double m[2] = {1.0, 3.0};
   Vec3 p = Vec3::Zero(), l = Vec3::Zero();
@@ -239,7 +242,7 @@ TEST(OdeDynamics, CubeCornerOnStaticSlab) {
     s.bodies.push_back(box_spec("slab", Vec3(4, 4, 1), Vec3(0, 0, slab_z)));
     s.bodies.back().is_static = true;
     if (slab_first) std::swap(s.bodies[0], s.bodies[1]);
-    const DynamicsResult r = ode_hull_dynamics(s, {});
+    const DynamicsResult r = ode_hull.dynamics(s, {});
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     const BodyFinal& cube = r.finals[slab_first ? 1 : 0];
     const BodyFinal& slab = r.finals[slab_first ? 0 : 1];
@@ -289,7 +292,7 @@ TEST(OdeDynamics, FrictionIsCoulombMuTimesTheNormalImpulse) {
   // Slab top 2 mm - 1 um below the vertex: seen 1 um deep at the third step (dt = 1 ms).
   s.bodies.push_back(box_spec("slab", Vec3(4, 4, 1), Vec3(0, 0, -h - 0.5 - 0.002 + 1e-6)));
   s.bodies.back().is_static = true;
-  const DynamicsResult r = ode_hull_dynamics(s, {});
+  const DynamicsResult r = ode_hull.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   const BodyFinal& cube = r.finals[0];
   EXPECT_NEAR(cube.velocity.x(), 1.85, 1e-5);
@@ -312,7 +315,7 @@ TEST(OdeDynamics, FreeRotationStaysInTheWorldFrame) {
   s.sim.duration = 0.1;
   s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero(), 1.0, q0));
   s.bodies.back().angular_velocity = w;
-  const DynamicsResult r = ode_hull_dynamics(s, {});
+  const DynamicsResult r = ode_hull.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   EXPECT_LT((r.finals[0].angular_velocity - w).norm(), 1e-9);
   const Quat expect = Quat(Eigen::AngleAxisd(w.norm() * 0.1, w.normalized())) * q0;
@@ -329,7 +332,7 @@ TEST(OdeDynamics, FreeFallSamples) {
   s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3(0, 0, 5)));
   DynamicsOptions opt;
   opt.sample_every = 10;
-  const DynamicsResult r = ode_hull_dynamics(s, opt);
+  const DynamicsResult r = ode_hull.dynamics(s, opt);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.samples.size(), 11u);  // t = 0, 0.01, ..., 0.1
   for (size_t k = 0; k < r.samples.size(); ++k) {
@@ -346,7 +349,7 @@ TEST(OdeDynamics, OdeErrorsBecomeStatusError) {
   Scene bad_mass;
   bad_mass.sim.duration = 0.01;
   bad_mass.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero(), -1.0));
-  const DynamicsResult r = ode_hull_dynamics(bad_mass, {});
+  const DynamicsResult r = ode_hull.dynamics(bad_mass, {});
   EXPECT_EQ(r.status, Status::Error);
   EXPECT_NE(r.message.find("ODE"), std::string::npos) << r.message;
   // A NaN velocity propagates silently in ODE: the adapter reports the non-finite state.
@@ -354,9 +357,9 @@ TEST(OdeDynamics, OdeErrorsBecomeStatusError) {
   nan_state.sim.duration = 0.01;
   nan_state.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   nan_state.bodies.back().velocity = Vec3(std::nan(""), 0, 0);
-  EXPECT_EQ(ode_hull_dynamics(nan_state, {}).status, Status::Error);
+  EXPECT_EQ(ode_hull.dynamics(nan_state, {}).status, Status::Error);
   // And ODE still works afterwards.
-  EXPECT_EQ(ode_hull_dynamics(head_on(1.0), {}).status, Status::Ok);
+  EXPECT_EQ(ode_hull.dynamics(head_on(1.0), {}).status, Status::Ok);
 }
 
 }  // namespace

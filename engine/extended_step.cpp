@@ -1,7 +1,7 @@
-// The extended engine's step (World::step_extended): the seed's bounding check and Moore &
-// Wilhelms detector, then contact manifolds, simultaneous impulses with Coulomb friction,
-// resting contact and position projection (engine/contact_solver.h). Kept out of world.cpp so
-// the seed's step stays as it was.
+// The extended engine's step (engine/extended_step.h). A departure from the seed in every stage
+// but detection; the seed's own step is engine/seed_step.cpp.
+#include "engine/extended_step.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -15,67 +15,70 @@
 #include "engine/manifold.h"
 #include "engine/separation.h"
 #include "engine/time_of_impact.h"
-#include "engine/world.h"
 
 namespace rbx {
 
 // The step as a list of stages: detect, approach velocities, forces, solve, events, time of
 // impact, integrate, project.
-void World::step_extended() {
-  std::vector<PairManifold> manifolds = detect_manifolds();
+ExtendedStep::ExtendedStep(const WorldSettings& tunables)
+    : ahead_broad_phase_(BroadPhaseMethod::Tree, tunables) {}
+
+void ExtendedStep::advance(WorldState& world) {
+  std::vector<PairManifold> manifolds = detect_manifolds(world);
   // Approach velocities before this step's forces: the restitution law's v_n0.
-  const std::vector<std::vector<double>> approach = normal_velocities(bodies_, manifolds);
+  const std::vector<std::vector<double>> approach = normal_velocities(world.bodies, manifolds);
   // Symplectic: forces first (Guendelman et al. 2003), so the contacts see this step's gravity
   // and a resting body ends the step at rest. The seed's Euler adds gravity after the move;
   // there the solve runs before it, as the seed's impulses do.
-  if (sim_.integrator == Integrator::Symplectic)
-    for (RigidBody& b : bodies_)
-      if (!b.is_static) b.velocity += sim_.gravity * sim_.dt;
-  const ContactSolverSettings settings = solver_settings();
+  if (world.sim.integrator == Integrator::Symplectic)
+    for (RigidBody& b : world.bodies)
+      if (!b.is_static) b.velocity += world.sim.gravity * world.sim.dt;
+  const ContactSolverSettings settings = solver_settings(world);
   const std::vector<SolvedPoint> solved =
-      solve_contact_velocities(bodies_, manifolds, approach, settings);
+      solve_contact_velocities(world.bodies, manifolds, approach, settings);
   // One event per manifold that was a collision.
-  const std::vector<double> impulse = record_events(manifolds, solved, time_, settings.rest_speed);
+  const std::vector<double> impulse = record_events(world, manifolds, solved, world.time, settings.rest_speed);
   // Time of impact: pairs separated at the step's start that the step's motion brings into
   // contact (engine/time_of_impact.h) are moved to their first contact, resolved there, and
   // moved on for the rest of the step: an adaptive step for those two bodies only.
-  const std::vector<bool> moved = time_of_impact_step(manifolds, settings);
-  integrate_bodies(moved);
+  const std::vector<bool> moved = time_of_impact_step(world, manifolds, settings);
+  integrate_bodies(world, moved);
   // Only pairs that pressed together (a normal impulse) are projected apart: a penetration
   // that no approach caused, such as two overlapping bodies moving together
   // (stress/zero_relative_velocity), is left as it is, as the seed leaves it.
   std::vector<PairManifold> pressed;
   for (size_t m = 0; m < manifolds.size(); ++m)
     if (impulse[m] > 0.0) pressed.push_back(std::move(manifolds[m]));
-  project_contact_positions(bodies_, pressed, tunables_);
+  project_contact_positions(world.bodies, pressed, world.tunables);
 }
 
-std::vector<PairManifold> World::detect_manifolds() {
+std::vector<PairManifold> ExtendedStep::detect_manifolds(WorldState& world) {
   // One manifold per pair passing the bounding check, at the step's start poses.
   std::vector<PairManifold> manifolds;
-  for (const BodyPair& pair : broad_phase_.find_pairs(bodies_)) {
-    const RigidBody &a = bodies_[pair.first], &b = bodies_[pair.second];
+  for (const BodyPair& pair : world.broad_phase.find_pairs(world.bodies)) {
+    const RigidBody &a = world.bodies[pair.first], &b = world.bodies[pair.second];
     if (a.is_static && b.is_static) continue;
-    if (separated(pair.first, pair.second)) continue;  // the detector would find nothing
-    auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant_);
+    if (separated(world, pair.first, pair.second)) continue;  // the detector would find nothing
+    auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant);
     if (m) manifolds.push_back({pair.first, pair.second, std::move(*m), a.pose(), b.pose()});
   }
   return manifolds;
 }
 
-ContactSolverSettings World::solver_settings() const {
+ContactSolverSettings ExtendedStep::solver_settings(const WorldState& world) {
   // Resting threshold: a few steps of gravity (WorldSettings::rest_gravity_steps).
   ContactSolverSettings settings;
-  settings.restitution = sim_.restitution;
-  settings.friction = sim_.friction;
-  settings.rest_speed = tunables_.rest_gravity_steps * sim_.gravity.norm() * sim_.dt;
-  settings.tunables = tunables_;
+  settings.restitution = world.sim.restitution;
+  settings.friction = world.sim.friction;
+  settings.rest_speed = world.tunables.rest_gravity_steps * world.sim.gravity.norm() * world.sim.dt;
+  settings.tunables = world.tunables;
   return settings;
 }
 
-std::vector<double> World::record_events(const std::vector<PairManifold>& manifolds,
-                                         const std::vector<SolvedPoint>& solved, double time,
-                                         std::optional<double> rest_speed) {
+std::vector<double> ExtendedStep::record_events(WorldState& world,
+                                                const std::vector<PairManifold>& manifolds,
+                                                const std::vector<SolvedPoint>& solved,
+                                                double time, std::optional<double> rest_speed) {
   // A manifold's event: its total normal impulse at the centre of the normal impulses (the
   // centre of pressure), with the detector's contact for the rest.
   std::vector<double> impulse(manifolds.size(), 0.0);
@@ -92,32 +95,31 @@ std::vector<double> World::record_events(const std::vector<PairManifold>& manifo
     c.point = moment[m] / impulse[m];
     c.normal = manifolds[m].manifold.normal;
     c.depth = manifolds[m].manifold.depth;
-    events_.push_back(
-        {time, step_, bodies_[manifolds[m].a].name, bodies_[manifolds[m].b].name, c, impulse[m]});
+    world.add_event(manifolds[m].a, manifolds[m].b, c, impulse[m], time);
   }
   return impulse;
 }
 
-void World::integrate_bodies(const std::vector<bool>& moved) {
+void ExtendedStep::integrate_bodies(WorldState& world, const std::vector<bool>& moved) {
   // Gravity is already in the velocities for the symplectic scheme.
-  const std::vector<ShapeFacts>& facts = shape_facts();
-  for (size_t i = 0; i < bodies_.size(); ++i) {
-    RigidBody& b = bodies_[i];
+  const std::vector<BodyFacts>& facts = world.facts;
+  for (size_t i = 0; i < world.bodies.size(); ++i) {
+    RigidBody& b = world.bodies[i];
     if (moved[i]) continue;  // already carried through the step by its time of impact
-    if (sim_.integrator == Integrator::Symplectic)
-      integrate_symplectic(b, Vec3::Zero(), sim_.dt, &facts[i].principal);
+    if (world.sim.integrator == Integrator::Symplectic)
+      integrate_symplectic(b, Vec3::Zero(), world.sim.dt, &facts[i].principal);
     else
-      integrate(b, sim_, sim_.dt, &facts[i].principal);
+      integrate(b, world.sim, world.sim.dt, &facts[i].principal);
   }
 }
 
-bool World::separated(int i, int j) {
-  const RigidBody &a = bodies_[i], &b = bodies_[j];
-  const std::vector<ShapeFacts>& facts = shape_facts();
+bool ExtendedStep::separated(const WorldState& world, int i, int j) {
+  const RigidBody &a = world.bodies[i], &b = world.bodies[j];
+  const std::vector<BodyFacts>& facts = world.facts;
   // The pair's tolerance, 1e-9 x the larger size, is the larger of the two bodies' own.
   const double margin = separation_margin(std::max(facts[i].own_tol, facts[j].own_tol),
                                           facts[i].reach, facts[j].reach);
-  const long long key = static_cast<long long>(i) * static_cast<long long>(bodies_.size()) + j;
+  const long long key = static_cast<long long>(i) * static_cast<long long>(world.bodies.size()) + j;
   const auto kept = witnesses_.find(key);
   if (kept != witnesses_.end() &&
       gap_along(*a.shape, a.pose(), *b.shape, b.pose(), b.orientation * kept->second) > margin)
@@ -131,18 +133,19 @@ bool World::separated(int i, int j) {
   return false;
 }
 
-std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& manifolds,
-                                             const ContactSolverSettings& settings) {
-  const double dt = sim_.dt;
-  const size_t n = bodies_.size();
+std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
+                                                    const std::vector<PairManifold>& manifolds,
+                                                    const ContactSolverSettings& settings) {
+  const double dt = world.sim.dt;
+  const size_t n = world.bodies.size();
   std::vector<bool> moved(n, false);
-  if (sim_.integrator != Integrator::Symplectic) return moved;  // the seed's Euler: no TOI
+  if (world.sim.integrator != Integrator::Symplectic) return moved;  // the seed's Euler: no TOI
   // Per body: thickness and bounding radius (fixed by the shape), sweep over the step.
-  const std::vector<ShapeFacts>& facts = shape_facts();
+  const std::vector<BodyFacts>& facts = world.facts;
   std::vector<double> sweep(n);
   double thinnest = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < n; ++i) {
-    sweep[i] = sweep_length(bodies_[i], dt);
+    sweep[i] = sweep_length(world.bodies[i], dt);
     thinnest = std::min(thinnest, facts[i].thickness);
   }
   std::set<std::pair<int, int>> touching;
@@ -154,16 +157,16 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
   // fast bodies.
   std::vector<std::tuple<double, int, int>> hits;  // (time of impact, i, j), i < j
   for (size_t i = 0; i < n; ++i) {
-    if (!(sweep[i] > tunables_.toi_body_sweep * thinnest)) continue;
+    if (!(sweep[i] > world.tunables.toi_body_sweep * thinnest)) continue;
     for (size_t j = 0; j < n; ++j) {
       if (j == i) continue;
       if (sweep[j] > sweep[i] || (sweep[j] == sweep[i] && j < i)) continue;  // the faster one asks
       const int lo = static_cast<int>(std::min(i, j)), hi = static_cast<int>(std::max(i, j));
       if (touching.count({lo, hi})) continue;
       if (!(sweep[i] + sweep[j] >
-            tunables_.toi_pair_sweep * std::min(facts[i].thickness, facts[j].thickness)))
+            world.tunables.toi_pair_sweep * std::min(facts[i].thickness, facts[j].thickness)))
         continue;
-      const RigidBody &a = bodies_[lo], &b = bodies_[hi];
+      const RigidBody &a = world.bodies[lo], &b = world.bodies[hi];
       // Swept spheres (the bounding check along the step): the centres' closest approach over
       // the step within the radii sum; the radius about the centre of mass bounds every
       // orientation, so rotation needs no margin.
@@ -171,7 +174,7 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
       const double s =
           q.squaredNorm() > 0.0 ? std::clamp(-p.dot(q) / q.squaredNorm(), 0.0, 1.0) : 0.0;
       if ((p + s * q).norm() > facts[lo].radius + facts[hi].radius) continue;
-      if (const auto t = time_of_impact(a, b, dt, variant_)) hits.emplace_back(*t, lo, hi);
+      if (const auto t = time_of_impact(a, b, dt, world.variant)) hits.emplace_back(*t, lo, hi);
     }
   }
   // Every other new contact (departure from the seed, whose detection after penetration resolves
@@ -180,7 +183,7 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
   // step's velocities, touch is moved to its first touch like the fast pairs above, so an impact
   // is resolved where it begins whatever its phase in the step.
   ahead_.clear();
-  for (const RigidBody& b : bodies_) ahead_.push_back(b.is_static ? b : advanced(b, dt));
+  for (const RigidBody& b : world.bodies) ahead_.push_back(b.is_static ? b : advanced(b, dt));
   std::set<std::pair<int, int>> asked;
   for (const auto& [t, i, j] : hits) asked.insert({i, j});
   for (const BodyPair& pair : ahead_broad_phase_.find_pairs(ahead_)) {
@@ -191,21 +194,21 @@ std::vector<bool> World::time_of_impact_step(const std::vector<PairManifold>& ma
                                             facts[i].reach, facts[j].reach);
     if (find_separating_axis(*a.shape, a.pose(), *b.shape, b.pose(), margin) != Vec3::Zero())
       continue;  // still apart at the step's end
-    if (const auto t = time_of_impact(bodies_[i], bodies_[j], dt, variant_))
+    if (const auto t = time_of_impact(world.bodies[i], world.bodies[j], dt, world.variant))
       hits.emplace_back(*t, i, j);
   }
   std::sort(hits.begin(), hits.end());
   for (const auto& [t, i, j] : hits) {
     // One time of impact per body and step (the earliest): the rest waits for the next step.
     if (moved[i] || moved[j]) continue;
-    RigidBody &a = bodies_[i], &b = bodies_[j];
+    RigidBody &a = world.bodies[i], &b = world.bodies[j];
     a = advanced(a, t);
     b = advanced(b, t);
-    if (auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant_)) {
+    if (auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant)) {
       const std::vector<PairManifold> one = {{i, j, std::move(*m), a.pose(), b.pose()}};
-      const auto approach = normal_velocities(bodies_, one);
+      const auto approach = normal_velocities(world.bodies, one);
       // Every impact here is a collision: its event whatever its approach speed.
-      record_events(one, solve_contact_velocities(bodies_, one, approach, settings), time_ + t,
+      record_events(world, one, solve_contact_velocities(world.bodies, one, approach, settings), world.time + t,
                     std::nullopt);
     }
     a = advanced(a, dt - t);

@@ -1,0 +1,62 @@
+// What every contact model steps: the bodies, the clock, the collisions resolved so far, and
+// what is fixed per body. World owns it; SeedStep and ExtendedStep advance it by one step.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "engine/body.h"
+#include "engine/broadphase.h"
+#include "engine/contact.h"
+#include "engine/detect.h"
+#include "engine/integrate.h"
+#include "engine/scene.h"
+#include "engine/settings.h"
+
+namespace rbx {
+
+/// One resolved collision: a detection that applied a non-zero impulse.
+struct CollisionEvent {
+  double time = 0.0;  // s, start of the step in which it was detected
+  long step = 0;
+  std::string body_a, body_b;
+  ContactPoint contact;  // normal from body_b toward body_a
+  double impulse = 0.0;  // N s, magnitude j along the normal
+};
+
+/// What a body's shape and mass fix for the whole run.
+struct BodyFacts {
+  double thickness = 0.0;  // m, shape_thickness: what a fast body must not pass through
+  double radius = 0.0;     // m, bounding radius about the centre of mass
+  double reach = 1.0;      // m, how far the detector's tolerance reaches beyond it
+  double own_tol = 0.0;    // m, its point-in-mesh tolerance against itself (1e-9 x its size)
+  PrincipalFrame principal;  // its inertia's principal frame (the free rotation's)
+
+  /// The facts of `body`.
+  static BodyFacts of(const RigidBody& body);
+};
+
+/// The state both contact models advance, step by step.
+struct WorldState {
+  /// Places the bodies at t = 0, with their facts and the broad phase built from `tunables`.
+  WorldState(SimSettings sim, std::vector<RigidBody> bodies, DetectorVariant variant,
+             BroadPhaseMethod broad_phase, const WorldSettings& tunables);
+
+  SimSettings sim;
+  std::vector<RigidBody> bodies;  // in scene order
+  std::vector<BodyFacts> facts;   // per body, in the same order
+  DetectorVariant variant;
+  WorldSettings tunables;
+  BroadPhase broad_phase;  // the pairs passing the bounding check, at the step's start poses
+  std::vector<CollisionEvent> events;  // every collision resolved so far, in order
+  double time = 0.0;                   // s, at the start of the step being taken
+  long step = 0;                       // steps taken
+
+  /// Records a collision of bodies i and j resolved at `time` with normal impulse `impulse`
+  /// (N s): the one place both contact models build an event.
+  void add_event(int i, int j, const ContactPoint& contact, double impulse, double at) {
+    events.push_back({at, step, bodies[i].name, bodies[j].name, contact, impulse});
+  }
+};
+
+}  // namespace rbx
