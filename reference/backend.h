@@ -238,6 +238,18 @@ struct Adapter {
   }
 };
 
+/// A library's contact query and dynamics run at explicit settings of type `Settings`, so that a
+/// test can measure each setting against its alternatives (tests/reference/fair_settings_test.cpp).
+/// An empty member: the library has no such entry.
+template <class Settings>
+struct AtSettings {
+  std::function<ContactResult(const RigidBody& a, const RigidBody& b, const Settings& settings)>
+      contact;
+  std::function<DynamicsResult(const Scene& scene, const DynamicsOptions& opt,
+                               const Settings& settings)>
+      dynamics;
+};
+
 /// Every query variant, one line each (reference/registry.cpp).
 const std::vector<QueryVariant>& query_variants();
 /// The variant `variant` of `backend`, or nullptr.

@@ -456,20 +456,19 @@ BulletSettings bullet_hull_settings() {
   return s;
 }
 
-ContactResult bullet_contact_with(const RigidBody& a, const RigidBody& b,
-                                  const BulletSettings& settings) {
-  return pair_query(a, b, settings);
-}
-
-DynamicsResult bullet_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
-                                    const BulletSettings& settings) {
-  return run_world(scene, opt, settings);
-}
-
-DynamicsResult bullet_dynamics_default_world(const Scene& scene, const DynamicsOptions& opt) {
+BulletSettings bullet_default_world_settings() {
   BulletSettings s = bullet_hull_settings();
   s.fair_world = false;
-  return run_world(scene, opt, s);
+  return s;
+}
+
+const AtSettings<BulletSettings>& bullet_at_settings() {
+  static const AtSettings<BulletSettings> entries = {
+      [](const RigidBody& a, const RigidBody& b, const BulletSettings& settings) {
+        return pair_query(a, b, settings);
+      },
+      run_world};
+  return entries;
 }
 
 namespace {

@@ -26,6 +26,9 @@ struct BulletSettings {
 BulletSettings bullet_native_settings();
 /// `bullet-hull`: every body a zero-margin btConvexHullShape through GJK + EPA, the fair world.
 BulletSettings bullet_hull_settings();
+/// The hull world with Bullet's default settings throughout (kept to pin the known defects they
+/// cause).
+BulletSettings bullet_default_world_settings();
 
 /// Bullet's backends: `bullet` (native boxes, polyhedral hulls clipped about the GJK + EPA axis),
 /// `bullet-hull` (every body a zero-margin GJK + EPA hull, one point) and `bullet-sat` (every
@@ -33,13 +36,7 @@ BulletSettings bullet_hull_settings();
 /// through contactPairTest, dynamics in btDiscreteDynamicsWorld with the fair settings.
 const Adapter& bullet_adapter();
 
-/// The contact query with explicit settings.
-ContactResult bullet_contact_with(const RigidBody& a, const RigidBody& b,
-                                  const BulletSettings& settings);
-/// The world with explicit settings.
-DynamicsResult bullet_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
-                                    const BulletSettings& settings);
-/// The hull world with Bullet's default settings (kept to pin the known defects they cause).
-DynamicsResult bullet_dynamics_default_world(const Scene& scene, const DynamicsOptions& opt);
+/// Bullet's contact query and world at explicit settings.
+const AtSettings<BulletSettings>& bullet_at_settings();
 
 }  // namespace rbx

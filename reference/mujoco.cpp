@@ -545,11 +545,15 @@ ContactResult prebuilt_query(const RigidBody& a, const RigidBody& b, const Mujoc
 
 }  // namespace
 
+namespace {
+
 ContactResult mujoco_contact_with(const RigidBody& a, const RigidBody& b,
                                   const MujocoSettings& settings) {
   QueryModel q = make_query_model(a, b, settings);
   return query_model(q, a, b);
 }
+
+}  // namespace
 
 namespace {
 
@@ -643,6 +647,8 @@ void Episodes::read_step(const mjModel* mc, mjData* dd, const std::vector<int>& 
 
 }  // namespace
 
+namespace {
+
 DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
                                     const MujocoSettings& settings) {
   DynamicsResult r;
@@ -701,6 +707,8 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
   return r;
 }
 
+}  // namespace
+
 namespace {
 
 // `mujoco`: contacts from mj_forward on box geoms for two boxes, mesh geoms with multiccd
@@ -752,6 +760,11 @@ MassResult mujoco_mass(const RigidBody& body) {
 MassResult mujoco_hull_mass(const RigidBody& body) { return mass_of_geom(body, false); }
 
 }  // namespace
+
+const AtSettings<MujocoSettings>& mujoco_at_settings() {
+  static const AtSettings<MujocoSettings> entries = {mujoco_contact_with, mujoco_dynamics_with};
+  return entries;
+}
 
 const Adapter& mujoco_adapter() {
   static const Adapter adapter = {

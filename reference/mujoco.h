@@ -23,11 +23,7 @@ MujocoSettings mujoco_hull_settings();
 /// one point), each with its "prebuilt" variant and MuJoCo's own mass properties.
 const Adapter& mujoco_adapter();
 
-/// The contact query with explicit settings.
-ContactResult mujoco_contact_with(const RigidBody& a, const RigidBody& b,
-                                  const MujocoSettings& settings);
-/// The dynamics run with explicit settings.
-DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
-                                    const MujocoSettings& settings);
+/// MuJoCo's contact query and dynamics run at explicit settings.
+const AtSettings<MujocoSettings>& mujoco_at_settings();
 
 }  // namespace rbx

@@ -486,6 +486,8 @@ int points_of(const CollideContext& ctx, const std::vector<RigidBody>& bodies,
 
 }  // namespace
 
+namespace {
+
 DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
                                  const OdeSettings& settings) {
   // One ODE world steps at a time in the process: ODE 0.16's worlds share its default
@@ -557,6 +559,8 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
   return r;
 }
 
+}  // namespace
+
 namespace {
 
 // `ode`: dCollide on dCreateBox geoms for boxes (dBoxBox), dCreateConvex otherwise.
@@ -592,6 +596,15 @@ DynamicsResult ode_hull_dynamics(const Scene& scene, const DynamicsOptions& opt)
 }
 
 }  // namespace
+
+const AtSettings<OdeSettings>& ode_at_settings() {
+  static const AtSettings<OdeSettings> entries = {
+      [](const RigidBody& a, const RigidBody& b, const OdeSettings& settings) {
+        return contact_query(a, b, settings.native_boxes);
+      },
+      ode_dynamics_with};
+  return entries;
+}
 
 const Adapter& ode_adapter() {
   static const Adapter adapter = {

@@ -21,8 +21,7 @@ OdeSettings ode_hull_settings();
 /// `ode-hull` (dCreateConvex for every body, libccd MPR in Debian's build, one point); dCollide,
 /// and dWorldStep with bounce = e; each with its "prebuilt" variant.
 const Adapter& ode_adapter();
-/// The dynamics run with explicit settings.
-DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
-                                 const OdeSettings& settings);
+/// ODE's contact query (settings.native_boxes) and dynamics run at explicit settings.
+const AtSettings<OdeSettings>& ode_at_settings();
 
 }  // namespace rbx

@@ -374,7 +374,7 @@ TEST(BulletDynamics, CubeCornerOnStaticSlab) {
 TEST(BulletDynamics, DefaultWorldDefectAndFairFix) {
   const Scene s = head_on(1, 1, 1, 0, 1.0);
 
-  const DynamicsResult def = bullet_dynamics_default_world(s, {});
+  const DynamicsResult def = bullet_at_settings().dynamics(s, {}, bullet_default_world_settings());
   ASSERT_EQ(def.status, Status::Ok) << def.message;
   EXPECT_NEAR(def.finals[0].velocity.x(), 0.5, kRoundOff);
   EXPECT_NEAR(def.finals[1].velocity.x(), 0.5, kRoundOff);

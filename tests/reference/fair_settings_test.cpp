@@ -232,7 +232,7 @@ TEST(BulletSettingsMeasured, BoxMarginZeroOrDefaultMakesNoDifference) {
   for (const Case& c : box_cases()) {
     const double with_default = ke_error(c, bullet.dynamics(c.scene, {}));
     const double with_zero =
-        ke_error(c, bullet_dynamics_with(
+        ke_error(c, bullet_at_settings().dynamics(
                         c.scene, {}, bullet_with([](BulletSettings& s) { s.box_margin = 0.0; })));
     EXPECT_LT(measured("bullet box margin default", c, with_default), kExact) << c.name;
     EXPECT_LT(measured("bullet box margin 0", c, with_zero), kExact) << c.name;
@@ -250,7 +250,7 @@ TEST(BulletSettingsMeasured, PolyhedralHullsClippedAboutTheGjkAxisNotSat) {
       measured("bullet polyhedral hull, GJK axis", c, ke_error(c, bullet.dynamics(c.scene, {}))),
       kExact);
   EXPECT_GT(measured("bullet polyhedral hull, SAT axis", c,
-                     ke_error(c, bullet_dynamics_with(c.scene, {}, sat))),
+                     ke_error(c, bullet_at_settings().dynamics(c.scene, {}, sat))),
             kWrong);
   EXPECT_LT(measured("bullet-hull GJK+EPA hull", c, ke_error(c, bullet_hull.dynamics(c.scene, {}))),
             kExact);
@@ -280,8 +280,9 @@ TEST(BulletSettingsMeasured, HullMarginZero) {
   inflated.hull_margin = 0.04;
   const double zero =
       measured("bullet hull margin 0", c, ke_error(c, bullet.dynamics(c.scene, {})));
-  const double with_margin = measured("bullet hull margin 0.04", c,
-                                      ke_error(c, bullet_dynamics_with(c.scene, {}, inflated)));
+  const double with_margin =
+      measured("bullet hull margin 0.04", c,
+               ke_error(c, bullet_at_settings().dynamics(c.scene, {}, inflated)));
   EXPECT_LT(zero, kExact);
   EXPECT_LE(zero, with_margin);
 }
@@ -297,7 +298,7 @@ TEST(BulletSettingsMeasured, SplitImpulseAtEveryDepth) {
   EXPECT_LT(measured("bullet split impulse always", c, ke_error(c, bullet.dynamics(c.scene, {}))),
             kExact);
   EXPECT_GT(measured("bullet split impulse below -0.04 m (default)", c,
-                     ke_error(c, bullet_dynamics_with(c.scene, {}, baumgarte))),
+                     ke_error(c, bullet_at_settings().dynamics(c.scene, {}, baumgarte))),
             kWrong);
 }
 
@@ -315,7 +316,7 @@ TEST(BulletSettingsMeasured, RestitutionAtAnyApproachSpeed) {
       measured("bullet restitution threshold 0", c, ke_error(c, bullet.dynamics(c.scene, {}))),
       kExact);
   EXPECT_GT(measured("bullet restitution threshold 0.2 (default)", c,
-                     ke_error(c, bullet_dynamics_with(c.scene, {}, default_threshold))),
+                     ke_error(c, bullet_at_settings().dynamics(c.scene, {}, default_threshold))),
             kWrong);
 }
 
@@ -330,14 +331,15 @@ TEST(BulletSettingsMeasured, ContactsSolvedOnlyOnceTheyOverlap) {
   EXPECT_LT(measured("bullet processing threshold 0", c, ke_error(c, bullet.dynamics(c.scene, {}))),
             kExact);
   EXPECT_LT(measured("bullet processing threshold default", c,
-                     ke_error(c, bullet_dynamics_with(c.scene, {}, early))),
+                     ke_error(c, bullet_at_settings().dynamics(c.scene, {}, early))),
             kExact);
   BulletSettings hull_early = bullet_hull_settings();
   hull_early.processing_threshold = 1e30;
   const double hull_zero = measured("bullet-hull processing threshold 0", c,
                                     ke_error(c, bullet_hull.dynamics(c.scene, {})));
-  const double hull_default = measured("bullet-hull processing threshold default", c,
-                                       ke_error(c, bullet_dynamics_with(c.scene, {}, hull_early)));
+  const double hull_default =
+      measured("bullet-hull processing threshold default", c,
+               ke_error(c, bullet_at_settings().dynamics(c.scene, {}, hull_early)));
   EXPECT_LT(hull_zero, hull_default);
 }
 
@@ -369,15 +371,15 @@ TEST(OdeSettingsMeasured, DefaultCfmAgainstHardAndSoft) {
     const double e_default =
         measured("ode CFM 1e-10 (default)", c, ke_error(c, ode.dynamics(c.scene, {})));
     const double e_hard =
-        measured("ode CFM 0", c, ke_error(c, ode_dynamics_with(c.scene, {}, hard)));
+        measured("ode CFM 0", c, ke_error(c, ode_at_settings().dynamics(c.scene, {}, hard)));
     const double e_soft =
-        measured("ode CFM 1e-5", c, ke_error(c, ode_dynamics_with(c.scene, {}, soft)));
+        measured("ode CFM 1e-5", c, ke_error(c, ode_at_settings().dynamics(c.scene, {}, soft)));
     EXPECT_LT(e_default, kOdeSoft) << c.name;
     EXPECT_LT(e_hard, kExact) << c.name;
     EXPECT_GT(e_soft, kWrong) << c.name;
   }
   const double drift_default = stack_drift(ode.dynamics(resting_stack(), {}));
-  const double drift_hard = stack_drift(ode_dynamics_with(resting_stack(), {}, hard));
+  const double drift_hard = stack_drift(ode_at_settings().dynamics(resting_stack(), {}, hard));
   std::printf("[measured] ode resting stack drift: CFM 1e-10 %.3g m, CFM 0 %.3g m\n", drift_default,
               drift_hard);
   // Resting under gravity with CFM 1e-10: the contact yields by ~CFM * m g per step, ~1e-10 m.
@@ -393,14 +395,14 @@ TEST(OdeSettingsMeasured, DefaultErpKeepsAStackUpAtAKnownCostForInelasticImpacts
   OdeSettings no_erp;
   no_erp.erp = 0.0;
   const double drift_default = stack_drift(ode.dynamics(resting_stack(), {}));
-  const double drift_no_erp = stack_drift(ode_dynamics_with(resting_stack(), {}, no_erp));
+  const double drift_no_erp = stack_drift(ode_at_settings().dynamics(resting_stack(), {}, no_erp));
   std::printf("[measured] ode resting stack drift: ERP 0.2 %.3g m, ERP 0 %.3g m\n", drift_default,
               drift_no_erp);
   EXPECT_LT(drift_default, 1e-9);
   EXPECT_GT(drift_no_erp, 0.1);
   const Case c = headon_off_step(0.0);
   EXPECT_GT(measured("ode ERP 0.2 (default)", c, ke_error(c, ode.dynamics(c.scene, {}))), 0.1);
-  EXPECT_LT(measured("ode ERP 0", c, ke_error(c, ode_dynamics_with(c.scene, {}, no_erp))),
+  EXPECT_LT(measured("ode ERP 0", c, ke_error(c, ode_at_settings().dynamics(c.scene, {}, no_erp))),
             kOdeSoft);
 }
 
@@ -429,11 +431,12 @@ TEST(MujocoSettingsMeasured, BoxGeomsWithDoubledStiffnessAgainstMeshes) {
         measured("mujoco box geoms, stiffness x2", c, ke_error(c, mujoco.dynamics(c.scene, {})));
     log_box2 += std::log(box2);
     log_box1 += std::log(measured("mujoco box geoms, stiffness x1", c,
-                                  ke_error(c, mujoco_dynamics_with(c.scene, {}, box_x1))));
-    log_multi += std::log(measured("mujoco mesh + multiccd", c,
-                                   ke_error(c, mujoco_dynamics_with(c.scene, {}, mesh_multi))));
+                                  ke_error(c, mujoco_at_settings().dynamics(c.scene, {}, box_x1))));
+    log_multi +=
+        std::log(measured("mujoco mesh + multiccd", c,
+                          ke_error(c, mujoco_at_settings().dynamics(c.scene, {}, mesh_multi))));
     log_mesh += std::log(measured("mujoco-hull mesh (one point)", c,
-                                  ke_error(c, mujoco_dynamics_with(c.scene, {}, mesh))));
+                                  ke_error(c, mujoco_at_settings().dynamics(c.scene, {}, mesh))));
     EXPECT_LT(box2, kMujocoSoftLimit) << c.name;
   }
   EXPECT_LT(log_box2, log_box1);
@@ -523,7 +526,7 @@ TEST(FairReferences, NativeBoxQueriesGiveTheFourCornerFaceManifold) {
   }
   MujocoSettings meshes;
   meshes.box_geoms = false;
-  const ContactResult m = mujoco_contact_with(a, b, meshes);
+  const ContactResult m = mujoco_at_settings().contact(a, b, meshes);
   ASSERT_EQ(m.status, Status::Ok) << m.message;
   ASSERT_GE(m.contacts.size(), 2u);  // a manifold, not MPR's single point
   for (const ContactPoint& c : m.contacts) {
