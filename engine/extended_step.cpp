@@ -37,7 +37,8 @@ void ExtendedStep::advance(WorldState& world) {
   const std::vector<SolvedPoint> solved =
       solve_contact_velocities(world.bodies, manifolds, approach, settings);
   // One event per manifold that was a collision.
-  const std::vector<double> impulse = record_events(world, manifolds, solved, world.time, settings.rest_speed);
+  const std::vector<double> impulse =
+      record_events(world, manifolds, solved, world.time, settings.rest_speed);
   // Time of impact: pairs separated at the step's start that the step's motion brings into
   // contact (engine/time_of_impact.h) are moved to their first contact, resolved there, and
   // moved on for the rest of the step: an adaptive step for those two bodies only.
@@ -77,8 +78,8 @@ ContactSolverSettings ExtendedStep::solver_settings(const WorldState& world) {
 
 std::vector<double> ExtendedStep::record_events(WorldState& world,
                                                 const std::vector<PairManifold>& manifolds,
-                                                const std::vector<SolvedPoint>& solved,
-                                                double time, std::optional<double> rest_speed) {
+                                                const std::vector<SolvedPoint>& solved, double time,
+                                                std::optional<double> rest_speed) {
   // A manifold's event: its total normal impulse at the centre of the normal impulses (the
   // centre of pressure), with the detector's contact for the rest.
   std::vector<double> impulse(manifolds.size(), 0.0);
@@ -208,8 +209,8 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
       const std::vector<PairManifold> one = {{i, j, std::move(*m), a.pose(), b.pose()}};
       const auto approach = normal_velocities(world.bodies, one);
       // Every impact here is a collision: its event whatever its approach speed.
-      record_events(world, one, solve_contact_velocities(world.bodies, one, approach, settings), world.time + t,
-                    std::nullopt);
+      record_events(world, one, solve_contact_velocities(world.bodies, one, approach, settings),
+                    world.time + t, std::nullopt);
     }
     a = advanced(a, dt - t);
     b = advanced(b, dt - t);

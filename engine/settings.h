@@ -11,7 +11,7 @@ namespace rbx {
 /// Tunables of the world step (engine/world.h) and the stages it calls. Scene physics
 /// (restitution, friction, gravity, dt) is not here: it comes from the scene (SimSettings).
 struct WorldSettings {
-  // Resting contact (World::solver_settings).
+  // Resting contact (ExtendedStep::solver_settings).
 
   /// Steps of gravity: an approach no faster than this many steps of gravity (m/s, this many
   /// times |g| dt) is a body settling, not a collision, and gets e = 0; else a resting body with
@@ -48,7 +48,7 @@ struct WorldSettings {
   /// a body the issue allows at rest.
   double position_slop = 1e-4;
 
-  // Time of impact (World::time_of_impact_step).
+  // Time of impact (ExtendedStep::time_of_impact_step).
 
   /// Relative to the thinnest body's thickness: a body sweeping less than this in a step asks
   /// for no time of impact (the faster body of a candidate pair always sweeps more).

@@ -26,10 +26,10 @@ struct CollisionEvent {
 
 /// What a body's shape and mass fix for the whole run.
 struct BodyFacts {
-  double thickness = 0.0;  // m, shape_thickness: what a fast body must not pass through
-  double radius = 0.0;     // m, bounding radius about the centre of mass
-  double reach = 1.0;      // m, how far the detector's tolerance reaches beyond it
-  double own_tol = 0.0;    // m, its point-in-mesh tolerance against itself (1e-9 x its size)
+  double thickness = 0.0;    // m, shape_thickness: what a fast body must not pass through
+  double radius = 0.0;       // m, bounding radius about the centre of mass
+  double reach = 1.0;        // m, how far the detector's tolerance reaches beyond it
+  double own_tol = 0.0;      // m, its point-in-mesh tolerance against itself (1e-9 x its size)
   PrincipalFrame principal;  // its inertia's principal frame (the free rotation's)
 
   /// The facts of `body`.
