@@ -33,6 +33,7 @@ struct Options {
   rbx::TossesOptions tosses;
   rbx::ViewOptions view;
   rbx::ExploreOptions explore;
+  rbx::EnsembleOptions ensemble;
 };
 
 // run, contacts, compare: the commands on scene files.
@@ -87,7 +88,7 @@ void add_library_commands(CLI::App& app, Options& o) {
   bench->add_flag("--quick", o.bench.quick, "fewer sizes and shorter runs (under a minute)");
 }
 
-// tosses, view, explore.
+// tosses, view, explore, ensemble.
 void add_study_commands(CLI::App& app, Options& o) {
   CLI::App* tosses =
       app.add_subcommand("tosses", "every dynamics backend against measured cube tosses");
@@ -117,6 +118,22 @@ void add_study_commands(CLI::App& app, Options& o) {
                       "evaluations per group while shrinking");
   explore->add_flag("--bench", o.explore.bench, "time the sampling only (hulls under 100 points)");
   explore->add_flag("--no-figure", o.explore.no_figure, "skip the matplotlib figure");
+  CLI::App* ensemble = app.add_subcommand(
+      "ensemble",
+      "nudged copies of a scene through every dynamics backend: how far outcomes spread");
+  scene_options(ensemble, o.ensemble.scene, false, true);
+  ensemble->add_option("--count", o.ensemble.count, "number of copies (default 50)");
+  ensemble->add_option("--seed", o.ensemble.seed, "seed (default 1)");
+  ensemble->add_option("--perturb", o.ensemble.perturb,
+                       "nudge scale KEY=SCALE, KEY: position (m), orientation (rad), velocity "
+                       "(m/s), angular_velocity (rad/s); default 1e-6 each (repeatable)");
+  ensemble->add_flag("--step-test", o.ensemble.step_test,
+                     "also run every copy at dt/10: a spread that stays is the physics', one "
+                     "that shrinks the engine's");
+  ensemble->add_option("--out", o.ensemble.out,
+                       "folder: ensemble.json with the spread at a tenth and ten times the "
+                       "nudges too, and the figures");
+  ensemble->add_option("--threads", o.ensemble.threads, "threads per rank (default: every core)");
 }
 
 // An unknown command is named as such (CLI11 would say only that a subcommand is required).
@@ -174,6 +191,7 @@ int dispatch(CLI::App& app, const Options& o) {
     if (app.got_subcommand("tosses")) return rbx::tosses_command(o.tosses);
     if (app.got_subcommand("view")) return rbx::view_command(o.view);
     if (app.got_subcommand("explore")) return rbx::explore_command(o.explore);
+    if (app.got_subcommand("ensemble")) return rbx::ensemble_command(o.ensemble);
   } catch (const rbx::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;

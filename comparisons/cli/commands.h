@@ -105,6 +105,23 @@ struct ExploreOptions {
   bool no_figure = false;        // --no-figure: skip matplotlib (tests)
 };
 
+/// Options of `rbx ensemble`.
+struct EnsembleOptions {
+  SceneCommandOptions scene;         // the scene, --json, --set, --force, --backends
+  long count = 50;                   // copies
+  unsigned long long seed = 1;       // copy k of seed s depends on (s, k) only
+  std::vector<std::string> perturb;  // --perturb KEY=SCALE
+  bool step_test = false;            // --step-test: also every copy at dt / 10
+  std::string out;  // --out DIR: ensemble.json with three nudge sizes, and the figures
+  int threads = 0;  // per rank (0: the cores of the node, divided among its ranks)
+};
+
+/// `rbx ensemble SCENE`: nudged copies of the scene through every dynamics backend; per backend
+/// the spread of the final states, its amplification, the contact sequences and clusters (and
+/// with --step-test whether the spread is the physics' or the engine's). Exit 1 when a copy's
+/// run failed in some backend.
+int ensemble_command(const EnsembleOptions& opt);
+
 /// `rbx explore`: random contact pairs against the exact oracle on every core or MPI rank;
 /// disagreements grouped by signature, each group shrunk to a scene; writes explore.json,
 /// explore.md and scenes/*.toml. Exit 1 when --baseline finds a backend worse.

@@ -134,6 +134,39 @@ TEST(Cli, UsageErrorsExitTwo) {
   EXPECT_EQ(rbx("run no/such/file.toml").code, 2);
 }
 
+// `rbx ensemble`: a bad nudge or count is one line and exit 2 with no output file; a good run
+// from another folder writes the JSON with every dynamics backend named.
+TEST(Cli, EnsembleRefusesBadNudgesAndWritesItsJson) {
+  const fs::path dir = temp_dir("ensemble");
+  const fs::path json = dir / "ensemble.json";
+  const std::string scene = std::string(RBX_SOURCE_DIR) + "/scenes/seed/edge_drop.toml";
+  for (const char* bad :
+       {"--perturb spin=1e-6", "--perturb position=-1", "--perturb velocity=x", "--count 1"}) {
+    const CmdResult r =
+        rbx_in(dir.string(), "ensemble '" + scene + "' " + bad + " --json '" + json.string() + "'");
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(json)) << bad;
+  }
+  const CmdResult r = rbx_in(dir.string(), "ensemble '" + scene +
+                                               "' --count 4 --perturb orientation=1e-4 --json '" +
+                                               json.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  std::ifstream in(json);
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  EXPECT_EQ(doc["count"], 4);
+  EXPECT_EQ(doc["perturb"]["orientation"], 1e-4);
+  for (const char* name : {"custom", "custom-seed", "bullet", "mujoco", "ode"}) {
+    SCOPED_TRACE(name);
+    ASSERT_TRUE(doc["backends"].contains(name));
+    EXPECT_EQ(doc["backends"][name]["runs"], 4);
+    EXPECT_GE(doc["backends"][name]["contact_sequences"].size(), 1u);
+  }
+  EXPECT_NE(r.out.find("amplification"), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
 // Removes every "runtime_s" value, the only non-deterministic numbers.
 std::string without_timings(const std::string& json) {
   return std::regex_replace(json, std::regex("\"runtime_s\": [-+0-9.eE]+"), "\"runtime_s\": 0");
