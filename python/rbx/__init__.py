@@ -22,7 +22,8 @@ import numpy as np
 
 import _rbx
 
-__all__ = ["backends", "compare", "run", "trajectory", "contacts", "contact", "explore", "tosses", "check",
+__all__ = ["backends", "compare", "run", "trajectory", "contacts", "contact", "explore", "ensemble",
+           "tosses", "check",
            "report", "register_contact_backend", "register_response_backend", "scene_toml"]
 
 
@@ -300,6 +301,20 @@ def explore(count=20000, seed=1, kind="contact", backends=None, out=None, thread
     doc["out"] = folder
     doc["exit_code"] = code
     return doc
+
+
+def ensemble(scene, count=50, seed=1, perturb=None, step_test=False, backends=None, sets=None):
+    """`rbx ensemble SCENE --json`: `count` nudged copies through every dynamics backend (or
+    `backends`); `perturb` sets nudge scales ({"position": 1e-6, "orientation": ...}, docs/
+    ensemble.md); `step_test` also runs every copy at dt/10. Per backend: the spread, its
+    amplification, the contact sequences, the clusters (and the step test's verdict)."""
+    extra = ["--count", int(count), "--seed", int(seed)]
+    for key, scale in (perturb or {}).items():
+        extra += ["--perturb", f"{key}={float(scale)!r}"]
+    if step_test:
+        extra.append("--step-test")
+    with _SceneFiles(scene) as paths:
+        return _with_json(["ensemble", *paths[:1], *_names(backends), *_sets(sets)] + extra)
 
 
 def tosses(data, params=None, fit=False, backends=None):

@@ -84,6 +84,13 @@ def test_contacts_is_the_command_lines_document_and_a_dict_scene_is_a_file():
     assert np.allclose(c["normal"], [0, 0, 1]) and abs(c["depth"] - 0.5 ** 0.5) < 1e-12
 
 
+def test_ensemble_is_the_command_lines_document():
+    path = os.path.join(ROOT, "scenes", "seed", "edge_drop.toml")
+    args = ["--count", "6", "--perturb", "orientation=1e-05", "--backends", "custom,ode"]
+    assert cli_json("ensemble", path, *args) == rbx.ensemble(
+        path, count=6, perturb={"orientation": 1e-5}, backends=["custom", "ode"])
+
+
 def test_tosses_is_the_command_lines_document():
     data = os.path.join(ROOT, "scenes", "real", "cube_toss", "test.csv.gz")
     assert without_timings(cli_json("tosses", data, "--backends", "custom")) == \
