@@ -120,7 +120,7 @@ CopyStates finished(const std::vector<CopyRun>& runs) {
 double ratio(double num, double den) { return den > 0.0 ? num / den : 0.0; }
 
 // One backend's summary from its copies' runs at the scene's step (and at dt / 10).
-BackendEnsemble summarise(const Scene& scene, const std::string& name, const Spread& input,
+BackendEnsemble summarise(const Scene& scene, const std::string& name, const StateSpread& input,
                           const std::vector<CopyRun>& runs, const std::vector<CopyRun>& fine) {
   BackendEnsemble b;
   b.backend = name;
@@ -134,7 +134,7 @@ BackendEnsemble summarise(const Scene& scene, const std::string& name, const Spr
     ++sequences[c.sequence];
   }
   const CopyStates states = finished(runs);
-  b.spread = spread_of(scene, states);
+  b.spread = state_spread(scene, states);
   b.amplification = ratio(b.spread.position, input.position);
   b.velocity_amplification = ratio(b.spread.velocity, input.velocity);
   b.sequences.assign(sequences.begin(), sequences.end());
@@ -145,7 +145,7 @@ BackendEnsemble summarise(const Scene& scene, const std::string& name, const Spr
   double widest = -1.0;
   for (size_t i = 0; i < scene.bodies.size(); ++i) {
     if (scene.bodies[i].is_static) continue;
-    const double sp = spread_of(scene, states, static_cast<int>(i)).position;
+    const double sp = state_spread(scene, states, static_cast<int>(i)).position;
     if (sp <= widest) continue;
     widest = sp;
     b.scatter_body = scene.bodies[i].name;
@@ -154,7 +154,7 @@ BackendEnsemble summarise(const Scene& scene, const std::string& name, const Spr
   }
   if (!fine.empty()) {
     b.step_tested = true;
-    b.fine_spread = spread_of(scene, finished(fine));
+    b.fine_spread = state_spread(scene, finished(fine));
     b.step_ratio = ratio(b.fine_spread.position, b.spread.position);
     // A spread that stays (within a factor of two) when the step shrinks ten times is the
     // physics'; one that shrinks or grows with the step is the engine's. No spread: no class.
@@ -191,8 +191,8 @@ std::string contact_sequence(const std::vector<CollisionEvent>& events) {
   return text;
 }
 
-Spread spread_of(const Scene& scene, const CopyStates& copies, int only) {
-  Spread s;
+StateSpread state_spread(const Scene& scene, const CopyStates& copies, int only) {
+  StateSpread s;
   for (size_t i = 0; i < scene.bodies.size(); ++i) {
     if (scene.bodies[i].is_static || (only >= 0 && static_cast<int>(i) != only)) continue;
     std::vector<Vec3> p, v, w;
@@ -274,7 +274,7 @@ EnsembleResult run_ensemble(const Scene& scene, const std::vector<std::string>& 
       states.push_back({b.name, b.position, b.orientation, b.velocity, b.angular_velocity});
     initial.push_back(std::move(states));
   }
-  r.input = spread_of(scene, initial);
+  r.input = state_spread(scene, initial);
   // Item i: backend i / (steps * copies), step (i / copies) % steps (1: dt / 10), copy i % copies.
   const std::vector<std::string> raw =
       par.map(backends.size() * steps * copies, [&](size_t i) -> std::string {
@@ -309,7 +309,7 @@ EnsembleResult run_ensemble(const Scene& scene, const std::vector<std::string>& 
 
 namespace {
 
-Json spread_json(const Spread& s) {
+Json spread_json(const StateSpread& s) {
   return Json{{"position_m", s.position},
               {"orientation_rad", s.orientation},
               {"velocity_m_s", s.velocity},

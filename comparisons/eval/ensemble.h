@@ -40,7 +40,7 @@ Scene nudged_copy(const Scene& scene, const Nudge& nudge, uint64_t seed, uint64_
 /// the root mean square distance of the copies from their mean (orientation: the angle from
 /// their mean orientation); each range is the widest 5-95 % range of one coordinate (for the
 /// orientation, of that angle).
-struct Spread {
+struct StateSpread {
   double position = 0.0;                // m
   double orientation = 0.0;             // rad
   double velocity = 0.0;                // m/s
@@ -56,7 +56,7 @@ using CopyStates = std::vector<std::vector<BodyFinal>>;
 
 /// The spread of the moving bodies (is_static false in `scene`) over `copies`; `only` >= 0: of
 /// that body alone.
-Spread spread_of(const Scene& scene, const CopyStates& copies, int only = -1);
+StateSpread state_spread(const Scene& scene, const CopyStates& copies, int only = -1);
 
 /// The number of clusters among the copies' final positions (every moving body's, one vector
 /// per copy): single linkage, copies joined when closer than five times the median distance of
@@ -70,7 +70,7 @@ struct BackendEnsemble {
   long runs = 0;                        // copies that ran to the end
   long failed = 0;                      // copies that ended in error or timeout
   std::string first_failure;            // the first failed copy's message
-  Spread spread;                        // of the final states
+  StateSpread spread;                   // of the final states
   double amplification = 0.0;           // final position spread / input position spread
   double velocity_amplification = 0.0;  // final velocity spread / input velocity spread
   // Distinct contact sequences, most frequent first (ties: the sequence text): which pairs
@@ -82,7 +82,7 @@ struct BackendEnsemble {
   std::vector<Vec3> scatter;
   // The step test (EnsembleSettings::step_test): the same copies at dt / 10.
   bool step_tested = false;
-  Spread fine_spread;
+  StateSpread fine_spread;
   double step_ratio = 0.0;  // fine position spread / position spread
   std::string verdict;      // "physics" (ratio in [0.5, 2]: the spread stays) | "engine" | "none"
 };
@@ -91,8 +91,8 @@ struct BackendEnsemble {
 struct EnsembleResult {
   std::string scene, file;
   EnsembleSettings settings;
-  double dt = 0.0;  // s, the scene's step
-  Spread input;     // of the nudged initial states
+  double dt = 0.0;    // s, the scene's step
+  StateSpread input;  // of the nudged initial states
   std::vector<BackendEnsemble> backends;
 };
 

@@ -98,7 +98,7 @@ TEST(Ensemble, SpreadIsTheRootMeanSquareDistanceFromTheMean) {
   Scene s;
   s.bodies.resize(1);
   // Two copies 2 mm apart: each 1 mm from their mean.
-  const Spread sp = spread_of(s, copies_at({Vec3(0, 0, 0), Vec3(0, 0.002, 0)}));
+  const StateSpread sp = state_spread(s, copies_at({Vec3(0, 0, 0), Vec3(0, 0.002, 0)}));
   EXPECT_NEAR(sp.position, 1e-3, 1e-15);
   // 5-95 % of two values by linear interpolation: 90 % of the gap.
   EXPECT_NEAR(sp.position_range, 0.0018, 1e-15);
