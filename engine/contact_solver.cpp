@@ -414,6 +414,7 @@ struct IslandSolver {
   std::vector<int> involved;                    // the bodies in the problem
   std::vector<std::pair<Vec3, Vec3>> start;     // their velocities before the solve
   double kinetic_before = 0.0;                  // J, their kinetic energy before the solve
+  long budget_left = 0;  // sweeps this solve may still take (WorldSettings::sweep_budget)
 };
 
 IslandSolver::IslandSolver(std::vector<RigidBody>& bodies_in,
@@ -547,7 +548,9 @@ int IslandSolver::stage(bool friction) {
   int moving = 0;
   unknowns(friction, before);
   drift.clear();
-  for (int sweep = 0; sweep < tun.max_sweeps; ++sweep) {
+  const bool budgeted = tun.sweep_budget > 0;
+  for (int sweep = 0; sweep < tun.max_sweeps && !(budgeted && budget_left <= 0); ++sweep) {
+    --budget_left;
     if ((friction ? friction_sweep() : normal_sweep()) <= converged) break;
     ++moving;
     unknowns(friction, after);
@@ -583,6 +586,7 @@ int IslandSolver::stage(bool friction) {
 // refused, from zero.
 void IslandSolver::solve() {
   ++work.solves;
+  budget_left = settings.tunables.sweep_budget;
   if (rows.size() <= static_cast<size_t>(std::max(settings.active_set_rows, 0)))
     work.active_set += solve_active_set(bodies, inv, rows, mu, converged);
   for (int round = 0; round < settings.tunables.max_stage_rounds && !rows.empty(); ++round) {

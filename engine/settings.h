@@ -30,6 +30,11 @@ struct WorldSettings {
   int max_sweeps = 10000;
   /// Rounds of the two stages (normal, then friction) at most, for the same reason.
   int max_stage_rounds = 100;
+  /// Sweeps of one island solve at most, both stages and every round together; 0: no budget,
+  /// the solve runs to convergence within the caps above (the engine's only mode). The
+  /// iteration budget other engines expose, kept for comparison: the report sweeps it along
+  /// with theirs (reference/custom.cpp, custom_budget); the active sets come first either way.
+  long sweep_budget = 0;
   /// Relative: two sweeps that moved the impulses by the same vector to this fraction of its
   /// size are a steady drift, taken at once up to the first bound (solve_island).
   double drift_match = 1e-9;

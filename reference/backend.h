@@ -11,6 +11,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/body.h"
@@ -162,6 +163,16 @@ inline FirstImpulse first_impulse_of(const std::vector<CollisionEvent>& step_eve
 struct DynamicsOptions {
   double dt = 0.0;        // s; 0: the scene's sim.dt
   long sample_every = 0;  // record the state every this many steps (0: never)
+  int budget = 0;         // the solver's iteration budget (Backend::budget); 0: as configured
+};
+
+/// A dynamics backend's solver iteration budget, swept by the harness at the scene's step (the
+/// other axis of error against run time, beside the step). Empty `values`: no budget to turn.
+struct SolverBudget {
+  std::string what;         // what is counted, in the library's own terms
+  std::vector<int> values;  // swept, ascending, the library's default among them
+  int library_default = 0;  // the library's own default (0: it solves to convergence)
+  int configured = 0;       // what the backend runs with (0: not an iteration count)
 };
 
 /// Mass properties as a library computes them by itself from the body's hull (with its own
@@ -185,15 +196,22 @@ using MassFn = std::function<MassResult(const RigidBody& body)>;
 
 /// One row of the registry.
 struct Backend {
-  std::string name;         // as in JSON and reports
-  std::string description;  // one line: library, algorithm
-  ContactFn contact;        // empty: no contact queries
-  DynamicsFn dynamics;      // empty: no dynamics
-  MassFn mass = nullptr;    // empty: the library computes no mass properties of a hull
-  bool library = true;      // an outside library's code: isolated with a deadline per call
-  bool friction = true;     // its dynamics apply Coulomb friction (false: mu is ignored)
-  bool user = false;        // registered at run time (register_backend): never cached
+  std::string name;          // as in JSON and reports
+  std::string description;   // one line: library, algorithm
+  ContactFn contact;         // empty: no contact queries
+  DynamicsFn dynamics;       // empty: no dynamics
+  MassFn mass = nullptr;     // empty: the library computes no mass properties of a hull
+  bool library = true;       // an outside library's code: isolated with a deadline per call
+  bool friction = true;      // its dynamics apply Coulomb friction (false: mu is ignored)
+  bool user = false;         // registered at run time (register_backend): never cached
+  SolverBudget budget = {};  // the solver's iteration budget, when it has one
 };
+
+/// `b` with its solver budget (adapters' tables name the other fields in order).
+inline Backend with_budget(Backend b, SolverBudget budget) {
+  b.budget = std::move(budget);
+  return b;
+}
 
 /// Every backend, in report order; those added by register_backend last.
 const std::vector<Backend>& backends();

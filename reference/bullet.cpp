@@ -395,6 +395,7 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
     // Bullet's default gravity is (0, -10, 0); the scene's is the input in both modes.
     world.setGravity(to_bt(scene.sim.gravity));
     if (settings.fair_world) make_solver_fair(world, settings);
+    if (opt.budget > 0) world.getSolverInfo().m_numIterations = opt.budget;
 
     // Bodies: the engine's own (make_body), so hull, mass, centre of mass and inertia are
     // exactly the custom engine's.
@@ -499,6 +500,12 @@ DynamicsResult dynamics_run(const Scene& scene, const DynamicsOptions& opt) {
 
 MassResult bullet_hull_mass(const RigidBody& body);
 
+// The budget swept along: Bullet's sequential-impulse sweeps (library default 10; the fair
+// world's 100, make_solver_fair).
+SolverBudget bullet_budget() {
+  return {"m_numIterations (sequential-impulse sweeps)", {1, 3, 10, 30, 100}, 10, 100};
+}
+
 // `bullet` mass: btBoxShape::calculateLocalInertia for boxes (the solid box's, exact), the hull
 // routine below otherwise.
 MassResult bullet_mass(const RigidBody& body) {
@@ -541,11 +548,15 @@ const Adapter& bullet_adapter() {
       {
           // Native boxes (btBoxShape, btBoxBoxDetector on two boxes), polyhedral hulls clipped
           // about the GJK + EPA axis otherwise, zero hull margin, the fair world.
-          {"bullet", "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
-           query<bullet_native_settings>, dynamics_run<bullet_native_settings>, bullet_mass},
+          with_budget(
+              {"bullet", "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
+               query<bullet_native_settings>, dynamics_run<bullet_native_settings>, bullet_mass},
+              bullet_budget()),
           // Every body a zero-margin btConvexHullShape through GJK + EPA (one point).
-          {"bullet-hull", "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",
-           query<bullet_hull_settings>, dynamics_run<bullet_hull_settings>, bullet_hull_mass},
+          with_budget(
+              {"bullet-hull", "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",
+               query<bullet_hull_settings>, dynamics_run<bullet_hull_settings>, bullet_hull_mass},
+              bullet_budget()),
           // Every body a polyhedral hull (boxes too), SAT + clipping; contact queries only.
           {"bullet-sat", "Bullet 3.24 double: polyhedral hull SAT + clipping, boxes too",
            query<bullet_sat_settings>, nullptr},

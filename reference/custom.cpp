@@ -56,7 +56,11 @@ DynamicsResult run_dynamics(const Scene& scene, const DynamicsOptions& opt, Cont
   try {
     SimSettings sim = scene.sim;
     if (opt.dt > 0) sim.dt = opt.dt;
-    World world(sim, make_bodies(scene));
+    // A swept budget caps the projections' sweeps per island solve (custom_budget).
+    WorldSettings tunables;
+    tunables.sweep_budget = opt.budget;
+    World world(sim, make_bodies(scene), DetectorVariant::Accelerated, BroadPhaseMethod::Tree,
+                tunables);
     world.set_contact_model(model);
     world.set_response(response);
     const long steps = sim.steps();
@@ -104,14 +108,28 @@ DynamicsResult custom_seed_dynamics_with(const Scene& scene, const DynamicsOptio
   return run_dynamics(scene, opt, ContactModel::Seed, response);
 }
 
+// The budget swept along: the projected Gauss-Seidel sweeps of one island solve, both stages
+// together (WorldSettings::sweep_budget). The engine itself has no budget: it solves to
+// convergence (configured 0), and islands of up to 32 points are settled by active sets first,
+// which no budget limits.
+SolverBudget custom_budget() {
+  return {"sweep_budget (projected Gauss-Seidel sweeps per island solve, after the active sets)",
+          {1, 10, 100, 1000},
+          0,
+          0};
+}
+
 const Adapter& custom_adapter() {
   // The engine's own code: not isolated (library = false); the seed model has no friction.
   static const Adapter adapter = {
       {
-          {"custom",
-           "rbx engine, extended: Moore & Wilhelms tests with the plane of least overlap, contact "
-           "manifolds, Coulomb friction, resting contact, time of impact for every new contact",
-           custom_contact, custom_dynamics, nullptr, false},
+          with_budget(
+              {"custom",
+               "rbx engine, extended: Moore & Wilhelms tests with the plane of least overlap, "
+               "contact manifolds, Coulomb friction, resting contact, time of impact for every "
+               "new contact",
+               custom_contact, custom_dynamics, nullptr, false},
+              custom_budget()),
           {"custom-seed",
            "rbx engine, the seed's algorithm: first hit, single-point frictionless impulse",
            nullptr, custom_seed_dynamics, nullptr, false, false},

@@ -665,6 +665,7 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
     r.message = error;
     return r;
   }
+  if (opt.budget > 0) m->opt.iterations = opt.budget;  // the swept budget (mujoco_budget)
   const mjModel* mc = m.get();
   mjData* dd = d.get();
   set_state(mc, dd, bodies);
@@ -766,14 +767,24 @@ const AtSettings<MujocoSettings>& mujoco_at_settings() {
   return entries;
 }
 
+// The budget swept along: the constraint solver's iterations (Newton, MuJoCo's default solver;
+// it stops earlier at its tolerance, 1e-8), library default 100, which rbx keeps.
+SolverBudget mujoco_budget() {
+  return {"opt.iterations (Newton solver)", {1, 3, 10, 100}, 100, 100};
+}
+
 const Adapter& mujoco_adapter() {
   static const Adapter adapter = {
       {
-          {"mujoco",
-           "MuJoCo 2.2.2 box geoms (box-box) or mesh + multiccd; mj_step, negative solref",
-           mujoco_contact, mujoco_dynamics, mujoco_mass},
-          {"mujoco-hull", "MuJoCo 2.2.2 mesh geoms (MPR, one point); mj_step, negative solref",
-           mujoco_hull_contact, mujoco_hull_dynamics, mujoco_hull_mass},
+          with_budget(
+              {"mujoco",
+               "MuJoCo 2.2.2 box geoms (box-box) or mesh + multiccd; mj_step, negative solref",
+               mujoco_contact, mujoco_dynamics, mujoco_mass},
+              mujoco_budget()),
+          with_budget(
+              {"mujoco-hull", "MuJoCo 2.2.2 mesh geoms (MPR, one point); mj_step, negative solref",
+               mujoco_hull_contact, mujoco_hull_dynamics, mujoco_hull_mass},
+              mujoco_budget()),
       },
       {
           {"mujoco", "prebuilt", "the pair's model compiled once and kept (poses set, mj_forward)",

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <thread>
 
+#include "comparisons/eval/budgets.h"
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/impact_cause.h"
 #include "comparisons/eval/measures.h"
@@ -39,12 +40,8 @@ bool same_answer(const ContactPoint& x, const ContactPoint& y) {
 
 std::string pair_name(const RigidBody& a, const RigidBody& b) { return a.name + "-" + b.name; }
 
-}  // namespace
-
 // ---------------------------------------------------------------------------------------------
 // The checks
-
-namespace {
 
 class Evaluator {
  public:
@@ -89,13 +86,12 @@ class Evaluator {
       causes.push_back({{"backend", c.backend}, {"kind", c.kind}, {"detail", c.detail}});
     j["causes"] = causes;
     Json sweep = Json::array();
-    for (const SweepPoint& s : out_.sweep)
-      sweep.push_back({{"backend", s.backend},
-                       {"kind", s.kind},
-                       {"dt", s.dt},
-                       {"runtime_s", s.runtime_s},
-                       {"error", s.error},
-                       {"against", s.against}});
+    for (const SweepPoint& s : out_.sweep) {
+      Json point = {{"backend", s.backend},     {"kind", s.kind},   {"dt", s.dt},
+                    {"runtime_s", s.runtime_s}, {"error", s.error}, {"against", s.against}};
+      if (s.kind == "budget") point["budget"] = s.budget;
+      sweep.push_back(std::move(point));
+    }
     j["sweep"] = sweep;
     j["stability"] = stability_json_.is_null() ? Json::object() : stability_json_;
     if (!stability_sweep_json_.is_null()) j["stability_sweep"] = stability_sweep_json_;
@@ -462,12 +458,18 @@ class Evaluator {
         velocity_reference(name, main, sw, fr, against);
     contact_phases(name, main, fr, bj);
     if (fr.wants_sweep && !against.empty()) {
+      const auto error_of = [&](const std::vector<BodyFinal>& finals) {
+        return ke_norm_error(inputs_, finals, ref, fr.e0_kin);
+      };
       for (const DynRun& r : sw.runs) {
         if (r.result.status != Status::Ok) continue;
         if (!fr.have_expect && &r == &sw.runs.back()) continue;  // zero by construction
-        out_.sweep.push_back({name, "dynamics", r.dt, r.runtime_s,
-                              ke_norm_error(inputs_, r.result.finals, ref, fr.e0_kin), against});
+        out_.sweep.push_back(
+            {name, "dynamics", r.dt, r.runtime_s, error_of(r.result.finals), against});
       }
+      const std::vector<SweepPoint> budgets = budget_points(
+          backend(name), scene_, main, cache_, inputs_, error_of, against, &out_.skipped);
+      out_.sweep.insert(out_.sweep.end(), budgets.begin(), budgets.end());
     }
     trajectory_divergence(name, main, sw, fr);
     // Contact time: first event against the finest-step run of the same backend.

@@ -53,11 +53,13 @@ struct Metric {
 /// One point of error against run time.
 struct SweepPoint {
   std::string backend;
-  std::string kind;  // "dynamics" (a time step) or "contact" (a query)
-  double dt = 0.0;   // s (dynamics)
+  std::string kind;  // "dynamics" (a time step), "budget" (a solver budget at the scene's
+                     // step), "contact" or "contact-prebuilt" (a query)
+  double dt = 0.0;   // s (dynamics, budget)
   double runtime_s = 0.0;
   double error = 0.0;  // velocity error in the kinetic-energy norm, or normal angle (deg)
   std::string against;
+  int budget = 0;  // the solver budget (kind "budget"; Backend::budget), else 0: as configured
 };
 
 /// Everything the harness learned about one scene.

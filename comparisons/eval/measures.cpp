@@ -15,13 +15,13 @@ namespace rbx {
 // A reference backend's run comes from the cache when it holds this very call (the bodies as
 // built from the scene, the settings, dt and sampling); otherwise it runs and is stored.
 DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every,
-                    const ResultCache& cache, const std::vector<RigidBody>& bodies) {
+                    const ResultCache& cache, const std::vector<RigidBody>& bodies, int budget) {
   DynRun run;
   run.dt = dt;
+  const DynamicsOptions opt{dt, sample_every, budget};
   const bool cacheable = cache.enabled() && ResultCache::caches(b.name);
   const std::string key =
-      cacheable ? cache.dynamics_key(b.name, scene, bodies, DynamicsOptions{dt, sample_every})
-                : std::string();
+      cacheable ? cache.dynamics_key(b.name, scene, bodies, opt) : std::string();
   run.cache_key = key;
   if (cacheable)
     if (auto hit = cache.load_dynamics(key)) {
@@ -30,7 +30,7 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
       run.cached = true;
       return run;
     }
-  const TimedDynamics t = run_dynamics_isolated(b, scene, DynamicsOptions{dt, sample_every});
+  const TimedDynamics t = run_dynamics_isolated(b, scene, opt);
   run.result = t.result;
   run.runtime_s = t.runtime_s;
   // A backend that returns fewer final states than bodies has failed in a way we must show.

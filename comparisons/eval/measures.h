@@ -26,11 +26,12 @@ struct DynRun {
   std::string cache_key;  // the run's cache key ("" : not cacheable)
 };
 
-/// Runs `b` on the scene at step `dt`, sampling every `sample_every` steps (0: none). A
-/// reference backend's run comes from the cache when it holds this very call (the bodies as
-/// built from the scene, the settings, dt and sampling); otherwise it runs and is stored.
+/// Runs `b` on the scene at step `dt`, sampling every `sample_every` steps (0: none), at solver
+/// budget `budget` (DynamicsOptions::budget; 0: as configured). A reference backend's run comes
+/// from the cache when it holds this very call (the bodies as built from the scene, the
+/// settings, dt, sampling and budget); otherwise it runs and is stored.
 DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every,
-                    const ResultCache& cache, const std::vector<RigidBody>& bodies);
+                    const ResultCache& cache, const std::vector<RigidBody>& bodies, int budget = 0);
 
 /// A contact query timed for about `budget_s` (median of the repeats, at most 200), or the
 /// cached result of the same query (a reference backend's, see result_cache.h).

@@ -101,6 +101,7 @@ std::string ResultCache::dynamics_key(const std::string& backend, const Scene& s
   w.put(s.max_energy_ratio);
   w.put(opt.dt);
   w.put(opt.sample_every);
+  w.put(static_cast<long>(opt.budget));
   // The specifications (what an adapter may read from the scene) and the bodies built from them.
   w.put(static_cast<long>(scene.bodies.size()));
   for (const BodySpec& b : scene.bodies) {

@@ -68,72 +68,99 @@ def roundoff_band(ax, xlabel_side=False):
 
 
 def error_vs_runtime(report, out):
-    """One point per (backend, time step): the median over the family's closed-form scenes with
-    the 25-75 % band; contacts: one point per backend for the normal and for the depth."""
+    """One point per (backend, time step), and per (backend, solver budget) at the scene's step:
+    the median over the family's closed-form scenes with the 25-75 % band; contacts: one point
+    per backend for the normal and for the depth."""
     rows = list(csv.DictReader(open(os.path.join(report, "sweep.csv"))))
     metrics = list(csv.DictReader(open(os.path.join(report, "metrics.csv"))))
     sweeps = defaultdict(list)  # (family, scene, backend) -> [(dt, runtime, error)]
+    budgets = defaultdict(list)  # (family, scene, backend) -> [(budget, runtime, error)]
     qtime = defaultdict(lambda: defaultdict(list))  # family, backend -> query times (s)
     ptime = defaultdict(lambda: defaultdict(list))  # the same with the shapes prebuilt
     for r in rows:
-        if r["kind"] == "dynamics":
+        if r["kind"] in ("dynamics", "budget"):
             # Only closed-form references are comparable across time steps and scenes (a
             # self-consistency error is zero at the finest step by construction).
             if r["against"] != "analytic":
                 continue
-            sweeps[(r["family"], r["scene"], r["backend"])].append(
-                (float(r["dt"]), float(r["runtime_s"]), float(r["error"])))
+            point = (float(r["runtime_s"]), float(r["error"]))
+            if r["kind"] == "dynamics":
+                sweeps[(r["family"], r["scene"], r["backend"])].append((float(r["dt"]),) + point)
+            else:
+                budgets[(r["family"], r["scene"], r["backend"])].append((int(r["budget"]),) + point)
         elif r["kind"] == "contact-prebuilt":
             ptime[r["family"]][r["backend"]].append(float(r["runtime_s"]))
         else:
             qtime[r["family"]][r["backend"]].append(float(r["runtime_s"]))
-    # Scenes differ in dt (and some set their own sweep_dt), so the points of a curve are the
-    # k-th step of each scene's sweep, coarse to fine; only steps every scene of the family has
-    # are drawn, so the same scenes stand behind every point of a curve.
+    # Scenes differ in dt (and some set their own sweep_dt), so the points of a step curve are
+    # the k-th step of each scene's sweep, coarse to fine; a budget curve's points are the
+    # budgets themselves. Only points every scene of the family has are drawn, so the same
+    # scenes stand behind every point of a curve.
     dyn = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))  # family, backend, k
+    bud = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))  # family, backend, budget
     nscenes = defaultdict(lambda: defaultdict(int))
+    nbudget = defaultdict(lambda: defaultdict(int))
     for (family, _, backend), pts in sweeps.items():
         nscenes[family][backend] += 1
         for k, (_, runtime, error) in enumerate(sorted(pts, reverse=True)):
             dyn[family][backend][k].append((runtime, error))
-    for family, per_backend in dyn.items():
-        fig, ax = plt.subplots(figsize=(7.2, 6.0))
-        roundoff_band(ax)
+    for (family, _, backend), pts in budgets.items():
+        nbudget[family][backend] += 1
+        for budget, runtime, error in pts:
+            bud[family][backend][budget].append((runtime, error))
+    for family in sorted(set(dyn) | set(bud)):
+        fig, (ax, axb) = plt.subplots(1, 2, figsize=(12.5, 6.0), sharey=True)
         allpts = []
-        for backend in order(per_backend):
-            colour, marker = style(backend)
-            n = nscenes[family][backend]
-            xs, ys, lo, hi = [], [], [], []
-            for k, vals in sorted(per_backend[backend].items()):
-                if len(vals) < n:
+        for panel, curves, counts in ((ax, dyn[family], nscenes[family]),
+                                      (axb, bud[family], nbudget[family])):
+            roundoff_band(panel)
+            for backend in order(curves):
+                colour, marker = style(backend)
+                n = counts[backend]
+                xs, ys, lo, hi, keys = [], [], [], [], []
+                for k, vals in sorted(curves[backend].items()):
+                    if len(vals) < n:
+                        continue
+                    _, tx, _ = quartiles([v[0] for v in vals])
+                    q1, q2, q3 = quartiles([v[1] for v in vals])
+                    xs.append(tx)
+                    ys.append(floored(q2))
+                    lo.append(floored(q2) - floored(q1))
+                    hi.append(floored(q3) - floored(q2))
+                    keys.append(k)
+                if not xs:
                     continue
-                _, tx, _ = quartiles([v[0] for v in vals])
-                q1, q2, q3 = quartiles([v[1] for v in vals])
-                xs.append(tx)
-                ys.append(floored(q2))
-                lo.append(floored(q2) - floored(q1))
-                hi.append(floored(q3) - floored(q2))
-            if not xs:
-                continue
-            ax.errorbar(xs, ys, yerr=[lo, hi], color=colour, marker=marker, ms=5, lw=1.4,
-                        capsize=2, label=f"{backend} ({n} scenes)")
-            # The coarsest step: a large open marker.
-            ax.scatter([xs[0]], [ys[0]], s=150, facecolors="none", edgecolors=colour, lw=1.5)
-            allpts += [(x, y, backend) for x, y in zip(xs, ys)]
-        front = pareto([(x, y) for x, y, _ in allpts])
+                panel.errorbar(xs, ys, yerr=[lo, hi], color=colour, marker=marker, ms=5, lw=1.4,
+                               capsize=2, ls="-" if panel is ax else "--",
+                               label=f"{backend} ({n} scenes)")
+                if panel is ax:
+                    # The coarsest step: a large open marker; its points join the Pareto front.
+                    ax.scatter([xs[0]], [ys[0]], s=150, facecolors="none", edgecolors=colour,
+                               lw=1.5)
+                    allpts += [(x, y) for x, y in zip(xs, ys)]
+                else:
+                    # Each point names its budget.
+                    for x, y, k in zip(xs, ys, keys):
+                        axb.annotate(str(k), (x, y), textcoords="offset points", xytext=(4, 3),
+                                     fontsize=6, color=colour)
+            panel.set_xscale("log")
+            panel.set_yscale("log")
+            panel.set_xlabel("run time of one scene run (s), median over the scenes")
+            panel.grid(True, which="both", alpha=0.3)
+            readable_log_ticks(panel.xaxis)
+            # Below the axes: the legend hides no point.
+            panel.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
+        front = pareto(allpts)
         if len(front) > 1:
             ax.step([p[0] for p in front], [p[1] for p in front], where="post", color="black",
                     ls="--", lw=0.9, label="Pareto front over backends")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("run time of one scene run (s), median over the scenes")
+            ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
         ax.set_ylabel("velocity error, kinetic-energy norm:\nmedian over scenes, bar 25-75 %")
-        ax.set_title(f"{family}: error against run time, closed-form scenes\n"
-                     "one point per time step; large open marker: the coarsest step", fontsize=9)
-        ax.grid(True, which="both", alpha=0.3)
-        readable_log_ticks(ax.xaxis)
-        # Below the axes: the legend hides no point.
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3)
+        ax.set_title("along the time step (one point per step;\nlarge open marker: the "
+                     "coarsest)", fontsize=9)
+        axb.set_title("along the solver budget, at the scene's step\n(each point labelled with "
+                      "its budget)", fontsize=9)
+        fig.suptitle(f"{family}: error against run time, closed-form scenes", fontsize=10)
         save(fig, out, f"error_vs_runtime_{family}")
     # Contacts: normal angle and depth error, each against the query time.
     con = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))  # family, backend, metric

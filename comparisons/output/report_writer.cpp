@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "comparisons/eval/budgets.h"
 #include "comparisons/eval/trajectory.h"
 #include "comparisons/output/scorecard.h"
 #include "comparisons/output/table.h"
@@ -426,7 +427,50 @@ std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs,
     if (figures_ok && std::filesystem::exists(std::filesystem::path(report_dir) / file))
       md << "![error against run time, " << f << "](" << file << ")\n\n";
   }
+  md << solver_budgets_markdown(evs);
+  return md.str();
+}
 
+std::string solver_budgets_markdown(const std::vector<SceneEvaluation>& evs) {
+  const std::vector<BudgetRow> rows = budget_rows(evs);
+  if (rows.empty()) return "";
+  std::ostringstream md;
+  md << "### Solver budgets\n\n"
+        "Each dynamics backend with an iteration budget is also run at the scene's own step "
+        "along that budget (the right-hand panel of each figure above; `sweep.csv`, kind "
+        "`budget`), measured against the same truth as the step sweep. A backend's own "
+        "converged error on a scene is its error at the largest budget; the table gives the "
+        "smallest budget from which every larger one is within "
+     << fmt_num(100 * kBudgetConvergedRel, 3) << " % of it (or both are round-off, under "
+     << fmt_num(kBudgetRoundoff, 3)
+     << "), on every scene of the family and on the median scene, and the median over the "
+        "scenes of the error at the library's default budget and of the converged error.\n\n";
+  std::set<std::string> named;
+  for (const BudgetRow& r : rows) {
+    const Backend* be = find_backend(r.backend);
+    if (!be || !named.insert(r.backend).second) continue;
+    std::string values;
+    for (int v : be->budget.values) values += (values.empty() ? "" : ", ") + std::to_string(v);
+    md << "- `" << r.backend << "`: " << be->budget.what << "; swept " << values
+       << "; library default "
+       << (be->budget.library_default > 0 ? std::to_string(be->budget.library_default)
+                                          : std::string("none (it solves to convergence)"))
+       << "; rbx runs "
+       << (be->budget.configured > 0
+               ? std::to_string(be->budget.configured)
+               : std::string("no iteration count (an exact or converged solve)"))
+       << "\n";
+  }
+  md << "\n";
+  Table t({"backend", "family", "scenes", "converged from (every scene)",
+           "converged from (median scene)", "error at the library default (median)",
+           "converged error (median)"});
+  for (const BudgetRow& r : rows)
+    t.add({r.backend, md_escape(r.family), std::to_string(r.scenes), std::to_string(r.every_scene),
+           std::to_string(r.median_scene),
+           r.default_error < 0 ? std::string("—") : fmt_num(r.default_error, 3),
+           fmt_num(r.converged_error, 3)});
+  md << t.markdown() << "\n";
   return md.str();
 }
 
@@ -483,7 +527,7 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
 
   std::ostringstream metrics, sweep, stab;
   metrics << "scene,family,check,backend,pair,metric,value,against\n";
-  sweep << "scene,family,backend,kind,dt,runtime_s,error,against\n";
+  sweep << "scene,family,backend,kind,dt,budget,runtime_s,error,against\n";
   stab << "scene,family,backend,dt,restitution,verdict,energy_growth_rel,energy_drift_rel,"
           "max_penetration_rel,rest_penetration_rel,tunnelled_pairs,jitter_rms_mps\n";
   for (size_t i = 0; i < evs.size(); ++i) {
@@ -493,8 +537,8 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
               << m.name << "," << fmt_num(m.value, 17) << "," << csv_escape(m.against) << "\n";
     for (const SweepPoint& p : evs[i].sweep)
       sweep << sc << "," << fam << "," << p.backend << "," << p.kind << "," << fmt_num(p.dt, 17)
-            << "," << fmt_num(p.runtime_s, 6) << "," << fmt_num(p.error, 17) << ","
-            << csv_escape(p.against) << "\n";
+            << "," << p.budget << "," << fmt_num(p.runtime_s, 6) << "," << fmt_num(p.error, 17)
+            << "," << csv_escape(p.against) << "\n";
     std::vector<std::pair<std::string, Json>> stab_rows;  // the scene's step, then its sweep
     for (const auto& [name, s] : evs[i].json["stability"].items()) {
       stab_rows.emplace_back(name, s);

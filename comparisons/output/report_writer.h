@@ -24,6 +24,11 @@ std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs,
                                       const std::string& report_dir, bool figures_ok,
                                       const std::string& figures_msg);
 
+/// The solver-budget table: per backend and family, the smallest budget that reaches the
+/// backend's own converged error (comparisons/eval/budgets.h), with each backend's budget
+/// named; "" when no scene has budget points.
+std::string solver_budgets_markdown(const std::vector<SceneEvaluation>& evs);
+
 /// details.md: the scorecard with every failing scene named, the summary of every scene for
 /// every backend, contact phase, who disagrees and why, contact query time, stability and every
 /// scene's detail.

@@ -252,35 +252,68 @@ TEST(ContactSolver, ActiveSetsAndProjectionsReachTheSameFrictionlessVelocities) 
   EXPECT_GT(compared, 300);
 }
 
-TEST(ContactSolver, AStackOfFiveThatSlidesIsSettledByActiveSets) {
-  // Five unit cubes (1 to 5 kg upward) resting on a static floor, mu = 0.5, one step of gravity
-  // in the velocities, the middle cube nudged sideways by 1e-6 m/s: 20 face-contact points. The
-  // projections alone converge on it only after thousands of sweeps a step once anything slides
-  // (an ensemble of friction/stack_five found it); the active sets settle it, and the answer
-  // meets every contact condition to round-off of speeds of order g dt (1e-12 m/s).
-  const double dt = 1e-3, g = 9.81, mu = 0.5;
-  std::vector<RigidBody> bodies = {box_body("floor", Vec3(4, 4, 1), 1.0, Vec3(0, 0, -0.5),
-                                            Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true)};
-  for (int k = 1; k <= 5; ++k)
-    bodies.push_back(box_body("box" + std::to_string(k), Vec3::Ones(), k, Vec3(0, 0, k - 0.5),
-                              Quat::Identity(), Vec3(k == 3 ? 1e-6 : 0.0, 0, 0), Vec3::Zero()));
+// Five unit cubes (1 to 5 kg upward) resting on a static floor, one step of gravity (dt = 1e-3)
+// in the velocities, the middle cube nudged sideways by 1e-6 m/s: 20 face-contact points.
+struct StackOfFive {
+  std::vector<RigidBody> bodies;
   std::vector<PairManifold> manifolds;
-  for (int k = 0; k + 1 < static_cast<int>(bodies.size()); ++k) {
-    const RigidBody &a = bodies[k + 1], &b = bodies[k];
+  std::vector<std::vector<double>> approach;
+  ContactSolverSettings settings;
+};
+
+StackOfFive stack_of_five(double mu) {
+  const double dt = 1e-3, g = 9.81;
+  StackOfFive st;
+  st.bodies = {box_body("floor", Vec3(4, 4, 1), 1.0, Vec3(0, 0, -0.5), Quat::Identity(),
+                        Vec3::Zero(), Vec3::Zero(), true)};
+  for (int k = 1; k <= 5; ++k)
+    st.bodies.push_back(box_body("box" + std::to_string(k), Vec3::Ones(), k, Vec3(0, 0, k - 0.5),
+                                 Quat::Identity(), Vec3(k == 3 ? 1e-6 : 0.0, 0, 0), Vec3::Zero()));
+  for (int k = 0; k + 1 < static_cast<int>(st.bodies.size()); ++k) {
+    const RigidBody &a = st.bodies[k + 1], &b = st.bodies[k];
     auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), DetectorVariant::Faithful);
-    ASSERT_TRUE(m) << "pair " << k;
-    manifolds.push_back({k + 1, k, *m, a.pose(), b.pose()});
+    if (m) st.manifolds.push_back({k + 1, k, *m, a.pose(), b.pose()});
   }
-  const auto approach = normal_velocities(bodies, manifolds);
-  for (RigidBody& b : bodies)
+  st.approach = normal_velocities(st.bodies, st.manifolds);
+  for (RigidBody& b : st.bodies)
     if (!b.is_static) b.velocity.z() -= g * dt;
-  ContactSolverSettings s = settings(0.0, mu);
-  s.rest_speed = 2 * g * dt;  // as the world sets it
+  st.settings = settings(0.0, mu);
+  st.settings.rest_speed = 2 * g * dt;  // as the world sets it
+  return st;
+}
+
+TEST(ContactSolver, AStackOfFiveThatSlidesIsSettledByActiveSets) {
+  // At mu = 0.5 the projections alone converge on the stack only after thousands of sweeps a
+  // step once anything slides (an ensemble of friction/stack_five found it); the active sets
+  // settle it, and the answer meets every contact condition to round-off of speeds of order
+  // g dt (1e-12 m/s).
+  StackOfFive st = stack_of_five(0.5);
+  ASSERT_EQ(st.manifolds.size(), 5u);
   SolverWork work;
-  const auto solved = solve_contact_velocities(bodies, manifolds, approach, s, &work);
+  const auto solved =
+      solve_contact_velocities(st.bodies, st.manifolds, st.approach, st.settings, &work);
   EXPECT_EQ(solved.size(), 20u);
   EXPECT_EQ(work.active_set, work.solves);
-  EXPECT_LE(breach(bodies, manifolds, solved, mu), 1e-12);
+  EXPECT_LE(breach(st.bodies, st.manifolds, solved, 0.5), 1e-12);
+}
+
+TEST(ContactSolver, ASweepBudgetStopsTheProjectionsShort) {
+  // The stack of five on the projections alone: unbudgeted they sweep to convergence; with a
+  // budget of 5 sweeps per island solve (the iteration budget other engines expose, swept by
+  // the report) no solve takes more, and the answer breaks the contact conditions by more.
+  StackOfFive free_run = stack_of_five(0.5), budgeted = free_run;
+  free_run.settings.active_set_rows = 0;
+  budgeted.settings.active_set_rows = 0;
+  budgeted.settings.tunables.sweep_budget = 5;
+  SolverWork free_work, budget_work;
+  const auto a = solve_contact_velocities(free_run.bodies, free_run.manifolds, free_run.approach,
+                                          free_run.settings, &free_work);
+  const auto b = solve_contact_velocities(budgeted.bodies, budgeted.manifolds, budgeted.approach,
+                                          budgeted.settings, &budget_work);
+  EXPECT_GT(free_work.sweeps, 5L * free_work.solves);
+  EXPECT_LE(budget_work.sweeps, 5L * budget_work.solves);
+  EXPECT_GT(breach(budgeted.bodies, budgeted.manifolds, b, 0.5),
+            10 * breach(free_run.bodies, free_run.manifolds, a, 0.5) + 1e-12);
 }
 
 TEST(ContactSolver, ProjectionsAloneTakeASteadyDriftAtOnce) {
