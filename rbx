@@ -5,7 +5,7 @@
 # `./rbx python [ARGS...]` builds the Python module and runs python3 with `import rbx` working.
 # `./rbx format [--check]` applies (or checks) clang-format on every tracked C++ source.
 # `./rbx fuzz [SECONDS]` builds the libFuzzer targets (tests/fuzz) with clang, ASan and UBSan in
-# build-fuzz/ and runs each for SECONDS (default 60) from its seed corpus.
+# build-fuzz/ and runs each for SECONDS (default 60) from its seed corpus, one per core at a time.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 # Paths on the command line are the caller's: remember where the caller stands, build from the
@@ -116,18 +116,36 @@ if [ "${1:-}" = "fuzz" ]; then
   fi
   targets=(scene_parser obj_loader convex_detect)
   cmake --build build-fuzz -j "$jobs" --target "${targets[@]/#/fuzz_}" >&2
-  failed=()
-  for t in "${targets[@]}"; do
+  # One target per core at a time, each for its full SECONDS; each one's output is kept in its
+  # own log and printed whole, in target order, once it has finished.
+  fuzz_one() {
+    local t=$1
     mkdir -p "build-fuzz/corpus/$t" "build-fuzz/crashes/$t"
-    dict=()
+    local dict=()
     [ -f "tests/fuzz/$t.dict" ] && dict=(-dict="tests/fuzz/$t.dict")
-    echo "rbx fuzz: $t for ${seconds} s" >&2
     # -timeout: one input running 30 s is a hang; -rss_limit_mb: 2 GiB is far above any input.
-    if ! "build-fuzz/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=30 -rss_limit_mb=2048 \
-        -print_final_stats=1 "${dict[@]}" -artifact_prefix="build-fuzz/crashes/$t/" \
-        "build-fuzz/corpus/$t" "tests/fuzz/corpus/$t"; then
-      failed+=("$t")
+    "build-fuzz/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=30 -rss_limit_mb=2048 \
+      -print_final_stats=1 "${dict[@]}" -artifact_prefix="build-fuzz/crashes/$t/" \
+      "build-fuzz/corpus/$t" "tests/fuzz/corpus/$t" >"build-fuzz/$t.log" 2>&1
+  }
+  failed=()
+  pids=()
+  for i in "${!targets[@]}"; do
+    t=${targets[$i]}
+    # Wait for the oldest running target once every core has one.
+    if [ ${#pids[@]} -ge "$jobs" ]; then
+      j=$((i - jobs))
+      wait "${pids[$j]}" || failed+=("${targets[$j]}")
+      echo "rbx fuzz: ${targets[$j]} for ${seconds} s" >&2
+      cat "build-fuzz/${targets[$j]}.log" >&2
     fi
+    fuzz_one "$t" &
+    pids+=($!)
+  done
+  for ((j = ${#targets[@]} - jobs < 0 ? 0 : ${#targets[@]} - jobs; j < ${#targets[@]}; j++)); do
+    wait "${pids[$j]}" || failed+=("${targets[$j]}")
+    echo "rbx fuzz: ${targets[$j]} for ${seconds} s" >&2
+    cat "build-fuzz/${targets[$j]}.log" >&2
   done
   if [ ${#failed[@]} -gt 0 ]; then
     echo "rbx fuzz: FAILED: ${failed[*]} (inputs in build-fuzz/crashes/)" >&2
