@@ -75,10 +75,15 @@ std::vector<BudgetRow> budget_rows(const std::vector<SceneEvaluation>& evs) {
         if (be && budget == be->budget.library_default) a.at_default.push_back(error);
     }
   }
-  // The lower middle of a sorted list (0 when empty).
-  const auto middle = [](auto v) {
+  // Budgets: the lower middle of an even count (a budget that was swept); errors: the median.
+  const auto lower_middle = [](std::vector<int> v) {
     std::sort(v.begin(), v.end());
-    return v.empty() ? typename decltype(v)::value_type{} : v[(v.size() - 1) / 2];
+    return v[(v.size() - 1) / 2];
+  };
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
   };
   std::vector<BudgetRow> rows;
   for (const auto& key : order) {
@@ -88,9 +93,9 @@ std::vector<BudgetRow> budget_rows(const std::vector<SceneEvaluation>& evs) {
     r.family = key.second;
     r.scenes = static_cast<int>(a.converged.size());
     r.every_scene = *std::max_element(a.converged.begin(), a.converged.end());
-    r.median_scene = middle(a.converged);
-    if (!a.at_default.empty()) r.default_error = middle(a.at_default);
-    r.converged_error = middle(a.at_top);
+    r.median_scene = lower_middle(a.converged);
+    if (!a.at_default.empty()) r.default_error = median(a.at_default);
+    r.converged_error = median(a.at_top);
     rows.push_back(r);
   }
   return rows;
