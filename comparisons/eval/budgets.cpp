@@ -6,6 +6,7 @@
 #include <optional>
 #include <utility>
 
+#include "comparisons/eval/metrics.h"
 #include "reference/backend.h"
 
 namespace rbx {
@@ -80,11 +81,6 @@ std::vector<BudgetRow> budget_rows(const std::vector<SceneEvaluation>& evs) {
     std::sort(v.begin(), v.end());
     return v[(v.size() - 1) / 2];
   };
-  const auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  };
   std::vector<BudgetRow> rows;
   for (const auto& key : order) {
     const Acc& a = acc[key];
@@ -94,8 +90,8 @@ std::vector<BudgetRow> budget_rows(const std::vector<SceneEvaluation>& evs) {
     r.scenes = static_cast<int>(a.converged.size());
     r.every_scene = *std::max_element(a.converged.begin(), a.converged.end());
     r.median_scene = lower_middle(a.converged);
-    if (!a.at_default.empty()) r.default_error = median(a.at_default);
-    r.converged_error = median(a.at_top);
+    if (!a.at_default.empty()) r.default_error = median_of(a.at_default);
+    r.converged_error = median_of(a.at_top);
     rows.push_back(r);
   }
   return rows;

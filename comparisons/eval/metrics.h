@@ -12,6 +12,9 @@
 
 namespace rbx {
 
+/// The median of `v` (the mean of the middle two when even); `v` must not be empty.
+double median_of(std::vector<double> v);
+
 /// Reference final velocities of one body; a quantity left empty is not compared.
 struct RefState {
   std::optional<Vec3> velocity;          // m/s, centre of mass, world

@@ -191,12 +191,6 @@ std::string group_title(const ScoreRow& row) {
   return row.family + " — " + measure_title(row.measure);
 }
 
-double median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 std::string scene_slug(const std::string& family, const std::string& file) {
   return family + "_" + std::filesystem::path(file).stem().string();
 }

@@ -7,12 +7,10 @@
 #include <vector>
 
 #include "comparisons/eval/harness.h"
+#include "comparisons/eval/metrics.h"  // median_of, for the scorecard's users
 #include "engine/scene.h"
 
 namespace rbx {
-
-/// The median of `v` (the mean of the middle two when even); `v` must not be empty.
-double median_of(std::vector<double> v);
 
 /// The file-name slug of a scene in a report: FAMILY_STEM (figures, replay pages).
 std::string scene_slug(const std::string& family, const std::string& file);
