@@ -753,7 +753,7 @@ std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies
   std::vector<SolvedPoint> out;
   out.reserve(rows.size());
   for (const Row& r : rows) {
-    out.push_back({r.manifold, r.point, r.jn, r.jt.x() * r.t1 + r.jt.y() * r.t2,
+    out.push_back({r.manifold, r.index, r.point, r.jn, r.jt.x() * r.t1 + r.jt.y() * r.t2,
                    -approach[r.manifold][r.index], r.target});
   }
   return out;

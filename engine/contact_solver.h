@@ -53,6 +53,7 @@ struct ContactSolverSettings {
 /// One solved point: the accumulated impulses (N s) in the manifold's frame.
 struct SolvedPoint {
   int manifold = 0;
+  int index = 0;                         // the point's index in its manifold
   Vec3 point = Vec3::Zero();             // m, world, at detection
   double normal_impulse = 0.0;           // N s, >= 0, along the manifold normal (on A)
   Vec3 friction_impulse = Vec3::Zero();  // N s, world, tangent to the normal (on A)

@@ -86,6 +86,11 @@ std::vector<double> ExtendedStep::record_events(WorldState& world,
   std::vector<Vec3> moment(manifolds.size(), Vec3::Zero());
   std::vector<bool> collision(manifolds.size(), !rest_speed);
   for (const SolvedPoint& p : solved) {
+    const PairManifold& pm = manifolds[p.manifold];
+    world.step_contacts.push_back({pm.a, pm.b, p.point, pm.manifold.normal,
+                                   pm.manifold.points[p.index].depth,
+                                   p.normal_impulse * pm.manifold.normal + p.friction_impulse,
+                                   pm.pose_a.position, pm.pose_b.position});
     impulse[p.manifold] += p.normal_impulse;
     moment[p.manifold] += p.normal_impulse * p.point;
     if (rest_speed && p.approach_speed > *rest_speed) collision[p.manifold] = true;

@@ -45,11 +45,18 @@ void SeedStep::collide_pair(WorldState& world, int i, int j, bool bounded) {
         throw std::runtime_error("the response returned a non-finite impulse");
       if (impulse.isZero(0.0)) continue;
       apply_impulse_at(a, b, contact->point, impulse);
+      world.step_contacts.push_back(
+          {i, j, contact->point, contact->normal, contact->depth, impulse, a.position, b.position});
       world.add_event(i, j, *contact, impulse.dot(contact->normal), world.time);
       continue;
     }
     const double j_mag = apply_impulse(a, b, *contact, world.sim.restitution);
-    if (j_mag > 0.0) world.add_event(i, j, *contact, j_mag, world.time);
+    if (!(j_mag > 0.0)) continue;
+    // Only the hits that pushed: a later test's hit on a separating pair carries a depth the
+    // seed never uses.
+    world.step_contacts.push_back({i, j, contact->point, contact->normal, contact->depth,
+                                   j_mag * contact->normal, a.position, b.position});
+    world.add_event(i, j, *contact, j_mag, world.time);
   }
 }
 

@@ -92,6 +92,7 @@ bool World::check_state() {
 
 bool World::step() {
   if (!failure_.empty()) return false;
+  state_.step_contacts.clear();
   if (contact_model_ == ContactModel::Extended)
     extended_.advance(state_);  // manifolds, friction, resting contact, time of impact
   else

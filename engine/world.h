@@ -66,6 +66,8 @@ class World {
   const std::vector<RigidBody>& bodies() const { return state_.bodies; }
   /// Every collision resolved so far, in order.
   const std::vector<CollisionEvent>& events() const { return state_.events; }
+  /// Every contact point the last step solved, with its impulse (empty before the first step).
+  const std::vector<SolvedContact>& step_contacts() const { return state_.step_contacts; }
   /// Simulated time (s) reached.
   double time() const { return state_.time; }
   /// Total kinetic plus gravitational potential energy (J).

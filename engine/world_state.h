@@ -24,6 +24,18 @@ struct CollisionEvent {
   double impulse = 0.0;  // N s, magnitude j along the normal
 };
 
+/// One contact point as a step's solve left it: the impulse it applied and where, so that the
+/// contact laws can be checked on it (the comparisons' contact-law residuals).
+struct SolvedContact {
+  int a = 0, b = 0;              // body indices, scene order
+  Vec3 point = Vec3::Zero();     // m, world, at detection
+  Vec3 normal = Vec3::UnitZ();   // unit, world, from b toward a
+  double depth = 0.0;            // m, >= 0, the point's penetration at detection
+  Vec3 impulse = Vec3::Zero();   // N s, on a (normal and friction); b takes the opposite
+  Vec3 centre_a = Vec3::Zero();  // m, a's centre of mass at detection
+  Vec3 centre_b = Vec3::Zero();  // m, b's centre of mass at detection
+};
+
 /// What a body's shape and mass fix for the whole run.
 struct BodyFacts {
   double thickness = 0.0;    // m, shape_thickness: what a fast body must not pass through
@@ -48,9 +60,10 @@ struct WorldState {
   DetectorVariant variant;
   WorldSettings tunables;
   BroadPhase broad_phase;  // the pairs passing the bounding check, at the step's start poses
-  std::vector<CollisionEvent> events;  // every collision resolved so far, in order
-  double time = 0.0;                   // s, at the start of the step being taken
-  long step = 0;                       // steps taken
+  std::vector<CollisionEvent> events;        // every collision resolved so far, in order
+  double time = 0.0;                         // s, at the start of the step being taken
+  long step = 0;                             // steps taken
+  std::vector<SolvedContact> step_contacts;  // every contact point the last step solved
 
   /// Records a collision of bodies i and j resolved at `time` with normal impulse `impulse`
   /// (N s): the one place both contact models build an event.

@@ -231,3 +231,39 @@ TEST(World, VertexOnStaticSlabBouncesWithClosedFormSpin) {
 
 }  // namespace
 }  // namespace rbx
+
+namespace rbx {
+namespace {
+
+TEST(World, StepContactsAreTheSolvedPointsWithTheirImpulses) {
+  // A unit cube resting on a static floor: the last step's points carry the impulse that holds
+  // its weight for one step, pushing it up, at its centre's height minus half its size.
+  SimSettings sim;
+  sim.dt = 0.01;
+  sim.gravity = Vec3(0.0, 0.0, -9.81);
+  sim.restitution = 0.0;
+  sim.friction = 0.5;
+  const RigidBody floor = test::box_body("floor", Vec3(10.0, 10.0, 1.0), 1.0, Vec3(0.0, 0.0, -0.5),
+                                         Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true);
+  const RigidBody cube = test::box_body("cube", Vec3::Ones(), 2.0, Vec3(0.0, 0.0, 0.5));
+  World world(sim, {floor, cube});
+  world.set_contact_model(ContactModel::Extended);
+  EXPECT_TRUE(world.step_contacts().empty());
+  for (int k = 0; k < 3; ++k) ASSERT_TRUE(world.step());
+  Vec3 total = Vec3::Zero();
+  for (const SolvedContact& c : world.step_contacts()) {
+    EXPECT_EQ(c.a, 0);
+    EXPECT_EQ(c.b, 1);
+    EXPECT_NEAR(c.point.z(), 0.0, 1e-9);
+    // Its centre at detection: the cube rests, so where it is now, to round-off.
+    EXPECT_LT((c.centre_b - world.bodies()[1].position).norm(), 1e-15);
+    total += c.impulse;  // on the floor, so the cube takes -total
+  }
+  EXPECT_GE(world.step_contacts().size(), 3u);
+  // Round-off of the solve: 1e-12 of the weight's impulse.
+  EXPECT_NEAR(-total.z(), 2.0 * 9.81 * sim.dt, 1e-12 * 2.0 * 9.81 * sim.dt);
+  EXPECT_NEAR(total.head<2>().norm(), 0.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace rbx
