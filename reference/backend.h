@@ -18,6 +18,7 @@
 #include "engine/contact.h"
 #include "engine/scene.h"
 #include "engine/world.h"
+#include "reference/contact_laws.h"
 
 namespace rbx {
 
@@ -118,6 +119,7 @@ struct DynamicsResult {
   std::vector<BodyFinal> finals;       // same order as scene.bodies
   std::vector<StateSample> samples;    // filled when `sample_every` > 0
   FirstImpulse first_impulse;          // what the first impulse saw
+  ContactLaws laws;                    // contact-law residuals (measured: false when unknown)
 };
 
 /// The first impulse of a run from the events one step added (`step_events`: those of the

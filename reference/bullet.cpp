@@ -361,6 +361,41 @@ void read_events(const btCollisionDispatcher& dispatcher, long k, double dt,
   }
 }
 
+/// Every manifold point the solver used this step (within the processing threshold), with the
+/// impulse it applied to body A: the normal impulse and the friction impulses along Bullet's
+/// lateral directions (the second only when the solver runs two), given to `recorder`.
+void record_contacts(const btCollisionDispatcher& dispatcher, const btContactSolverInfo& info,
+                     DynamicsRecorder& recorder) {
+  const bool two_directions = (info.m_solverMode & SOLVER_USE_2_FRICTION_DIRECTIONS) != 0;
+  for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+    const btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
+    const int i0 = manifold->getBody0()->getUserIndex();
+    const int i1 = manifold->getBody1()->getUserIndex();
+    for (int p = 0; p < manifold->getNumContacts(); ++p) {
+      const btManifoldPoint& cp = manifold->getContactPoint(p);
+      if (cp.getDistance() > manifold->getContactProcessingThreshold()) continue;
+      // On body 0: the normal (from body 1 toward body 0) and friction impulses.
+      Vec3 n = from_bt(cp.m_normalWorldOnB).normalized();
+      Vec3 impulse = cp.getAppliedImpulse() * n +
+                     cp.m_appliedImpulseLateral1 * from_bt(cp.m_lateralFrictionDir1);
+      if (two_directions)
+        impulse += cp.m_appliedImpulseLateral2 * from_bt(cp.m_lateralFrictionDir2);
+      SolvedContact c;
+      c.a = std::min(i0, i1);
+      c.b = std::max(i0, i1);
+      if (i0 > i1) {
+        n = -n;
+        impulse = -impulse;
+      }
+      c.point = 0.5 * (from_bt(cp.getPositionWorldOnA()) + from_bt(cp.getPositionWorldOnB()));
+      c.normal = n;
+      c.depth = std::max(0.0, -static_cast<double>(cp.getDistance()));
+      c.impulse = impulse;
+      recorder.contact_at_start(c);
+    }
+  }
+}
+
 /// Throws when a body's state is not finite after step `k`: an error, not a result.
 void check_finite(const std::vector<BulletBody>& bodies, const std::vector<std::string>& names,
                   long k) {
@@ -422,6 +457,7 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
       for (size_t i = 0; i < bodies.size(); ++i) states.push_back(final_state(names[i], bodies[i]));
       return states;
     });
+    recorder.measure_contact_laws(scene.sim);
     recorder.start();
     for (long k = 0; k < steps; ++k) {
       recorder.before_step(result.events);
@@ -432,8 +468,10 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
       // The first impulse: one event per manifold point, so the count is the events'.
       recorder.first_impulse_from_step(result.events, dt);
       check_finite(bodies, names, k);
+      record_contacts(dispatcher, world.getSolverInfo(), recorder);
       recorder.after_step(k + 1, (k + 1) * dt);
     }
+    recorder.finish_laws();
 
     for (size_t i = 0; i < bodies.size(); ++i)
       result.finals.push_back(final_state(names[i], bodies[i]));

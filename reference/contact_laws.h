@@ -43,13 +43,13 @@ struct ContactLaws {
 /// What one contact point is scored on. Velocities are of A's material point at the contact
 /// relative to B's, before the step (no forces yet) and after it (every impulse and force).
 struct LawInputs {
-  Vec3 normal = Vec3::UnitZ();      // unit, from B toward A
-  double depth = 0.0;               // m, >= 0: penetration at detection
-  Vec3 impulse = Vec3::Zero();      // N s, on A over the step
-  Vec3 v_before = Vec3::Zero();     // m/s
-  Vec3 v_after = Vec3::Zero();      // m/s
-  double restitution = 0.0;         // the scene's e
-  double friction = 0.0;            // the scene's mu
+  Vec3 normal = Vec3::UnitZ();   // unit, from B toward A
+  double depth = 0.0;            // m, >= 0: penetration at detection
+  Vec3 impulse = Vec3::Zero();   // N s, on A over the step
+  Vec3 v_before = Vec3::Zero();  // m/s
+  Vec3 v_after = Vec3::Zero();   // m/s
+  double restitution = 0.0;      // the scene's e
+  double friction = 0.0;         // the scene's mu
 };
 
 /// The five residuals of one contact point, by Law:

@@ -69,14 +69,18 @@ DynamicsResult run_dynamics(const Scene& scene, const DynamicsOptions& opt, Cont
       for (const RigidBody& b : world.bodies()) states.push_back(final_of(b));
       return states;
     });
+    recorder.measure_contact_laws(sim);
     recorder.start();
     while (world.steps_taken() < steps) {
       recorder.before_step(world.events());
       if (!world.step()) break;
       // The first impulse from the step's events (the engine's: one per resolved contact).
       recorder.first_impulse_from_step(world.events(), sim.dt);
+      // Every solved point with its centres at detection (a time of impact's are mid-step).
+      for (const SolvedContact& c : world.step_contacts()) recorder.contact(c);
       recorder.after_step(world.steps_taken(), world.time());
     }
+    recorder.finish_laws();
     if (!world.failure().empty()) {
       r.status = Status::Error;
       r.message = world.failure();

@@ -21,10 +21,48 @@ void DynamicsRecorder::start() {
   if (sample_every_ > 0) sample(0.0);
 }
 
+void DynamicsRecorder::measure_contact_laws(const SimSettings& sim) {
+  measuring_ = true;
+  restitution_ = sim.restitution;
+  friction_ = sim.friction;
+}
+
+void DynamicsRecorder::contact(const SolvedContact& c) {
+  if (measuring_) step_contacts_.push_back(c);
+}
+
+void DynamicsRecorder::contact_at_start(SolvedContact c) {
+  if (!measuring_) return;
+  c.centre_a = before_[static_cast<size_t>(c.a)].position;
+  c.centre_b = before_[static_cast<size_t>(c.b)].position;
+  step_contacts_.push_back(c);
+}
+
 void DynamicsRecorder::before_step(const std::vector<CollisionEvent>& events) {
   events_before_ = events.size();
-  // Only the step of the first impulse needs them: no reading after it.
-  if (!result_.first_impulse.seen) before_ = read_states_();
+  // Without contact laws only the step of the first impulse needs them: no reading after it.
+  // With them, every step's, kept from the last step's end when it was read there.
+  if ((measuring_ && !before_known_) || (!measuring_ && !result_.first_impulse.seen))
+    before_ = read_states_();
+  before_known_ = false;
+}
+
+void DynamicsRecorder::score_step() {
+  if (step_contacts_.empty()) return;
+  std::vector<BodyFinal> after = read_states_();
+  for (const SolvedContact& c : step_contacts_) {
+    // The relative velocity of A's material point at the contact to B's.
+    auto relative = [&](const std::vector<BodyFinal>& s) {
+      const BodyFinal &a = s[static_cast<size_t>(c.a)], &b = s[static_cast<size_t>(c.b)];
+      return Vec3(a.velocity + a.angular_velocity.cross(c.point - c.centre_a) - b.velocity -
+                  b.angular_velocity.cross(c.point - c.centre_b));
+    };
+    tally_.add(law_residuals({c.normal, c.depth, c.impulse, relative(before_), relative(after),
+                              restitution_, friction_}));
+  }
+  step_contacts_.clear();
+  before_ = std::move(after);
+  before_known_ = true;
 }
 
 void DynamicsRecorder::first_impulse_from_step(const std::vector<CollisionEvent>& events,
@@ -45,7 +83,12 @@ void DynamicsRecorder::first_impulse_from_event(const CollisionEvent& first, dou
   result_.first_impulse = first_impulse_of({first}, before_, dt, points);
 }
 
+void DynamicsRecorder::finish_laws() {
+  if (measuring_) result_.laws = tally_.summary();
+}
+
 void DynamicsRecorder::finish(const std::string& library) {
+  finish_laws();
   for (BodyFinal& f : read_states_()) {
     if (!f.position.allFinite() || !f.velocity.allFinite() || !f.angular_velocity.allFinite()) {
       result_.status = Status::Error;
@@ -56,6 +99,7 @@ void DynamicsRecorder::finish(const std::string& library) {
 }
 
 void DynamicsRecorder::after_step(long steps_taken, double time) {
+  if (measuring_) score_step();
   if (sample_every_ > 0 && steps_taken % sample_every_ == 0) sample(time);
 }
 

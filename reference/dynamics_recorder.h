@@ -1,14 +1,18 @@
 // What every adapter's dynamics run records the same way, whatever library steps it: a state
 // sample at t = 0 and after every `sample_every` steps, the bodies' states before each step
-// until the first impulse, and that first impulse from the events the step added. An adapter
-// keeps its own stepping, events and checks, and calls the recorder around each step:
+// until the first impulse, that first impulse from the events the step added, and the
+// contact-law residuals (reference/contact_laws.h) of every contact point the library reports
+// with its impulse. An adapter keeps its own stepping, events and checks, and calls the
+// recorder around each step:
 //
 //   DynamicsRecorder rec(result, opt, read_states);
+//   rec.measure_contact_laws(scene.sim);
 //   rec.start();
 //   for each step k: rec.before_step(events); step; add events;
 //                    rec.first_impulse_from_step(events, dt) (or _from_event);
+//                    rec.contact(...) or rec.contact_at_start(...) per solved point;
 //                    rec.after_step(k + 1, (k + 1) * dt);
-//   rec.finish(library) (or the adapter's own finals)
+//   rec.finish(library) (or the adapter's own finals and rec.finish_laws())
 //
 // make_bodies (reference/backend.h), the bodies every adapter is given, is defined here too.
 #pragma once
@@ -18,7 +22,9 @@
 #include <string>
 #include <vector>
 
+#include "engine/world_state.h"
 #include "reference/backend.h"
+#include "reference/contact_laws.h"
 
 namespace rbx {
 
@@ -32,6 +38,15 @@ class DynamicsRecorder {
   /// never), reading the bodies with `read_states`.
   DynamicsRecorder(DynamicsResult& result, const DynamicsOptions& opt, ReadStates read_states);
 
+  /// Scores every contact point given by contact() against the laws of `sim` (its restitution
+  /// and friction) after each step; the result's `laws` are filled from then on.
+  void measure_contact_laws(const SimSettings& sim);
+  /// One contact point the step solved, its impulse as the library reports it and the bodies'
+  /// centres of mass at its detection (the velocities' lever arms).
+  void contact(const SolvedContact& c);
+  /// The same, detected at the step's start poses (as the libraries detect): the centres are
+  /// the bodies' positions before the step.
+  void contact_at_start(SolvedContact c);
   /// The sample at t = 0, when sampling.
   void start();
   /// Before a step: where the step's events will begin in `events` (the run's events so far)
@@ -48,18 +63,27 @@ class DynamicsRecorder {
   /// After step number `steps_taken` (1 for the first), at simulated time `time` (s): a sample
   /// when it is a multiple of sample_every.
   void after_step(long steps_taken, double time);
-  /// After the run: every body's final state; a non-finite one makes the result an error
-  /// naming `library` and the body.
+  /// After the run: the contact-law residuals into the result (finish does it too).
+  void finish_laws();
+  /// After the run: the contact-law residuals and every body's final state; a non-finite one makes
+  /// the result an error naming `library` and the body.
   void finish(const std::string& library);
 
  private:
   void sample(double time);
+  // Scores the step's contacts against the states after it.
+  void score_step();
 
   DynamicsResult& result_;
   long sample_every_;
   ReadStates read_states_;
   std::size_t events_before_ = 0;  // the step's first event in the run's events
-  std::vector<BodyFinal> before_;  // states before the step, until the first impulse
+  std::vector<BodyFinal> before_;  // states before the step (every step when measuring)
+  bool measuring_ = false;         // contact laws measured
+  bool before_known_ = false;      // before_ holds the states at the coming step's start
+  double restitution_ = 0.0, friction_ = 0.0;  // the scene's laws
+  std::vector<SolvedContact> step_contacts_;   // the step's scored points
+  LawTally tally_;
 };
 
 }  // namespace rbx

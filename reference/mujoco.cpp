@@ -645,6 +645,34 @@ void Episodes::read_step(const mjModel* mc, mjData* dd, const std::vector<int>& 
   open = std::move(still_open);
 }
 
+// Every contact of step `step` in the constraint solve, with the impulse on its body A over the
+// step (the force mj_contactForce gives in the contact frame, in world axes, times dt), given to
+// `recorder`. The force acts on geom2 along the frame (its normal points from geom1 to geom2),
+// so on geom1 against it.
+void record_contacts(const mjModel* mc, mjData* dd, const std::vector<int>& scene_of_geom,
+                     double dt, DynamicsRecorder& recorder) {
+  for (int i = 0; i < dd->ncon; ++i) {
+    const mjContact& con = dd->contact[i];
+    if (con.efc_address < 0) continue;
+    mjtNum frame_force[6];
+    mj_contactForce(mc, dd, i, frame_force);
+    Vec3 on_geom2 = Vec3::Zero();
+    for (int r = 0; r < 3; ++r)
+      on_geom2 +=
+          frame_force[r] * Vec3(con.frame[3 * r], con.frame[3 * r + 1], con.frame[3 * r + 2]);
+    const int g1 = scene_of_geom[con.geom1], g2 = scene_of_geom[con.geom2];
+    const ContactPoint cp = convert_contact(con, g1 < g2);
+    SolvedContact c;
+    c.a = std::min(g1, g2);
+    c.b = std::max(g1, g2);
+    c.point = cp.point;
+    c.normal = cp.normal;
+    c.depth = std::max(0.0, cp.depth);
+    c.impulse = (g1 < g2 ? Vec3(-on_geom2) : on_geom2) * dt;
+    recorder.contact_at_start(c);
+  }
+}
+
 }  // namespace
 
 namespace {
@@ -653,7 +681,7 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
                                     const MujocoSettings& settings) {
   DynamicsResult r;
   const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
-  if (!(dt > 0.0)) return {Status::Error, "MuJoCo: time step must be > 0", {}, {}, {}, {}};
+  if (!(dt > 0.0)) return {Status::Error, "MuJoCo: time step must be > 0", {}, {}, {}, {}, {}};
   const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
   const std::vector<RigidBody> bodies = make_bodies(scene);
 
@@ -681,6 +709,7 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
   });
   Episodes episodes;
   t_trap.clear_warning();
+  recorder.measure_contact_laws(scene.sim);
   recorder.start();
   for (long step = 0; step < steps; ++step) {
     recorder.before_step(r.events);
@@ -701,6 +730,7 @@ DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& o
       recorder.first_impulse_from_event(*first, dt, episodes.points[key]);
       r.first_impulse.depth = episodes.deepest[key];
     }
+    record_contacts(mc, dd, scene_of_geom, dt, recorder);
     recorder.after_step(step + 1, (step + 1) * dt);
   }
 

@@ -475,6 +475,26 @@ void pair_events(const CollideContext& ctx, const std::vector<RigidBody>& bodies
   }
 }
 
+// Every contact joint of the step with the impulse it applied to body a over the step (its
+// feedback force times dt), given to `recorder`. With two bodies f1 acts on a; with one, ODE
+// moves the body into the first slot, so f1 acts on whichever of a and b is the body.
+void record_contacts(const CollideContext& ctx, const std::vector<dBodyID>& ode_bodies, double dt,
+                     DynamicsRecorder& recorder) {
+  for (const StepContact& sc : ctx.contacts) {
+    const ContactPoint cp = convert_contact(sc.geom, sc.feature);
+    const dJointFeedback& fb = *sc.feedback;
+    const Vec3 f1(fb.f1[0], fb.f1[1], fb.f1[2]);
+    SolvedContact c;
+    c.a = sc.a;
+    c.b = sc.b;
+    c.point = cp.point;
+    c.normal = cp.normal;
+    c.depth = cp.depth;
+    c.impulse = (ode_bodies[sc.a] ? f1 : Vec3(-f1)) * dt;
+    recorder.contact_at_start(c);
+  }
+}
+
 // How many of the step's contact points belong to the pair of `event`.
 int points_of(const CollideContext& ctx, const std::vector<RigidBody>& bodies,
               const CollisionEvent& event) {
@@ -499,7 +519,7 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
   init_ode();
   DynamicsResult r;
   const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
-  if (!(dt > 0.0)) return {Status::Error, "ODE: time step must be > 0", {}, {}, {}, {}};
+  if (!(dt > 0.0)) return {Status::Error, "ODE: time step must be > 0", {}, {}, {}, {}, {}};
   const long steps = step_count(scene.sim.duration, dt);  // throws when uncountable
   const std::vector<RigidBody> bodies = make_bodies(scene);
 
@@ -529,6 +549,7 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
   t_trap.clear_warning();
   t_trap.warning_count = 0;
   long first_message_step = -1;
+  recorder.measure_contact_laws(scene.sim);
   recorder.start();
   for (long step = 0; step < steps; ++step) {
     recorder.before_step(r.events);
@@ -554,6 +575,7 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
     // event keeps the deepest of the pair's points already).
     if (const CollisionEvent* first = recorder.first_new_event(r.events))
       recorder.first_impulse_from_event(*first, dt, points_of(ctx, bodies, *first));
+    record_contacts(ctx, ode_bodies, dt, recorder);
     dJointGroupEmpty(w.contacts);
     recorder.after_step(step + 1, (step + 1) * dt);
   }

@@ -42,6 +42,8 @@ void result_fields(Io& io, R& d, Is<R, DynamicsResult> = 0) {
   auto& fi = d.first_impulse;
   io.io(fi.seen, fi.body_a, fi.body_b, fi.step, fi.contact_points, fi.normal, fi.point, fi.depth,
         fi.impulse, fi.approach_speed, fi.entry_phase);
+  io.io(d.laws.measured, d.laws.contacts);
+  for (auto& r : d.laws.residuals) io.io(r.worst, r.median);
 }
 
 template <class Io, class R>

@@ -28,7 +28,7 @@ std::vector<Backend> table_with_failing_backends() {
                    return ContactResult{Status::Error, "failer: gave up", {}};
                  },
                  [](const Scene&, const DynamicsOptions&) {
-                   return DynamicsResult{Status::Error, "failer: diverged", {}, {}, {}, {}};
+                   return DynamicsResult{Status::Error, "failer: diverged", {}, {}, {}, {}, {}};
                  }};
   return {thrower, *find_backend("custom"), *find_backend("exact"), failer};
 }

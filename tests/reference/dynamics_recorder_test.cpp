@@ -134,3 +134,57 @@ TEST(DynamicsRecorder, AFiniteRunKeepsItsStatusAndANonFiniteOneIsAnError) {
 
 }  // namespace
 }  // namespace rbx
+
+namespace rbx {
+namespace {
+
+TEST(DynamicsRecorder, ScoresTheContactLawsOnTheVelocitiesAroundEachStep) {
+  // Body a falls faster every step (velocity -k before step k, -(k+1) after it): a contact that
+  // pushed 1 N s up and yet leaves the bodies approaching at 1 m/s misses complementarity by
+  // 1 N s x 1 m/s; its friction, 0.3 < mu j_n = 0.5 with no slip, obeys the cone.
+  DynamicsResult result;
+  FakeRun run;
+  DynamicsRecorder recorder(result, {}, [&] { return run.states(); });
+  SimSettings sim;
+  sim.restitution = 0.0;
+  sim.friction = 0.5;
+  recorder.measure_contact_laws(sim);
+  recorder.start();
+  for (long k = 0; k < 3; ++k) {
+    recorder.before_step(run.events);
+    ++run.steps;
+    if (k == 0) {
+      SolvedContact c;
+      c.a = 0;
+      c.b = 1;
+      c.point = Vec3(0.0, 0.5, 0.0);
+      c.normal = Vec3::UnitY();
+      c.impulse = Vec3(0.3, 1.0, 0.0);
+      recorder.contact_at_start(c);
+    }
+    recorder.after_step(k + 1, (k + 1) * 0.1);
+  }
+  EXPECT_FALSE(result.laws.measured);  // filled when the run ends
+  recorder.finish_laws();
+  ASSERT_TRUE(result.laws.measured);
+  EXPECT_EQ(result.laws.contacts, 1);
+  for (Law law : kAllLaws)
+    EXPECT_DOUBLE_EQ(result.laws.residuals[static_cast<int>(law)].worst,
+                     law == Law::Complementarity ? 1.0 : 0.0)
+        << to_string(law);
+}
+
+TEST(DynamicsRecorder, MeasuresNoContactLawsUnlessAsked) {
+  DynamicsResult result;
+  FakeRun run;
+  DynamicsRecorder recorder(result, {}, [&] { return run.states(); });
+  recorder.start();
+  recorder.before_step(run.events);
+  recorder.contact_at_start({});
+  recorder.after_step(1, 0.1);
+  recorder.finish_laws();
+  EXPECT_FALSE(result.laws.measured);
+}
+
+}  // namespace
+}  // namespace rbx
