@@ -81,6 +81,7 @@ Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsRe
   j["contacts"] = events;
   j["bodies"] = bodies_json(inputs, &r.finals);
   j["first_impulse"] = first_impulse_json(r.first_impulse);
+  j["contact_laws"] = contact_laws_json(r.laws);
   // The sampled states (DynamicsOptions::sample_every), frame by frame: one row per body of
   // position (centre of mass) and orientation (w, x, y, z).
   if (!r.samples.empty()) {
@@ -96,6 +97,16 @@ Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsRe
     Json names = Json::array();
     for (const BodyFinal& b : r.samples.front().bodies) names.push_back(b.name);
     j["trajectory"] = {{"time", time}, {"bodies", names}, {"states", states}};
+  }
+  return j;
+}
+
+Json contact_laws_json(const ContactLaws& laws) {
+  if (!laws.measured) return {{"measured", false}};
+  Json j = {{"measured", true}, {"contacts", laws.contacts}};
+  for (Law law : kAllLaws) {
+    const LawResidual& r = laws.residuals[static_cast<int>(law)];
+    j[to_string(law)] = {{"worst", r.worst}, {"median", r.median}};
   }
   return j;
 }

@@ -43,6 +43,10 @@ Json settings_json(const Scene& scene);
 Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsResult& r,
                           double runtime_s);
 
+/// A run's contact-law residuals (reference/contact_laws.h): {"measured": false} when the
+/// backend reported no impulses; else the points scored and each law's worst and median.
+Json contact_laws_json(const ContactLaws& laws);
+
 /// What the run's first impulse saw (FirstImpulse), or null when no impulse was applied:
 /// pair, step, contact_points, normal, point, depth, impulse, approach_speed, entry_phase.
 Json first_impulse_json(const FirstImpulse& f);

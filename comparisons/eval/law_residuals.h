@@ -30,11 +30,11 @@ LawScales law_scales(const Scene& scene);
 /// One backend's residuals on one scene, read from its dynamics result (the "contact_laws"
 /// object of results.json).
 struct SceneLaws {
-  bool measured = false;                    // the backend reported its impulses
-  long contacts = 0;                        // contact points scored
-  std::array<double, kLaws> worst{};        // own units
-  std::array<double, kLaws> median{};       // own units
-  std::array<double, kLaws> relative{};     // worst / the scene's scale
+  bool measured = false;                 // the backend reported its impulses
+  long contacts = 0;                     // contact points scored
+  std::array<double, kLaws> worst{};     // own units
+  std::array<double, kLaws> median{};    // own units
+  std::array<double, kLaws> relative{};  // worst / the scene's scale
 };
 
 /// `backend`'s residuals on the scene of `ev` (`scene` its scene); measured = false when the
@@ -47,12 +47,12 @@ std::pair<Law, double> worst_relative(const SceneLaws& s);
 /// One backend on one scene family.
 struct LawRow {
   std::string backend, family;
-  int scenes = 0;                          // scenes with measured residuals
-  int unmeasured = 0;                      // scenes it ran without reporting impulses
-  long contacts = 0;                       // points scored, every scene
-  std::array<double, kLaws> worst{};       // own units, the largest over the scenes
-  std::array<double, kLaws> median{};      // own units, the median of the scenes' medians
-  std::array<double, kLaws> relative{};    // the largest relative residual over the scenes
+  int scenes = 0;                              // scenes with measured residuals
+  int unmeasured = 0;                          // scenes it ran without reporting impulses
+  long contacts = 0;                           // points scored, every scene
+  std::array<double, kLaws> worst{};           // own units, the largest over the scenes
+  std::array<double, kLaws> median{};          // own units, the median of the scenes' medians
+  std::array<double, kLaws> relative{};        // the largest relative residual over the scenes
   std::array<std::string, kLaws> worst_scene;  // the scene of each law's largest relative one
 };
 

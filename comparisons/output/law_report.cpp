@@ -1,5 +1,6 @@
 #include "comparisons/output/law_report.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
@@ -16,6 +17,38 @@ std::string worst_median(double worst, double median) {
   return fmt_num(worst, 2) + " (" + fmt_num(median, 2) + ")";
 }
 
+// The law of a row's largest relative residual.
+int top_law(const LawRow& row) {
+  int top = 0;
+  for (int l = 1; l < kLaws; ++l)
+    if (row.relative[l] > row.relative[top]) top = l;
+  return top;
+}
+
+// "RELATIVE LAW" of a row's largest relative residual; "no contact" when it scored none.
+std::string worst_cell(const LawRow& row) {
+  if (row.contacts == 0) return "no contact";
+  const int top = top_law(row);
+  return fmt_num(row.relative[top], 2) + " " + to_string(kAllLaws[top]);
+}
+
+// What each residual measures and how a cell reads (both pages).
+const char* kLawsIntro =
+    "Where no closed form exists, whether each backend obeys the laws of rigid contact, at "
+    "every contact point of every step of its run at the scene's step (docs/contact_laws.md), "
+    "from the impulses the library itself reports (Bullet's manifold points, ODE's joint "
+    "feedback, MuJoCo's contact forces, the custom engine's solved points) and the bodies' "
+    "velocities before and after the step: **penetration** at detection (m); **pulling**, a "
+    "negative normal impulse (N s); **complementarity**, a pushing contact that does not leave "
+    "at Newton's speed e times its approach, normal impulse times the speed it misses (J); "
+    "**cone**, friction beyond mu times the normal impulse (N s); **dissipation**, a sliding "
+    "contact's friction not at the cone's edge against its slip, the power it fails to remove "
+    "times the step (J). *Relative*: a residual divided by its scene's scale (the smallest "
+    "moving body's size; its mass times the fastest initial speed, or the speed of a fall "
+    "through that size; that times the speed again). A soft contact (MuJoCo) penetrates and "
+    "pushes while it separates by design: its residuals are its model's, not round-off. "
+    "Numbers: `laws.csv`.";
+
 }  // namespace
 
 std::string contact_laws_markdown(const std::vector<Scene>& scenes,
@@ -24,54 +57,74 @@ std::string contact_laws_markdown(const std::vector<Scene>& scenes,
                                   const std::string& report_dir, bool figures_ok) {
   const std::vector<LawRow> rows = law_rows(scenes, evs, backends);
   if (rows.empty()) return "";
+  std::vector<std::string> families;
+  for (const LawRow& r : rows)
+    if (std::find(families.begin(), families.end(), r.family) == families.end())
+      families.push_back(r.family);
   std::ostringstream md;
   md << "## Contact laws\n\n"
-        "Where no closed form exists, whether each backend obeys the laws of rigid contact, at "
-        "every contact point of every step of its run at the scene's step "
-        "(docs/contact_laws.md), from the impulses the library itself reports (Bullet's "
-        "manifold points, ODE's joint feedback, MuJoCo's contact forces, the custom engine's "
-        "solved points) and the bodies' velocities before and after the step: "
-        "**penetration** at detection (m); **pulling**, a negative normal impulse (N s); "
-        "**complementarity**, a pushing contact that does not leave at Newton's speed e times "
-        "its approach, normal impulse times the speed it misses (J); **cone**, friction beyond "
-        "mu times the normal impulse (N s); **dissipation**, a sliding contact's friction not "
-        "at the cone's edge against its slip, the power it fails to remove times the step (J). "
-        "Each cell: the worst over the family's scenes (the median of the scenes' medians). "
-        "*Worst relative*: the largest residual divided by the scene's scale (the smallest "
-        "moving body's size, its mass times the fastest initial speed, or the speed of a fall "
-        "through that size, and that times the speed again), with its law and scene. A soft "
-        "contact (MuJoCo) penetrates and pushes while it separates by design: its residuals are "
-        "its model's, not round-off. Numbers: `laws.csv`.\n\n";
+     << kLawsIntro
+     << " Each cell: the largest relative residual over the family's scenes and its law; "
+        "details.md has every law in its own unit per family and per scene.\n\n";
+  std::vector<std::string> header = {"backend"};
+  for (const std::string& f : families) header.push_back(md_escape(f));
+  Table t(header);
+  for (const std::string& b : backends) {
+    std::vector<std::string> cells = {md_escape(b)};
+    bool any = false;
+    for (const std::string& f : families) {
+      std::string cell = "—";
+      for (const LawRow& r : rows)
+        if (r.backend == b && r.family == f) {
+          cell = r.scenes == 0 ? std::string("not reported") : worst_cell(r);
+          any = true;
+        }
+      cells.push_back(cell);
+    }
+    if (any) t.add(cells);
+  }
+  md << t.markdown() << "\n";
+  for (const std::string& f : families) {
+    const std::string file = "figures/contact_laws_" + f + ".png";
+    if (figures_ok && std::filesystem::exists(std::filesystem::path(report_dir) / file))
+      md << "![contact laws, " << md_escape(f) << "](" << file << ")\n\n";
+  }
+  return md.str();
+}
+
+std::string contact_laws_details_markdown(const std::vector<Scene>& scenes,
+                                          const std::vector<SceneEvaluation>& evs,
+                                          const std::vector<std::string>& backends) {
+  const std::vector<LawRow> rows = law_rows(scenes, evs, backends);
+  if (rows.empty()) return "";
+  std::ostringstream md;
+  md << "## Contact laws\n\n"
+     << kLawsIntro
+     << " Each cell: the worst over the family's scenes (the median of the scenes' medians); "
+        "*worst relative*: the largest relative residual, its law and scene.\n\n";
   for (size_t k = 0; k < rows.size();) {
     size_t end = k;
     while (end < rows.size() && rows[end].family == rows[k].family) ++end;
-    md << "### " << md_escape(rows[k].family) << "\n\n";
+    md << "### Contact laws: " << md_escape(rows[k].family) << "\n\n";
     Table t({"backend", "scenes", "points", "penetration (m)", "pulling (N s)",
              "complementarity (J)", "cone (N s)", "dissipation (J)", "worst relative"});
     for (size_t r = k; r < end; ++r) {
       const LawRow& row = rows[r];
       if (row.scenes == 0) {
-        t.add({md_escape(row.backend), std::to_string(row.unmeasured), "—",
-               "impulses not reported", "—", "—", "—", "—", "—"});
+        t.add({md_escape(row.backend), std::to_string(row.unmeasured), "—", "impulses not reported",
+               "—", "—", "—", "—", "—"});
         continue;
       }
       std::vector<std::string> cells = {md_escape(row.backend), std::to_string(row.scenes),
                                         std::to_string(row.contacts)};
-      int top = 0;
-      for (int l = 0; l < kLaws; ++l) {
-        cells.push_back(worst_median(row.worst[l], row.median[l]));
-        if (row.relative[l] > row.relative[top]) top = l;
-      }
-      cells.push_back(fmt_num(row.relative[top], 2) + " " + to_string(kAllLaws[top]) + ", " +
-                      md_escape(row.worst_scene[top]));
+      for (int l = 0; l < kLaws; ++l) cells.push_back(worst_median(row.worst[l], row.median[l]));
+      cells.push_back(worst_cell(row) + ", " + md_escape(row.worst_scene[top_law(row)]));
       t.add(cells);
     }
     md << t.markdown() << "\n";
-    const std::string file = "figures/contact_laws_" + rows[k].family + ".png";
-    if (figures_ok && std::filesystem::exists(std::filesystem::path(report_dir) / file))
-      md << "![contact laws, " << md_escape(rows[k].family) << "](" << file << ")\n\n";
     k = end;
   }
+  md << scene_laws_markdown(scenes, evs, backends);
   return md.str();
 }
 
@@ -83,16 +136,16 @@ std::string scene_laws_markdown(const std::vector<Scene>& scenes,
   for (size_t i = 0; i < evs.size() && i < scenes.size(); ++i)
     for (const std::string& b : backends) {
       const SceneLaws s = scene_laws(scenes[i], evs[i], b);
-      if (!s.measured) continue;
+      if (!s.measured || s.contacts == 0) continue;
       std::vector<std::string> cells = {md_escape(evs[i].family + "/" + scenes[i].name),
                                         md_escape(b), std::to_string(s.contacts)};
       for (int l = 0; l < kLaws; ++l) cells.push_back(worst_median(s.worst[l], s.median[l]));
       t.add(cells);
     }
   if (t.size() == 0) return "";
-  return "## Contact laws per scene\n\nEach law's residual, worst (median) over every contact "
-         "point of every step, in its own unit (report.md, \"Contact laws\", says what each "
-         "measures).\n\n" +
+  return "### Contact laws per scene\n\nEach law's residual, worst (median) over every contact "
+         "point of every step, in its own unit; scenes where a backend scored no contact point "
+         "are left out.\n\n" +
          t.markdown() + "\n";
 }
 

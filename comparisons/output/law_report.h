@@ -11,17 +11,23 @@
 
 namespace rbx {
 
-/// report.md's "Contact laws" section: what is measured, then per scene family a table of
-/// every backend in `backends` (points scored, each law's worst and median in its own unit,
-/// the largest relative residual with its law and scene) and the family's figure when
-/// `report_dir`/figures holds it (`figures_ok`). "" when no dynamics run reported contacts.
+/// report.md's "Contact laws" section: what is measured, one table of every backend in
+/// `backends` by scene family (the largest relative residual and its law), and each family's
+/// figure when `report_dir`/figures holds it (`figures_ok`). "" when no dynamics run was scored.
 std::string contact_laws_markdown(const std::vector<Scene>& scenes,
                                   const std::vector<SceneEvaluation>& evs,
                                   const std::vector<std::string>& backends,
                                   const std::string& report_dir, bool figures_ok);
 
-/// details.md's table: every scene and backend with measured residuals, each law's worst and
-/// median; backends that reported no impulses are named. "" when there are none.
+/// details.md's "Contact laws": per scene family a table of every backend (points scored, each
+/// law's worst and median in its own unit, the largest relative residual with its law and
+/// scene; backends that reported no impulses named), then scene_laws_markdown.
+std::string contact_laws_details_markdown(const std::vector<Scene>& scenes,
+                                          const std::vector<SceneEvaluation>& evs,
+                                          const std::vector<std::string>& backends);
+
+/// The table per scene: every scene and backend with scored contact points, each law's worst
+/// and median. "" when there are none.
 std::string scene_laws_markdown(const std::vector<Scene>& scenes,
                                 const std::vector<SceneEvaluation>& evs,
                                 const std::vector<std::string>& backends);

@@ -1,8 +1,10 @@
 #!/usr/bin/python3
-"""Figures of an rbx report: error against run time per family, per-scene velocity bars, and a
-3-D picture of each contact scene with every backend's contact point and normal.
+"""Figures of an rbx report: error against run time per family, the contact-law residuals per
+family (law_plots.py), per-scene velocity bars, and a 3-D picture of each contact scene with
+every backend's contact point and normal.
 
-Usage: plots.py REPORT_DIR  (reads results.json and sweep.csv, writes figures/*.png and *.svg)
+Usage: plots.py REPORT_DIR  (reads results.json, sweep.csv and laws.csv, writes figures/*.png
+and *.svg)
 """
 import csv
 import json
@@ -21,6 +23,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 # One (colour, marker) per backend, the same in every figure (backend_style.py).
 from backend_style import order, save, style  # noqa: E402,F401
+from law_plots import contact_laws  # noqa: E402
 
 
 # Errors below ROUNDOFF are round-off (a few ulps of double precision on unit-sized numbers) and
@@ -371,6 +374,7 @@ def main():
     os.makedirs(out, exist_ok=True)
     results = json.load(open(os.path.join(report, "results.json")))
     error_vs_runtime(report, out)
+    contact_laws(report, out)
     for scene in results["scenes"]:
         if "contact" in scene["checks"]:
             contact_picture(scene, out)

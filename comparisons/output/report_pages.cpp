@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "comparisons/output/backend_style.h"
+#include "comparisons/output/law_report.h"
 #include "comparisons/output/markdown_html.h"
 #include "comparisons/output/report_writer.h"
 #include "comparisons/output/scorecard.h"
@@ -181,11 +182,12 @@ std::string report_summary_markdown(const std::vector<Scene>& scenes,
      << ". Every table in full, and every scene's numbers: [details.md](details.md) "
         "([details.html](details.html)); as data: [metrics.csv](metrics.csv), "
         "[sweep.csv](sweep.csv), [stability.csv](stability.csv), "
-        "[results.json](results.json).\n\n";
+        "[laws.csv](laws.csv), [results.json](results.json).\n\n";
   md << glance_markdown(rows);
   // The causes name one scene each here; details.md names every one.
   md << scorecard_markdown(rows) << causes_markdown(causes, true, in.views_ok);
   md << error_vs_runtime_markdown(evs, in.report_dir, in.figures_ok, in.figures_msg);
+  md << contact_laws_markdown(scenes, evs, cols, in.report_dir, in.figures_ok);
   md << explore_markdown(in.explore, in.explore_set);
   md << in.tosses;
   md << backends_markdown(cols);

@@ -12,6 +12,7 @@
 
 #include "comparisons/eval/budgets.h"
 #include "comparisons/eval/trajectory.h"
+#include "comparisons/output/law_report.h"
 #include "comparisons/output/scorecard.h"
 #include "comparisons/output/table.h"
 #include "engine/format.h"
@@ -21,13 +22,6 @@ namespace fs = std::filesystem;
 namespace rbx {
 
 namespace {
-
-std::string csv_escape(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
 
 // True when one of the lines is about backend `name`.
 bool mentions(const std::vector<std::string>& lines, const std::string& name) {
@@ -497,7 +491,7 @@ std::string report_details_markdown(const std::vector<Scene>& scenes,
         "The summary, its figures and the real tosses are in [report.md](report.md) "
         "([index.html](index.html) as a page); here, every table in full and every scene's "
         "numbers. The same numbers as CSV: [metrics.csv](metrics.csv), [sweep.csv](sweep.csv), "
-        "[stability.csv](stability.csv).\n\n";
+        "[stability.csv](stability.csv), [laws.csv](laws.csv).\n\n";
   std::vector<FailureCause> causes;
   const std::vector<ScoreRow> rows = score_rows(scenes, evs, cols, &causes);
   md << scorecard_markdown(rows) << causes_markdown(causes, false, views_ok);
@@ -505,7 +499,8 @@ std::string report_details_markdown(const std::vector<Scene>& scenes,
      << disagreement_section(scenes, evs, cols);
   if (const std::string q = query_time_markdown(evs, cols); !q.empty())
     md << "## Contact query time\n\n" << q;
-  md << stability_section(scenes, evs) << scene_details_section(scenes, evs, figures_ok, views_ok);
+  md << stability_section(scenes, evs) << contact_laws_details_markdown(scenes, evs, cols)
+     << scene_details_section(scenes, evs, figures_ok, views_ok);
   return md.str();
 }
 
@@ -560,6 +555,7 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
   write_text((tmp / "metrics.csv").string(), metrics.str());
   write_text((tmp / "sweep.csv").string(), sweep.str());
   write_text((tmp / "stability.csv").string(), stab.str());
+  write_text((tmp / "laws.csv").string(), laws_csv(scenes, evs, report_columns(evs)));
 }
 
 bool draw_report_figures(const std::string& dir, std::string& message) {

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "comparisons/eval/law_residuals.h"
 #include "comparisons/output/table.h"
 #include "engine/format.h"
 
@@ -107,6 +108,13 @@ void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, con
     return;
   }
   if (const double v = truth_metric(ev, b, "velocity_err_ke"); v >= 0) row.error.push_back(v);
+  if (const SceneLaws laws = scene_laws(scene, ev, b); laws.measured && laws.contacts > 0) {
+    const auto [law, relative] = worst_relative(laws);
+    if (relative > row.law_relative) {
+      row.law_relative = relative;
+      row.law = to_string(law);
+    }
+  }
   const long steps = scene.sim.steps();
   if (steps > 0 && bj.contains("runtime_s"))
     row.time.push_back(bj["runtime_s"].get<double>() / static_cast<double>(steps));
@@ -185,6 +193,11 @@ std::string ScoreRow::time_text() const {
   // The library's query with its shapes built once, where it has that variant.
   if (!prebuilt.empty()) t += " (" + fmt_num(median_of(prebuilt) * 1e6, 3) + " prebuilt)";
   return t;
+}
+
+std::string ScoreRow::law_text() const {
+  if (law_relative < 0) return "—";
+  return fmt_num(law_relative, 2) + " (" + law + ")";
 }
 
 std::string group_title(const ScoreRow& row) {
@@ -274,19 +287,31 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
         "truth to compare with (the others have none). Run time: median, "
         "wall clock; a library builds its shapes inside each query, custom reuses its hulls; "
         "in brackets the same query with the library's shapes prebuilt, the fair comparison "
-        "with custom.\n\n";
+        "with custom. *Worst contact-law residual* (dynamics): the largest residual of the "
+        "contact laws over the family's scenes, relative to its scene's scale, and its law "
+        "(the \"Contact laws\" section).\n\n";
   for (size_t k = 0; k < rows.size();) {
     size_t end = k;
     while (end < rows.size() && rows[end].family == rows[k].family &&
            rows[end].measure == rows[k].measure)
       ++end;
     md << "### " << md_escape(group_title(rows[k])) << "\n\n";
-    Table t({"rank", "backend", "scenes run", "within tolerance", "median error", "worst error",
-             "median run time"});
-    for (size_t r = k; r < end; ++r)
-      t.add({std::to_string(r - k + 1), "**" + md_escape(rows[r].backend) + "**",
-             std::to_string(rows[r].run), rows[r].within_text(), rows[r].median_text(),
-             rows[r].worst_text(), rows[r].time_text()});
+    // Dynamics groups also show the worst contact-law residual (report.md, "Contact laws").
+    const bool laws = rows[k].measure == Measure::Dynamics;
+    std::vector<std::string> header = {
+        "rank",         "backend",     "scenes run",     "within tolerance",
+        "median error", "worst error", "median run time"};
+    if (laws) header.push_back("worst contact-law residual");
+    Table t(header);
+    for (size_t r = k; r < end; ++r) {
+      std::vector<std::string> cells = {
+          std::to_string(r - k + 1),   "**" + md_escape(rows[r].backend) + "**",
+          std::to_string(rows[r].run), rows[r].within_text(),
+          rows[r].median_text(),       rows[r].worst_text(),
+          rows[r].time_text()};
+      if (laws) cells.push_back(rows[r].law_text());
+      t.add(cells);
+    }
     md << t.markdown() << "\n";
     k = end;
   }

@@ -35,8 +35,14 @@ struct ScoreRow {
   /// Run time (s) per query (contact) or per step (dynamics); prebuilt: the library's shapes
   /// built once (its "prebuilt" variant, where it has one).
   std::vector<double> time, prebuilt;
-  /// The row's cells as text: within tolerance, median and worst error, run time.
-  std::string within_text() const, median_text() const, worst_text() const, time_text() const;
+  /// Dynamics: the largest contact-law residual relative to its scene's scale over the scenes
+  /// (comparisons/eval/law_residuals.h) and its law; negative when none was measured.
+  double law_relative = -1.0;
+  std::string law;
+  /// The row's cells as text: within tolerance, median and worst error, run time, worst
+  /// contact-law residual.
+  std::string within_text() const, median_text() const, worst_text() const, time_text() const,
+      law_text() const;
 };
 
 /// A scene named in a report: FAMILY/NAME and its slug (views/SLUG.html is its replay page).

@@ -12,6 +12,9 @@ namespace rbx {
 /// Text safe inside HTML element content and attribute values (& < > " ').
 std::string html_escape(const std::string& s);
 
+/// A CSV cell: `s` as it is, or quoted (quotes doubled) when it holds a comma, quote or newline.
+std::string csv_escape(const std::string& s);
+
 /// A table with a header row, columns padded to width.
 class Table {
  public:

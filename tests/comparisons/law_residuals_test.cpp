@@ -56,8 +56,8 @@ TEST(ContactLaws, EveryDynamicsBackendReportsImpulsesWithTheContractsSigns) {
   // model (a pyramid, a soft contact) leaves at its median point.
   const Scene scene = load_scene(RBX_SOURCE_DIR "/scenes/friction/incline_slide.toml");
   const double per_point = 9.81 * std::cos(20.0 * M_PI / 180.0) * scene.sim.dt / 4.0;
-  const double flipped = 2.0 * scene.sim.friction * per_point * 0.75 /
-                         law_scales(scene).of(Law::Dissipation);
+  const double flipped =
+      2.0 * scene.sim.friction * per_point * 0.75 / law_scales(scene).of(Law::Dissipation);
   for (const Backend& b : backends()) {
     if (!b.dynamics || b.user) continue;
     SCOPED_TRACE(b.name);
@@ -77,8 +77,8 @@ TEST(ContactLaws, TheCustomEngineObeysThemToRoundOffOnTheFrictionAndRestingScene
   // Its solver stops where these conditions hold; 1e-12 of the scene's scales is round-off of
   // impulses and velocities accumulated over thousands of steps (measured: below 1e-17).
   for (const char* file : {"friction/incline_slide", "friction/incline_stick",
-                           "friction/landing_slide", "friction/spin_to_rest",
-                           "friction/stack_five", "friction/tipping_box", "stress/resting_stack"}) {
+                           "friction/landing_slide", "friction/spin_to_rest", "friction/stack_five",
+                           "friction/tipping_box", "stress/resting_stack"}) {
     SCOPED_TRACE(file);
     const Scene scene = load_scene(std::string(RBX_SOURCE_DIR "/scenes/") + file + ".toml");
     const Relative r = run_relative("custom", scene);
