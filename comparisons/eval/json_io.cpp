@@ -81,7 +81,7 @@ Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsRe
   j["contacts"] = events;
   j["bodies"] = bodies_json(inputs, &r.finals);
   j["first_impulse"] = first_impulse_json(r.first_impulse);
-  j["contact_laws"] = contact_laws_json(r.laws);
+  j["contact_laws"] = contact_laws_json(r);
   // The sampled states (DynamicsOptions::sample_every), frame by frame: one row per body of
   // position (centre of mass) and orientation (w, x, y, z).
   if (!r.samples.empty()) {
@@ -101,8 +101,19 @@ Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsRe
   return j;
 }
 
-Json contact_laws_json(const ContactLaws& laws) {
-  if (!laws.measured) return {{"measured", false}};
+Json contact_laws_json(const DynamicsResult& r) {
+  const ContactLaws& laws = r.laws;
+  if (!laws.measured) {
+    // No impulses: the penetration its events saw at detection is all that can be scored.
+    Json j = {{"measured", false}};
+    if (r.events.empty()) return j;
+    LawTally tally;
+    for (const CollisionEvent& e : r.events) tally.add({e.contact.depth, 0.0, 0.0, 0.0, 0.0});
+    const LawResidual pen = tally.summary().residuals[static_cast<int>(Law::Penetration)];
+    j["contacts"] = static_cast<long>(r.events.size());
+    j["penetration"] = {{"worst", pen.worst}, {"median", pen.median}};
+    return j;
+  }
   Json j = {{"measured", true}, {"contacts", laws.contacts}};
   for (Law law : kAllLaws) {
     const LawResidual& r = laws.residuals[static_cast<int>(law)];

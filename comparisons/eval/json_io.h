@@ -43,9 +43,10 @@ Json settings_json(const Scene& scene);
 Json dynamics_result_json(const std::vector<RigidBody>& inputs, const DynamicsResult& r,
                           double runtime_s);
 
-/// A run's contact-law residuals (reference/contact_laws.h): {"measured": false} when the
-/// backend reported no impulses; else the points scored and each law's worst and median.
-Json contact_laws_json(const ContactLaws& laws);
+/// A run's contact-law residuals (reference/contact_laws.h): the points scored and each law's
+/// worst and median; when the backend reported no impulses, {"measured": false} with, when it
+/// has events, their count as `contacts` and the penetration at their detection.
+Json contact_laws_json(const DynamicsResult& r);
 
 /// What the run's first impulse saw (FirstImpulse), or null when no impulse was applied:
 /// pair, step, contact_points, normal, point, depth, impulse, approach_speed, entry_phase.

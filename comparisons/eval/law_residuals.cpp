@@ -51,9 +51,19 @@ SceneLaws scene_laws(const Scene& scene, const SceneEvaluation& ev, const std::s
   SceneLaws s;
   if (!ev.json.contains("backends") || !ev.json["backends"].contains(backend)) return s;
   const Json& bj = ev.json["backends"][backend];
-  if (!bj.contains("contact_laws") || !bj["contact_laws"].value("measured", false)) return s;
+  if (!bj.contains("contact_laws")) return s;
   const Json& laws = bj["contact_laws"];
   const LawScales scales = law_scales(scene);
+  if (!laws.value("measured", false)) {
+    if (!laws.contains("penetration")) return s;
+    const int pen = static_cast<int>(Law::Penetration);
+    s.penetration_only = true;
+    s.contacts = laws["contacts"].get<long>();
+    s.worst[pen] = laws["penetration"]["worst"].get<double>();
+    s.median[pen] = laws["penetration"]["median"].get<double>();
+    s.relative[pen] = s.worst[pen] / scales.length;
+    return s;
+  }
   s.measured = true;
   s.contacts = laws["contacts"].get<long>();
   for (Law law : kAllLaws) {
@@ -94,6 +104,9 @@ std::vector<LawRow> law_rows(const std::vector<Scene>& scenes,
         const SceneLaws s = scene_laws(scenes[i], ev, b);
         if (!s.measured) {
           ++row.unmeasured;
+          if (s.penetration_only)
+            row.penetration_only =
+                std::max(row.penetration_only, s.relative[static_cast<int>(Law::Penetration)]);
           continue;
         }
         ++row.scenes;

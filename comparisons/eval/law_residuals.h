@@ -31,6 +31,7 @@ LawScales law_scales(const Scene& scene);
 /// object of results.json).
 struct SceneLaws {
   bool measured = false;                 // the backend reported its impulses
+  bool penetration_only = false;         // it did not, yet its events' depths were scored
   long contacts = 0;                     // contact points scored
   std::array<double, kLaws> worst{};     // own units
   std::array<double, kLaws> median{};    // own units
@@ -38,7 +39,7 @@ struct SceneLaws {
 };
 
 /// `backend`'s residuals on the scene of `ev` (`scene` its scene); measured = false when the
-/// backend did not run there or reported no impulses.
+/// backend did not run there or reported no impulses (penetration_only: its events' depths).
 SceneLaws scene_laws(const Scene& scene, const SceneEvaluation& ev, const std::string& backend);
 
 /// The largest relative residual of `s` and its law.
@@ -47,12 +48,13 @@ std::pair<Law, double> worst_relative(const SceneLaws& s);
 /// One backend on one scene family.
 struct LawRow {
   std::string backend, family;
-  int scenes = 0;                              // scenes with measured residuals
-  int unmeasured = 0;                          // scenes it ran without reporting impulses
-  long contacts = 0;                           // points scored, every scene
-  std::array<double, kLaws> worst{};           // own units, the largest over the scenes
-  std::array<double, kLaws> median{};          // own units, the median of the scenes' medians
-  std::array<double, kLaws> relative{};        // the largest relative residual over the scenes
+  int scenes = 0;                        // scenes with measured residuals
+  int unmeasured = 0;                    // scenes it ran without reporting impulses
+  double penetration_only = -1.0;        // their worst relative penetration from events (-1: none)
+  long contacts = 0;                     // points scored, every scene
+  std::array<double, kLaws> worst{};     // own units, the largest over the scenes
+  std::array<double, kLaws> median{};    // own units, the median of the scenes' medians
+  std::array<double, kLaws> relative{};  // the largest relative residual over the scenes
   std::array<std::string, kLaws> worst_scene;  // the scene of each law's largest relative one
 };
 

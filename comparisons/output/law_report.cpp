@@ -17,6 +17,13 @@ std::string worst_median(double worst, double median) {
   return fmt_num(worst, 2) + " (" + fmt_num(median, 2) + ")";
 }
 
+// A row of a backend that reported no impulses: what its events' depths gave, if anything.
+std::string unreported_cell(const LawRow& row) {
+  if (row.penetration_only < 0) return "impulses not reported";
+  return "impulses not reported; from its events, " + fmt_num(row.penetration_only, 2) +
+         " penetration";
+}
+
 // The law of a row's largest relative residual.
 int top_law(const LawRow& row) {
   int top = 0;
@@ -76,7 +83,7 @@ std::string contact_laws_markdown(const std::vector<Scene>& scenes,
       std::string cell = "—";
       for (const LawRow& r : rows)
         if (r.backend == b && r.family == f) {
-          cell = r.scenes == 0 ? std::string("not reported") : worst_cell(r);
+          cell = r.scenes == 0 ? unreported_cell(r) : worst_cell(r);
           any = true;
         }
       cells.push_back(cell);
@@ -111,7 +118,7 @@ std::string contact_laws_details_markdown(const std::vector<Scene>& scenes,
     for (size_t r = k; r < end; ++r) {
       const LawRow& row = rows[r];
       if (row.scenes == 0) {
-        t.add({md_escape(row.backend), std::to_string(row.unmeasured), "—", "impulses not reported",
+        t.add({md_escape(row.backend), std::to_string(row.unmeasured), "—", unreported_cell(row),
                "—", "—", "—", "—", "—"});
         continue;
       }

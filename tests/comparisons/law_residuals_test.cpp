@@ -8,8 +8,10 @@
 
 #include <cmath>
 
+#include "comparisons/eval/json_io.h"
 #include "comparisons/scene/scene_file.h"
 #include "reference/backend.h"
+#include "reference/dynamics_recorder.h"
 
 namespace rbx {
 namespace {
@@ -122,6 +124,35 @@ TEST(LawRows, TakeTheWorstSceneAndTheMedianOfTheScenesMedians) {
   EXPECT_EQ(rows[1].backend, "ode");
   EXPECT_EQ(rows[1].scenes, 0);
   EXPECT_EQ(rows[1].unmeasured, 2);
+}
+
+TEST(ContactLaws, ABackendWithoutImpulsesSaysSoAndKeepsThePenetrationOfItsEvents) {
+  // A researcher's backend that returns events (their depth at detection) and no impulses.
+  const Scene scene = load_scene(RBX_SOURCE_DIR "/scenes/analytic/headon_e05.toml");
+  DynamicsResult r;
+  for (double depth : {0.02, 0.01, 0.0}) {
+    CollisionEvent e;
+    e.body_a = "A";
+    e.body_b = "B";
+    e.contact.depth = depth;
+    r.events.push_back(e);
+  }
+  SceneEvaluation ev;
+  ev.family = "analytic";
+  ev.json["backends"]["mine"] = dynamics_result_json(make_bodies(scene), r, 0.0);
+  const Json& laws = ev.json["backends"]["mine"]["contact_laws"];
+  EXPECT_FALSE(laws["measured"].get<bool>());
+  EXPECT_EQ(laws["contacts"].get<long>(), 3);
+  EXPECT_DOUBLE_EQ(laws["penetration"]["worst"].get<double>(), 0.02);
+  EXPECT_FALSE(laws.contains("cone"));
+  const SceneLaws s = scene_laws(scene, ev, "mine");
+  EXPECT_FALSE(s.measured);
+  EXPECT_TRUE(s.penetration_only);
+  const std::vector<LawRow> rows = law_rows({scene}, {ev}, {"mine"});
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].scenes, 0);
+  EXPECT_EQ(rows[0].unmeasured, 1);
+  EXPECT_DOUBLE_EQ(rows[0].penetration_only, 0.02 / law_scales(scene).length);
 }
 
 }  // namespace
