@@ -164,7 +164,7 @@ std::string laws_csv(const std::vector<Scene>& scenes, const std::vector<SceneEv
     const LawScales scales = law_scales(scenes[i]);
     for (const std::string& b : backends) {
       const SceneLaws s = scene_laws(scenes[i], evs[i], b);
-      if (!s.measured) continue;
+      if (!s.measured || s.contacts == 0) continue;  // nothing scored: no row to plot
       for (Law law : kAllLaws) {
         const int l = static_cast<int>(law);
         csv << csv_escape(scenes[i].name) << "," << csv_escape(evs[i].family) << "," << b << ","

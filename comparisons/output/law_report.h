@@ -33,7 +33,7 @@ std::string scene_laws_markdown(const std::vector<Scene>& scenes,
                                 const std::vector<std::string>& backends);
 
 /// laws.csv: scene, family, backend, law, unit, worst, median, scale, relative (worst / scale),
-/// contacts; one row per measured (scene, backend, law).
+/// contacts; one row per (scene, backend, law) with scored contact points.
 std::string laws_csv(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs,
                      const std::vector<std::string>& backends);
 
