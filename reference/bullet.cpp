@@ -323,49 +323,15 @@ BulletBody make_bullet_body(const RigidBody& rb, int i, const Scene& scene,
   return bb;
 }
 
-/// Events of step `k` (time step dt): manifold points the solver used this step with a
-/// positive impulse, appended to `events`. Points beyond the processing threshold were not
-/// solved and may keep an old impulse.
-void read_events(const btCollisionDispatcher& dispatcher, long k, double dt,
-                 const std::vector<std::string>& names, const std::vector<BulletBody>& bodies,
-                 const BulletSettings& settings, std::vector<CollisionEvent>& events) {
-  for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
-    const btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
-    int i0 = manifold->getBody0()->getUserIndex();
-    int i1 = manifold->getBody1()->getUserIndex();
-    for (int p = 0; p < manifold->getNumContacts(); ++p) {
-      const btManifoldPoint& cp = manifold->getContactPoint(p);
-      if (cp.getAppliedImpulse() <= 0 ||
-          cp.getDistance() > manifold->getContactProcessingThreshold())
-        continue;
-      CollisionEvent ev;
-      ev.time = k * dt;  // detection runs at the start-of-step poses
-      ev.step = k;
-      // Normal from body 1 toward body 0; order the pair by scene index.
-      Vec3 n = from_bt(cp.m_normalWorldOnB).normalized();
-      int ia = i0, ib = i1;
-      if (ia > ib) {
-        std::swap(ia, ib);
-        n = -n;
-      }
-      ev.body_a = names[ia];
-      ev.body_b = names[ib];
-      ev.contact.normal = n;
-      ev.contact.depth = std::max(0.0, -static_cast<double>(cp.getDistance()));
-      ev.contact.point =
-          0.5 * (from_bt(cp.getPositionWorldOnA()) + from_bt(cp.getPositionWorldOnB()));
-      ev.contact.feature = pair_feature(bodies[i0].box, bodies[i1].box, settings);
-      ev.impulse = cp.getAppliedImpulse();  // N s, along the normal
-      events.push_back(ev);
-    }
-  }
-}
-
-/// Every manifold point the solver used this step (within the processing threshold), with the
-/// impulse it applied to body A: the normal impulse and the friction impulses along Bullet's
-/// lateral directions (the second only when the solver runs two), given to `recorder`.
-void record_contacts(const btCollisionDispatcher& dispatcher, const btContactSolverInfo& info,
-                     DynamicsRecorder& recorder) {
+/// Step `k` (time step dt) as the solver left it: every manifold point it used (within the
+/// processing threshold; points beyond it were not solved and may keep an old impulse), given
+/// to `recorder` with the impulse it applied to body A (the normal impulse and the friction
+/// impulses along Bullet's lateral directions, the second only when the solver runs two); those
+/// with a positive normal impulse are also the step's events, appended to `events`.
+void read_step(const btCollisionDispatcher& dispatcher, const btContactSolverInfo& info, long k,
+               double dt, const std::vector<std::string>& names,
+               const std::vector<BulletBody>& bodies, const BulletSettings& settings,
+               std::vector<CollisionEvent>& events, DynamicsRecorder& recorder) {
   const bool two_directions = (info.m_solverMode & SOLVER_USE_2_FRICTION_DIRECTIONS) != 0;
   for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
     const btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
@@ -374,7 +340,8 @@ void record_contacts(const btCollisionDispatcher& dispatcher, const btContactSol
     for (int p = 0; p < manifold->getNumContacts(); ++p) {
       const btManifoldPoint& cp = manifold->getContactPoint(p);
       if (cp.getDistance() > manifold->getContactProcessingThreshold()) continue;
-      // On body 0: the normal (from body 1 toward body 0) and friction impulses.
+      // On body 0: the normal (from body 1 toward body 0) and friction impulses; the pair is
+      // ordered by scene index.
       Vec3 n = from_bt(cp.m_normalWorldOnB).normalized();
       Vec3 impulse = cp.getAppliedImpulse() * n +
                      cp.m_appliedImpulseLateral1 * from_bt(cp.m_lateralFrictionDir1);
@@ -392,6 +359,18 @@ void record_contacts(const btCollisionDispatcher& dispatcher, const btContactSol
       c.depth = std::max(0.0, -static_cast<double>(cp.getDistance()));
       c.impulse = impulse;
       recorder.contact_at_start(c);
+      if (cp.getAppliedImpulse() <= 0) continue;
+      CollisionEvent ev;
+      ev.time = k * dt;  // detection runs at the start-of-step poses
+      ev.step = k;
+      ev.body_a = names[c.a];
+      ev.body_b = names[c.b];
+      ev.contact.normal = c.normal;
+      ev.contact.depth = c.depth;
+      ev.contact.point = c.point;
+      ev.contact.feature = pair_feature(bodies[i0].box, bodies[i1].box, settings);
+      ev.impulse = cp.getAppliedImpulse();  // N s, along the normal
+      events.push_back(ev);
     }
   }
 }
@@ -464,11 +443,11 @@ DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
       // One internal step of exactly dt (maxSubSteps = 0: no fixed 1/60 s sub-stepping and no
       // interpolated motion states).
       world.stepSimulation(dt, 0, dt);
-      read_events(dispatcher, k, dt, names, bodies, settings, result.events);
+      read_step(dispatcher, world.getSolverInfo(), k, dt, names, bodies, settings, result.events,
+                recorder);
       // The first impulse: one event per manifold point, so the count is the events'.
       recorder.first_impulse_from_step(result.events, dt);
       check_finite(bodies, names, k);
-      record_contacts(dispatcher, world.getSolverInfo(), recorder);
       recorder.after_step(k + 1, (k + 1) * dt);
     }
     recorder.finish_laws();
