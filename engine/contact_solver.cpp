@@ -128,7 +128,8 @@ struct ActiveSet {
   std::vector<RigidBody>& bodies;
   const std::vector<BodyInverse>& inv;
   std::vector<Row>& rows;
-  const double mu, tolerance;
+  const double mu, base_tolerance;
+  double tolerance;         // m/s: base_tolerance, or the last guess's round-off if larger
   const int per;            // unknowns per row: 3 with friction (n, t1, t2), else 1
   const size_t m;           // rows
   const Eigen::Index size;  // per * m
@@ -145,6 +146,7 @@ ActiveSet::ActiveSet(std::vector<RigidBody>& bodies_in, const std::vector<BodyIn
       inv(inv_in),
       rows(rows_in),
       mu(mu_in),
+      base_tolerance(tolerance_in),
       tolerance(tolerance_in),
       per(mu_in > 0.0 ? 3 : 1),
       m(rows_in.size()),
@@ -212,6 +214,7 @@ double ActiveSet::solve_guess(Eigen::Index& worst) {
   worst = -1;
   x.setZero();
   if (equations.empty()) {
+    tolerance = base_tolerance;
     w = -b;
     return 0.0;
   }
@@ -223,9 +226,20 @@ double ActiveSet::solve_guess(Eigen::Index& worst) {
     A.row(q) = KE.row(equations[q]);
     rhs(q) = b(equations[q]);
   }
-  const Eigen::VectorXd y = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(A).solve(rhs);
+  // One step of iterative refinement: the residual of the first solve, solved again and added,
+  // takes the answer's round-off from cond(A) ulps down to a few.
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
+  Eigen::VectorXd y = cod.solve(rhs);
+  y += cod.solve(rhs - A * y);
   x = E.leftCols(unknowns) * y;
   w = K * x - b;
+  // Each equation K x - b sums `size` terms K_qj x_j and b_q, which cancel at a resting stack
+  // (the weight above a box pressing down, the floor pressing up); the rounding bound of such a
+  // sum, size * eps * (sum |K_qj x_j| + |b_q|) (Higham's gamma_n), is the finest test the answer
+  // can pass.
+  tolerance =
+      std::max(base_tolerance, static_cast<double>(size) * std::numeric_limits<double>::epsilon() *
+                                   (K.cwiseAbs() * x.cwiseAbs() + b.cwiseAbs()).maxCoeff());
   Eigen::Index q = 0;
   const double residual = (A * y - rhs).cwiseAbs().maxCoeff(&q);
   worst = equations[q];
@@ -299,8 +313,9 @@ bool ActiveSet::drop_assumption(Eigen::Index worst) {
 }
 
 // Corrects the guess where the answer breaks it: a sticking point whose impulse pulls or leaves
-// its cone slides against that impulse; a sliding one that pulls separates; a separating one
-// that goes below its target is pressed, sliding if it slips. Returns whether anything changed.
+// its cone slides against that impulse; a sliding one that pulls separates, one whose slip
+// reversed sticks; a separating one that goes below its target is pressed, sliding if it slips.
+// Returns whether anything changed.
 bool ActiveSet::correct_guess() {
   bool changed = false;
   for (size_t i = 0; i < m; ++i) {
@@ -321,6 +336,10 @@ bool ActiveSet::correct_guess() {
       }
     } else if (jn < 0.0) {
       mode[i] = Mode::Separate;
+    } else if (vt.norm() <= tolerance) {
+      // Stopped with the friction at the cone's edge: sticking at the most the cone allows, a
+      // valid answer (v_t = 0, |j_t| = mu j_n); calling it sticking instead made the guess cycle
+      // (the least-norm sticking answer leaves the cone, which slides it again).
     } else if (!(vt.dot(slip[i]) > tolerance)) {
       mode[i] = Mode::Stick;  // stopped or reversed: try it sticking
     } else if (std::abs(slip[i].x() * vt.y() - slip[i].y() * vt.x()) > tolerance) {
@@ -366,7 +385,7 @@ bool solve_active_set(std::vector<RigidBody>& bodies, const std::vector<BodyInve
     Eigen::Index worst = -1;
     double residual = problem.solve_guess(worst);
     residual = problem.settle_slip_directions(residual, worst);
-    if (!(residual <= tolerance)) {
+    if (!(residual <= problem.tolerance)) {
       if (!problem.drop_assumption(worst)) return false;
       continue;
     }
@@ -394,6 +413,7 @@ struct IslandSolver {
 
   double normal_sweep();
   double friction_sweep();
+  void rescale();
   void unknowns(bool friction, std::vector<double>& out) const;
   double sweeps_to_bound(bool friction, const std::vector<double>& d) const;
   void take_drift(bool friction, const std::vector<double>& d, double count);
@@ -409,6 +429,7 @@ struct IslandSolver {
   const ContactSolverSettings& settings;
   SolverWork& work;
   const double mu;
+  double speed_scale = 0.0;                     // m/s, the largest speed in the problem
   double converged = 0.0;                       // m/s, the convergence test's threshold
   std::vector<double> before, after, d, drift;  // the stages' buffers, kept across sweeps
   std::vector<int> involved;                    // the bodies in the problem
@@ -426,11 +447,8 @@ IslandSolver::IslandSolver(std::vector<RigidBody>& bodies_in,
       settings(settings_in),
       work(work_in),
       mu(settings_in.friction) {
-  double speed_scale = 0.0;  // m/s, the largest speed in the problem
   for (const Row& r : rows) speed_scale = std::max(speed_scale, r.speed);
-  // Converged: a sweep that changes no point's velocity by more than `convergence` of the
-  // problem's speed is a fixed point to round-off (see ContactSolverSettings).
-  converged = settings.tunables.convergence * std::max(speed_scale, 1e-300);
+  rescale();
   // The bodies in the problem and their start, for the energy guard.
   for (const Row& r : rows)
     for (int i : {r.a, r.b})
@@ -533,6 +551,18 @@ void IslandSolver::take_drift(bool friction, const std::vector<double>& dd, doub
   }
 }
 
+// Converged: a sweep that changes no point's velocity by more than `convergence` of the
+// problem's speeds is a fixed point to round-off (see ContactSolverSettings). The speeds are the
+// bodies' at the start and the velocity change each accumulated impulse alone gives its point
+// (j_n k_n): under a resting stack those are much larger than the motion and cancel, and every
+// impulse applied rounds the velocities by ulps of them.
+void IslandSolver::rescale() {
+  double scale = speed_scale;
+  for (const Row& r : rows)
+    scale = std::max({scale, std::abs(r.jn) / r.normal_mass_inv, r.jt.norm() * r.kt_max});
+  converged = settings.tunables.convergence * std::max(scale, 1e-300);
+}
+
 // Sweeps of one stage until converged; returns how many changed something.
 // Steady drift: where the targets are inconsistent with the bodies' degrees of freedom (four
 // points of a face, three of them free; some get a restitution target and some rest), the
@@ -546,6 +576,7 @@ void IslandSolver::take_drift(bool friction, const std::vector<double>& dd, doub
 int IslandSolver::stage(bool friction) {
   const WorldSettings& tun = settings.tunables;
   int moving = 0;
+  rescale();
   unknowns(friction, before);
   drift.clear();
   const bool budgeted = tun.sweep_budget > 0;

@@ -60,7 +60,8 @@ std::vector<PairManifold> ExtendedStep::detect_manifolds(WorldState& world) {
     const RigidBody &a = world.bodies[pair.first], &b = world.bodies[pair.second];
     if (a.is_static && b.is_static) continue;
     if (separated(world, pair.first, pair.second)) continue;  // the detector would find nothing
-    auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant);
+    auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant,
+                            world.tunables.position_slop);
     if (m) manifolds.push_back({pair.first, pair.second, std::move(*m), a.pose(), b.pose()});
   }
   return manifolds;
@@ -210,7 +211,8 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
     RigidBody &a = world.bodies[i], &b = world.bodies[j];
     a = advanced(a, t);
     b = advanced(b, t);
-    if (auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant)) {
+    if (auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant,
+                                world.tunables.position_slop)) {
       const std::vector<PairManifold> one = {{i, j, std::move(*m), a.pose(), b.pose()}};
       const auto approach = normal_velocities(world.bodies, one);
       // Every impact here is a collision: its event whatever its approach speed.

@@ -52,11 +52,81 @@ bool crossing(const Vec3& p0, const Vec3& d0, const Vec3& q0, const Vec3& d1, Ve
   return true;
 }
 
+// The points that span the contact region: the corners of its outline in the contact plane.
+// Departure from collecting every point: a point inside the outline, or within `slack` of the
+// line through its two neighbours on it, adds no contact wrench the others cannot give (normal
+// velocity and a rigid body's wrench are affine in the point, so a point that is a mix of
+// others is redundant), but it adds a nearly dependent row to the solve: a cube turned by
+// 1e-6 rad on another gives an octagon whose corners come in pairs 1e-6 apart, whose rows the
+// solver cannot tell apart to round-off. The corners are found on the plane's coordinates by
+// Andrew's monotone chain; then the corner nearest the line of its neighbours is dropped while
+// it is within `slack`. A region within `slack` of a segment keeps its two ends; of a point,
+// its deepest point.
+std::vector<ManifoldPoint> support_corners(const std::vector<ManifoldPoint>& pts, const Vec3& n,
+                                           double slack) {
+  if (pts.size() <= 1) return pts;
+  const Vec3 t1 = (std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+  const Vec3 t2 = n.cross(t1);
+  struct Planar {
+    double u, v;
+    size_t index;
+  };
+  std::vector<Planar> q;
+  for (size_t i = 0; i < pts.size(); ++i)
+    q.push_back({pts[i].point.dot(t1), pts[i].point.dot(t2), i});
+  std::sort(q.begin(), q.end(), [](const Planar& a, const Planar& b) {
+    return a.u < b.u || (a.u == b.u && (a.v < b.v || (a.v == b.v && a.index < b.index)));
+  });
+  auto cross = [](const Planar& o, const Planar& a, const Planar& b) {
+    return (a.u - o.u) * (b.v - o.v) - (a.v - o.v) * (b.u - o.u);
+  };
+  // Lower and upper chains, counter-clockwise, collinear points dropped.
+  std::vector<Planar> hull;
+  for (int pass = 0; pass < 2; ++pass) {
+    const size_t base = hull.size();
+    for (const Planar& p : q) {
+      while (hull.size() >= base + 2 && cross(hull[hull.size() - 2], hull.back(), p) <= 0.0)
+        hull.pop_back();
+      hull.push_back(p);
+    }
+    hull.pop_back();  // each chain's last point starts the other
+    std::reverse(q.begin(), q.end());
+  }
+  // Corners within `slack` of the line through their neighbours, nearest first.
+  auto off_line = [&](size_t k) {
+    const Planar &a = hull[(k + hull.size() - 1) % hull.size()], &b = hull[(k + 1) % hull.size()];
+    const double length = std::hypot(b.u - a.u, b.v - a.v);
+    if (!(length > 0.0)) return std::hypot(hull[k].u - a.u, hull[k].v - a.v);
+    return std::abs(cross(a, b, hull[k])) / length;
+  };
+  while (hull.size() > 2) {
+    size_t nearest = 0;
+    for (size_t k = 1; k < hull.size(); ++k)
+      if (off_line(k) < off_line(nearest)) nearest = k;
+    if (!(off_line(nearest) <= slack)) break;
+    hull.erase(hull.begin() + static_cast<std::ptrdiff_t>(nearest));
+  }
+  if (hull.size() == 1 ||
+      (hull.size() == 2 && std::hypot(hull[1].u - hull[0].u, hull[1].v - hull[0].v) <= slack)) {
+    // A region within `slack` of a point: its deepest point.
+    const auto deepest = std::max_element(
+        pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.depth < b.depth; });
+    return {*deepest};
+  }
+  // In the order the points were found (deterministic, and the solver sweeps in that order).
+  std::vector<size_t> kept;
+  for (const Planar& p : hull) kept.push_back(p.index);
+  std::sort(kept.begin(), kept.end());
+  std::vector<ManifoldPoint> out;
+  for (size_t i : kept) out.push_back(pts[i]);
+  return out;
+}
+
 }  // namespace
 
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
                                               const ConvexPolyhedron& b, const Pose& pb,
-                                              DetectorVariant variant) {
+                                              DetectorVariant variant, double support_slack) {
   const auto hit = detect(a, pa, b, pb, variant);
   if (!hit) return std::nullopt;
   ContactManifold m;
@@ -133,6 +203,8 @@ std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const P
     });
     if (!dup) m.points.push_back(p);
   }
+  // The corners of the region, to the slack the position projection leaves alone.
+  m.points = support_corners(m.points, n, support_slack * std::min(shape_size(a), shape_size(b)));
   if (m.points.empty()) m.points.push_back({hit->point, m.depth});
   // No point is deeper than the shapes overlap.
   for (ManifoldPoint& p : m.points) p.depth = std::min(p.depth, m.depth);

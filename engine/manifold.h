@@ -17,6 +17,7 @@
 #include "engine/contact.h"
 #include "engine/detect.h"
 #include "engine/polyhedron.h"
+#include "engine/settings.h"
 
 namespace rbx {
 
@@ -40,10 +41,14 @@ struct ContactManifold {
 /// shape inside the other (point_in_mesh with point_in_mesh_tolerance) and the edge-edge crossings
 /// whose midpoint lies in both shapes. Edges between two coplanar triangles (a face's triangulation
 /// diagonal) are not edges of the solid and are skipped. Points closer than 1e-7 of the larger
-/// shape's size are merged. When no point qualifies (a face centroid inside, no vertex), the
-/// detector's point is the manifold.
+/// shape's size are merged. Of the rest only the corners of the region they span in the contact
+/// plane are kept: a point inside it, or within `support_slack` (relative to the smaller shape's
+/// size) of the line through its neighbours on its outline, is dropped (it adds no contact wrench
+/// the corners cannot give; engine/manifold.cpp, support_corners). When no point qualifies (a face
+/// centroid inside, no vertex), the detector's point is the manifold.
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
                                               const ConvexPolyhedron& b, const Pose& pb,
-                                              DetectorVariant variant);
+                                              DetectorVariant variant,
+                                              double support_slack = WorldSettings{}.position_slop);
 
 }  // namespace rbx

@@ -56,6 +56,50 @@ TEST(Manifold, CrossedEdgesGiveTheirCrossing) {
   EXPECT_NEAR(std::abs(m->normal.z()), 1.0, 1e-12);
 }
 
+TEST(Manifold, ACubeTurnedAMicroradianKeepsTheFourCornersOfItsFace) {
+  // A unit cube turned 1e-6 rad about z, 1 mm into another: the region is an octagon whose
+  // corners come in pairs ~5e-7 m apart; within the slack (1e-4 of the size) of the line through
+  // their neighbours, one of each pair goes, and the four left are the square's corners to 1e-6.
+  const ConvexPolyhedron cube = make_box(Vec3::Ones());
+  const Pose pa = at(Vec3(0, 0, 0.999), Quat(Eigen::AngleAxisd(1e-6, Vec3::UnitZ())));
+  const auto m = build_manifold(cube, pa, cube, at(Vec3::Zero()), DetectorVariant::Faithful);
+  ASSERT_TRUE(m);
+  ASSERT_EQ(m->points.size(), 4u);
+  for (const ManifoldPoint& p : m->points) {
+    EXPECT_NEAR(std::abs(p.point.x()), 0.5, 1e-6);
+    EXPECT_NEAR(std::abs(p.point.y()), 0.5, 1e-6);
+  }
+  // With no slack the octagon's eight corners stay.
+  EXPECT_EQ(build_manifold(cube, pa, cube, at(Vec3::Zero()), DetectorVariant::Faithful, 0.0)
+                ->points.size(),
+            8u);
+}
+
+TEST(Manifold, ACubeTurned45DegreesKeepsItsOctagon) {
+  // Turned 45 deg, the octagon is the region itself: no corner is near its neighbours' line.
+  const ConvexPolyhedron cube = make_box(Vec3::Ones());
+  const Pose pa = at(Vec3(0, 0, 0.999), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ())));
+  const auto m = build_manifold(cube, pa, cube, at(Vec3::Zero()), DetectorVariant::Faithful);
+  ASSERT_TRUE(m);
+  EXPECT_EQ(m->points.size(), 8u);
+}
+
+TEST(Manifold, APointInsideTheRegionIsLeftOut) {
+  // A unit cube corner-down, 0.766 m into a slab: its lowest corner and the three next to it
+  // are inside; seen along the normal the lowest lies inside the triangle of the other three,
+  // so it adds no wrench they cannot give (with any slack, even none), and the three are the
+  // manifold, each 0.5 / sqrt(3) below the centre.
+  const Quat q = Quat(Eigen::AngleAxisd(std::atan(std::sqrt(2.0)), Vec3(1, -1, 0).normalized()));
+  const ConvexPolyhedron cube = make_box(Vec3::Ones()), slab = make_box(Vec3(4, 4, 1));
+  const Pose pa = at(Vec3(0, 0, 0.1), q), pb = at(Vec3(0, 0, -0.5));
+  const auto m = build_manifold(cube, pa, slab, pb, DetectorVariant::Faithful);
+  ASSERT_TRUE(m);
+  EXPECT_NEAR(std::abs(m->normal.z()), 1.0, 1e-12);
+  ASSERT_EQ(m->points.size(), 3u);
+  for (const ManifoldPoint& p : m->points)
+    EXPECT_NEAR(p.point.z(), 0.1 - 0.5 / std::sqrt(3.0), 1e-12);
+}
+
 TEST(Manifold, NothingWhenApart) {
   const ConvexPolyhedron cube = make_box(Vec3::Ones());
   EXPECT_FALSE(build_manifold(cube, at(Vec3(0, 0, 1.01)), cube, at(Vec3::Zero()),
