@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/result_cache.h"
@@ -227,16 +228,19 @@ CheckDiff diff_check(const Json& base, const CheckRun& run, const CheckSettings&
 
 Json merged_baseline(const Json& base, const CheckRun& run, const CheckSettings& set, bool whole,
                      int& kept) {
-  // Metrics of scenes (and, with --backends, backends) not in this run stay as they were.
-  Json metrics = Json::object();
+  // Metrics of scenes (and, with --backends, backends) not in this run stay as they were; all
+  // in key order, so that a partial update changes only the lines of the metrics it changed.
+  std::map<std::string, Json> sorted;
   kept = 0;
   for (const auto& [k, v] : base["metrics"].items()) {
     const KeyParts p = parse_key(k);
     if (run.scene_in_run.count(p.scene) && set.selected(p.backend)) continue;
-    metrics[k] = v;
+    sorted[k] = v;
     ++kept;
   }
-  for (const auto& [k, v] : run.now) metrics[k] = v;
+  for (const auto& [k, v] : run.now) sorted[k] = v;
+  Json metrics = Json::object();
+  for (const auto& [k, v] : sorted) metrics[k] = v;
   Json b;
   b["about"] = "rbx check baseline: accuracy metrics (names with err) per scene, check, backend";
   // The run time is that of a whole-library run; a partial update keeps the recorded one.

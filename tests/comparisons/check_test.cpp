@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -163,6 +164,12 @@ TEST(Check, BackendsLimitTheComparisonAndUpdateMergesOnlyWhatRan) {
   EXPECT_EQ(after["metrics"][bullet_key], -1.0);
   EXPECT_EQ(after["metrics"]["other/not_run | contact | fcl | A-B | depth_err"], 0.25);
   EXPECT_EQ(after["metrics"].size(), b["metrics"].size());
+  // In key order whatever was merged, so that a partial update changes only its own lines.
+  nlohmann::ordered_json in_order;
+  std::ifstream(opt.baseline) >> in_order;
+  std::vector<std::string> keys;
+  for (const auto& [k, v] : in_order["metrics"].items()) keys.push_back(k);
+  EXPECT_TRUE(std::is_sorted(keys.begin(), keys.end()));
   fs::remove_all(dir);
 }
 
