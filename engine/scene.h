@@ -117,6 +117,14 @@ struct Expect {
 };
 
 /// A whole scene.
+/// A scene's [ensemble] table: its nudged copies belong in the report's Predictability section
+/// (comparisons/eval/ensemble.h has what an ensemble measures).
+struct EnsembleSpec {
+  long count = 50;         // copies, >= 2
+  bool step_test = false;  // also every copy at a ten times smaller step
+  double duration = 0.0;   // s: > 0, the copies run this long (whole steps); 0, the scene's
+};
+
 struct Scene {
   std::string name;
   std::string description;
@@ -131,6 +139,7 @@ struct Scene {
   SimSettings sim;
   std::vector<BodySpec> bodies;
   std::optional<Expect> expect;
+  std::optional<EnsembleSpec> ensemble;  // [ensemble]: in the report's Predictability section
 
   /// True when `checks` holds c.
   bool has_check(CheckKind c) const;

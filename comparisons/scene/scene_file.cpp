@@ -335,6 +335,33 @@ Expect read_expect(const Reader& r, const toml::table& t, const std::vector<Body
   return e;
 }
 
+// [ensemble]: the copies the report runs for its Predictability section.
+EnsembleSpec read_ensemble(const Reader& r, const toml::table& t, const SimSettings& sim) {
+  EnsembleSpec e;
+  r.check_keys(t, "ensemble.", keys_under("ensemble."), false);
+  if (const toml::node* n = t.get("count")) {
+    e.count = r.integer(*n, "ensemble.count", "ensemble.count");
+    if (e.count < 2)
+      r.fail(line_of(n), "ensemble.count",
+             "must be at least 2 copies, got " + std::to_string(e.count), "write e.g. count = 50");
+  }
+  if (const toml::node* n = t.get("step_test"))
+    e.step_test = r.boolean(*n, "ensemble.step_test", "ensemble.step_test");
+  if (const toml::node* n = t.get("duration")) {
+    e.duration = r.number(*n, "ensemble.duration", "ensemble.duration");
+    // Whole steps of the scene's step, to 1e-9 of the count (as sim.duration).
+    const double steps = e.duration / sim.dt;
+    if (!(e.duration > 0 && e.duration <= sim.duration) ||
+        std::abs(steps - std::round(steps)) > 1e-9 * std::max(1.0, steps))
+      r.fail(line_of(n), "ensemble.duration",
+             "must be > 0, at most the scene's duration " + num(sim.duration) +
+                 " s and a whole number of steps of dt = " + num(sim.dt) + " s, got " +
+                 num(e.duration),
+             "write e.g. duration = " + num(sim.duration / 4) + ", or leave it out");
+  }
+  return e;
+}
+
 // True when the text holds nothing but blanks and comments.
 bool blank(const std::string& text) {
   std::istringstream in(text);
@@ -425,13 +452,24 @@ Scene parse_scene(const std::string& text, const std::string& path,
 
   if (const toml::node* n = root.get("expect"))
     scene.expect = read_expect(r, r.table(*n, "expect"), scene.bodies);
+  if (const toml::node* n = root.get("ensemble"))
+    scene.ensemble = read_ensemble(r, r.table(*n, "ensemble"), scene.sim);
   // [expect] is the closed form of the physics the file describes: an override of that physics
   // (a body, gravity, restitution, friction, the duration it is judged at) sets it aside, to be
   // reported as not checked with the key that changed it. A step size, the integrator, the
   // checks, the backends or the expectation itself leave it standing.
-  static const std::vector<std::string> kKeepExpect = {
-      "sim.dt", "sim.sweep_dt", "sim.integrator", "sim.max_energy_ratio", "name", "description",
-      "checks", "backends",     "force"};
+  static const std::vector<std::string> kKeepExpect = {"sim.dt",
+                                                       "sim.sweep_dt",
+                                                       "sim.integrator",
+                                                       "sim.max_energy_ratio",
+                                                       "name",
+                                                       "description",
+                                                       "checks",
+                                                       "backends",
+                                                       "force",
+                                                       "ensemble.count",
+                                                       "ensemble.step_test",
+                                                       "ensemble.duration"};
   if (scene.expect)
     for (const std::string& key : r.overridden_keys())
       if (!starts_with(key, "expect.") &&

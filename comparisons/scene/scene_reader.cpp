@@ -60,6 +60,9 @@ const KeyInfo kKeys[] = {
     {"expect.contact.either_sign", "true"},
     {"expect.contact.depth", "0.1"},
     {"expect.contact.point", "[0, 0, 0]"},
+    {"ensemble.count", "50"},
+    {"ensemble.step_test", "true"},
+    {"ensemble.duration", "0.5"},
 };
 
 }  // namespace

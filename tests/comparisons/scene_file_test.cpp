@@ -573,8 +573,30 @@ TEST(SceneFile, KeysListEveryLevel) {
   const auto& keys = scene_keys();
   for (const char* k :
        {"name", "checks", "sim.dt", "sim.max_energy_ratio", "body.mass", "body.orientation",
-        "expect.tolerance", "expect.body.velocity", "expect.contact.depth"})
+        "expect.tolerance", "expect.body.velocity", "expect.contact.depth", "ensemble.count",
+        "ensemble.step_test", "ensemble.duration"})
     EXPECT_NE(std::find(keys.begin(), keys.end(), k), keys.end()) << k;
+}
+
+TEST(SceneFile, EnsembleTableIsReadWithItsDefaults) {
+  // No table: no ensemble; an empty one: 50 copies, no step test, the scene's duration.
+  const std::string body = "[sim]\nduration = 2\n\n[[body]]\nname = \"A\"\n";
+  EXPECT_FALSE(parse_scene(body, "t.toml").ensemble);
+  const Scene plain = parse_scene("[ensemble]\n" + body, "t.toml");
+  ASSERT_TRUE(plain.ensemble);
+  EXPECT_EQ(plain.ensemble->count, 50);
+  EXPECT_FALSE(plain.ensemble->step_test);
+  EXPECT_EQ(plain.ensemble->duration, 0.0);
+  const Scene set =
+      parse_scene("[ensemble]\ncount = 7\nstep_test = true\nduration = 0.5\n" + body, "t.toml");
+  ASSERT_TRUE(set.ensemble);
+  EXPECT_EQ(set.ensemble->count, 7);
+  EXPECT_TRUE(set.ensemble->step_test);
+  EXPECT_EQ(set.ensemble->duration, 0.5);
+  // Like every key, settable from the command line; it leaves [expect] standing.
+  const Scene over = parse_scene("[ensemble]\n" + body, "t.toml", {"ensemble.count=9"});
+  EXPECT_EQ(over.ensemble->count, 9);
+  EXPECT_TRUE(over.expect_set_aside_by.empty());
 }
 
 // ---- convex hulls (Qhull) ----------------------------------------------------------------------
