@@ -9,6 +9,7 @@
 #include <mutex>
 
 #include "comparisons/cli/commands.h"
+#include "comparisons/eval/ensemble.h"
 #include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/parallel.h"
 #include "comparisons/eval/scene_batch.h"
@@ -68,6 +69,8 @@ int report_command(const ReportOptions& opt) {
     progress.show(++finished, scenes.size(), scenes[i].file, clock.seconds());
   });
   progress.done();
+  // The Predictability section: the nudged copies of every scene with an [ensemble] table.
+  run_scene_ensembles(scenes, opt.backends, evs, par);
   // Explore's fixed random samples (the whole library, or --explore), on every rank.
   SummaryInputs in;
   if (opt.explore || opt.inputs.empty()) {

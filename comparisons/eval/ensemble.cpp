@@ -8,6 +8,7 @@
 
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/explore.h"
+#include "comparisons/eval/select_backends.h"
 #include "reference/result_codec.h"
 
 namespace rbx {
@@ -264,6 +265,7 @@ EnsembleResult run_ensemble(const Scene& scene, const std::vector<std::string>& 
   r.file = scene.file;
   r.settings = settings;
   r.dt = scene.sim.dt;
+  r.duration = scene.sim.duration;
   const size_t copies = static_cast<size_t>(std::max(0L, settings.count));
   const size_t steps = settings.step_test ? 2 : 1;
   // The input spread: every copy's nudged initial state, as the engine's bodies (centre of mass).
@@ -345,6 +347,7 @@ Json ensemble_json(const EnsembleResult& r, const std::vector<EnsembleResult>& s
   doc["count"] = r.settings.count;
   doc["seed"] = r.settings.seed;
   doc["dt"] = r.dt;
+  doc["duration"] = r.duration;
   doc["perturb"] = Json{{"position", r.settings.nudge.position},
                         {"orientation", r.settings.nudge.orientation},
                         {"velocity", r.settings.nudge.velocity},
@@ -388,6 +391,23 @@ Json ensemble_json(const EnsembleResult& r, const std::vector<EnsembleResult>& s
     doc["nudge_sizes"] = rows;
   }
   return doc;
+}
+
+void run_scene_ensembles(const std::vector<Scene>& scenes, const std::string& backends,
+                         std::vector<SceneEvaluation>& evs, const ParallelRun& par) {
+  for (size_t i = 0; i < scenes.size(); ++i) {
+    if (!scenes[i].ensemble) continue;
+    const std::vector<std::string> names =
+        select_backends(scenes[i], backends, Capability::Dynamics);
+    if (names.empty()) continue;
+    EnsembleSettings settings;
+    settings.count = scenes[i].ensemble->count;
+    settings.step_test = scenes[i].ensemble->step_test;
+    Scene scene = scenes[i];
+    if (scene.ensemble->duration > 0) scene.sim.duration = scene.ensemble->duration;
+    const EnsembleResult r = run_ensemble(scene, names, settings, par);
+    if (par.root() && i < evs.size()) evs[i].json["ensemble"] = ensemble_json(r);
+  }
 }
 
 }  // namespace rbx

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "comparisons/eval/harness.h"
 #include "comparisons/eval/json_io.h"
 #include "comparisons/eval/parallel.h"
 #include "engine/scene.h"
@@ -91,8 +92,9 @@ struct BackendEnsemble {
 struct EnsembleResult {
   std::string scene, file;
   EnsembleSettings settings;
-  double dt = 0.0;    // s, the scene's step
-  StateSpread input;  // of the nudged initial states
+  double dt = 0.0;        // s, the scene's step
+  double duration = 0.0;  // s, how long each copy ran
+  StateSpread input;      // of the nudged initial states
   std::vector<BackendEnsemble> backends;
 };
 
@@ -113,6 +115,14 @@ std::vector<EnsembleResult> scaled_ensembles(const Scene& scene,
 /// The ensemble as JSON (docs/contract.md, `rbx ensemble --json`); `sizes`, when given, adds
 /// `nudge_sizes`: each scaled ensemble's input spread and every backend's position spread.
 Json ensemble_json(const EnsembleResult& r, const std::vector<EnsembleResult>& sizes = {});
+
+/// The report's ensembles (its Predictability section): every scene with an [ensemble] table
+/// runs its copies (the table's count, step test and duration, the default nudges and seed) through
+/// the dynamics backends it runs (`backends`: --backends, "" for the scene's own), and its
+/// evaluation gets the result as `ensemble` (ensemble_json). Collective over the ranks of `par`;
+/// `evs` is filled on rank 0.
+void run_scene_ensembles(const std::vector<Scene>& scenes, const std::string& backends,
+                         std::vector<SceneEvaluation>& evs, const ParallelRun& par);
 
 /// The contact sequence of a run's events: each distinct (pair, feature) in the order of its
 /// first event, as "A-B:face > B-C:edge" ("none" without events).

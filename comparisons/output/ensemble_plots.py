@@ -21,7 +21,8 @@ import backend_style  # noqa: E402
 FLOOR = 1e-18  # a spread of zero is drawn at this floor on log axes
 
 
-def scatter(j, out):
+def scatter(j, out, figure="ensemble_scatter"):
+    """Per backend, the copies' final positions about their mean; writes out/FIGURE.png."""
     names = [n for n in j["backends"] if j["backends"][n]["final_positions"]["positions_m"]]
     cols = min(4, max(1, len(names)))
     rows = max(1, math.ceil(len(names) / cols))
@@ -43,7 +44,7 @@ def scatter(j, out):
         ax.set_title(f"{name}: {j['backends'][name]['clusters']} cluster(s)", fontsize=9)
         ax.ticklabel_format(style="sci", scilimits=(-2, 2))
     fig.suptitle(f"{j['scene']}: final positions of {j['count']} nudged copies", fontsize=10)
-    backend_style.save(fig, out, "ensemble_scatter")
+    backend_style.save(fig, out, figure)
 
 
 def spread(j, out):

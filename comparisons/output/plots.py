@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Figures of an rbx report: error against run time per family, the contact-law residuals per
-family (law_plots.py), per-scene velocity bars, and a 3-D picture of each contact scene with
-every backend's contact point and normal.
+family (law_plots.py), per-scene velocity bars, a 3-D picture of each contact scene with
+every backend's contact point and normal, and each ensemble's final positions
+(ensemble_plots.py).
 
 Usage: plots.py REPORT_DIR  (reads results.json, sweep.csv and laws.csv, writes figures/*.png
 and *.svg)
@@ -23,6 +24,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 # One (colour, marker) per backend, the same in every figure (backend_style.py).
 from backend_style import order, save, style  # noqa: E402,F401
+from ensemble_plots import scatter as ensemble_scatter  # noqa: E402
 from law_plots import contact_laws  # noqa: E402
 
 
@@ -380,6 +382,8 @@ def main():
             contact_picture(scene, out)
         if "impulse" in scene["checks"]:
             velocity_bars(scene, out)
+        if "ensemble" in scene:
+            ensemble_scatter(scene["ensemble"], out, f"ensemble_{slug(scene)}")
 
 
 if __name__ == "__main__":

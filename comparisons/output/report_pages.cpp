@@ -8,6 +8,7 @@
 #include "comparisons/output/backend_style.h"
 #include "comparisons/output/law_report.h"
 #include "comparisons/output/markdown_html.h"
+#include "comparisons/output/predictability_report.h"
 #include "comparisons/output/report_writer.h"
 #include "comparisons/output/scorecard.h"
 #include "comparisons/output/table.h"
@@ -188,6 +189,7 @@ std::string report_summary_markdown(const std::vector<Scene>& scenes,
   md << scorecard_markdown(rows) << causes_markdown(causes, true, in.views_ok);
   md << error_vs_runtime_markdown(evs, in.report_dir, in.figures_ok, in.figures_msg);
   md << contact_laws_markdown(scenes, evs, cols, in.report_dir, in.figures_ok);
+  md << predictability_markdown(scenes, evs, in.report_dir, in.figures_ok);
   md << explore_markdown(in.explore, in.explore_set);
   md << in.tosses;
   md << backends_markdown(cols);

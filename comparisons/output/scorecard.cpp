@@ -115,6 +115,11 @@ void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, con
       row.law = to_string(law);
     }
   }
+  // The ensemble's amplification, where the scene has one and the backend's copies ran.
+  if (ev.json.contains("ensemble") && ev.json["ensemble"]["backends"].contains(b)) {
+    const Json& e = ev.json["ensemble"]["backends"][b];
+    if (e.value("runs", 0L) > 0) row.amplification.push_back(e.value("amplification", 0.0));
+  }
   const long steps = scene.sim.steps();
   if (steps > 0 && bj.contains("runtime_s"))
     row.time.push_back(bj["runtime_s"].get<double>() / static_cast<double>(steps));
@@ -193,6 +198,11 @@ std::string ScoreRow::time_text() const {
   // The library's query with its shapes built once, where it has that variant.
   if (!prebuilt.empty()) t += " (" + fmt_num(median_of(prebuilt) * 1e6, 3) + " prebuilt)";
   return t;
+}
+
+std::string ScoreRow::predictability_text() const {
+  if (amplification.empty()) return "—";
+  return fmt_num(median_of(amplification), 2) + " (" + std::to_string(amplification.size()) + ")";
 }
 
 std::string ScoreRow::law_text() const {
@@ -289,7 +299,9 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
         "in brackets the same query with the library's shapes prebuilt, the fair comparison "
         "with custom. *Worst contact-law residual* (dynamics): the largest residual of the "
         "contact laws over the family's scenes, relative to its scene's scale, and its law "
-        "(the \"Contact laws\" section).\n\n";
+        "(the \"Contact laws\" section). *Predictability* (families with ensembles): the "
+        "median over the family's ensembles of how many times the nudge the final positions "
+        "spread, with their number (the \"Predictability\" section).\n\n";
   for (size_t k = 0; k < rows.size();) {
     size_t end = k;
     while (end < rows.size() && rows[end].family == rows[k].family &&
@@ -298,10 +310,14 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
     md << "### " << md_escape(group_title(rows[k])) << "\n\n";
     // Dynamics groups also show the worst contact-law residual (report.md, "Contact laws").
     const bool laws = rows[k].measure == Measure::Dynamics;
+    // And, where the family has ensembles, the predictability (report.md, "Predictability").
+    bool ensembles = false;
+    for (size_t r = k; r < end; ++r) ensembles = ensembles || !rows[r].amplification.empty();
     std::vector<std::string> header = {
         "rank",         "backend",     "scenes run",     "within tolerance",
         "median error", "worst error", "median run time"};
     if (laws) header.push_back("worst contact-law residual");
+    if (ensembles) header.push_back("predictability (median amplification)");
     Table t(header);
     for (size_t r = k; r < end; ++r) {
       std::vector<std::string> cells = {
@@ -310,6 +326,7 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
           rows[r].median_text(),       rows[r].worst_text(),
           rows[r].time_text()};
       if (laws) cells.push_back(rows[r].law_text());
+      if (ensembles) cells.push_back(rows[r].predictability_text());
       t.add(cells);
     }
     md << t.markdown() << "\n";

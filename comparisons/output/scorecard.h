@@ -39,10 +39,13 @@ struct ScoreRow {
   /// (comparisons/eval/law_residuals.h) and its law; negative when none was measured.
   double law_relative = -1.0;
   std::string law;
+  /// Dynamics: per scene of the family with an ensemble (report.md, "Predictability"), the
+  /// backend's position amplification.
+  std::vector<double> amplification;
   /// The row's cells as text: within tolerance, median and worst error, run time, worst
-  /// contact-law residual.
+  /// contact-law residual, predictability (the median amplification).
   std::string within_text() const, median_text() const, worst_text() const, time_text() const,
-      law_text() const;
+      law_text() const, predictability_text() const;
 };
 
 /// A scene named in a report: FAMILY/NAME and its slug (views/SLUG.html is its replay page).

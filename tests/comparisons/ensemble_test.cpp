@@ -146,6 +146,31 @@ TEST(Ensemble, HeadOnImpactsKeepTheInputSpreadWhereTheClosedFormIsMetAndTheStepT
   EXPECT_EQ(seed.verdict, "engine");
 }
 
+TEST(Ensemble, TheReportRunsTheScenesWithATableForTheirDurationAndANudgedStackRests) {
+  // Two scenes, one with an [ensemble] table (6 copies of the first 0.2 s of the stack of
+  // five): only it gets an `ensemble`, run for that long through the backends asked for.
+  std::vector<Scene> scenes = {scene_at("scenes/analytic/headon_e05.toml"),
+                               scene_at("scenes/friction/stack_five.toml")};
+  scenes[0].ensemble.reset();
+  scenes[1].ensemble = EnsembleSpec{6, false, 0.2};
+  std::vector<SceneEvaluation> evs(2);
+  const ParallelRun par(2);
+  run_scene_ensembles(scenes, "custom,ode", evs, par);
+  EXPECT_FALSE(evs[0].json.contains("ensemble"));
+  ASSERT_TRUE(evs[1].json.contains("ensemble"));
+  const Json& e = evs[1].json["ensemble"];
+  EXPECT_EQ(e["count"], 6);
+  EXPECT_EQ(e["duration"], 0.2);
+  ASSERT_EQ(e["backends"].size(), 2u);
+  // The custom engine's nudged stacks rest: the copies end where they started to within the
+  // nudge's order (the start's overlaps pushed apart, 1e-6 m/s drifts for 0.2 s); one that slid
+  // or toppled would spread millimetres, thousands of times the nudge.
+  const Json& custom = e["backends"]["custom"];
+  EXPECT_EQ(custom["runs"], 6);
+  EXPECT_EQ(custom["failed"], 0);
+  EXPECT_LT(custom["amplification"].get<double>(), 100.0);
+}
+
 TEST(Ensemble, TheResultIsTheSameOnOneAndOnThreeThreads) {
   const Scene s = scene_at("scenes/seed/edge_drop.toml");
   EnsembleSettings set;

@@ -1,0 +1,102 @@
+// The report's Predictability section (output/predictability_report.h) and the scorecard's
+// predictability column (output/scorecard.h), from ensembles as the report stores them.
+#include "comparisons/output/predictability_report.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "comparisons/output/scorecard.h"
+
+namespace rbx {
+namespace {
+
+// One backend's ensemble as ensemble_json writes it: `amplification`, and a step test when
+// `verdict` is not empty.
+Json backend_ensemble(double amplification, const std::string& verdict = "") {
+  Json b = {
+      {"runs", 50},
+      {"failed", 0},
+      {"spread", {{"position_m", 1e-4}, {"position_range_m", 3e-4}}},
+      {"amplification", amplification},
+      {"velocity_amplification", 2.0},
+      {"clusters", 2},
+      {"contact_sequences", Json::array({{{"sequence", "A-B:edge > A-B:face"}, {"copies", 30}},
+                                         {{"sequence", "A-B:face"}, {"copies", 20}}})}};
+  if (!verdict.empty()) b["step_test"] = {{"dt", 1e-4}, {"ratio", 0.1}, {"verdict", verdict}};
+  return b;
+}
+
+// A dynamics scene of family `family` whose backends ran ok, with an ensemble of `amplification`
+// per backend (none when empty).
+void add_scene(std::vector<Scene>& scenes, std::vector<SceneEvaluation>& evs,
+               const std::string& family, const std::string& name,
+               const std::vector<std::pair<std::string, double>>& amplification,
+               const std::string& verdict = "") {
+  Scene s;
+  s.name = name;
+  s.file = family + "/" + name + ".toml";
+  s.checks = {CheckKind::Trajectory};
+  SceneEvaluation ev;
+  ev.family = family;
+  Json ensemble = {{"count", 50},
+                   {"dt", 1e-3},
+                   {"duration", 0.2},
+                   {"perturb", {{"position", 1e-6}}},
+                   {"input_spread", {{"position_m", 1.7e-6}}},
+                   {"backends", Json::object()}};
+  for (const auto& [b, a] : amplification) {
+    ev.json["backends"][b] = {{"status", "ok"}};
+    ensemble["backends"][b] = backend_ensemble(a, verdict);
+  }
+  if (!amplification.empty()) ev.json["ensemble"] = ensemble;
+  scenes.push_back(s);
+  evs.push_back(ev);
+}
+
+TEST(Predictability, EachSceneHasItsTableWithTheStepTestsVerdictAndItsTextStaysText) {
+  std::vector<Scene> scenes;
+  std::vector<SceneEvaluation> evs;
+  add_scene(scenes, evs, "seed", "plain", {});
+  add_scene(scenes, evs, "seed", "edge_*drop*", {{"custom", 130.0}, {"ode", 250.0}}, "engine");
+  const std::string md = predictability_markdown(scenes, evs, "", false);
+  EXPECT_NE(md.find("## Predictability"), std::string::npos);
+  // The scene's name is text, not emphasis; the one without an ensemble is not there.
+  EXPECT_NE(md.find("### seed/edge\\_\\*drop\\*"), std::string::npos) << md;
+  EXPECT_EQ(md.find("plain"), std::string::npos);
+  // One row per backend, with its amplification and whose spread the step test says it is.
+  EXPECT_NE(md.find("| **custom** | 50 | 0.0001 | 0.0003 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 1.3e+02 | 2 | 2 | 2 | 0.1 | the engine's |"), std::string::npos) << md;
+  // Each backend's most frequent contact sequence, as text.
+  EXPECT_NE(md.find("- ode: `A-B:edge \\> A-B:face` (30)"), std::string::npos) << md;
+  // No scene with an ensemble: no section.
+  std::vector<Scene> none_s;
+  std::vector<SceneEvaluation> none_e;
+  add_scene(none_s, none_e, "seed", "plain", {});
+  EXPECT_EQ(predictability_markdown(none_s, none_e, "", false), "");
+}
+
+TEST(Predictability, TheScorecardShowsTheMedianAmplificationOfAFamilysEnsembles) {
+  // friction: three ensembles (custom 10, 30, 1000: median 30) and a scene without one; seed:
+  // none, so its table has no predictability column.
+  std::vector<Scene> scenes;
+  std::vector<SceneEvaluation> evs;
+  add_scene(scenes, evs, "friction", "a", {{"custom", 10.0}});
+  add_scene(scenes, evs, "friction", "b", {{"custom", 1000.0}});
+  add_scene(scenes, evs, "friction", "c", {{"custom", 30.0}});
+  add_scene(scenes, evs, "seed", "d", {});
+  evs[3].json["backends"]["custom"] = {{"status", "ok"}};
+  const std::vector<ScoreRow> rows = score_rows(scenes, evs, {"custom"});
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].predictability_text(), "30 (3)");
+  EXPECT_EQ(rows[1].predictability_text(), "—");
+  const std::string md = scorecard_markdown(rows);
+  const size_t seed = md.find("### seed");
+  ASSERT_NE(seed, std::string::npos);
+  EXPECT_LT(md.find("predictability (median amplification)"), seed);
+  EXPECT_EQ(md.find("predictability (median amplification)", seed), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rbx
