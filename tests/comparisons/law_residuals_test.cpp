@@ -78,9 +78,10 @@ TEST(ContactLaws, EveryDynamicsBackendReportsImpulsesWithTheContractsSigns) {
 TEST(ContactLaws, TheCustomEngineObeysThemToRoundOffOnTheFrictionAndRestingScenes) {
   // Its solver stops where these conditions hold; 1e-12 of the scene's scales is round-off of
   // impulses and velocities accumulated over thousands of steps (measured: below 1e-17).
-  for (const char* file : {"friction/incline_slide", "friction/incline_stick",
-                           "friction/landing_slide", "friction/spin_to_rest", "friction/stack_five",
-                           "friction/tipping_box", "stress/resting_stack"}) {
+  for (const char* file :
+       {"friction/incline_slide", "friction/incline_stick", "friction/landing_slide",
+        "friction/spin_to_rest", "friction/spin_landing", "friction/stack_five",
+        "friction/tipping_box", "stress/resting_stack"}) {
     SCOPED_TRACE(file);
     const Scene scene = load_scene(std::string(RBX_SOURCE_DIR "/scenes/") + file + ".toml");
     const Relative r = run_relative("custom", scene);
