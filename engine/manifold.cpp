@@ -61,7 +61,7 @@ bool crossing(const Vec3& p0, const Vec3& d0, const Vec3& q0, const Vec3& d1, Ve
 // solver cannot tell apart to round-off. The corners are found on the plane's coordinates by
 // Andrew's monotone chain; then the corner nearest the line of its neighbours is dropped while
 // it is within `slack`. A region within `slack` of a segment keeps its two ends; of a point,
-// its deepest point.
+// its deepest point. The deepest point always stays (see below).
 std::vector<ManifoldPoint> support_corners(const std::vector<ManifoldPoint>& pts, const Vec3& n,
                                            double slack) {
   if (pts.size() <= 1) return pts;
@@ -119,6 +119,23 @@ std::vector<ManifoldPoint> support_corners(const std::vector<ManifoldPoint>& pts
   std::sort(kept.begin(), kept.end());
   std::vector<ManifoldPoint> out;
   for (size_t i : kept) out.push_back(pts[i]);
+  // The deepest point stays, so that the position projection sees the whole penetration (a
+  // region that is not flat, a corner pushed deep into a face, is deepest inside its outline):
+  // where it is deeper than every corner by more than `slack`, a corner within `slack` of it
+  // takes its depth, else it is kept as well.
+  auto shallower = [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.depth < b.depth; };
+  const ManifoldPoint& deepest = *std::max_element(pts.begin(), pts.end(), shallower);
+  if (!(deepest.depth > std::max_element(out.begin(), out.end(), shallower)->depth + slack))
+    return out;
+  const Vec3& pd = deepest.point;
+  for (ManifoldPoint& p : out) {
+    const Vec3 d = p.point - pd;
+    if (std::hypot(d.dot(t1), d.dot(t2)) <= slack) {
+      p.depth = deepest.depth;
+      return out;
+    }
+  }
+  out.push_back(deepest);
   return out;
 }
 

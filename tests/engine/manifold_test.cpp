@@ -84,20 +84,40 @@ TEST(Manifold, ACubeTurned45DegreesKeepsItsOctagon) {
   EXPECT_EQ(m->points.size(), 8u);
 }
 
-TEST(Manifold, APointInsideTheRegionIsLeftOut) {
-  // A unit cube corner-down, 0.766 m into a slab: its lowest corner and the three next to it
-  // are inside; seen along the normal the lowest lies inside the triangle of the other three,
-  // so it adds no wrench they cannot give (with any slack, even none), and the three are the
-  // manifold, each 0.5 / sqrt(3) below the centre.
+TEST(Manifold, APointInsideTheRegionIsLeftOutUnlessItIsTheDeepest) {
+  // A unit cube corner-down, 0.1 m above a slab's top face at its centre: its lowest corner
+  // (0.766 m deep) and the three next to it (0.189 m deep) are inside. Seen along the normal the
+  // lowest lies inside the triangle of the three; it adds no wrench they cannot give, but it is
+  // the deepest, and the position projection must see that depth: all four stay.
   const Quat q = Quat(Eigen::AngleAxisd(std::atan(std::sqrt(2.0)), Vec3(1, -1, 0).normalized()));
   const ConvexPolyhedron cube = make_box(Vec3::Ones()), slab = make_box(Vec3(4, 4, 1));
   const Pose pa = at(Vec3(0, 0, 0.1), q), pb = at(Vec3(0, 0, -0.5));
   const auto m = build_manifold(cube, pa, slab, pb, DetectorVariant::Faithful);
   ASSERT_TRUE(m);
   EXPECT_NEAR(std::abs(m->normal.z()), 1.0, 1e-12);
-  ASSERT_EQ(m->points.size(), 3u);
-  for (const ManifoldPoint& p : m->points)
-    EXPECT_NEAR(p.point.z(), 0.1 - 0.5 / std::sqrt(3.0), 1e-12);
+  ASSERT_EQ(m->points.size(), 4u);
+  double deepest = 0.0;
+  for (const ManifoldPoint& p : m->points) deepest = std::max(deepest, p.depth);
+  EXPECT_NEAR(deepest, std::sqrt(3.0) / 2 - 0.1, 1e-12);
+}
+
+TEST(Manifold, ARoundBodyKeepsItsOutlineAndItsDeepestPointOnly) {
+  // An icosphere (radius 0.5, two subdivisions) with a vertex straight down, 0.1 m into a slab:
+  // the vertices inside are that vertex and rings around it. The inner rings lie inside the
+  // outer ring's outline and are not the deepest: they go; the outline's corners and the lowest
+  // vertex (as deep as the shapes overlap) stay.
+  const ConvexPolyhedron ball = make_icosphere(0.5, 2), slab = make_box(Vec3(4, 4, 1));
+  const Vec3 down = Vec3(0, 1, -(1 + std::sqrt(5.0)) / 2).normalized();  // a vertex's direction
+  const Quat q = Quat::FromTwoVectors(down, -Vec3::UnitZ());
+  const Pose pa = at(Vec3(0, 0, 0.4), q), pb = at(Vec3(0, 0, -0.5));
+  int inside = 0;
+  for (const Vec3& v : ball.vertices()) inside += pa.apply(v).z() < 0.0 ? 1 : 0;
+  const auto m = build_manifold(ball, pa, slab, pb, DetectorVariant::Faithful);
+  ASSERT_TRUE(m);
+  EXPECT_GT(inside, static_cast<int>(m->points.size()));
+  double deepest = 0.0;
+  for (const ManifoldPoint& p : m->points) deepest = std::max(deepest, p.depth);
+  EXPECT_NEAR(deepest, 0.1, 1e-12);
 }
 
 TEST(Manifold, NothingWhenApart) {
