@@ -122,14 +122,15 @@ void add_study_commands(CLI::App& app, Options& o) {
       "ensemble",
       "nudged copies of a scene through every dynamics backend: how far outcomes spread");
   scene_options(ensemble, o.ensemble.scene, false, true);
-  ensemble->add_option("--count", o.ensemble.count, "number of copies (default 50)");
+  ensemble->add_option("--count", o.ensemble.count,
+                       "number of copies (default: the scene's [ensemble] count, else 50)");
   ensemble->add_option("--seed", o.ensemble.seed, "seed (default 1)");
   ensemble->add_option("--perturb", o.ensemble.perturb,
                        "nudge scale KEY=SCALE, KEY: position (m), orientation (rad), velocity "
                        "(m/s), angular_velocity (rad/s); default 1e-6 each (repeatable)");
   ensemble->add_flag("--step-test", o.ensemble.step_test,
                      "also run every copy at dt/10: a spread that stays is the physics', one "
-                     "that shrinks the engine's");
+                     "that shrinks the engine's (also when the scene's [ensemble] asks for it)");
   ensemble->add_option("--out", o.ensemble.out,
                        "folder: ensemble.json with the spread at a tenth and ten times the "
                        "nudges too, and the figures");
@@ -191,7 +192,11 @@ int dispatch(CLI::App& app, const Options& o) {
     if (app.got_subcommand("tosses")) return rbx::tosses_command(o.tosses);
     if (app.got_subcommand("view")) return rbx::view_command(o.view);
     if (app.got_subcommand("explore")) return rbx::explore_command(o.explore);
-    if (app.got_subcommand("ensemble")) return rbx::ensemble_command(o.ensemble);
+    if (app.got_subcommand("ensemble")) {
+      rbx::EnsembleOptions e = o.ensemble;
+      e.count_given = app.get_subcommand("ensemble")->count("--count") > 0;
+      return rbx::ensemble_command(e);
+    }
   } catch (const rbx::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;

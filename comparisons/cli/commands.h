@@ -109,6 +109,7 @@ struct ExploreOptions {
 struct EnsembleOptions {
   SceneCommandOptions scene;         // the scene, --json, --set, --force, --backends
   long count = 50;                   // copies
+  bool count_given = false;          // --count was given (else the scene's [ensemble] count)
   unsigned long long seed = 1;       // copy k of seed s depends on (s, k) only
   std::vector<std::string> perturb;  // --perturb KEY=SCALE
   bool step_test = false;            // --step-test: also every copy at dt / 10
@@ -118,8 +119,9 @@ struct EnsembleOptions {
 
 /// `rbx ensemble SCENE`: nudged copies of the scene through every dynamics backend; per backend
 /// the spread of the final states, its amplification, the contact sequences and clusters (and
-/// with --step-test whether the spread is the physics' or the engine's). Exit 1 when a copy's
-/// run failed in some backend.
+/// with --step-test whether the spread is the physics' or the engine's). A scene with an
+/// [ensemble] table runs as the report runs it: its count unless --count is given, its step test
+/// (or --step-test), its duration. Exit 1 when a copy's run failed in some backend.
 int ensemble_command(const EnsembleOptions& opt);
 
 /// `rbx explore`: random contact pairs against the exact oracle on every core or MPI rank;

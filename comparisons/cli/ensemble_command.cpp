@@ -47,12 +47,14 @@ Nudge parse_nudges(const std::vector<std::string>& items) {
 
 int ensemble_command(const EnsembleOptions& opt) {
   if (opt.count < 2) throw InputError("rbx ensemble: --count must be at least 2");
-  const Scene scene = load_scene_for_command(opt.scene.scenes.at(0), opt.scene);
+  Scene scene = load_scene_for_command(opt.scene.scenes.at(0), opt.scene);
   EnsembleSettings settings;
   settings.count = opt.count;
   settings.seed = opt.seed;
   settings.nudge = parse_nudges(opt.perturb);
   settings.step_test = opt.step_test;
+  // The scene's [ensemble] table: the run the report makes of it, unless the options say more.
+  apply_ensemble_table(scene, settings, opt.count_given);
   const std::vector<std::string> names =
       select_backends(scene, opt.scene.backends, Capability::Dynamics);
   ParallelRun par(opt.threads);

@@ -393,6 +393,13 @@ Json ensemble_json(const EnsembleResult& r, const std::vector<EnsembleResult>& s
   return doc;
 }
 
+void apply_ensemble_table(Scene& scene, EnsembleSettings& settings, bool keep_count) {
+  if (!scene.ensemble) return;
+  if (!keep_count) settings.count = scene.ensemble->count;
+  settings.step_test = settings.step_test || scene.ensemble->step_test;
+  if (scene.ensemble->duration > 0) scene.sim.duration = scene.ensemble->duration;
+}
+
 void run_scene_ensembles(const std::vector<Scene>& scenes, const std::string& backends,
                          std::vector<SceneEvaluation>& evs, const ParallelRun& par) {
   for (size_t i = 0; i < scenes.size(); ++i) {
@@ -401,10 +408,8 @@ void run_scene_ensembles(const std::vector<Scene>& scenes, const std::string& ba
         select_backends(scenes[i], backends, Capability::Dynamics);
     if (names.empty()) continue;
     EnsembleSettings settings;
-    settings.count = scenes[i].ensemble->count;
-    settings.step_test = scenes[i].ensemble->step_test;
     Scene scene = scenes[i];
-    if (scene.ensemble->duration > 0) scene.sim.duration = scene.ensemble->duration;
+    apply_ensemble_table(scene, settings, false);
     const EnsembleResult r = run_ensemble(scene, names, settings, par);
     if (par.root() && i < evs.size()) evs[i].json["ensemble"] = ensemble_json(r);
   }

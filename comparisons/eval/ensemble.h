@@ -116,6 +116,11 @@ std::vector<EnsembleResult> scaled_ensembles(const Scene& scene,
 /// `nudge_sizes`: each scaled ensemble's input spread and every backend's position spread.
 Json ensemble_json(const EnsembleResult& r, const std::vector<EnsembleResult>& sizes = {});
 
+/// A scene as its [ensemble] table runs it (nothing changes without one): the table's count
+/// (unless `keep_count`), its step test (added to the one `settings` asks for) and its duration
+/// (on the scene).
+void apply_ensemble_table(Scene& scene, EnsembleSettings& settings, bool keep_count);
+
 /// The report's ensembles (its Predictability section): every scene with an [ensemble] table
 /// runs its copies (the table's count, step test and duration, the default nudges and seed) through
 /// the dynamics backends it runs (`backends`: --backends, "" for the scene's own), and its

@@ -164,6 +164,18 @@ TEST(Cli, EnsembleRefusesBadNudgesAndWritesItsJson) {
     EXPECT_GE(doc["backends"][name]["contact_sequences"].size(), 1u);
   }
   EXPECT_NE(r.out.find("amplification"), std::string::npos) << r.out;
+  // Without --count, the scene's [ensemble] table decides, as in the report: its count, its step
+  // test (edge_drop asks for one) and its duration.
+  fs::remove(json);
+  const CmdResult t = rbx_in(dir.string(), "ensemble '" + scene +
+                                               "' --backends custom --set ensemble.count=3 --set "
+                                               "ensemble.duration=0.1 --json '" +
+                                               json.string() + "'");
+  ASSERT_EQ(t.code, 0) << t.err;
+  const nlohmann::json table = nlohmann::json::parse(std::ifstream(json));
+  EXPECT_EQ(table["count"], 3);
+  EXPECT_EQ(table["duration"], 0.1);
+  EXPECT_TRUE(table["backends"]["custom"].contains("step_test"));
   fs::remove_all(dir);
 }
 
