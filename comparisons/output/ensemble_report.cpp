@@ -10,8 +10,9 @@ namespace rbx {
 
 void print_ensemble(std::ostream& out, const EnsembleResult& r) {
   const Nudge& n = r.settings.nudge;
-  out << "ensemble: " << r.scene << " (" << r.file << "), " << r.settings.count << " copies, seed "
-      << r.settings.seed << ", dt " << fmt_num(r.dt) << " s\n";
+  out << "ensemble: " << r.scene << " (" << r.file << "), " << r.settings.count << " copies of "
+      << fmt_num(r.duration) << " s, seed " << r.settings.seed << ", dt " << fmt_num(r.dt)
+      << " s\n";
   out << "nudges (standard deviation per component): position " << fmt_num(n.position)
       << " m, orientation " << fmt_num(n.orientation) << " rad, velocity " << fmt_num(n.velocity)
       << " m/s, angular velocity " << fmt_num(n.angular_velocity) << " rad/s\n";
