@@ -44,7 +44,8 @@ struct ContactManifold {
 /// shape's size are merged. Of the rest only the corners of the region they span in the contact
 /// plane are kept: a point inside it, or within `support_slack` (relative to the smaller shape's
 /// size) of the line through its neighbours on its outline, is dropped (it adds no contact wrench
-/// the corners cannot give; engine/manifold.cpp, support_corners). When no point qualifies (a face
+/// the corners cannot give; engine/manifold.cpp, support_corners), except the deepest point when
+/// it is deeper than every corner by more than the slack. When no point qualifies (a face
 /// centroid inside, no vertex), the detector's point is the manifold.
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
                                               const ConvexPolyhedron& b, const Pose& pb,

@@ -116,7 +116,6 @@ struct Expect {
   std::optional<ExpectContact> contact;
 };
 
-/// A whole scene.
 /// A scene's [ensemble] table: its nudged copies belong in the report's Predictability section
 /// (comparisons/eval/ensemble.h has what an ensemble measures).
 struct EnsembleSpec {
@@ -125,6 +124,7 @@ struct EnsembleSpec {
   double duration = 0.0;   // s: > 0, the copies run this long (whole steps); 0, the scene's
 };
 
+/// A whole scene.
 struct Scene {
   std::string name;
   std::string description;
