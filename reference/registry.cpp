@@ -4,6 +4,7 @@
 #include "reference/backend.h"
 #include "reference/bullet.h"
 #include "reference/custom.h"
+#include "reference/dart.h"
 #include "reference/exact.h"
 #include "reference/fcl.h"
 #include "reference/libccd.h"
@@ -33,7 +34,7 @@ namespace {
 // Every adapter, in report order: our engine and oracle, then the libraries.
 std::vector<const Adapter*> adapters() {
   return {&custom_adapter(), &exact_adapter(),  &fcl_adapter(), &libccd_adapter(),
-          &bullet_adapter(), &mujoco_adapter(), &ode_adapter()};
+          &bullet_adapter(), &mujoco_adapter(), &ode_adapter(), &dart_adapter()};
 }
 
 std::vector<Backend>& registry_table() {
