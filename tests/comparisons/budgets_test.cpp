@@ -115,8 +115,8 @@ TEST(SolverBudgets, AreSweptOverFourValuesOrMoreWithTheLibraryDefault) {
     }
     EXPECT_FALSE(b.budget.what.empty()) << b.name;
   }
-  // Bullet, MuJoCo and ODE (each on both shape paths) and the custom engine.
-  EXPECT_EQ(with_budget, 7);
+  // Bullet, MuJoCo, ODE and DART (each on both shape paths) and the custom engine.
+  EXPECT_EQ(with_budget, 9);
 }
 
 }  // namespace

@@ -254,8 +254,8 @@ TEST(Cli, ContactsRunsEveryBackendInTheContractConvention) {
   const auto j = nlohmann::json::parse(r.out);
   int answered = 0;
   for (const auto& [name, b] : j["backends"].items()) {
-    if (b["status"] != "ok" || name == "fcl-indep")
-      continue;  // INDEP: known defects, pinned elsewhere
+    // INDEP and DART's triangle-mesh path: known defects, pinned elsewhere (fcl_test, dart_test).
+    if (b["status"] != "ok" || name == "fcl-indep" || name == "dart-hull") continue;
     ASSERT_FALSE(b["contacts"].empty()) << name;
     const auto& c = b["contacts"][0];
     EXPECT_EQ(c["bodies"], nlohmann::json::array({"A", "B"})) << name;

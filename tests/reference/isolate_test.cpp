@@ -324,6 +324,28 @@ TEST(RunItemsIsolated, ResultsAreTheItemsOwnBytesInOrder) {
   expect_no_child_left();
 }
 
+TEST(IsolatedDynamics, DartsAssertionOnANonFiniteStateIsItsError) {
+  // Debian builds DART 6.12 with its assertions on: a NaN velocity fails one in BodyNode and
+  // aborts. Isolated, as every library call in rbx's runs is, that is the backend's error naming
+  // the signal, and this process goes on.
+  for (const char* name : {"dart", "dart-hull"}) {
+    Scene s;
+    s.sim.duration = 0.01;
+    BodySpec a;
+    a.name = "A";
+    a.shape = std::make_shared<const ConvexPolyhedron>(make_box(Vec3::Ones()));
+    a.velocity = Vec3(std::nan(""), 0, 0);
+    s.bodies = {a};
+    const Backend* backend = find_backend(name);
+    ASSERT_NE(backend, nullptr) << name;
+    const TimedDynamics r = isolated_dynamics(name, 30.0, [&] {
+      return TimedDynamics{backend->dynamics(s, {}), 0.0};
+    });
+    EXPECT_EQ(r.result.status, Status::Error) << name;
+    EXPECT_NE(r.result.message.find("Aborted"), std::string::npos) << r.result.message;
+  }
+}
+
 TEST(IsolatedDynamics, AWholeRunComesBackIntact) {
   // Every field of a dynamics result crosses the process boundary bit for bit.
   DynamicsResult sent;

@@ -69,9 +69,9 @@ TEST(Prebuilt, EveryVariantAnswersAsItsBackendAtEveryPose) {
     // The pairs are not all trivial for this backend: most of them touch.
     EXPECT_GE(touching, 4) << v.backend;
   }
-  // fcl, fcl-hull, bullet, bullet-hull, bullet-sat, ode, ode-hull, mujoco, mujoco-hull; and
-  // custom's faithful variant.
-  EXPECT_EQ(variants, 10);
+  // fcl, fcl-hull, bullet, bullet-hull, bullet-sat, ode, ode-hull, mujoco, mujoco-hull, dart,
+  // dart-hull; and custom's faithful variant.
+  EXPECT_EQ(variants, 12);
 }
 
 }  // namespace
