@@ -20,9 +20,9 @@ namespace rbx::scene_detail {
 inline const std::vector<std::string> kChecks = {"contact", "impulse", "trajectory", "stability",
                                                  "mass"};
 inline const std::vector<std::string> kBackends = {
-    "custom",    "custom-seed", "exact",      "fcl",     "fcl-hull",    "fcl-epa",
-    "fcl-indep", "libccd-mpr",  "libccd-epa", "bullet",  "bullet-hull", "bullet-sat",
-    "mujoco",    "mujoco-hull", "ode",        "ode-hull"};
+    "custom",    "custom-seed", "exact",      "fcl",      "fcl-hull",    "fcl-epa",
+    "fcl-indep", "libccd-mpr",  "libccd-epa", "bullet",   "bullet-hull", "bullet-sat",
+    "mujoco",    "mujoco-hull", "ode",        "ode-hull", "dart",        "dart-hull"};
 
 inline const std::vector<std::string> kShapes = {"box", "icosphere", "prism", "convex", "mesh"};
 
