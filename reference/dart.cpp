@@ -289,38 +289,14 @@ std::vector<StepContact> step_contacts(const dart::simulation::World& world,
   return out;
 }
 
-// Events of a step: one per pair closing at some point whose normal impulse pushed; point and
-// normal averaged over the pair's points, depth the largest, impulse the sum of normal impulses.
+// Events of a step (append_pair_events).
 void pair_events(const std::vector<StepContact>& contacts, const std::vector<RigidBody>& bodies,
                  long step, double dt, std::vector<CollisionEvent>& events) {
-  std::map<std::pair<int, int>, CollisionEvent> by_pair;
-  std::map<std::pair<int, int>, int> points;
-  std::map<std::pair<int, int>, bool> closing;
-  for (const StepContact& s : contacts) {
-    const std::pair<int, int> key{s.a, s.b};
-    CollisionEvent& ev = by_pair[key];
-    if (points[key]++ == 0) {
-      ev.time = step * dt;
-      ev.step = step;
-      ev.body_a = bodies[s.a].name;
-      ev.body_b = bodies[s.b].name;
-      ev.contact = s.contact;
-      ev.contact.point.setZero();
-      ev.contact.normal.setZero();
-      ev.contact.depth = 0.0;
-    }
-    ev.contact.point += s.contact.point;
-    ev.contact.normal += s.contact.normal;
-    ev.contact.depth = std::max(ev.contact.depth, s.contact.depth);
-    ev.impulse += s.impulse.dot(s.contact.normal);
-    if (s.approach < -kClosingSpeed) closing[key] = true;
-  }
-  for (auto& [key, ev] : by_pair) {
-    if (!closing[key] || !(ev.impulse > 0.0)) continue;
-    ev.contact.point /= points[key];
-    if (ev.contact.normal.norm() > 0.0) ev.contact.normal.normalize();
-    events.push_back(ev);
-  }
+  std::vector<PairPoint> points;
+  for (const StepContact& s : contacts)
+    points.push_back(
+        {s.a, s.b, s.contact, s.impulse.dot(s.contact.normal), s.approach < -kClosingSpeed});
+  append_pair_events(points, bodies, step, dt, events);
 }
 
 DynamicsResult dart_dynamics_with(const Scene& scene, const DynamicsOptions& opt,

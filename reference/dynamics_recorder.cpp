@@ -1,5 +1,7 @@
 #include "reference/dynamics_recorder.h"
 
+#include <algorithm>
+#include <map>
 #include <utility>
 
 namespace rbx {
@@ -101,6 +103,38 @@ void DynamicsRecorder::finish(const std::string& library) {
 void DynamicsRecorder::after_step(long steps_taken, double time) {
   if (measuring_) score_step();
   if (sample_every_ > 0 && steps_taken % sample_every_ == 0) sample(time);
+}
+
+void append_pair_events(const std::vector<PairPoint>& points, const std::vector<RigidBody>& bodies,
+                        long step, double dt, std::vector<CollisionEvent>& events) {
+  std::map<std::pair<int, int>, CollisionEvent> by_pair;
+  std::map<std::pair<int, int>, int> count;
+  std::map<std::pair<int, int>, bool> closing;
+  for (const PairPoint& p : points) {
+    const std::pair<int, int> key{p.a, p.b};
+    CollisionEvent& ev = by_pair[key];
+    if (count[key]++ == 0) {
+      ev.time = step * dt;
+      ev.step = step;
+      ev.body_a = bodies[p.a].name;
+      ev.body_b = bodies[p.b].name;
+      ev.contact = p.contact;
+      ev.contact.point.setZero();
+      ev.contact.normal.setZero();
+      ev.contact.depth = 0.0;
+    }
+    ev.contact.point += p.contact.point;
+    ev.contact.normal += p.contact.normal;
+    ev.contact.depth = std::max(ev.contact.depth, p.contact.depth);
+    ev.impulse += p.normal_impulse;
+    if (p.closing) closing[key] = true;
+  }
+  for (auto& [key, ev] : by_pair) {
+    if (!closing[key] || !(ev.impulse > 0.0)) continue;
+    ev.contact.point /= count[key];
+    if (ev.contact.normal.norm() > 0.0) ev.contact.normal.normalize();
+    events.push_back(ev);
+  }
 }
 
 }  // namespace rbx

@@ -86,4 +86,19 @@ class DynamicsRecorder {
   LawTally tally_;
 };
 
+/// One contact point a library solved in a step, for events merged per pair (libraries that
+/// solve a pair at several points but report no impulse per pair: ODE, DART).
+struct PairPoint {
+  int a = 0, b = 0;             // scene indices, a < b
+  ContactPoint contact;         // ours: normal from b toward a
+  double normal_impulse = 0.0;  // N s, on a along the normal over the step
+  bool closing = false;         // a approached b at this point before the step
+};
+
+/// Appends the events of step `step` to `events`, in pair order: one per pair with a closing
+/// point whose normal impulses sum to a push; its point and normal the means over the pair's
+/// points, its depth the largest, its impulse the sum.
+void append_pair_events(const std::vector<PairPoint>& points, const std::vector<RigidBody>& bodies,
+                        long step, double dt, std::vector<CollisionEvent>& events);
+
 }  // namespace rbx

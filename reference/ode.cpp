@@ -430,49 +430,30 @@ std::string add_bodies(WorldOwner& w, const std::vector<RigidBody>& bodies,
   return "";
 }
 
-// Events of step `step`: one per pair where the bodies were closing at some contact point and
-// the contact pushed; point and normal averaged over the pair's points, depth the largest,
-// impulse the sum of the normal impulses f . n dt. Appended to `events` in pair order.
+// Events of step `step` (append_pair_events): each point's normal impulse is its normal force
+// f . n times dt.
 void pair_events(const CollideContext& ctx, const std::vector<RigidBody>& bodies,
                  const std::vector<dBodyID>& ode_bodies, long step, double dt,
                  std::vector<CollisionEvent>& events) {
-  std::map<std::pair<int, int>, CollisionEvent> by_pair;
-  std::map<std::pair<int, int>, int> pair_points;
-  std::map<std::pair<int, int>, bool> pair_closing;
+  std::vector<PairPoint> points;
   for (const StepContact& sc : ctx.contacts) {
-    const std::pair<int, int> key{sc.a, sc.b};
-    const ContactPoint cp = convert_contact(sc.geom, sc.feature);
+    PairPoint p;
+    p.a = sc.a;
+    p.b = sc.b;
+    p.contact = convert_contact(sc.geom, sc.feature);
     // Force along the normal (N). With two bodies f1 acts on a; with one, ODE moves the
     // body into the first slot, so take whichever slot is filled (the push is >= 0).
     const dJointFeedback& fb = *sc.feedback;
     const Vec3 f1(fb.f1[0], fb.f1[1], fb.f1[2]), f2(fb.f2[0], fb.f2[1], fb.f2[2]);
+    const Vec3& n = p.contact.normal;
     const double push = (ode_bodies[sc.a] && ode_bodies[sc.b])
-                            ? f1.dot(cp.normal)
-                            : std::max(std::abs(f1.dot(cp.normal)), std::abs(f2.dot(cp.normal)));
-    const double impulse = push * dt;  // N s
-    CollisionEvent& ev = by_pair[key];
-    if (pair_points[key]++ == 0) {
-      ev.time = step * dt;
-      ev.step = step;
-      ev.body_a = bodies[sc.a].name;
-      ev.body_b = bodies[sc.b].name;
-      ev.contact = cp;
-      ev.contact.point.setZero();
-      ev.contact.normal.setZero();
-      ev.contact.depth = 0.0;
-    }
-    ev.contact.point += cp.point;
-    ev.contact.normal += cp.normal;
-    ev.contact.depth = std::max(ev.contact.depth, cp.depth);
-    ev.impulse += impulse;
-    if (sc.approach < -kClosingSpeed) pair_closing[key] = true;
+                            ? f1.dot(n)
+                            : std::max(std::abs(f1.dot(n)), std::abs(f2.dot(n)));
+    p.normal_impulse = push * dt;  // N s
+    p.closing = sc.approach < -kClosingSpeed;
+    points.push_back(p);
   }
-  for (auto& [key, ev] : by_pair) {
-    if (!pair_closing[key] || !(ev.impulse > 0.0)) continue;
-    ev.contact.point /= pair_points[key];
-    if (ev.contact.normal.norm() > 0.0) ev.contact.normal.normalize();
-    events.push_back(ev);
-  }
+  append_pair_events(points, bodies, step, dt, events);
 }
 
 // Every contact joint of the step with the impulse it applied to body a over the step (its
