@@ -63,7 +63,8 @@ BenchPlan bench_plan(bool quick) {
 
 // The caps keep the full run under ten minutes on two cores; each is named, with its reason, in
 // perf.md: the seed loops' 16 N^2 primitive tests, bullet-sat's polyhedral features rebuilt on
-// every call, the exact oracle's, ODE's and MuJoCo's cost at the largest sizes.
+// every call, the exact oracle's, ODE's, MuJoCo's and DART's (triangle meshes) cost at the
+// largest sizes.
 std::vector<NarrowBackend> narrow_backends() {
   auto registry = [](const std::string& name) { return find_backend(name)->contact; };
   auto variant = [](const std::string& name, const std::string& v) {
@@ -81,6 +82,9 @@ std::vector<NarrowBackend> narrow_backends() {
       {"bullet-sat", "default", registry("bullet-sat"), 512, 128},
       {"mujoco", "default", registry("mujoco"), 8192, 512},
       {"ode", "default", registry("ode"), 8192, 512},
+      // DART: BoxShapes on its own detector for the box pair, meshes on FCL for the hulls.
+      {"dart", "default", registry("dart"), 2048, 512},
+      {"dart", "prebuilt", variant("dart", "prebuilt"), 2048, 512},
       // `fcl` on two box bodies runs fcl::Box (boxBoxIntersect); the row keeps its old name.
       {"fcl-box", "default", registry("fcl"), 8, 8, true},
   };

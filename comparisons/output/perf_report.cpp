@@ -311,12 +311,14 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
     for (const NarrowBackend& b : nb) {
       const int cap = plan.quick ? b.max_vertices_quick : b.max_vertices_full;
       if (!b.boxes_only && cap < plan.hull_sizes.back())
-        caps.push_back("`" + b.backend + (b.backend == "custom" ? " (" + b.variant + ")" : "") +
+        caps.push_back("`" + b.backend + (b.variant != "default" ? " (" + b.variant + ")" : "") +
                        "` up to N = " + std::to_string(cap));
     }
     for (std::size_t i = 0; i < caps.size(); ++i) md << (i ? ", " : "") << caps[i];
     md << " (the seed loops cost about 16 N^2 primitive tests per query; bullet-sat rebuilds its "
-          "polyhedral features on every call; `fcl-box` takes boxes only).\n\n";
+          "polyhedral features on every call; DART collides the hulls as triangle meshes; "
+          "`fcl-box` "
+          "takes boxes only).\n\n";
   }
   for (const PoseKind& k : kPoseKinds) {
     md << "### " << k.name << "\n\n| backend | variant |";
