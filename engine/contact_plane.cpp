@@ -28,9 +28,19 @@ bool lex_less(const Vec3& p, const Vec3& q) {
 
 ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
                                   const ConvexPolyhedron& b, const Pose& pb, PlaneMethod method) {
+  return choose_contact_plane(a, pa, b, pb, Vec3::UnitZ(), plane_detail::kInf, method);
+}
+
+ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
+                                  const ConvexPolyhedron& b, const Pose& pb,
+                                  const Vec3& known_normal, double known_overlap,
+                                  PlaneMethod method) {
   thread_local plane_detail::Candidates found;
   found.kept.clear();
   found.upper = plane_detail::kInf;
+  // A NaN is no bound.
+  found.known = known_overlap == known_overlap ? known_overlap : plane_detail::kInf;
+  found.known_normal = known_normal;
   const GaussMap &ga = a.gauss_map(), &gb = b.gauss_map();
   const std::size_t features = ga.faces.size() + ga.arcs.size() + gb.faces.size() + gb.arcs.size();
   if (method == PlaneMethod::Automatic)

@@ -51,4 +51,14 @@ ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
                                   const ConvexPolyhedron& b, const Pose& pb,
                                   PlaneMethod method = PlaneMethod::Automatic);
 
+/// The same plane, given an overlap already measured along one direction: `known_overlap` (m)
+/// along the unit `known_normal` (from B toward A), such as the detector's contact (its depth is
+/// the overlap along its normal). The least overlap is at most that, so every candidate beyond it
+/// is skipped from the start instead of after the first few are measured; every candidate within
+/// the tie margin of the least is still measured, so the plane chosen is the same, bit for bit.
+ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
+                                  const ConvexPolyhedron& b, const Pose& pb,
+                                  const Vec3& known_normal, double known_overlap,
+                                  PlaneMethod method = PlaneMethod::Automatic);
+
 }  // namespace rbx

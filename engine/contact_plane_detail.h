@@ -29,12 +29,16 @@ struct Candidate {
 };
 
 /// What a search leaves: its candidates (every one within `tie` of the least overlap among
-/// them), the tie margin, and a fallback direction should none be kept.
+/// them), the tie margin, and a fallback direction should none be kept. On entry, `known` and
+/// `known_normal` are an overlap measured along some direction (kInf: none): an upper bound on
+/// the least overlap that each search starts from.
 struct Candidates {
   std::vector<Candidate> kept;
   double tie = 0.0;  // m, overlaps closer than this are equal (round-off)
   double upper = kInf;
   Vec3 upper_normal = Vec3::UnitZ();
+  double known = kInf;  // m
+  Vec3 known_normal = Vec3::UnitZ();
 };
 
 /// The sign-free form of an axis: the one of +-n whose first nonzero component is positive, so

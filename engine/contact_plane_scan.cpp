@@ -321,6 +321,9 @@ bool scan_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPoly
   const double scale = std::max({q.a.lo.cwiseAbs().maxCoeff(), q.a.hi.cwiseAbs().maxCoeff(),
                                  q.b.lo.cwiseAbs().maxCoeff(), q.b.hi.cwiseAbs().maxCoeff()});
   q.tie = 1e-12 * scale;
+  // A known overlap bounds the least from the start; one tie margin more absorbs the round-off
+  // between its arithmetic and this scan's.
+  q.best = out.known + q.tie;
 
   q.witness_in = nullptr;
   q.witness_overlap = kInf;

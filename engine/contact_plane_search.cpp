@@ -274,6 +274,11 @@ void search_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPo
   const double scale = std::max(pa.position.cwiseAbs().maxCoeff() + q.a.map->radius,
                                 pb.position.cwiseAbs().maxCoeff() + q.b.map->radius);
   q.tie = 1e-12 * scale;
+  // A known overlap bounds the least from the start (one tie margin more, as in the scan).
+  if (out.known < kInf) {
+    q.upper = out.known + q.tie;
+    q.upper_normal = out.known_normal;
+  }
   q.search();
   q.pair_arcs();
   out.kept.swap(q.kept);

@@ -148,8 +148,9 @@ std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const P
   if (!hit) return std::nullopt;
   ContactManifold m;
   m.detector_contact = *hit;
-  // The tests decide that the shapes touch; the plane is chosen (engine/contact_plane.h).
-  const ContactPlane plane = choose_contact_plane(a, pa, b, pb);
+  // The tests decide that the shapes touch; the plane is chosen (engine/contact_plane.h), the
+  // overlap along the tests' normal bounding it from the start.
+  const ContactPlane plane = choose_contact_plane(a, pa, b, pb, hit->normal, hit->depth);
   m.normal = plane.normal;
   m.depth = plane.depth;
   const Vec3& n = m.normal;

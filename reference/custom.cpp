@@ -26,8 +26,10 @@ ContactResult chosen_plane_contact(const RigidBody& a, const RigidBody& b,
   auto c = first_hit(a, b, variant);
   if (!c) return r;
   // Departure from the seed (engine/contact_plane.h): the tests find the contact and its point;
-  // the plane is the direction of least overlap, not the first face hit.
-  const ContactPlane plane = choose_contact_plane(*a.shape, a.pose(), *b.shape, b.pose());
+  // the plane is the direction of least overlap, not the first face hit (the overlap along the
+  // tests' normal bounds it from the start).
+  const ContactPlane plane =
+      choose_contact_plane(*a.shape, a.pose(), *b.shape, b.pose(), c->normal, c->depth);
   c->normal = plane.normal;
   c->depth = plane.depth;
   r.contacts.push_back(*c);

@@ -223,5 +223,33 @@ TEST(ContactPlane, TheScanAndTheSearchChooseTheSamePlane) {
   EXPECT_GT(touching, 40);
 }
 
+TEST(ContactPlane, AKnownOverlapChangesNothing) {
+  // The detector's normal and depth (the overlap along it) given as the known overlap: the plane
+  // is the same bit for bit, by either method, whether the detector's normal was the answer or
+  // a worse one (the second count: the bound was not the answer itself).
+  std::mt19937 rng(23);
+  const std::vector<ConvexPolyhedron> all = {
+      stretched_icosphere(1, Vec3(1.3, 0.7, 1.0)), stretched_icosphere(3, Vec3(0.6, 1.4, 0.9)),
+      make_prism(0.4, 1.2, 24), make_box(Vec3(0.9, 0.4, 0.7)), make_box(Vec3(1.0, 1.0, 1.0))};
+  int touching = 0, worse = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const RandomPair r = random_pair(all, rng);
+    const auto hit = detect(*r.a, r.pa, *r.b, r.pb);
+    if (!hit) continue;
+    ++touching;
+    for (const PlaneMethod method : {PlaneMethod::Scan, PlaneMethod::Search}) {
+      const ContactPlane plain = choose_contact_plane(*r.a, r.pa, *r.b, r.pb, method);
+      const ContactPlane known =
+          choose_contact_plane(*r.a, r.pa, *r.b, r.pb, hit->normal, hit->depth, method);
+      EXPECT_EQ(known.normal, plain.normal) << "trial " << trial;
+      EXPECT_EQ(known.depth, plain.depth) << "trial " << trial;
+      EXPECT_EQ(known.axis, plain.axis) << "trial " << trial;
+      if (method == PlaneMethod::Scan && hit->depth > plain.depth + 1e-6) ++worse;
+    }
+  }
+  EXPECT_GT(touching, 150);
+  EXPECT_GT(worse, 30);
+}
+
 }  // namespace
 }  // namespace rbx
