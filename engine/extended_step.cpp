@@ -24,6 +24,7 @@ ExtendedStep::ExtendedStep(const WorldSettings& tunables)
     : ahead_broad_phase_(BroadPhaseMethod::Tree, tunables) {}
 
 void ExtendedStep::advance(WorldState& world) {
+  ++steps_;
   std::vector<PairManifold> manifolds = detect_manifolds(world);
   // Approach velocities before this step's forces: the restitution law's v_n0.
   const std::vector<std::vector<double>> approach = normal_velocities(world.bodies, manifolds);
@@ -43,7 +44,7 @@ void ExtendedStep::advance(WorldState& world) {
   // contact (engine/time_of_impact.h) are moved to their first contact, resolved there, and
   // moved on for the rest of the step: an adaptive step for those two bodies only.
   const std::vector<bool> moved = time_of_impact_step(world, manifolds, settings);
-  integrate_bodies(world, moved);
+  integrate_bodies(world, moved, ahead_);
   // Only pairs that pressed together (a normal impulse) are projected apart: a penetration
   // that no approach caused, such as two overlapping bodies moving together
   // (stress/zero_relative_velocity), is left as it is, as the seed leaves it.
@@ -56,10 +57,11 @@ void ExtendedStep::advance(WorldState& world) {
 std::vector<PairManifold> ExtendedStep::detect_manifolds(WorldState& world) {
   // One manifold per pair passing the bounding check, at the step's start poses.
   std::vector<PairManifold> manifolds;
+  place_boxes(world.bodies, world.facts);
   for (const BodyPair& pair : world.broad_phase.find_pairs(world.bodies)) {
     const RigidBody &a = world.bodies[pair.first], &b = world.bodies[pair.second];
     if (a.is_static && b.is_static) continue;
-    if (separated(world, pair.first, pair.second)) continue;  // the detector would find nothing
+    if (separated(world, a, b, pair.first, pair.second)) continue;  // the detector finds nothing
     auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant,
                             world.tunables.position_slop);
     if (m) manifolds.push_back({pair.first, pair.second, std::move(*m), a.pose(), b.pose()});
@@ -107,33 +109,79 @@ std::vector<double> ExtendedStep::record_events(WorldState& world,
   return impulse;
 }
 
-void ExtendedStep::integrate_bodies(WorldState& world, const std::vector<bool>& moved) {
+void ExtendedStep::integrate_bodies(WorldState& world, const std::vector<bool>& moved,
+                                    const std::vector<RigidBody>& ahead) {
   // Gravity is already in the velocities for the symplectic scheme.
   const std::vector<BodyFacts>& facts = world.facts;
   for (size_t i = 0; i < world.bodies.size(); ++i) {
     RigidBody& b = world.bodies[i];
     if (moved[i]) continue;  // already carried through the step by its time of impact
-    if (world.sim.integrator == Integrator::Symplectic)
+    if (world.sim.integrator == Integrator::Symplectic && ahead.size() == world.bodies.size()) {
+      // The time of impact's look ahead already made this very move (advanced() is the same
+      // integration with no gravity), and nothing touched the body since.
+      b.position = ahead[i].position;
+      b.orientation = ahead[i].orientation;
+      b.velocity = ahead[i].velocity;
+      b.angular_velocity = ahead[i].angular_velocity;
+    } else if (world.sim.integrator == Integrator::Symplectic)
       integrate_symplectic(b, Vec3::Zero(), world.sim.dt, &facts[i].principal);
     else
       integrate(b, world.sim, world.sim.dt, &facts[i].principal);
   }
 }
 
-bool ExtendedStep::separated(const WorldState& world, int i, int j) {
-  const RigidBody &a = world.bodies[i], &b = world.bodies[j];
+void ExtendedStep::place_boxes(const std::vector<RigidBody>& bodies,
+                               const std::vector<BodyFacts>& facts) {
+  const size_t n = bodies.size();
+  if (static_lo_.size() != n) {
+    static_lo_.assign(n, Vec3::Zero());
+    static_hi_.assign(n, Vec3::Zero());
+    for (size_t i = 0; i < n; ++i) {
+      if (!bodies[i].is_static) continue;
+      const Pose pose = bodies[i].pose();
+      static_lo_[i] = static_hi_[i] = pose.apply(bodies[i].shape->vertices().front());
+      for (const Vec3& v : bodies[i].shape->vertices()) {
+        const Vec3 w = pose.apply(v);
+        static_lo_[i] = static_lo_[i].cwiseMin(w);
+        static_hi_[i] = static_hi_[i].cwiseMax(w);
+      }
+    }
+  }
+  box_lo_.resize(n);
+  box_hi_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const RigidBody& b = bodies[i];
+    box_lo_[i] = b.is_static ? static_lo_[i] : Vec3(b.position.array() - facts[i].radius);
+    box_hi_[i] = b.is_static ? static_hi_[i] : Vec3(b.position.array() + facts[i].radius);
+  }
+}
+
+bool ExtendedStep::separated(const WorldState& world, const RigidBody& a, const RigidBody& b, int i,
+                             int j) {
   const std::vector<BodyFacts>& facts = world.facts;
   // The pair's tolerance, 1e-9 x the larger size, is the larger of the two bodies' own.
   const double margin = separation_margin(std::max(facts[i].own_tol, facts[j].own_tol),
                                           facts[i].reach, facts[j].reach);
+  // Apart along a world axis by their boxes (a wall beside a body): no axis to keep.
+  const Vec3 gap_ab = box_lo_[i] - box_hi_[j], gap_ba = box_lo_[j] - box_hi_[i];
+  if (gap_ab.maxCoeff() > margin || gap_ba.maxCoeff() > margin) return true;
   const long long key = static_cast<long long>(i) * static_cast<long long>(world.bodies.size()) + j;
   const auto kept = witnesses_.find(key);
-  if (kept != witnesses_.end() &&
-      gap_along(*a.shape, a.pose(), *b.shape, b.pose(), b.orientation * kept->second) > margin)
-    return true;
+  if (kept != witnesses_.end()) {
+    // The bounding boxes' bound first (exact for boxes), the vertices only when it falls short.
+    const Vec3 u = b.orientation * kept->second.axis;
+    double gap = gap_bound_along(*a.shape, a.pose(), *b.shape, b.pose(), u);
+    if (!(gap > margin)) gap = gap_along(*a.shape, a.pose(), *b.shape, b.pose(), u);
+    if (gap > margin) {
+      kept->second.gap = gap;
+      kept->second.step = steps_;
+      return true;
+    }
+  }
   const Vec3 u = find_separating_axis(*a.shape, a.pose(), *b.shape, b.pose(), margin);
   if (u != Vec3::Zero()) {
-    witnesses_[key] = b.orientation.conjugate() * u;
+    witnesses_[key] = {b.orientation.conjugate() * u,
+                       gap_along(*a.shape, a.pose(), *b.shape, b.pose(), u), steps_};
     return true;
   }
   if (kept != witnesses_.end()) witnesses_.erase(kept);
@@ -146,6 +194,7 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
   const double dt = world.sim.dt;
   const size_t n = world.bodies.size();
   std::vector<bool> moved(n, false);
+  ahead_.clear();
   if (world.sim.integrator != Integrator::Symplectic) return moved;  // the seed's Euler: no TOI
   // Per body: thickness and bounding radius (fixed by the shape), sweep over the step.
   const std::vector<BodyFacts>& facts = world.facts;
@@ -181,7 +230,9 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
       const double s =
           q.squaredNorm() > 0.0 ? std::clamp(-p.dot(q) / q.squaredNorm(), 0.0, 1.0) : 0.0;
       if ((p + s * q).norm() > facts[lo].radius + facts[hi].radius) continue;
-      if (const auto t = time_of_impact(a, b, dt, world.variant)) hits.emplace_back(*t, lo, hi);
+      if (const auto t =
+              time_of_impact(a, b, dt, world.variant, &facts[lo].principal, &facts[hi].principal))
+        hits.emplace_back(*t, lo, hi);
     }
   }
   // Every other new contact (departure from the seed, whose detection after penetration resolves
@@ -189,19 +240,31 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
   // on that depth): a pair apart at the step's start whose poses at its end, moved with the
   // step's velocities, touch is moved to its first touch like the fast pairs above, so an impact
   // is resolved where it begins whatever its phase in the step.
-  ahead_.clear();
-  for (const RigidBody& b : world.bodies) ahead_.push_back(b.is_static ? b : advanced(b, dt));
+  std::vector<double> travel(n, 0.0);
+  for (size_t i = 0; i < n; ++i)
+    travel[i] = travel_bound(world.bodies[i], facts[i].principal, facts[i].radius, dt);
+  for (size_t i = 0; i < n; ++i) {
+    const RigidBody& b = world.bodies[i];
+    ahead_.push_back(b.is_static ? b : advanced(b, dt, &facts[i].principal));
+  }
   std::set<std::pair<int, int>> asked;
   for (const auto& [t, i, j] : hits) asked.insert({i, j});
+  place_boxes(ahead_, facts);
   for (const BodyPair& pair : ahead_broad_phase_.find_pairs(ahead_)) {
     const auto [i, j] = pair;
     const RigidBody &a = ahead_[i], &b = ahead_[j];
     if ((a.is_static && b.is_static) || touching.count(pair) || asked.count(pair)) continue;
-    const double margin = separation_margin(std::max(facts[i].own_tol, facts[j].own_tol),
-                                            facts[i].reach, facts[j].reach);
-    if (find_separating_axis(*a.shape, a.pose(), *b.shape, b.pose(), margin) != Vec3::Zero())
-      continue;  // still apart at the step's end
-    if (const auto t = time_of_impact(world.bodies[i], world.bodies[j], dt, world.variant))
+    // Still apart at the step's end: proved at its start with room for both bodies' travel
+    // along the step (no point moves farther), else by the pair's kept axis or a new one.
+    const auto kept = witnesses_.find(static_cast<long long>(i) * static_cast<long long>(n) + j);
+    if (kept != witnesses_.end() && kept->second.step == steps_ &&
+        kept->second.gap - travel[i] - travel[j] >
+            separation_margin(std::max(facts[i].own_tol, facts[j].own_tol), facts[i].reach,
+                              facts[j].reach))
+      continue;
+    if (separated(world, a, b, i, j)) continue;
+    if (const auto t = time_of_impact(world.bodies[i], world.bodies[j], dt, world.variant,
+                                      &facts[i].principal, &facts[j].principal))
       hits.emplace_back(*t, i, j);
   }
   std::sort(hits.begin(), hits.end());
@@ -209,8 +272,8 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
     // One time of impact per body and step (the earliest): the rest waits for the next step.
     if (moved[i] || moved[j]) continue;
     RigidBody &a = world.bodies[i], &b = world.bodies[j];
-    a = advanced(a, t);
-    b = advanced(b, t);
+    a = advanced(a, t, &facts[i].principal);
+    b = advanced(b, t, &facts[j].principal);
     if (auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant,
                                 world.tunables.position_slop)) {
       const std::vector<PairManifold> one = {{i, j, std::move(*m), a.pose(), b.pose()}};
@@ -219,8 +282,8 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
       record_events(world, one, solve_contact_velocities(world.bodies, one, approach, settings),
                     world.time + t, std::nullopt);
     }
-    a = advanced(a, dt - t);
-    b = advanced(b, dt - t);
+    a = advanced(a, dt - t, &facts[i].principal);
+    b = advanced(b, dt - t, &facts[j].principal);
     moved[i] = !a.is_static;
     moved[j] = !b.is_static;
   }

@@ -41,18 +41,35 @@ class ExtendedStep {
   std::vector<bool> time_of_impact_step(WorldState& world,
                                         const std::vector<PairManifold>& manifolds,
                                         const ContactSolverSettings& settings);
-  // Integrates every body the time of impact did not carry (`moved`) through the step.
-  static void integrate_bodies(WorldState& world, const std::vector<bool>& moved);
-  // True when the pair (i, j) is proved apart (the detector would find nothing): by its kept
-  // axis, else by a new one, which is then kept.
-  bool separated(const WorldState& world, int i, int j);
+  // Integrates every body the time of impact did not carry (`moved`) through the step; with the
+  // symplectic scheme, takes the move from `ahead` (the bodies at the step's end) when filled.
+  static void integrate_bodies(WorldState& world, const std::vector<bool>& moved,
+                               const std::vector<RigidBody>& ahead);
+  // True when bodies i and j, as `a` and `b` (at the step's start, or moved to its end), are
+  // proved apart (the detector would find nothing): by the pair's kept axis, else by a new one,
+  // which is then kept.
+  bool separated(const WorldState& world, const RigidBody& a, const RigidBody& b, int i, int j);
+
+  // Places a world box around each of `bodies` (the set separated() is asked about next): a
+  // moving body's is its bounding ball's about the centre of mass, a static body's the box of its
+  // world vertices (computed once: a static body never moves).
+  void place_boxes(const std::vector<RigidBody>& bodies, const std::vector<BodyFacts>& facts);
 
   // The second broad phase, on the poses at the step's end (new contacts).
   BroadPhase ahead_broad_phase_;
   std::vector<RigidBody> ahead_;  // scratch: the bodies moved to the step's end
-  // Per pair (key i * bodies + j) that passed the bounding check but was found apart: the axis
-  // that proved it (engine/separation.h), in b's frame, tried first at the next step.
-  std::unordered_map<long long, Vec3> witnesses_;
+  // What proved a pair apart (engine/separation.h): the axis, in b's frame, tried first at the
+  // next test; the gap along it (m) and the step (steps_) at which it was measured.
+  struct Witness {
+    Vec3 axis = Vec3::UnitZ();
+    double gap = 0.0;
+    long step = -1;
+  };
+  // Per pair (key i * bodies + j) that passed the bounding check but was found apart.
+  std::unordered_map<long long, Witness> witnesses_;
+  long steps_ = 0;                     // steps advanced: stamps the witnesses measured in this one
+  std::vector<Vec3> box_lo_, box_hi_;  // m, world: place_boxes' boxes
+  std::vector<Vec3> static_lo_, static_hi_;  // m, world: the static bodies' boxes, once
 };
 
 }  // namespace rbx

@@ -49,6 +49,8 @@ Quat rotate_free_body(const Quat& orientation, const PrincipalFrame& frame, cons
   const double c_mid = 1.0 / moments(1) - 1.0 / reference;
   // Flow of c (u.l)^2 / 2 for time h: the body turns about its own axis u by c (u.l) h.
   auto about_body_axis = [&](const Quat& q, const Vec3& u, double c, double h) {
+    // No turn (c = 0: an isotropic or axisymmetric body): q times the identity is q exactly.
+    if (c == 0.0) return q.normalized();
     const Vec3 l = q.conjugate() * momentum;
     return (q * exp_map(u * (c * u.dot(l) * h))).normalized();
   };

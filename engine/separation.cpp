@@ -49,6 +49,15 @@ double gap_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedr
   return (low_a + pa.position.dot(u)) - (high_b + pb.position.dot(u));
 }
 
+double gap_bound_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                       const Pose& pb, const Vec3& u) {
+  // A box's extreme along d: per axis, the corner coordinate that d favours.
+  const Vec3 ua = pa.orientation.conjugate() * u, ub = pb.orientation.conjugate() * u;
+  const Vec3 low_a = ua.cwiseProduct(a.bounds().min).cwiseMin(ua.cwiseProduct(a.bounds().max));
+  const Vec3 high_b = ub.cwiseProduct(b.bounds().min).cwiseMax(ub.cwiseProduct(b.bounds().max));
+  return (low_a.sum() + pa.position.dot(u)) - (high_b.sum() + pb.position.dot(u));
+}
+
 namespace {
 
 // The world normal of `shape`'s triangle whose normal is nearest the world direction d.

@@ -32,6 +32,11 @@ double separation_margin(double tol, double reach_a, double reach_b);
 double gap_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                  const Pose& pb, const Vec3& u);
 
+/// A lower bound on gap_along(a, pa, b, pb, u) from each shape's bounding box in its own frame
+/// (exact for boxes): the same two rotations of u, no loop over the vertices.
+double gap_bound_along(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                       const Pose& pb, const Vec3& u);
+
 /// A unit world axis from b toward a along which the pair is apart by more than `margin`, from
 /// a few candidates (the direction between the centres of mass, b's triangle normal nearest it,
 /// a's triangle normal nearest its opposite; then the direction from each body's box, in its

@@ -18,9 +18,9 @@ double shape_thickness(const ConvexPolyhedron& shape) {
   return thinnest;
 }
 
-RigidBody advanced(const RigidBody& body, double t) {
+RigidBody advanced(const RigidBody& body, double t, const PrincipalFrame* frame) {
   RigidBody moved = body;
-  integrate_symplectic(moved, Vec3::Zero(), t);
+  integrate_symplectic(moved, Vec3::Zero(), t, frame);
   return moved;
 }
 
@@ -31,11 +31,21 @@ double sweep_length(const RigidBody& body, double t) {
   return (body.velocity.norm() + body.angular_velocity.norm() * radius) * t;
 }
 
+double travel_bound(const RigidBody& body, const PrincipalFrame& frame, double radius, double t) {
+  if (body.is_static) return 0.0;
+  const double turn =
+      3.0 * (body.inertia_world() * body.angular_velocity).norm() / frame.moments(0);
+  return (body.velocity.norm() + turn * radius) * t;
+}
+
 std::optional<double> time_of_impact(const RigidBody& a, const RigidBody& b, double dt,
-                                     DetectorVariant variant) {
+                                     DetectorVariant variant, const PrincipalFrame* frame_a,
+                                     const PrincipalFrame* frame_b) {
+  // One detection cache for every sample (its scratch lists allocated once).
+  DetectionCache cache;
   auto touching = [&](double t) {
-    const RigidBody ma = advanced(a, t), mb = advanced(b, t);
-    return detect(*a.shape, ma.pose(), *b.shape, mb.pose(), variant).has_value();
+    const RigidBody ma = advanced(a, t, frame_a), mb = advanced(b, t, frame_b);
+    return detect(*a.shape, ma.pose(), *b.shape, mb.pose(), variant, cache).has_value();
   };
   // Samples: the relative sweep over one sample interval stays under a quarter of the thinner
   // thickness, so a body cannot cross the other between two samples. At most 1e6 samples

@@ -9,6 +9,7 @@
 
 #include "engine/body.h"
 #include "engine/detect.h"
+#include "engine/integrate.h"
 
 namespace rbx {
 
@@ -18,19 +19,30 @@ double shape_thickness(const ConvexPolyhedron& shape);
 
 /// The body moved torque-free with its current velocities over time t (s): centre by v t,
 /// orientation by the symplectic integrator's free rotation (engine/integrate.h), no gravity.
-RigidBody advanced(const RigidBody& body, double t);
+/// `frame`, when given, is the body's principal frame kept by the caller (the same numbers).
+RigidBody advanced(const RigidBody& body, double t, const PrincipalFrame* frame = nullptr);
 
 /// Largest distance (m) a point of the body can travel over time t with its current velocity:
 /// |v| t + |w| r t, r its bounding radius about the centre of mass (a bound, not exact).
 double sweep_length(const RigidBody& body, double t);
+
+/// Largest distance (m) any point of the body can move as advanced(body, t) moves it, a bound
+/// that holds for any inertia: |v| t, plus the free rotation's three sub-turns (each by an angle
+/// of at most |L| t / I_min, L the world angular momentum) times `radius`, the body's bounding
+/// radius about its centre of mass (a chord is no longer than its arc). `frame`: the body's
+/// principal frame. Zero for a static body.
+double travel_bound(const RigidBody& body, const PrincipalFrame& frame, double radius, double t);
 
 /// First time in (0, dt] at which A and B, moving torque-free from their current poses with
 /// their current velocities, touch by the detector; nothing when they do not within dt.
 /// Conservative advancement in fixed samples: the relative motion between two samples is at most
 /// a quarter of the thinner body's thickness, so no sample pair can straddle a whole crossing;
 /// then bisection on the detector between the last separated and the first touching sample, to
-/// 1e-12 of dt. Meant for pairs separated at the step's start.
+/// 1e-12 of dt. Meant for pairs separated at the step's start. `frame_a`, `frame_b` as for
+/// advanced.
 std::optional<double> time_of_impact(const RigidBody& a, const RigidBody& b, double dt,
-                                     DetectorVariant variant);
+                                     DetectorVariant variant,
+                                     const PrincipalFrame* frame_a = nullptr,
+                                     const PrincipalFrame* frame_b = nullptr);
 
 }  // namespace rbx

@@ -70,6 +70,32 @@ TEST(Separation, AWitnessMeansTheDetectorFindsNothing) {
   EXPECT_GT(near, 100);
 }
 
+// The bounding boxes' bound on the gap, which the extended step tries before the vertices: never
+// above the gap, equal to it (to round-off) for two boxes.
+TEST(Separation, TheBoxBoundNeverExceedsTheGapAndIsExactForBoxes) {
+  const std::vector<ConvexPolyhedron> shapes = {make_box(Vec3(1.0, 1.0, 1.0)),
+                                                make_box(Vec3(2.0, 0.3, 0.7)),
+                                                make_prism(0.6, 1.2, 7), make_icosphere(0.5, 1)};
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 4000; ++k) {
+    const ConvexPolyhedron& a = shapes[k % shapes.size()];
+    const ConvexPolyhedron& b = shapes[(k / shapes.size()) % shapes.size()];
+    Pose pa, pb;
+    pa.orientation = random_rotation(rng);
+    pb.orientation = random_rotation(rng);
+    pa.position = Vec3(u(rng), u(rng), u(rng)) * 3.0;
+    pb.position = Vec3(u(rng), u(rng), u(rng)) * 3.0;
+    const Vec3 axis = Vec3(u(rng), u(rng), u(rng)).normalized();
+    const double gap = gap_along(a, pa, b, pb, axis), bound = gap_bound_along(a, pa, b, pb, axis);
+    // 1e-12 of the coordinates: the round-off of the two sums.
+    EXPECT_LE(bound, gap + 1e-12 * 6.0) << "trial " << k;
+    if (k % shapes.size() < 2 && (k / shapes.size()) % shapes.size() < 2) {
+      EXPECT_NEAR(bound, gap, 1e-12 * 6.0) << "trial " << k;
+    }
+  }
+}
+
 TEST(Separation, NoWitnessWithinTheMargin) {
   // Two unit cubes face to face: the margin ((sqrt 3 + 1) tol) refuses gaps up to 2.7 tol, as
   // the detector's tolerance may reach across them (a corner's region reaches sqrt 3 tol); at
