@@ -8,8 +8,7 @@ BoundingSphere bounding_sphere(const RigidBody& body) {
 }
 
 bool bounding_check(const RigidBody& a, const RigidBody& b) {
-  const BoundingSphere sa = bounding_sphere(a), sb = bounding_sphere(b);
-  return (sa.center - sb.center).norm() <= sa.radius + sb.radius;
+  return spheres_touch(bounding_sphere(a), bounding_sphere(b));
 }
 
 }  // namespace rbx

@@ -40,9 +40,7 @@ const char* to_string(BroadPhaseMethod method) {
 bool BroadPhase::spheres_touch(int i, int j) const {
   // Exactly bounding_check(): the same spheres (bounding_sphere() is deterministic), the same
   // expression.
-  const BoundingSphere& sa = spheres_[i];
-  const BoundingSphere& sb = spheres_[j];
-  return (sa.center - sb.center).norm() <= sa.radius + sb.radius;
+  return rbx::spheres_touch(spheres_[i], spheres_[j]);
 }
 
 void BroadPhase::test_pair(int i, int j) {
@@ -50,7 +48,8 @@ void BroadPhase::test_pair(int i, int j) {
   if (spheres_touch(i, j)) pairs_.push_back({i, j});
 }
 
-const std::vector<BodyPair>& BroadPhase::find_pairs(const std::vector<RigidBody>& bodies) {
+const std::vector<BodyPair>& BroadPhase::find_pairs(const std::vector<RigidBody>& bodies,
+                                                    double grow) {
   // The seed's spheres, once per body, and padded boxes around them.
   const int n = static_cast<int>(bodies.size());
   spheres_.resize(n);
@@ -60,6 +59,7 @@ const std::vector<BodyPair>& BroadPhase::find_pairs(const std::vector<RigidBody>
   for (int i = 0; i < n; ++i) {
     static_[i] = bodies[i].is_static;
     spheres_[i] = bounding_sphere(bodies[i]);
+    if (grow > 0.0) spheres_[i].radius += grow;
     const double pad =
         spheres_[i].radius + kPad * (spheres_[i].radius + spheres_[i].center.cwiseAbs().maxCoeff());
     box_min_[i] = spheres_[i].center.array() - pad;
@@ -204,7 +204,7 @@ bool BroadPhase::grid() {
     int i = in_cells_[x], j = in_cells_[y];
     if (i > j) std::swap(x, y), std::swap(i, j);
     const BoundingSphere &sa = leaf_spheres_[x], &sb = leaf_spheres_[y];
-    if ((sa.center - sb.center).norm() <= sa.radius + sb.radius) pairs_.push_back({i, j});
+    if (rbx::spheres_touch(sa, sb)) pairs_.push_back({i, j});
   };
   // Half the neighbourhood: offsets after (0, 0, 0) in lexicographic order.
   static constexpr int kHalf[13][3] = {{0, 0, 1},  {0, 1, -1}, {0, 1, 0},  {0, 1, 1}, {1, -1, -1},
@@ -314,8 +314,7 @@ void BroadPhase::test_leaves(int m, int q) {
   if (tree_order_[m] > tree_order_[q]) std::swap(m, q);
   const BoundingSphere& sa = leaf_spheres_[m];
   const BoundingSphere& sb = leaf_spheres_[q];
-  if ((sa.center - sb.center).norm() <= sa.radius + sb.radius)
-    pairs_.push_back({tree_order_[m], tree_order_[q]});
+  if (rbx::spheres_touch(sa, sb)) pairs_.push_back({tree_order_[m], tree_order_[q]});
 }
 
 void BroadPhase::tree_against_itself() {

@@ -46,8 +46,10 @@ class BroadPhase {
       : method_(method), tunables_(tunables) {}
 
   /// Every pair i < j of `bodies` for which bounding_check is true, sorted by (i, j). The
-  /// reference stays valid until the next call.
-  const std::vector<BodyPair>& find_pairs(const std::vector<RigidBody>& bodies);
+  /// reference stays valid until the next call. With `grow` > 0 (m), the pairs whose bounding
+  /// spheres, each grown by `grow`, touch: a superset, for a caller that filters it with the
+  /// seed's test at more than one pose of the bodies.
+  const std::vector<BodyPair>& find_pairs(const std::vector<RigidBody>& bodies, double grow = 0.0);
 
   /// The method this broad phase runs.
   BroadPhaseMethod method() const { return method_; }

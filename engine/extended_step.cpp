@@ -10,6 +10,7 @@
 #include <tuple>
 #include <utility>
 
+#include "engine/bounding.h"
 #include "engine/contact_solver.h"
 #include "engine/integrate.h"
 #include "engine/manifold.h"
@@ -54,13 +55,44 @@ void ExtendedStep::advance(WorldState& world) {
   project_contact_positions(world.bodies, pressed, world.tunables);
 }
 
+double ExtendedStep::look_ahead_growth(const WorldState& world) {
+  // The seed's Euler has no look-ahead.
+  if (world.sim.integrator != Integrator::Symplectic) return 0.0;
+  // Each body's reach over the step at its start velocity with this step's gravity (|v + g dt|
+  // <= |v| + |g| dt), doubled: room for the contact solve to exchange speeds between bodies.
+  const double dt = world.sim.dt;
+  double most = 0.0, least_radius = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < world.bodies.size(); ++i) {
+    const RigidBody& b = world.bodies[i];
+    if (b.is_static) continue;
+    most = std::max(most,
+                    travel_bound(b, world.facts[i].turn_rate, centre_reach(b, world.facts[i]), dt) +
+                        world.sim.gravity.norm() * dt * dt);
+    least_radius = std::min(least_radius, world.facts[i].radius);
+  }
+  // Worth it only while the growth keeps the spheres near their size (a fast body would grow
+  // every sphere): then the look-ahead runs its own broad phase.
+  const double grow = 2.0 * most;
+  return std::isfinite(grow) && grow <= 0.05 * least_radius ? grow : 0.0;
+}
+
 std::vector<PairManifold> ExtendedStep::detect_manifolds(WorldState& world) {
-  // One manifold per pair passing the bounding check, at the step's start poses.
+  // One manifold per pair passing the bounding check, at the step's start poses. With a growth,
+  // the broad phase's pairs are those of spheres grown by it, kept for the look-ahead; here the
+  // seed's test on the start spheres keeps exactly the bounding check's pairs, in its order.
   std::vector<PairManifold> manifolds;
   place_boxes(world.bodies, world.facts);
-  for (const BodyPair& pair : world.broad_phase.find_pairs(world.bodies)) {
+  grow_ = look_ahead_growth(world);
+  const std::vector<BodyPair>& pairs = world.broad_phase.find_pairs(world.bodies, grow_);
+  if (grow_ > 0.0) {
+    grown_pairs_.assign(pairs.begin(), pairs.end());
+    spheres_.resize(world.bodies.size());
+    for (size_t i = 0; i < world.bodies.size(); ++i) spheres_[i] = bounding_sphere(world.bodies[i]);
+  }
+  for (const BodyPair& pair : pairs) {
     const RigidBody &a = world.bodies[pair.first], &b = world.bodies[pair.second];
     if (a.is_static && b.is_static) continue;
+    if (grow_ > 0.0 && !spheres_touch(spheres_[pair.first], spheres_[pair.second])) continue;
     if (separated(world, a, b, pair.first, pair.second)) continue;  // the detector finds nothing
     auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant,
                             world.tunables.position_slop);
@@ -128,6 +160,30 @@ void ExtendedStep::integrate_bodies(WorldState& world, const std::vector<bool>& 
     else
       integrate(b, world.sim, world.sim.dt, &facts[i].principal);
   }
+}
+
+double ExtendedStep::centre_reach(const RigidBody& body, const BodyFacts& facts) {
+  return std::max(facts.radius, body.shape->bounds().center().norm());
+}
+
+const std::vector<BodyPair>& ExtendedStep::look_ahead_pairs(const WorldState& world) {
+  // The start's grown pairs hold every pair whose spheres touch at the step's end while no
+  // sphere centre moved more than half the growth (two centres then close in by at most the
+  // growth, which each grown radius adds): filtered by the seed's test on the end spheres, they
+  // are the look-ahead broad phase's pairs, in its order. Otherwise that broad phase runs.
+  const size_t n = ahead_.size();
+  bool within = grow_ > 0.0 && grown_pairs_.size() > 0;
+  for (size_t i = 0; within && i < n; ++i)
+    within =
+        travel_bound(world.bodies[i], world.facts[i].turn_rate,
+                     centre_reach(world.bodies[i], world.facts[i]), world.sim.dt) <= 0.5 * grow_;
+  if (!within) return ahead_broad_phase_.find_pairs(ahead_);
+  spheres_.resize(n);
+  for (size_t i = 0; i < n; ++i) spheres_[i] = bounding_sphere(ahead_[i]);
+  ahead_pairs_.clear();
+  for (const BodyPair& p : grown_pairs_)
+    if (spheres_touch(spheres_[p.first], spheres_[p.second])) ahead_pairs_.push_back(p);
+  return ahead_pairs_;
 }
 
 void ExtendedStep::place_boxes(const std::vector<RigidBody>& bodies,
@@ -242,7 +298,7 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
   // is resolved where it begins whatever its phase in the step.
   std::vector<double> travel(n, 0.0);
   for (size_t i = 0; i < n; ++i)
-    travel[i] = travel_bound(world.bodies[i], facts[i].principal, facts[i].radius, dt);
+    travel[i] = travel_bound(world.bodies[i], facts[i].turn_rate, facts[i].radius, dt);
   for (size_t i = 0; i < n; ++i) {
     const RigidBody& b = world.bodies[i];
     ahead_.push_back(b.is_static ? b : advanced(b, dt, &facts[i].principal));
@@ -250,7 +306,7 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
   std::set<std::pair<int, int>> asked;
   for (const auto& [t, i, j] : hits) asked.insert({i, j});
   place_boxes(ahead_, facts);
-  for (const BodyPair& pair : ahead_broad_phase_.find_pairs(ahead_)) {
+  for (const BodyPair& pair : look_ahead_pairs(world)) {
     const auto [i, j] = pair;
     const RigidBody &a = ahead_[i], &b = ahead_[j];
     if ((a.is_static && b.is_static) || touching.count(pair) || asked.count(pair)) continue;

@@ -50,6 +50,17 @@ class ExtendedStep {
   // which is then kept.
   bool separated(const WorldState& world, const RigidBody& a, const RigidBody& b, int i, int j);
 
+  // The growth of the bounding spheres (m) for one broad phase serving both the step's start and
+  // its end (the look-ahead): twice the farthest any body's sphere centre reaches at its start
+  // velocity; 0 (two broad phases) under the seed's Euler or when that is not small beside the
+  // smallest body.
+  static double look_ahead_growth(const WorldState& world);
+  // The distance from the centre of mass within which the body's points and its bounding
+  // sphere's centre lie (m): what travel_bound's radius must cover.
+  static double centre_reach(const RigidBody& body, const BodyFacts& facts);
+  // The pairs whose spheres touch at the step's end (ahead_): the start's grown pairs filtered,
+  // or the look-ahead broad phase when a sphere centre moved too far for them.
+  const std::vector<BodyPair>& look_ahead_pairs(const WorldState& world);
   // Places a world box around each of `bodies` (the set separated() is asked about next): a
   // moving body's is its bounding ball's about the centre of mass, a static body's the box of its
   // world vertices (computed once: a static body never moves).
@@ -69,6 +80,10 @@ class ExtendedStep {
   std::unordered_map<long long, Witness> witnesses_;
   long steps_ = 0;                     // steps advanced: stamps the witnesses measured in this one
   std::vector<Vec3> box_lo_, box_hi_;  // m, world: place_boxes' boxes
+  double grow_ = 0.0;                  // m, this step's growth (look_ahead_growth)
+  std::vector<BodyPair> grown_pairs_;  // the start's pairs of spheres grown by grow_
+  std::vector<BodyPair> ahead_pairs_;  // scratch: look_ahead_pairs' output
+  std::vector<BoundingSphere> spheres_;      // scratch: one pose's bounding spheres
   std::vector<Vec3> static_lo_, static_hi_;  // m, world: the static bodies' boxes, once
 };
 

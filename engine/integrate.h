@@ -36,6 +36,11 @@ void integrate_symplectic(RigidBody& body, const Vec3& gravity, double dt,
 Quat rotate_free_body(const Quat& orientation, const PrincipalFrame& frame, const Vec3& momentum,
                       double dt);
 
+/// The most rotate_free_body turns a body per unit of |L| and of time (1 / (kg m^2)): the sum of
+/// its sub-turns' rates (the top's turn about L, its symmetry-axis turn, the two middle-axis
+/// halves), each a bound on its angle over |L| dt. 1 / I for an isotropic body.
+double free_turn_rate(const PrincipalFrame& frame);
+
 /// rotate_free_body with the principal frame of `inertia_body` (kg m^2, body frame).
 Quat rotate_free_body(const Quat& orientation, const Mat3& inertia_body, const Vec3& momentum,
                       double dt);

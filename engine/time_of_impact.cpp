@@ -31,11 +31,12 @@ double sweep_length(const RigidBody& body, double t) {
   return (body.velocity.norm() + body.angular_velocity.norm() * radius) * t;
 }
 
-double travel_bound(const RigidBody& body, const PrincipalFrame& frame, double radius, double t) {
+double travel_bound(const RigidBody& body, double turn_rate, double radius, double t) {
   if (body.is_static) return 0.0;
-  const double turn =
-      3.0 * (body.inertia_world() * body.angular_velocity).norm() / frame.moments(0);
-  return (body.velocity.norm() + turn * radius) * t;
+  // |L| = |I_body R^T w|: a rotation keeps the norm.
+  const double momentum =
+      (body.inertia_body * (body.orientation.conjugate() * body.angular_velocity)).norm();
+  return (body.velocity.norm() + turn_rate * momentum * radius) * t;
 }
 
 std::optional<double> time_of_impact(const RigidBody& a, const RigidBody& b, double dt,

@@ -26,12 +26,12 @@ RigidBody advanced(const RigidBody& body, double t, const PrincipalFrame* frame 
 /// |v| t + |w| r t, r its bounding radius about the centre of mass (a bound, not exact).
 double sweep_length(const RigidBody& body, double t);
 
-/// Largest distance (m) any point of the body can move as advanced(body, t) moves it, a bound
-/// that holds for any inertia: |v| t, plus the free rotation's three sub-turns (each by an angle
-/// of at most |L| t / I_min, L the world angular momentum) times `radius`, the body's bounding
-/// radius about its centre of mass (a chord is no longer than its arc). `frame`: the body's
-/// principal frame. Zero for a static body.
-double travel_bound(const RigidBody& body, const PrincipalFrame& frame, double radius, double t);
+/// Largest distance (m) any point of the body can move as advanced(body, t) moves it: |v| t,
+/// plus the free rotation's turn (at most free_turn_rate(frame) |L| t, L the world angular
+/// momentum) times `radius`, the body's bounding radius about its centre of mass (a chord is no
+/// longer than its arc). `turn_rate`: free_turn_rate of the body's principal frame, kept by the
+/// caller. Zero for a static body.
+double travel_bound(const RigidBody& body, double turn_rate, double radius, double t);
 
 /// First time in (0, dt] at which A and B, moving torque-free from their current poses with
 /// their current velocities, touch by the detector; nothing when they do not within dt.

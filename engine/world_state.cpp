@@ -15,6 +15,7 @@ BodyFacts BodyFacts::of(const RigidBody& body) {
   f.reach = tolerance_reach(shape);
   f.own_tol = point_in_mesh_tolerance(shape, shape);
   f.principal = principal_frame(body.inertia_body);
+  f.turn_rate = free_turn_rate(f.principal);
   return f;
 }
 

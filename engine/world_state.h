@@ -43,6 +43,7 @@ struct BodyFacts {
   double reach = 1.0;        // m, how far the detector's tolerance reaches beyond it
   double own_tol = 0.0;      // m, its point-in-mesh tolerance against itself (1e-9 x its size)
   PrincipalFrame principal;  // its inertia's principal frame (the free rotation's)
+  double turn_rate = 0.0;    // 1 / (kg m^2), free_turn_rate(principal)
 
   /// The facts of `body`.
   static BodyFacts of(const RigidBody& body);

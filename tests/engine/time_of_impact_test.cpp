@@ -60,7 +60,7 @@ TEST(TimeOfImpact, NoPointTravelsFartherThanTheTravelBound) {
       EXPECT_EQ(moved.orientation.coeffs(), plain.orientation.coeffs());
       EXPECT_EQ(moved.position, plain.position);
       EXPECT_EQ(moved.angular_velocity, plain.angular_velocity);
-      const double bound = travel_bound(b, frame, radius, t);
+      const double bound = travel_bound(b, free_turn_rate(frame), radius, t);
       for (const Vec3& v : b.shape->vertices()) {
         const double d = (moved.pose().apply(v) - b.pose().apply(v)).norm();
         // 1e-12 of the bound: the round-off of the two placements.
