@@ -71,6 +71,45 @@ TEST(BroadPhase, EveryMethodFindsTheOraclePairs) {
   }
 }
 
+// Grown spheres (the extended step's one broad phase for a step's start and end): every method
+// finds exactly the pairs whose spheres, each grown, touch, a strict superset of the seed's; on
+// a crowd of mixed sizes (the tree's hierarchy) and one of like size (its grid).
+TEST(BroadPhase, GrownSpheresGiveTheGrownOraclePairs) {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<RigidBody> like;
+  for (int i = 0; i < 600; ++i)
+    like.push_back(test::box_body("c" + std::to_string(i), Vec3::Constant(0.3 + 0.2 * unit(rng)),
+                                  1.0, 7.0 * Vec3(unit(rng), unit(rng), unit(rng))));
+  const double grow = 0.03;
+  // 290 boxes of 0.3 m and 10 of 2 m: beyond 2x of the median, the tree's hierarchy.
+  std::vector<RigidBody> mixed;
+  for (int i = 0; i < 300; ++i)
+    mixed.push_back(test::box_body("m" + std::to_string(i), Vec3::Constant(i % 30 ? 0.3 : 2.0), 1.0,
+                                   6.0 * Vec3(unit(rng), unit(rng), unit(rng))));
+  const std::vector<RigidBody>* const crowds[] = {&mixed, &like};
+  for (const std::vector<RigidBody>* crowd_of : crowds) {
+    const std::vector<RigidBody>& bodies = *crowd_of;
+    std::vector<BodyPair> expected;
+    for (int i = 0; i < static_cast<int>(bodies.size()); ++i)
+      for (int j = i + 1; j < static_cast<int>(bodies.size()); ++j) {
+        BoundingSphere a = bounding_sphere(bodies[i]), b = bounding_sphere(bodies[j]);
+        a.radius += grow;
+        b.radius += grow;
+        if (spheres_touch(a, b)) expected.push_back({i, j});
+      }
+    EXPECT_GT(expected.size(), oracle_pairs(bodies).size());
+    for (const BroadPhaseMethod m : kMethods) {
+      BroadPhase bp(m);
+      EXPECT_EQ(bp.find_pairs(bodies, grow), expected) << to_string(m);
+      EXPECT_EQ(bp.find_pairs(bodies), oracle_pairs(bodies)) << to_string(m);
+      if (m == BroadPhaseMethod::Tree) {
+        EXPECT_EQ(bp.used_grid(), crowd_of == &like);
+      }
+    }
+  }
+}
+
 TEST(BroadPhase, TheGridFindsTheOraclePairs) {
   // 800 moving boxes of like size (0.3 to 0.5 m: within 2x of the median, so the tree takes
   // its hashed grid), centred on the origin so that cells have negative coordinates too, two
