@@ -172,7 +172,7 @@ const std::vector<BodyPair>& ExtendedStep::look_ahead_pairs(const WorldState& wo
   // growth, which each grown radius adds): filtered by the seed's test on the end spheres, they
   // are the look-ahead broad phase's pairs, in its order. Otherwise that broad phase runs.
   const size_t n = ahead_.size();
-  bool within = grow_ > 0.0 && grown_pairs_.size() > 0;
+  bool within = grow_ > 0.0;
   for (size_t i = 0; within && i < n; ++i)
     within =
         travel_bound(world.bodies[i], world.facts[i].turn_rate,
