@@ -15,6 +15,11 @@
 //     (median splits) and traversed against itself, each static body's box queried against it;
 //     O(N log N + pairs), whatever the mix of body sizes. For many moving bodies of like size
 //     it takes a uniform grid instead (O(N + cells + pairs)).
+// The faster methods keep their pairs from call to call (as Bullet's dynamic tree keeps fattened
+// boxes): each index is built for spheres grown by room to move (pair_cache_margin in
+// WorldSettings), and while no centre has moved further than that room since, a call only runs
+// the seed's test over the kept pairs. The kept pairs are a superset of the call's (the triangle
+// inequality, in cache_holds), in order, so the answer is the same.
 #pragma once
 
 #include <utility>
@@ -54,11 +59,20 @@ class BroadPhase {
   /// The method this broad phase runs.
   BroadPhaseMethod method() const { return method_; }
 
+  /// How many times an index was built (the rest of the calls reused the kept pairs).
+  long index_builds() const { return cache_builds_; }
+
   /// Whether the last tree call took the uniform grid (many moving bodies of like size, packed)
   /// instead of the hierarchy; the pairs are the same either way.
   bool used_grid() const { return used_grid_; }
 
  private:
+  // Indexes this call's spheres (base_), each grown by `grow`, into pairs_ in (i, j) order.
+  void index(double grow);
+  // Whether the kept pairs hold every pair of this call's spheres grown by `grow`.
+  bool cache_holds(double grow) const;
+  // The median bounding radius of the moving bodies (m; 0 without any).
+  double median_moving_radius();
   void all_pairs();
   void sweep_and_prune();
   void tree();
@@ -80,7 +94,8 @@ class BroadPhase {
   BroadPhaseMethod method_;
   WorldSettings tunables_;
   bool used_grid_ = false;
-  std::vector<BoundingSphere> spheres_;          // this call's bounding spheres (bounding_sphere())
+  std::vector<BoundingSphere> base_;             // this call's bounding spheres (bounding_sphere())
+  std::vector<BoundingSphere> spheres_;          // the index's: base_ grown
   std::vector<Vec3> box_min_, box_max_;          // m, padded boxes around them
   std::vector<int> order_;                       // sweep and prune: sorted along sap_axis_
   int sap_axis_ = -1;                            // axis of the last sweep (-1: none yet)
@@ -97,6 +112,14 @@ class BroadPhase {
   std::vector<int> cell_of_;                     // grid: each moving body's cell
   std::vector<int> cell_start_;                  // grid: first position of each cell
   std::vector<int> in_cells_;                    // grid: bodies in cell order
+  std::vector<double> radii_;                    // median_moving_radius: scratch
+  std::vector<BodyPair> cache_pairs_;            // kept: the pairs of the spheres grown by
+  double cache_grow_ = 0.0;                      //   cache_grow_ (m),
+  std::vector<Vec3> cache_centres_;              //   at these centres,
+  std::vector<double> cache_radii_;              //   with these radii,
+  std::vector<bool> cache_static_;               //   of these static flags
+  double cache_slack_ = 0.0;                     // m, round-off allowance of cache_holds
+  long cache_builds_ = 0;                        // indexes built
   std::vector<BodyPair> pairs_;
 };
 

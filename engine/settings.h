@@ -64,6 +64,10 @@ struct WorldSettings {
 
   // Broad phase (engine/broadphase.cpp); the pairs are the same whatever these say.
 
+  /// Room to move, relative to the median bounding radius of the moving bodies: the broad phase
+  /// keeps the pairs of spheres grown by it and reuses them until a centre moves that far
+  /// (0: a new index on every call).
+  double pair_cache_margin = 0.1;
   /// Moving bodies at least for the uniform grid: below, the tree is as cheap.
   int grid_min_moving = 64;
   /// Static bodies at most kept out of the tree (queried against it instead): a few walls and

@@ -166,6 +166,62 @@ TEST(BroadPhase, ManyStaticBodiesGoIntoTheTree) {
   EXPECT_EQ(tree.find_pairs(bodies), expected);
 }
 
+// The pairs kept from call to call: bodies creeping toward and away from each other across the
+// touching distance, a growth that changes from call to call (up to near the kept pairs' room to
+// move, so that a bound forgetting the growth fails), and now and then a jump (the kept pairs no
+// longer hold): every call gives the grown oracle's pairs, in order, on the grid and on
+// the hierarchy; and most calls reuse the kept pairs (so the reuse is what is being checked).
+TEST(BroadPhase, KeptPairsGiveTheOraclePairsFromCallToCall) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> g(0.0, 1.0);
+  auto grown_oracle = [](const std::vector<RigidBody>& bodies, double grow) {
+    std::vector<BodyPair> pairs;
+    for (int i = 0; i < static_cast<int>(bodies.size()); ++i)
+      for (int j = i + 1; j < static_cast<int>(bodies.size()); ++j) {
+        BoundingSphere a = bounding_sphere(bodies[i]), b = bounding_sphere(bodies[j]);
+        a.radius += grow;
+        b.radius += grow;
+        if (spheres_touch(a, b)) pairs.push_back({i, j});
+      }
+    return pairs;
+  };
+  for (const bool like : {true, false}) {
+    // 300 boxes of like size (the grid), or of 0.3 m with every thirtieth 2 m (the hierarchy),
+    // each with a slow velocity of its own.
+    std::vector<RigidBody> bodies;
+    std::vector<Vec3> velocity;
+    for (int i = 0; i < 300; ++i) {
+      const double side = like ? 0.3 + 0.1 * unit(rng) : (i % 30 ? 0.3 : 2.0);
+      bodies.push_back(test::box_body("c" + std::to_string(i), Vec3::Constant(side), 1.0,
+                                      4.5 * Vec3(unit(rng), unit(rng), unit(rng))));
+      velocity.push_back(0.002 * Vec3(g(rng), g(rng), g(rng)));
+    }
+    for (const BroadPhaseMethod m : {BroadPhaseMethod::SweepAndPrune, BroadPhaseMethod::Tree}) {
+      std::vector<RigidBody> moving = bodies;
+      BroadPhase bp(m);
+      int calls = 0, changes = 0;
+      std::vector<BodyPair> last;
+      for (int round = 0; round < 200; ++round, ++calls) {
+        const double grow = round % 3 == 0 ? 0.0 : 0.03 * unit(rng);
+        const std::vector<BodyPair> expected = grown_oracle(moving, grow);
+        ASSERT_EQ(bp.find_pairs(moving, grow), expected) << to_string(m) << " round " << round;
+        if (expected != last) ++changes;
+        last = expected;
+        for (size_t i = 0; i < moving.size(); ++i) moving[i].position += velocity[i];
+        if (round % 50 == 49) moving[round % 300].position += Vec3(1.0, 0.0, 0.0);
+      }
+      if (m == BroadPhaseMethod::Tree) {
+        EXPECT_EQ(bp.used_grid(), like);
+      }
+      // Pairs came and went between reuses, and the jumps forced new indexes.
+      EXPECT_GT(changes, 20) << to_string(m);
+      EXPECT_GT(bp.index_builds(), 3) << to_string(m);
+      EXPECT_LT(bp.index_builds(), calls / 3) << to_string(m);
+    }
+  }
+}
+
 TEST(BroadPhase, TheThresholdsChooseTheIndexNotThePairs) {
   // 100 moving boxes of like size and two static slabs: by default the grid (at least
   // grid_min_moving moving bodies) with the statics apart; with the thresholds moved, the
