@@ -28,6 +28,8 @@
 #include <utility>
 
 #include "comparisons/eval/explore.h"
+#include "comparisons/eval/explore_campaign.h"
+#include "comparisons/eval/parallel.h"
 #include "comparisons/scene/mesh_io.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/world.h"
@@ -495,38 +497,32 @@ CaseSet step_cases(const BenchPlan& plan, std::mt19937_64&) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Explore throughput: `rbx explore`'s contact samples of the default seed whose shapes have
-// fewer than 100 points, each through exact (the truth), custom and fcl, on one thread.
+// Explore throughput: `rbx explore --bench` on one thread, as `rbx explore` samples: the contact
+// samples of the default seed whose shapes have fewer than 100 points, each through exact (the
+// truth), custom and fcl, in one supervised child (reference/isolate.h) per block of samples.
+// (Calling the sampler directly outside such a block would fork a child for every library call,
+// from a process grown large by the cases before it, and time the forks.)
 
 CaseSet explore_cases(const BenchPlan& plan, std::mt19937_64&) {
-  struct State {
-    std::vector<ContactSample> samples;
-    std::size_t next = 0;
-  };
-  auto c = std::make_shared<State>();
-  const std::size_t wanted = plan.quick ? 200 : 1000;
-  auto small = [](const ExploreBody& b) { return b.shape_class == "box" || b.points.size() < 100; };
-  for (uint64_t i = 0; c->samples.size() < wanted && i < 100000; ++i) {
-    ContactSample s = make_contact_sample(1, i);
-    if (small(s.a) && small(s.b)) c->samples.push_back(std::move(s));
-  }
-  const std::vector<std::string> names = {"custom", "fcl"};
+  auto settings = std::make_shared<ExploreSettings>();
+  settings->count = plan.quick ? 500 : 2000;
+  settings->backends = "custom,fcl";
+  auto par = std::make_shared<ParallelRun>(1);
+  auto done = std::make_shared<long>(0);
   const std::string name = "explore/contact/exact+custom+fcl";
   CaseSet set;
   BenchCase bc;
   bc.name = name;
-  bc.warm_up = [c, names] { evaluate_contact_sample(c->samples.front(), names); };
-  // Samples in turn; the time per iteration is the mean over them once every one has run.
-  bc.body = [c, names] {
-    evaluate_contact_sample(c->samples[c->next++ % c->samples.size()], names);
-  };
-  bc.min_time_s = plan.quick ? 1.0 : 3.0;
+  bc.warm_up = [] {};
+  // One iteration is the whole block of samples.
+  bc.body = [settings, par, done] { *done = explore_throughput(*settings, *par).done; };
+  bc.min_time_s = plan.quick ? 0.5 : 3.0;
   bc.repetitions = kBenchRepetitions;
   set.cases.push_back(bc);
-  const int count = static_cast<int>(c->samples.size());
-  set.collect = [name, count](Collector& collector, BenchResults& out) {
-    ExploreRow r{"exact, custom, fcl", count, NAN};
-    if (collector.seconds.count(name)) r.samples_per_minute = 60.0 / collector.seconds[name];
+  set.collect = [name, done](Collector& collector, BenchResults& out) {
+    ExploreRow r{"exact, custom, fcl", static_cast<int>(*done), NAN};
+    if (collector.seconds.count(name) && *done > 0)
+      r.samples_per_minute = 60.0 * static_cast<double>(*done) / collector.seconds[name];
     out.explore.push_back(r);
   };
   return set;

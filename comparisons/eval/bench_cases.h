@@ -131,7 +131,7 @@ struct StepRow {
 /// An explore-throughput row: contact samples of `rbx explore` per minute on one core.
 struct ExploreRow {
   std::string backends;  // what each sample runs through
-  int samples = 0;       // distinct samples cycled through
+  int samples = 0;       // samples timed (a block, each under 100 points)
   double samples_per_minute = NAN;
 };
 

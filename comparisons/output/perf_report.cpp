@@ -179,7 +179,8 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
     goals.push_back({"rbx explore: at least 50,000 contact samples per minute per core through " +
                          r.backends + " on hulls under 100 points (issue 17)",
                      bench_num(r.samples_per_minute, 3) + " per minute (one thread, " +
-                         std::to_string(r.samples) + " samples of seed 1 in turn)",
+                         std::to_string(r.samples) +
+                         " samples of seed 1, as `rbx explore --bench --threads 1`)",
                      r.samples_per_minute >= 50000.0, ""});
   return goals;
 }
