@@ -550,11 +550,21 @@ bool AcceleratedView::inside(const Vec3& p) const {
   stack[size++] = 0;
   while (size > 0) {
     const int k = stack[--size];
-    if (accel->plane_upper(k, pl) <= certified) continue;
+    double lo, hi;
+    accel->plane_bounds(k, pl, lo, hi);
+    if (hi <= certified) continue;
+    // Every face of the cluster has p beyond it: outside, whichever face the seed's loop meets.
+    if (lo > outside) return false;
     const BvhNode& node = tree.nodes[k];
     if (node.child >= 0) {
-      stack[size++] = node.child + 1;
-      stack[size++] = node.child;
+      // The child reaching further outside first: the answer is an AND, so order changes only
+      // how soon a face with p outside is met.
+      double lo0, hi0, lo1, hi1;
+      accel->plane_bounds(node.child, pl, lo0, hi0);
+      accel->plane_bounds(node.child + 1, pl, lo1, hi1);
+      const bool first_is_0 = hi0 >= hi1;
+      stack[size++] = first_is_0 ? node.child + 1 : node.child;
+      stack[size++] = first_is_0 ? node.child : node.child + 1;
       continue;
     }
     for (int i = node.begin; i < node.end; ++i) {
