@@ -172,6 +172,7 @@ std::optional<CachedResult<ContactResult>> ResultCache::load_contact(const std::
 }
 
 void ResultCache::store(const std::string& key, const ContactResult& c, double runtime_s) const {
+  if (c.status == Status::Timeout) return;
   write(key, encode_result(c, runtime_s));
 }
 
@@ -181,6 +182,7 @@ std::optional<CachedResult<DynamicsResult>> ResultCache::load_dynamics(
 }
 
 void ResultCache::store(const std::string& key, const DynamicsResult& d, double runtime_s) const {
+  if (d.status == Status::Timeout) return;
   write(key, encode_result(d, runtime_s));
 }
 
@@ -221,6 +223,7 @@ std::optional<CachedResult<MassResult>> ResultCache::load_mass(const std::string
 }
 
 void ResultCache::store(const std::string& key, const MassResult& m, double runtime_s) const {
+  if (m.status == Status::Timeout) return;
   write(key, encode_result(m, runtime_s));
 }
 

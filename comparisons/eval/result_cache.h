@@ -64,7 +64,8 @@ class ResultCache {
                      const std::vector<double>& v) const;
 
   /// Stores (atomically: a temporary file renamed into place); failures to write are ignored
-  /// (the cache only saves time).
+  /// (the cache only saves time). A timeout is not stored: it depends on the machine's load at
+  /// the time, not on the inputs, so the next run asks the library again.
   void store(const std::string& key, const ContactResult& r, double runtime_s) const;
   void store(const std::string& key, const DynamicsResult& r, double runtime_s) const;
   void store(const std::string& key, const MassResult& r, double runtime_s) const;

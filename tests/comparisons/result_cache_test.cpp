@@ -104,6 +104,35 @@ TEST(ResultCache, AnotherReferenceCodeOrOtherInputsMiss) {
   fs::remove_all(dir);
 }
 
+// A timeout (the deadline of a loaded machine, not an answer of the inputs) is never kept, so the
+// next run asks the library again; a library's error is kept like any answer.
+TEST(ResultCache, TimeoutsAreNotKept) {
+  const fs::path dir = temp_dir("cache_timeout");
+  const Scene scene = parse_scene(
+      "[[body]]\nname = \"A\"\n[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n", "pair.toml");
+  const std::vector<RigidBody> bodies = make_bodies(scene);
+  const ResultCache cache(dir.string(), "adapters 1111");
+  const std::string fcl = cache.contact_key("fcl", bodies[0], bodies[1]);
+  const std::string ode = cache.contact_key("ode", bodies[0], bodies[1]);
+  cache.store(fcl, ContactResult{Status::Timeout, "past the deadline", {}}, 30.0);
+  cache.store(ode, ContactResult{Status::Error, "aborted", {}}, 0.1);
+  EXPECT_FALSE(cache.load_contact(fcl));
+  const auto kept = cache.load_contact(ode);
+  ASSERT_TRUE(kept);
+  EXPECT_EQ(kept->result.status, Status::Error);
+  DynamicsResult slow;
+  slow.status = Status::Timeout;
+  const std::string run = cache.dynamics_key("bullet", scene, bodies, DynamicsOptions{});
+  cache.store(run, slow, 600.0);
+  EXPECT_FALSE(cache.load_dynamics(run));
+  MassResult late;
+  late.status = Status::Timeout;
+  const std::string mass = cache.mass_key("mujoco", bodies[0]);
+  cache.store(mass, late, 0.0);
+  EXPECT_FALSE(cache.load_mass(mass));
+  fs::remove_all(dir);
+}
+
 // The build-time half: the source hash (comparisons/hash_sources.cmake) changes with one byte
 // of an adapter, so an edited adapter's cached results are never used.
 TEST(ResultCache, EditingAnAdapterChangesTheSourceHash) {
