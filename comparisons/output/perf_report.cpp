@@ -57,8 +57,9 @@ double find_time(const std::vector<NarrowRow>& rows, const std::string& backend,
 
 }  // namespace
 
-// The profiles behind the contact-query goals (perf, 2026-11-27, after the contact plane's
-// search; hulls of random points on a sphere), each a measured cause.
+// The profiles behind the contact-query goals (perf: touching 2026-11-27, after the contact
+// plane's search; deep 2026-11-28, after the point-in-mesh test's cluster bounds; hulls of random
+// points on a sphere), each a measured cause.
 constexpr const char* kDetectorProfile =
     "touching, the contact plane costs more than the tests: at N = 2048 its search is about 3/4 "
     "of the query, a third of it the vertex climbs (one per cone opened, a few hundred per "
@@ -66,20 +67,21 @@ constexpr const char* kDetectorProfile =
     "then every face's bound). The tests alone are about 1x FCL (prebuilt).";
 constexpr const char* kDeepProfile =
     "deep, the tests cost more than the plane: at N = 8192 the seed's point-in-mesh tests on the "
-    "cap's candidates are about 45 % of the query (points deep inside the other shape are "
+    "cap's candidates are about a third of the query (points deep inside the other shape are "
     "certified by its inscribed ball; those near its surface take its tree) and finding the cap "
-    "(a fifth of the vertices lie within the other shape) about 18 %: the seed's face test "
+    "(a fifth of the vertices lie within the other shape) about a fifth: the seed's face test "
     "averages the centroids of every triangle inside, so the cap is walked whole. The contact "
-    "plane's search is about a sixth.";
+    "plane's search is about an eighth.";
 
-// The profile behind the whole-step goal (perf, 2026-11-27, many_1000 over the bench's first 60
-// steps, after the one broad phase per step), a measured cause.
+// The profile behind the whole-step goal (perf, 2026-11-28, many_1000 over the bench's first 60
+// steps, with the broad phase's pairs kept from step to step), a measured cause.
 constexpr const char* kStepProfile =
-    "the whole step, many_1000: the broad phase is about a third of the step (the seed's "
-    "bounding spheres of neighbouring cubes overlap, so about 2,700 pairs pass it each step), "
-    "the separation proofs of those pairs about a fifth, the look-ahead's moves of every body "
-    "about an eighth, then the manifolds, the time of impact and the state check. On many_100 "
-    "Bullet's own time varies by a quarter from run to run (0.26 to 0.33 µs per body-step).";
+    "the whole step, many_1000: the separation proofs of the pairs passing the bounding check are "
+    "about a third of the step (the seed's bounding spheres of neighbouring cubes overlap, so "
+    "about 2,700 pairs pass it each step), the look-ahead's moves of every body about a sixth, "
+    "the broad phase (its pairs kept from step to step) and the state check about a tenth each. "
+    "On many_100 Bullet's own time varies by a quarter from run to run (0.26 to 0.33 µs per "
+    "body-step).";
 
 std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& results) {
   std::vector<PerfGoal> goals;
