@@ -48,8 +48,8 @@ BenchPlan bench_plan(bool quick) {
     p.crowd_sizes = {1000, 2000, 5000};
     p.crowd_min_time = 0.05;
     p.steps_100 = {10, 60};
-    p.steps_1000 = {2, 8};
-    p.step_min_time = 0.05;
+    p.steps_1000 = {2, 32};
+    p.step_min_time = 0.1;
   } else {
     p.hull_sizes = {32, 128, 512, 2048, 8192};
     p.poses = 5;
