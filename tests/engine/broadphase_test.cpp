@@ -28,6 +28,19 @@ std::vector<BodyPair> oracle_pairs(const std::vector<RigidBody>& bodies) {
   return pairs;
 }
 
+// The grown oracle: the pairs whose bounding spheres, each grown by `grow` (m), touch.
+std::vector<BodyPair> grown_oracle_pairs(const std::vector<RigidBody>& bodies, double grow) {
+  std::vector<BodyPair> pairs;
+  for (int i = 0; i < static_cast<int>(bodies.size()); ++i)
+    for (int j = i + 1; j < static_cast<int>(bodies.size()); ++j) {
+      BoundingSphere a = bounding_sphere(bodies[i]), b = bounding_sphere(bodies[j]);
+      a.radius += grow;
+      b.radius += grow;
+      if (spheres_touch(a, b)) pairs.push_back({i, j});
+    }
+  return pairs;
+}
+
 // A crowd of `n` boxes in a cube of side `extent` (m): sizes from 0.05 to 0.5 m, a few long
 // slabs (walls, 20 x 0.2 x 20) so that small and large boxes mix, random orientations.
 std::vector<RigidBody> crowd(int n, double extent, std::mt19937_64& rng) {
@@ -90,14 +103,7 @@ TEST(BroadPhase, GrownSpheresGiveTheGrownOraclePairs) {
   const std::vector<RigidBody>* const crowds[] = {&mixed, &like};
   for (const std::vector<RigidBody>* crowd_of : crowds) {
     const std::vector<RigidBody>& bodies = *crowd_of;
-    std::vector<BodyPair> expected;
-    for (int i = 0; i < static_cast<int>(bodies.size()); ++i)
-      for (int j = i + 1; j < static_cast<int>(bodies.size()); ++j) {
-        BoundingSphere a = bounding_sphere(bodies[i]), b = bounding_sphere(bodies[j]);
-        a.radius += grow;
-        b.radius += grow;
-        if (spheres_touch(a, b)) expected.push_back({i, j});
-      }
+    const std::vector<BodyPair> expected = grown_oracle_pairs(bodies, grow);
     EXPECT_GT(expected.size(), oracle_pairs(bodies).size());
     for (const BroadPhaseMethod m : kMethods) {
       BroadPhase bp(m);
@@ -175,17 +181,6 @@ TEST(BroadPhase, KeptPairsGiveTheOraclePairsFromCallToCall) {
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> g(0.0, 1.0);
-  auto grown_oracle = [](const std::vector<RigidBody>& bodies, double grow) {
-    std::vector<BodyPair> pairs;
-    for (int i = 0; i < static_cast<int>(bodies.size()); ++i)
-      for (int j = i + 1; j < static_cast<int>(bodies.size()); ++j) {
-        BoundingSphere a = bounding_sphere(bodies[i]), b = bounding_sphere(bodies[j]);
-        a.radius += grow;
-        b.radius += grow;
-        if (spheres_touch(a, b)) pairs.push_back({i, j});
-      }
-    return pairs;
-  };
   for (const bool like : {true, false}) {
     // 300 boxes of like size (the grid), or of 0.3 m with every thirtieth 2 m (the hierarchy),
     // each with a slow velocity of its own.
@@ -204,7 +199,7 @@ TEST(BroadPhase, KeptPairsGiveTheOraclePairsFromCallToCall) {
       std::vector<BodyPair> last;
       for (int round = 0; round < 200; ++round, ++calls) {
         const double grow = round % 3 == 0 ? 0.0 : 0.03 * unit(rng);
-        const std::vector<BodyPair> expected = grown_oracle(moving, grow);
+        const std::vector<BodyPair> expected = grown_oracle_pairs(moving, grow);
         ASSERT_EQ(bp.find_pairs(moving, grow), expected) << to_string(m) << " round " << round;
         if (expected != last) ++changes;
         last = expected;
