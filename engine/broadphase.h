@@ -11,9 +11,9 @@
 //   - sweep-and-prune: boxes sorted along the axis of largest spread (kept from call to call, so
 //     a small motion costs an insertion sort), then swept; O(N log N + pairs overlapping on that
 //     axis), which for bodies spread through a volume grows like N^(5/3).
-//   - tree: a bounding volume hierarchy of the moving bodies' boxes, rebuilt on every call
-//     (median splits) and traversed against itself, each static body's box queried against it;
-//     O(N log N + pairs), whatever the mix of body sizes. For many moving bodies of like size
+//   - tree: a bounding volume hierarchy of the moving bodies' boxes, rebuilt whenever an index
+//     is built (median splits) and traversed against itself, each static body's box queried against
+//     it; O(N log N + pairs), whatever the mix of body sizes. For many moving bodies of like size
 //     it takes a uniform grid instead (O(N + cells + pairs)).
 // The faster methods keep their pairs from call to call (as Bullet's dynamic tree keeps fattened
 // boxes): each index is built for spheres grown by room to move (pair_cache_margin in
