@@ -16,7 +16,7 @@ using plane_detail::Candidate;
 // Pairs with at most this many faces and solid edges in all take the scan, larger ones the
 // search: the crossover measured on hulls of random points on a sphere (docs/contact_plane.md).
 // The sum is the same in either body order, so both orders take the same path.
-constexpr std::size_t kScanFeatures = 600;
+constexpr std::size_t kScanFeatures = 64;
 
 bool lex_less(const Vec3& p, const Vec3& q) {
   if (p.x() != q.x()) return p.x() < q.x();
@@ -41,6 +41,8 @@ ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
   // A NaN is no bound.
   found.known = known_overlap == known_overlap ? known_overlap : plane_detail::kInf;
   found.known_normal = known_normal;
+  found.within = DirectionCone{};
+  found.polytope = method != PlaneMethod::WholeSearch;
   const GaussMap &ga = a.gauss_map(), &gb = b.gauss_map();
   const std::size_t features = ga.faces.size() + ga.arcs.size() + gb.faces.size() + gb.arcs.size();
   if (method == PlaneMethod::Automatic)

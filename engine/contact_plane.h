@@ -37,10 +37,12 @@ struct ContactPlane {
 
 /// How the candidate axes are found; every method gives the same plane (to round-off).
 enum class PlaneMethod {
-  Automatic,  ///< the scan on small pairs, the search on large ones (the faster of the two)
-  Scan,       ///< every face measured, every solid edge near the other shape paired: linear;
-              ///< for shapes it cannot prove to overlap (apart by a hair), the search
-  Search      ///< branch and bound over the shapes' Gauss maps: skips whole cones of them
+  Automatic,   ///< the scan on small pairs, the search on large ones (the faster of the two)
+  Scan,        ///< every face measured, every solid edge near the other shape paired: linear;
+               ///< for shapes it cannot prove to overlap (apart by a hair), the search
+  Search,      ///< branch and bound over the shapes' Gauss maps: skips whole cones of them, and
+               ///< first narrows the directions by an inner polytope of A - B (GJK, then EPA)
+  WholeSearch  ///< the search over every direction, without the polytope (its check)
 };
 
 /// The direction of least overlap of A and B at their poses: over every distinct face normal of

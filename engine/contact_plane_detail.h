@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "engine/contact_plane.h"
+#include "engine/gauss_map.h"
+#include "engine/polyhedron.h"
 
 namespace rbx::plane_detail {
 
@@ -39,6 +41,40 @@ struct Candidates {
   Vec3 upper_normal = Vec3::UnitZ();
   double known = kInf;  // m
   Vec3 known_normal = Vec3::UnitZ();
+  /// The search's directions (on D's Gauss map, world): no candidate outside this cone can be
+  /// within the tie margin of the least overlap (inner_polytope_bound); whole: every direction.
+  DirectionCone within;
+  /// Narrowed: the vertices of A and of B whose difference supports D along `within`'s axis.
+  int within_a = -1, within_b = -1;
+  /// The search: narrow it by the inner polytope first (false: the whole sphere, as a check).
+  bool polytope = true;
+};
+
+/// One shape of a query: its Gauss map and its pose.
+struct Side {
+  const ConvexPolyhedron* shape = nullptr;
+  const GaussMap* map = nullptr;
+  Mat3 r = Mat3::Identity();
+  Mat3 rt = Mat3::Identity();
+  Vec3 p = Vec3::Zero();
+
+  /// Places `s` at pose `pose`.
+  void set(const ConvexPolyhedron& s, const Pose& pose) {
+    shape = &s;
+    map = &s.gauss_map();
+    r = pose.rotation();
+    rt = r.transpose();
+    p = pose.position;
+  }
+  /// The support h(d) = max over the shape of x . d along a world direction, climbing from `at`
+  /// (left on a vertex that reaches it).
+  double support(const Vec3& d, int& at) const {
+    double h = 0.0;
+    at = map->climb(shape->vertices(), rt * d, at, h);
+    return h + p.dot(d);
+  }
+  /// Vertex v in the world.
+  Vec3 world(int v) const { return r * shape->vertices()[v] + p; }
 };
 
 /// The sign-free form of an axis: the one of +-n whose first nonzero component is positive, so
@@ -65,6 +101,26 @@ inline bool arcs_cross(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec
 /// answers).
 bool scan_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                      const Pose& pb, Candidates& out);
+
+/// Whether two cones of directions (axes unit, world) hold no direction in common: the angle
+/// between their axes exceeds the sum of their angles.
+inline bool cones_apart(const Vec3& axis0, const DirectionCone& c0, const Vec3& axis1,
+                        const DirectionCone& c1) {
+  if (c0.whole || c1.whole) return false;
+  const double cos_sum = c0.cos_angle * c1.cos_angle - c0.sin_angle * c1.sin_angle;
+  const bool sum_below_pi = c0.sin_angle * c1.cos_angle + c0.cos_angle * c1.sin_angle > 0.0;
+  return sum_below_pi && axis0.dot(axis1) < cos_sum;
+}
+
+/// The inner polytope (engine/contact_plane_polytope.cpp): GJK then EPA on D = A - B, with the
+/// shapes' own supports. Every triangle of the polytope lies in D, so along every direction that
+/// meets it D's support is at least the triangle's plane distance; the least support found along
+/// a triangle normal bounds the answer from above. Leaves in `out` that upper bound (`known`)
+/// and the cone `within` of the triangles whose plane distance does not exceed it (with a
+/// margin), the only directions that can hold a candidate within the tie margin of the least.
+/// Returns false, leaving `out` alone, when it cannot bound (shapes apart, touching, or a
+/// degenerate polytope): then the search covers every direction.
+bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& out);
 
 /// The search: branch and bound over both shapes' Gauss maps
 /// (engine/contact_plane_search.cpp).

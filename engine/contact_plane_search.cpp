@@ -17,24 +17,6 @@ namespace rbx::plane_detail {
 
 namespace {
 
-// One shape of the query: its Gauss map and its pose.
-struct Side {
-  const ConvexPolyhedron* shape = nullptr;
-  const GaussMap* map = nullptr;
-  Mat3 r = Mat3::Identity();
-  Mat3 rt = Mat3::Identity();
-  Vec3 p = Vec3::Zero();
-
-  // The support h(d) = max over the shape of x . d along a world direction, climbing from `at`
-  // (left on a vertex that reaches it).
-  double support(const Vec3& d, int& at) const {
-    double h = 0.0;
-    at = map->climb(shape->vertices(), rt * d, at, h);
-    return h + p.dot(d);
-  }
-  Vec3 world(int v) const { return r * shape->vertices()[v] + p; }
-};
-
 // The least of x . u over the unit vectors u of a cone (axis in the world): |x| cos(theta + r)
 // for theta the angle of x to the axis and r the cone's, or -|x| once theta + r reaches pi.
 double cone_bound(const Vec3& x, const Vec3& axis, const DirectionCone& cone) {
@@ -78,6 +60,9 @@ struct Query {
   double upper = kInf;  // m, the least overlap measured so far: an upper bound on the answer
   Vec3 upper_normal = Vec3::UnitZ();  // the normal of the candidate that gave `upper`
   double tie = 0.0;                   // m, overlaps closer than this are equal (round-off)
+  DirectionCone within;               // D's directions that may hold the answer (world)
+  int narrow_at[2] = {-1, -1};        // narrowed: A's and B's vertices supporting D along its axis
+  double narrow_bound[2] = {0, 0};    // narrowed: cone_bound over `within` from A's and B's side
   std::vector<Candidate> kept;
   std::vector<Pending> heap;
   std::vector<KeptArc> arcs[2];  // A's and B's arcs that may hold the answer
@@ -88,6 +73,10 @@ struct Query {
   const Side& side(int tree) const { return tree % 2 == 0 ? a : b; }
   // Directions of B's Gauss map are negated in D = A - B.
   static double sign(int tree) { return tree % 2 == 0 ? 1.0 : -1.0; }
+  // Whether a direction of D lies outside the directions searched.
+  bool outside(const Vec3& u) const {
+    return !within.whole && u.dot(within.axis) < within.cos_angle - 1e-12;
+  }
 
   void keep(const Candidate& c) {
     if (c.overlap < upper) {
@@ -98,7 +87,8 @@ struct Query {
   }
   void push(const Pending& p) {
     heap.push_back(p);
-    std::push_heap(heap.begin(), heap.end());
+    // Narrowed, the few nodes left are taken depth first (no order to keep).
+    if (within.whole) std::push_heap(heap.begin(), heap.end());
   }
   void search();
   void visit(const Pending& e);
@@ -114,11 +104,14 @@ void Query::search() {
     if (!(t < kArcsA ? g.face_tree : g.arc_tree).nodes.empty()) push({-kInf, t, 0, -1});
   }
   while (!heap.empty()) {
-    std::pop_heap(heap.begin(), heap.end());
+    if (within.whole) std::pop_heap(heap.begin(), heap.end());
     const Pending e = heap.back();
     heap.pop_back();
-    // Every node left has a bound at least this one's.
-    if (e.bound > threshold()) break;
+    if (e.bound > threshold()) {
+      // Every node left has a bound at least this one's (not so depth first).
+      if (within.whole) break;
+      continue;
+    }
     visit(e);
   }
 }
@@ -138,24 +131,32 @@ void Query::visit(const Pending& e) {
   const std::vector<DirectionCone>& cones = faces ? g.face_cones : g.arc_cones;
   const std::vector<double>& lows = faces ? g.face_lows : g.arc_lows;
   const Vec3 axis = own.r * cones[e.node].axis;
-  int at = e.at_other;
-  other.support(-axis, at);
+  const double s = sign(e.tree);
+  if (cones_apart(s * axis, cones[e.node], within.axis, within)) return;
+  // Narrowed, only the directions of `within` count: the other shape's point that supports D
+  // along its axis serves every node, with one cone bound per tree.
+  const bool narrowed = !within.whole;
+  int at = narrowed ? narrow_at[(e.tree + 1) % 2] : e.at_other;
+  if (!narrowed) other.support(-axis, at);
   const Vec3 y = own.p - other.world(at);
-  const double bound = std::max(e.bound, lows[e.node] + cone_bound(y, axis, cones[e.node]));
+  const double bound = std::max(
+      e.bound,
+      lows[e.node] + (narrowed ? narrow_bound[e.tree % 2] : cone_bound(y, axis, cones[e.node])));
   if (bound > threshold()) return;
   const BvhNode& node = tree.nodes[e.node];
   if (node.child >= 0) {
     for (const int c : {node.child, node.child + 1})
-      push({std::max(bound, lows[c] + cone_bound(y, own.r * cones[c].axis, cones[c])), e.tree, c,
-            at});
+      push({std::max(bound, lows[c] + (narrowed ? narrow_bound[e.tree % 2]
+                                                : cone_bound(y, own.r * cones[c].axis, cones[c]))),
+            e.tree, c, at});
     return;
   }
-  const double s = sign(e.tree);
   for (int i = node.begin; i < node.end; ++i) {
     const int item = tree.order[i];
     if (faces) {
       // The same bound at the face's own normal, before its climb.
       const GaussMap::Face& f = g.faces[item];
+      if (outside(s * (own.r * f.normal))) continue;
       if (f.offset + y.dot(own.r * f.normal) > threshold()) continue;
       face(e.tree, item, at);
       continue;
@@ -163,6 +164,7 @@ void Query::visit(const Pending& e) {
     const GaussMap::Arc& arc = g.arcs[item];
     KeptArc k;
     const Vec3 arc_axis = own.r * arc.cone.axis;
+    if (cones_apart(s * arc_axis, arc.cone, within.axis, within)) continue;
     k.bound = arc.low + cone_bound(y, arc_axis, arc.cone);
     if (k.bound > threshold()) continue;
     // For pairing, the arc on D's Gauss map (B's negated).
@@ -201,14 +203,7 @@ void Query::pair_arcs() {
     if (ka.bound > limit) continue;
     for (const KeptArc& kb : arcs[1]) {
       if (kb.bound > limit) continue;
-      if (!ka.cone->whole && !kb.cone->whole) {
-        // Cones apart: the angle between their axes exceeds the sum of their angles.
-        const double cos_sum =
-            ka.cone->cos_angle * kb.cone->cos_angle - ka.cone->sin_angle * kb.cone->sin_angle;
-        const bool sum_below_pi =
-            ka.cone->sin_angle * kb.cone->cos_angle + ka.cone->cos_angle * kb.cone->sin_angle > 0.0;
-        if (sum_below_pi && ka.axis.dot(kb.axis) < cos_sum) continue;
-      }
+      if (cones_apart(ka.axis, *ka.cone, kb.axis, *kb.cone)) continue;
       if (!arcs_cross(ka.n0, ka.n1, kb.n0, kb.n1)) continue;
       edge_pair(ka, kb);
     }
@@ -240,6 +235,7 @@ void Query::edge_pair(const KeptArc& ka, const KeptArc& kb) {
   for (const double sgn : {1.0, -1.0}) {
     if (std::abs(side) > 1e-9 && sgn * side < 0) continue;
     const Vec3 u = sgn * d;
+    if (outside(u)) continue;
     int at_a = ea.a, at_b = eb.a;
     const double overlap = a.support(u, at_a) + b.support(-u, at_b);
     if (overlap < c.overlap) {
@@ -256,15 +252,8 @@ void search_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPo
                        const Pose& pb, Candidates& out) {
   // Scratch reused across queries on this thread (allocated once, as the detector's).
   thread_local Query q;
-  auto set = [](Side& s, const ConvexPolyhedron& shape, const Pose& p) {
-    s.shape = &shape;
-    s.map = &shape.gauss_map();
-    s.r = p.rotation();
-    s.rt = s.r.transpose();
-    s.p = p.position;
-  };
-  set(q.a, a, pa);
-  set(q.b, b, pb);
+  q.a.set(a, pa);
+  q.b.set(b, pb);
   q.upper = kInf;
   q.kept.clear();
   q.arcs[0].clear();
@@ -274,6 +263,18 @@ void search_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPo
   const double scale = std::max(pa.position.cwiseAbs().maxCoeff() + q.a.map->radius,
                                 pb.position.cwiseAbs().maxCoeff() + q.b.map->radius);
   q.tie = 1e-12 * scale;
+  // The inner polytope narrows the directions and may lower the known overlap.
+  q.within = DirectionCone{};
+  if (out.polytope && inner_polytope_bound(q.a, q.b, q.tie, out)) q.within = out.within;
+  if (!q.within.whole) {
+    // Each side's cone bound over `within` (on its own side: B's directions negated), from the
+    // other's supporting vertex.
+    q.narrow_at[0] = out.within_a;
+    q.narrow_at[1] = out.within_b;
+    const Vec3 ya = q.a.p - q.b.world(out.within_b), yb = q.b.p - q.a.world(out.within_a);
+    q.narrow_bound[0] = cone_bound(ya, q.within.axis, q.within);
+    q.narrow_bound[1] = cone_bound(yb, -q.within.axis, q.within);
+  }
   // A known overlap bounds the least from the start (one tie margin more, as in the scan).
   if (out.known < kInf) {
     q.upper = out.known + q.tie;

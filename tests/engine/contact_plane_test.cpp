@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "engine/contact_plane_detail.h"
 #include "engine/detect.h"
 
 namespace rbx {
@@ -249,6 +250,83 @@ TEST(ContactPlane, AKnownOverlapChangesNothing) {
   }
   EXPECT_GT(touching, 150);
   EXPECT_GT(worse, 30);
+}
+
+TEST(ContactPlane, TheInnerPolytopeNarrowsTheSearchWithoutChangingThePlane) {
+  // The search narrowed to the inner polytope's cone chooses the plane of the search over every
+  // direction, bit for bit, in either body order: on shapes in general position, deep and
+  // shallow, and on poses full of ties (axis-aligned boxes overlapping equally along two or three
+  // axes, where every tied face must stay inside the cone for the keys to pick the same one).
+  std::mt19937 rng(29);
+  const std::vector<ConvexPolyhedron> all = {stretched_icosphere(2, Vec3(1.3, 0.7, 1.0)),
+                                             stretched_icosphere(3, Vec3(0.6, 1.4, 0.9)),
+                                             make_prism(0.4, 1.2, 24),
+                                             make_icosphere(0.5, 2),
+                                             make_box(Vec3(0.9, 0.4, 0.7)),
+                                             make_box(Vec3(1.0, 1.0, 1.0))};
+  std::vector<RandomPair> poses;
+  for (int trial = 0; trial < 300; ++trial) poses.push_back(random_pair(all, rng));
+  const ConvexPolyhedron& cube = all.back();
+  for (const Vec3& c : {Vec3(0.8, 0.8, 0.0), Vec3(0.8, 0.0, 0.8), Vec3(0.9, 0.9, 0.9),
+                        Vec3(-0.7, 0.7, 0.0), Vec3(0.0, 0.0, 0.6)})
+    poses.push_back({&cube, &cube, Pose{c, Quat::Identity()}, Pose{}});
+  int overlapping = 0;
+  for (const RandomPair& r : poses) {
+    const ContactPlane whole =
+        choose_contact_plane(*r.a, r.pa, *r.b, r.pb, PlaneMethod::WholeSearch);
+    if (whole.depth > 0) ++overlapping;
+    const ContactPlane narrowed = choose_contact_plane(*r.a, r.pa, *r.b, r.pb, PlaneMethod::Search);
+    EXPECT_EQ(narrowed.normal, whole.normal);
+    EXPECT_EQ(narrowed.depth, whole.depth);
+    EXPECT_EQ(narrowed.axis, whole.axis);
+    const ContactPlane swapped = choose_contact_plane(*r.b, r.pb, *r.a, r.pa, PlaneMethod::Search);
+    EXPECT_EQ(swapped.normal, Vec3(-whole.normal));
+    EXPECT_EQ(swapped.depth, whole.depth);
+  }
+  EXPECT_GT(overlapping, 150);
+}
+
+TEST(ContactPlane, TheInnerPolytopeBoundsOverlappingShapesOnly) {
+  // Overlapping shapes: the polytope bounds the least overlap from above (to round-off, at most
+  // the whole search's answer plus its tie margin) and leaves a narrow cone around the answer's
+  // direction (D's direction is minus the normal). Apart or touching: it declines.
+  const ConvexPolyhedron a = stretched_icosphere(3, Vec3(0.6, 1.4, 0.9));
+  const ConvexPolyhedron b = make_icosphere(0.5, 2);
+  std::mt19937 rng(31);
+  int narrowed = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const Pose pa{Vec3::Zero(), random_rotation(rng)};
+    const Vec3 dir = random_rotation(rng) * Vec3::UnitX();
+    for (const double gap : {-0.3, -0.01, 0.01}) {
+      // Slide B along dir until it just touches, then by `gap` (negative: into A).
+      double lo = 0.0, hi = 4.0;
+      for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (choose_contact_plane(a, pa, b, Pose{mid * dir, Quat::Identity()}).depth > 0 ? lo : hi) =
+            mid;
+      }
+      const Pose pb{(lo + gap) * dir, Quat::Identity()};
+      plane_detail::Side sa, sb;
+      sa.set(a, pa);
+      sb.set(b, pb);
+      plane_detail::Candidates out;
+      const double tie = 1e-12 * 4.0;
+      const bool bounded = plane_detail::inner_polytope_bound(sa, sb, tie, out);
+      if (gap > 0) {
+        EXPECT_FALSE(bounded) << "apart by " << gap;
+        continue;
+      }
+      ASSERT_TRUE(bounded) << "trial " << trial;
+      const ContactPlane whole = choose_contact_plane(a, pa, b, pb, PlaneMethod::WholeSearch);
+      // Round-off of the polytope's support points against the search's projections.
+      EXPECT_LE(out.known, whole.depth + 1e-12);
+      EXPECT_GE(out.known, whole.depth - 1e-12);
+      ASSERT_FALSE(out.within.whole);
+      EXPECT_GE((-whole.normal).dot(out.within.axis), out.within.cos_angle);
+      if (out.within.cos_angle > std::cos(1e-3)) ++narrowed;
+    }
+  }
+  EXPECT_EQ(narrowed, 100);
 }
 
 }  // namespace
