@@ -3,6 +3,7 @@
 #include "engine/contact_plane.h"
 
 #include <algorithm>
+#include <optional>
 
 #include "engine/contact_plane_detail.h"
 #include "engine/gauss_map.h"
@@ -31,10 +32,14 @@ ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
   return choose_contact_plane(a, pa, b, pb, Vec3::UnitZ(), plane_detail::kInf, method);
 }
 
-ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
-                                  const ConvexPolyhedron& b, const Pose& pb,
-                                  const Vec3& known_normal, double known_overlap,
-                                  PlaneMethod method) {
+namespace {
+
+// Both entry points: the plane, or nothing when `proof_only` and the method could not prove that
+// the shapes overlap (then the whole search is not run).
+std::optional<ContactPlane> choose(const ConvexPolyhedron& a, const Pose& pa,
+                                   const ConvexPolyhedron& b, const Pose& pb,
+                                   const Vec3& known_normal, double known_overlap,
+                                   PlaneMethod method, bool proof_only) {
   thread_local plane_detail::Candidates found;
   found.kept.clear();
   found.upper = plane_detail::kInf;
@@ -43,15 +48,20 @@ ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
   found.known_normal = known_normal;
   found.within = DirectionCone{};
   found.polytope = method != PlaneMethod::WholeSearch;
+  found.proof_only = proof_only;
+  found.proved = false;
   const GaussMap &ga = a.gauss_map(), &gb = b.gauss_map();
   const std::size_t features = ga.faces.size() + ga.arcs.size() + gb.faces.size() + gb.arcs.size();
   if (method == PlaneMethod::Automatic)
     method = features <= kScanFeatures ? PlaneMethod::Scan : PlaneMethod::Search;
   // The scan answers only for shapes it proves to overlap; the search for every pair.
-  if (method != PlaneMethod::Scan || !plane_detail::scan_candidates(a, pa, b, pb, found)) {
+  if (method == PlaneMethod::Scan && plane_detail::scan_candidates(a, pa, b, pb, found)) {
+    found.proved = true;
+  } else {
     found.kept.clear();
     plane_detail::search_candidates(a, pa, b, pb, found);
   }
+  if (proof_only && !found.proved) return std::nullopt;
 
   // Among the candidates within the tie margin of the least overlap: faces first, then the
   // smaller sign-free axis, then the smaller overlap. Every key is the geometry's, not the slot's.
@@ -77,6 +87,20 @@ ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
   out.depth = std::max(pick->overlap, 0.0);
   out.axis = pick->source;
   return out;
+}
+
+}  // namespace
+
+ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
+                                  const ConvexPolyhedron& b, const Pose& pb,
+                                  const Vec3& known_normal, double known_overlap,
+                                  PlaneMethod method) {
+  return *choose(a, pa, b, pb, known_normal, known_overlap, method, false);
+}
+
+std::optional<ContactPlane> choose_overlap_plane(const ConvexPolyhedron& a, const Pose& pa,
+                                                 const ConvexPolyhedron& b, const Pose& pb) {
+  return choose(a, pa, b, pb, Vec3::UnitZ(), plane_detail::kInf, PlaneMethod::Automatic, true);
 }
 
 }  // namespace rbx

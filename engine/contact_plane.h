@@ -16,6 +16,8 @@
 // negated and the same depth.
 #pragma once
 
+#include <optional>
+
 #include "engine/math.h"
 #include "engine/polyhedron.h"
 
@@ -62,5 +64,12 @@ ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
                                   const ConvexPolyhedron& b, const Pose& pb,
                                   const Vec3& known_normal, double known_overlap,
                                   PlaneMethod method = PlaneMethod::Automatic);
+
+/// The same plane, only for shapes proved to overlap by more than round-off: by the scan's point
+/// inside both shapes, or the inner polytope's tetrahedron around the origin of A - B (the
+/// search's narrowing). Nothing for shapes touching, apart, or too close to touching to tell
+/// (the whole search is then not run): a detector decides those.
+std::optional<ContactPlane> choose_overlap_plane(const ConvexPolyhedron& a, const Pose& pa,
+                                                 const ConvexPolyhedron& b, const Pose& pb);
 
 }  // namespace rbx

@@ -48,6 +48,11 @@ struct Candidates {
   int within_a = -1, within_b = -1;
   /// The search: narrow it by the inner polytope first (false: the whole sphere, as a check).
   bool polytope = true;
+  /// The search: stop when the polytope cannot prove the shapes overlap (no whole search).
+  bool proof_only = false;
+  /// Left by the method: whether it proved that the shapes overlap by more than round-off (the
+  /// scan's point inside both, the polytope's tetrahedron around the origin).
+  bool proved = false;
 };
 
 /// One shape of a query: its Gauss map and its pose.

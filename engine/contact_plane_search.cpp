@@ -265,7 +265,12 @@ void search_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPo
   q.tie = 1e-12 * scale;
   // The inner polytope narrows the directions and may lower the known overlap.
   q.within = DirectionCone{};
-  if (out.polytope && inner_polytope_bound(q.a, q.b, q.tie, out)) q.within = out.within;
+  if (out.polytope && inner_polytope_bound(q.a, q.b, q.tie, out)) {
+    q.within = out.within;
+    out.proved = true;
+  } else if (out.proof_only) {
+    return;
+  }
   if (!q.within.whole) {
     // Each side's cone bound over `within` (on its own side: B's directions negated), from the
     // other's supporting vertex.

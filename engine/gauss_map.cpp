@@ -124,6 +124,16 @@ GaussMap GaussMap::build(const ConvexPolyhedron& s) {
     g.neighbors[fill[e.a]++] = e.b;
     g.neighbors[fill[e.b]++] = e.a;
   }
+  // The triangles around each vertex (counting sort again).
+  const auto& tris = s.triangles();
+  g.vertex_triangle_start.assign(nv + 1, 0);
+  for (const auto& t : tris)
+    for (const int v : t) ++g.vertex_triangle_start[v + 1];
+  for (int v = 0; v < nv; ++v) g.vertex_triangle_start[v + 1] += g.vertex_triangle_start[v];
+  g.vertex_triangles.resize(g.vertex_triangle_start.back());
+  fill.assign(g.vertex_triangle_start.begin(), g.vertex_triangle_start.end() - 1);
+  for (int t = 0; t < static_cast<int>(tris.size()); ++t)
+    for (const int v : tris[t]) g.vertex_triangles[fill[v]++] = t;
   for (const Vec3& v : s.vertices()) g.radius = std::max(g.radius, v.norm());
   // The 26 start directions, each vertex found by a scan (once per shape).
   for (int x = -1; x <= 1; ++x)

@@ -50,6 +50,9 @@ struct GaussMap {
   /// Vertex adjacency, compressed: the neighbours of vertex v are
   /// neighbors[neighbor_start[v] .. neighbor_start[v + 1]).
   std::vector<int> neighbor_start, neighbors;
+  /// The triangles around each vertex, compressed the same way: those of vertex v are
+  /// vertex_triangles[vertex_triangle_start[v] .. vertex_triangle_start[v + 1]).
+  std::vector<int> vertex_triangle_start, vertex_triangles;
   double radius = 0.0;  // m, the largest distance of a vertex from the body origin
   /// Start vertices for a climb with no vertex near its direction: the support vertex along each
   /// of 26 directions (the faces, edges and corners of a cube), so that no climb starts more

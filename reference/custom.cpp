@@ -2,7 +2,7 @@
 
 #include <exception>
 
-#include "engine/contact_plane.h"
+#include "engine/contact_region.h"
 #include "engine/detect.h"
 #include "reference/dynamics_recorder.h"
 
@@ -10,42 +10,28 @@ namespace rbx {
 
 namespace {
 
-// The detector's first hit at the current poses, with a cache per thread: reused by every query
-// as the World reuses one per pair, its scratch lists are allocated once. Answers do not depend
-// on it.
-std::optional<ContactPoint> first_hit(const RigidBody& a, const RigidBody& b,
-                                      DetectorVariant variant) {
+// The contact of the `custom` backend on either detector: the plane of least overlap
+// (engine/contact_plane.h) and the centre of the contact region (engine/contact_region.h) for
+// shapes proved to overlap; the detector for the rest, from either body order alike. One
+// detection cache per thread, reused by every query as the World reuses one per pair: its
+// scratch lists are allocated once. Answers do not depend on it.
+ContactResult engine_contact(const RigidBody& a, const RigidBody& b, DetectorVariant variant) {
   thread_local DetectionCache cache;
-  return detect(*a.shape, a.pose(), *b.shape, b.pose(), variant, cache);
-}
-
-// The contact of the `custom` backend on either detector.
-ContactResult chosen_plane_contact(const RigidBody& a, const RigidBody& b,
-                                   DetectorVariant variant) {
   ContactResult r;
-  auto c = first_hit(a, b, variant);
-  if (!c) return r;
-  // Departure from the seed (engine/contact_plane.h): the tests find the contact and its point;
-  // the plane is the direction of least overlap, not the first face hit (the overlap along the
-  // tests' normal bounds it from the start).
-  const ContactPlane plane =
-      choose_contact_plane(*a.shape, a.pose(), *b.shape, b.pose(), c->normal, c->depth);
-  c->normal = plane.normal;
-  c->depth = plane.depth;
-  r.contacts.push_back(*c);
+  if (auto c = find_contact(*a.shape, a.pose(), *b.shape, b.pose(), variant, cache))
+    r.contacts.push_back(*c);
   return r;
 }
 
-// `custom`: the accelerated detector finds the contact and its point, the plane is the
-// direction of least overlap (engine/contact_plane.h), from either body order alike.
+// `custom`: the accelerated detector where one is needed.
 ContactResult custom_contact(const RigidBody& a, const RigidBody& b) {
-  return chosen_plane_contact(a, b, DetectorVariant::Accelerated);
+  return engine_contact(a, b, DetectorVariant::Accelerated);
 }
 
 // Variant "faithful" of `custom`: the seed's loops over every primitive (the accelerated
-// detector's oracle), then the same chosen plane; the same answer, slower.
+// detector's oracle) where a detector is needed; the same answer, slower on touching poses.
 ContactResult custom_faithful_contact(const RigidBody& a, const RigidBody& b) {
-  return chosen_plane_contact(a, b, DetectorVariant::Faithful);
+  return engine_contact(a, b, DetectorVariant::Faithful);
 }
 
 BodyFinal final_of(const RigidBody& b) {

@@ -1,0 +1,352 @@
+// The centre of the contact region on a chosen plane (engine/contact_region.h).
+#include "engine/contact_region.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "engine/contact_plane_detail.h"
+#include "engine/detect.h"
+
+namespace rbx {
+
+namespace {
+
+using Vec2 = Eigen::Vector2d;
+
+// Incident faces whose normals' dot products with the reference normal differ by less than this
+// are equally against it: round-off of unit normals of order-1 coordinates is ~1e-16, and a
+// real difference of 1e-10 is a tilt of 1e-5 rad.
+constexpr double kTieCosine = 1e-10;
+
+// The vertices of a placed shape within `eps` of its furthest along d (world), by index, in the
+// order found: the climb's vertex (from `start`, or the map's start vertex when negative), then
+// every vertex reached over edges without dropping below that height (the vertices above a plane
+// of a convex polyhedron are connected by its edges).
+void extreme_indices(const plane_detail::Side& s, const Vec3& d, double eps,
+                     std::vector<int>& found, int start = -1) {
+  const Vec3 local = s.rt * d;
+  const GaussMap& g = *s.map;
+  const std::vector<Vec3>& v = s.shape->vertices();
+  double h = 0.0;  // in the body frame
+  found.assign(1, g.climb(v, local, start, h));
+  for (std::size_t k = 0; k < found.size(); ++k)
+    for (int e = g.neighbor_start[found[k]]; e < g.neighbor_start[found[k] + 1]; ++e) {
+      const int o = g.neighbors[e];
+      if (v[o].dot(local) >= h - eps && std::find(found.begin(), found.end(), o) == found.end())
+        found.push_back(o);
+    }
+}
+
+// The same vertices, placed in the world.
+void extreme_feature(const plane_detail::Side& s, const Vec3& d, double eps,
+                     std::vector<Vec3>& out, int start = -1) {
+  thread_local std::vector<int> found;
+  extreme_indices(s, d, eps, found, start);
+  out.clear();
+  for (const int i : found) out.push_back(s.world(i));
+}
+
+double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+bool lex_less(const Vec2& p, const Vec2& q) {
+  return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y());
+}
+
+// The convex hull of points on the plane, counter-clockwise (Andrew's monotone chain): one point,
+// two (a segment) or a polygon without collinear corners.
+std::vector<Vec2> hull2(std::vector<Vec2> p) {
+  std::sort(p.begin(), p.end(), lex_less);
+  p.erase(std::unique(p.begin(), p.end()), p.end());
+  if (p.size() < 3) return p;
+  std::vector<Vec2> h(2 * p.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross2(h[k - 1] - h[k - 2], p[i] - h[k - 2]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  for (std::size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && cross2(h[k - 1] - h[k - 2], p[i] - h[k - 2]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+// Sutherland-Hodgman on one half-plane: the part of `poly` (a polygon, a segment or a point)
+// where f(x) = w . x - c <= tol, for |w| = 1 (so that f is a distance).
+std::vector<Vec2> clip_half(const std::vector<Vec2>& poly, const Vec2& w, double c, double tol) {
+  std::vector<Vec2> out;
+  for (std::size_t j = 0; j < poly.size(); ++j) {
+    const Vec2 &x = poly[j], &y = poly[(j + 1) % poly.size()];
+    const double fx = w.dot(x) - c, fy = w.dot(y) - c;
+    if (fx <= tol) out.push_back(x);
+    if (poly.size() > 1 && ((fx <= tol) != (fy <= tol))) out.push_back(x + (y - x) * (fx / (fx - fy)));
+  }
+  return out;
+}
+
+// The part of `poly` inside every edge of the counter-clockwise convex polygon `clip`.
+std::vector<Vec2> clip_by(std::vector<Vec2> poly, const std::vector<Vec2>& clip, double tol) {
+  for (std::size_t i = 0; i < clip.size() && !poly.empty(); ++i) {
+    const Vec2 e = clip[(i + 1) % clip.size()] - clip[i];
+    // The edge's outward normal (the polygon lies to the left of each edge).
+    const Vec2 w = Vec2(e.y(), -e.x()).normalized();
+    poly = clip_half(poly, w, w.dot(clip[i]), tol);
+  }
+  return poly;
+}
+
+// The midpoint of the closest points of two segments (or points) on the plane; for parallel
+// overlapping segments, the middle of their overlap.
+Vec2 segments_meet(const std::vector<Vec2>& s, const std::vector<Vec2>& t) {
+  const Vec2 p = s[0], q = t[0];
+  const Vec2 d1 = s.size() > 1 ? Vec2(s[1] - s[0]) : Vec2::Zero();
+  const Vec2 d2 = t.size() > 1 ? Vec2(t[1] - t[0]) : Vec2::Zero();
+  const double a = d1.squaredNorm(), e = d2.squaredNorm();
+  const Vec2 r = p - q;
+  double u = 0.0, v = 0.0;
+  if (a > 0 && e > 0 && std::abs(cross2(d1, d2)) > 1e-12 * std::sqrt(a * e)) {
+    // Crossing lines: the intersection, clamped to both segments.
+    u = std::clamp(cross2(q - p, d2) / cross2(d1, d2), 0.0, 1.0);
+    v = std::clamp((p + u * d1 - q).dot(d2) / e, 0.0, 1.0);
+    u = std::clamp((q + v * d2 - p).dot(d1) / a, 0.0, 1.0);
+  } else if (a > 0 && e > 0) {
+    // Parallel: the middle of the overlap of their projections on s.
+    const double lo = std::max(0.0, std::min((q - p).dot(d1), (q + d2 - p).dot(d1)) / a);
+    const double hi = std::min(1.0, std::max((q - p).dot(d1), (q + d2 - p).dot(d1)) / a);
+    u = lo <= hi ? 0.5 * (lo + hi) : (hi < 0.0 ? 0.0 : 1.0);
+    v = std::clamp((p + u * d1 - q).dot(d2) / e, 0.0, 1.0);
+  } else if (a > 0) {
+    u = std::clamp(-r.dot(d1) / a, 0.0, 1.0);
+  } else if (e > 0) {
+    v = std::clamp(r.dot(d2) / e, 0.0, 1.0);
+  }
+  return 0.5 * ((p + u * d1) + (q + v * d2));
+}
+
+// The centroid of a polygon, segment or point on the plane: by area when it has one, else the
+// middle of its two furthest points.
+Vec2 centroid2(const std::vector<Vec2>& p, double tol) {
+  if (p.size() >= 3) {
+    double area = 0.0;
+    Vec2 c = Vec2::Zero();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Vec2 &x = p[i], &y = p[(i + 1) % p.size()];
+      const double w = cross2(x - p[0], y - p[0]);
+      area += w;
+      c += w * (x + y - 2.0 * p[0]);
+    }
+    if (std::abs(area) > tol * tol) return p[0] + c / (3.0 * area);
+  }
+  Vec2 x = p[0], y = p[0];
+  double best = -1.0;
+  for (const Vec2& s : p)
+    for (const Vec2& t : p)
+      if ((s - t).squaredNorm() > best) {
+        best = (s - t).squaredNorm();
+        x = s;
+        y = t;
+      }
+  return 0.5 * (x + y);
+}
+
+// One side's feature on the plane: its hull and its mean height along the axis.
+struct Projected {
+  std::vector<Vec2> hull;
+  double height = 0.0;
+  int vertices = 0;
+};
+
+Projected project(const std::vector<Vec3>& feature, const Vec3& t1, const Vec3& t2,
+                  const Vec3& axis) {
+  Projected out;
+  std::vector<Vec2> p;
+  std::vector<double> h;
+  for (const Vec3& x : feature) {
+    p.emplace_back(x.dot(t1), x.dot(t2));
+    h.push_back(x.dot(axis));
+  }
+  // The heights summed in a fixed order (sorted), so that the mean does not depend on the order
+  // the climb found the vertices.
+  std::sort(h.begin(), h.end());
+  for (const double z : h) out.height += z;
+  out.height /= static_cast<double>(h.size());
+  out.vertices = static_cast<int>(feature.size());
+  out.hull = hull2(std::move(p));
+  return out;
+}
+
+// A geometric order of the two features (never the argument slot): the one with more hull
+// corners first, then the lexicographically smaller hull.
+bool before(const Projected& x, const Projected& y) {
+  if (x.hull.size() != y.hull.size()) return x.hull.size() > y.hull.size();
+  return std::lexicographical_compare(x.hull.begin(), x.hull.end(), y.hull.begin(), y.hull.end(),
+                                      lex_less);
+}
+
+}  // namespace
+
+namespace {
+
+// A frame of the plane with unit normal `axis`: two unit vectors across it, a function of the
+// axis alone.
+void plane_frame(const Vec3& axis, Vec3& t1, Vec3& t2) {
+  int k = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(axis[i]) < std::abs(axis[k])) k = i;
+  t1 = axis.cross(Vec3::Unit(k)).normalized();
+  t2 = axis.cross(t1);
+}
+
+// An edge-pair axis: each shape's feature along the normal (an edge, to round-off), projected,
+// and the midpoint of their closest points, midway between them along the normal.
+Vec3 edge_pair_centre(const plane_detail::Side& sa, const plane_detail::Side& sb, const Vec3& n,
+                      double eps) {
+  thread_local std::vector<Vec3> fa, fb;
+  extreme_feature(sa, -n, eps, fa);
+  extreme_feature(sb, n, eps, fb);
+  // The frame of the sign-free axis, and the two features in an order of the geometry: the
+  // same numbers in either body order.
+  const Vec3 axis = plane_detail::canonical(n);
+  Vec3 t1, t2;
+  plane_frame(axis, t1, t2);
+  const Projected pa = project(fa, t1, t2, axis), pb = project(fb, t1, t2, axis);
+  const Projected& ref = before(pa, pb) ? pa : pb;
+  const Projected& inc = &ref == &pa ? pb : pa;
+  Vec2 centre;
+  if (ref.hull.size() >= 3) {
+    // Parallel faces within round-off of the axis: their overlap.
+    const std::vector<Vec2> region = clip_by(inc.hull, ref.hull, eps);
+    centre = centroid2(region.empty() ? inc.hull : region, eps);
+  } else {
+    centre = segments_meet(ref.hull, inc.hull);
+  }
+  return centre.x() * t1 + centre.y() * t2 + (0.5 * (ref.height + inc.height)) * axis;
+}
+
+}  // namespace
+
+Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                           const Pose& pb, const ContactPlane& plane, std::string& feature) {
+  plane_detail::Side sa, sb;
+  sa.set(a, pa);
+  sb.set(b, pb);
+  const Vec3& n = plane.normal;
+  // The features within the engine's point-in-mesh tolerance of each extreme: a face's vertices
+  // lie within round-off of its plane, far inside it.
+  const double eps = point_in_mesh_tolerance(a, b);
+  if (plane.axis == PlaneAxis::EdgeEdge) {
+    feature = "edge";
+    return edge_pair_centre(sa, sb, n, eps);
+  }
+
+  // A face axis: the reference face (the face whose normal is the axis, outward m) and the
+  // incident face, the other shape's face most against m among those at its deepest vertex.
+  const bool ref_b = plane.axis == PlaneAxis::FaceOfB;
+  const plane_detail::Side& rs = ref_b ? sb : sa;
+  const plane_detail::Side& is = ref_b ? sa : sb;
+  const Vec3 m = ref_b ? n : Vec3(-n);
+  thread_local std::vector<Vec3> ref_pts, inc_pts;
+  extreme_feature(rs, m, eps, ref_pts);
+  const GaussMap& gi = *is.map;
+  const std::vector<Vec3>& vi = is.shape->vertices();
+  double deep_h = 0.0;
+  const int deep = gi.climb(vi, is.rt * -m, -1, deep_h);
+  const Vec3 m_local = is.rt * m;
+  // The incident face: the most against m of the faces around the deepest vertex; several within
+  // round-off of that (kTieCosine) give the feature they share instead (an edge, or the vertex),
+  // so that no choice among equals is made.
+  const auto& planes = is.shape->planes();
+  double most = plane_detail::kInf;
+  for (int k = gi.vertex_triangle_start[deep]; k < gi.vertex_triangle_start[deep + 1]; ++k)
+    most = std::min(most, planes[gi.vertex_triangles[k]].normal.dot(m_local));
+  thread_local std::vector<int> shared, face;
+  shared.clear();
+  Vec3 inc_n = Vec3::Zero();
+  double inc_offset = 0.0;
+  for (int k = gi.vertex_triangle_start[deep]; k < gi.vertex_triangle_start[deep + 1]; ++k) {
+    const Plane& pl = planes[gi.vertex_triangles[k]];
+    if (pl.normal.dot(m_local) > most + kTieCosine) continue;
+    const Vec3 nw = is.r * pl.normal;
+    if (nw == inc_n) continue;  // a coplanar triangle of a face already taken
+    extreme_indices(is, nw, eps, face, deep);
+    if (inc_n == Vec3::Zero()) {
+      shared = face;
+      inc_n = nw;
+      inc_offset = pl.offset + nw.dot(is.p);
+      continue;
+    }
+    shared.erase(std::remove_if(shared.begin(), shared.end(),
+                                [&](int v) {
+                                  return std::find(face.begin(), face.end(), v) == face.end();
+                                }),
+                 shared.end());
+  }
+  inc_pts.clear();
+  for (const int v : shared) inc_pts.push_back(is.world(v));
+  // A single deepest vertex is a vertex contact (its neighbours all rise above it).
+  bool single = true;
+  for (int k = gi.neighbor_start[deep]; k < gi.neighbor_start[deep + 1]; ++k)
+    single = single && vi[gi.neighbors[k]].dot(-m_local) < deep_h - eps;
+  feature = single ? "vertex" : "face";
+
+  // The frame of the sign-free axis (so that parallel faces, below, get the same numbers in
+  // either body order); `up` is m in it.
+  const Vec3 axis = plane_detail::canonical(m);
+  const double up = axis == m ? 1.0 : -1.0;
+  Vec3 t1, t2;
+  plane_frame(axis, t1, t2);
+  Projected ref = project(ref_pts, t1, t2, axis), inc = project(inc_pts, t1, t2, axis);
+  // Parallel faces (the incident one within round-off of against m): the plane's keys may have
+  // taken either as the reference, so the two are ordered by the geometry instead.
+  if (1.0 + inc_n.dot(m) <= 1e-12) {
+    const bool ref_first = !before(inc, ref);
+    const Projected& x = ref_first ? ref : inc;
+    const Projected& y = ref_first ? inc : ref;
+    const std::vector<Vec2> region = clip_by(y.hull, x.hull, eps);
+    const Vec2 c = centroid2(region.empty() ? y.hull : region, eps);
+    return c.x() * t1 + c.y() * t2 + (0.5 * (x.height + y.height)) * axis;
+  }
+  // Heights along m from here on.
+  ref.height *= up;
+  // The incident face's height along m over the plane's point (u, v): on its plane
+  // inc_n . x = inc_offset.
+  const double a0 = inc_offset / inc_n.dot(m), au = -inc_n.dot(t1) / inc_n.dot(m),
+               av = -inc_n.dot(t2) / inc_n.dot(m);
+  auto inc_height = [&](const Vec2& p) { return a0 + au * p.x() + av * p.y(); };
+  // The incident feature clipped to the reference face's sides, and of its corners those at or
+  // below the reference plane (the manifold's points, as Box2D keeps them); none left: the
+  // deepest vertex. The centre is their centroid, midway between the incident surface and the
+  // reference plane.
+  thread_local std::vector<Vec2> kept;
+  kept.clear();
+  for (const Vec2& p : clip_by(inc.hull, ref.hull, eps))
+    if (inc_height(p) - ref.height <= eps) kept.push_back(p);
+  if (kept.empty()) {
+    const Vec3 x = is.world(deep);
+    kept.emplace_back(x.dot(t1), x.dot(t2));
+  }
+  const Vec2 c = centroid2(hull2(kept), eps);
+  return c.x() * t1 + c.y() * t2 + (0.5 * (inc_height(c) + ref.height)) * m;
+}
+
+std::optional<ContactPoint> find_contact(const ConvexPolyhedron& a, const Pose& pa,
+                                         const ConvexPolyhedron& b, const Pose& pb,
+                                         DetectorVariant variant, DetectionCache& cache) {
+  if (const auto plane = choose_overlap_plane(a, pa, b, pb)) {
+    ContactPoint c;
+    c.normal = plane->normal;
+    c.depth = plane->depth;
+    c.point = contact_region_centre(a, pa, b, pb, *plane, c.feature);
+    return c;
+  }
+  auto c = detect(a, pa, b, pb, variant, cache);
+  if (!c) return c;
+  const ContactPlane plane = choose_contact_plane(a, pa, b, pb, c->normal, c->depth);
+  c->normal = plane.normal;
+  c->depth = plane.depth;
+  return c;
+}
+
+}  // namespace rbx
