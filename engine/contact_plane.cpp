@@ -47,6 +47,7 @@ std::optional<ContactPlane> choose(const ConvexPolyhedron& a, const Pose& pa,
   found.known = known_overlap == known_overlap ? known_overlap : plane_detail::kInf;
   found.known_normal = known_normal;
   found.within = DirectionCone{};
+  found.within_a = found.within_b = -1;
   found.polytope = method != PlaneMethod::WholeSearch;
   found.proof_only = proof_only;
   found.proved = false;
@@ -86,6 +87,8 @@ std::optional<ContactPlane> choose(const ConvexPolyhedron& a, const Pose& pa,
   out.normal = pick->normal;
   out.depth = std::max(pick->overlap, 0.0);
   out.axis = pick->source;
+  out.vertex_a = found.within_a;
+  out.vertex_b = found.within_b;
   return out;
 }
 

@@ -35,6 +35,9 @@ struct ContactPlane {
   Vec3 normal = Vec3::UnitZ();  // unit, world, from B toward A
   double depth = 0.0;           // m, >= 0: the overlap of the shapes along the normal
   PlaneAxis axis = PlaneAxis::FaceOfB;
+  // Where the inner polytope found the supports along the normal (A's lowest vertex, B's
+  // highest), or -1: starting points for later climbs over the same shapes, not part of the answer.
+  int vertex_a = -1, vertex_b = -1;
 };
 
 /// How the candidate axes are found; every method gives the same plane (to round-off).

@@ -131,7 +131,7 @@ bool enclose(const Side& a, const Side& b, std::array<Point, 4>& s) {
   return false;
 }
 
-// The polytope being grown: its points and triangles (dead ones stay, marked).
+// The polytope being grown: its points and its triangles.
 struct Polytope {
   std::vector<Point> points;
   std::vector<Face> faces;
@@ -173,6 +173,9 @@ struct Polytope {
           horizon.push_back(edge);
       }
     }
+    // The seen triangles go (the scans of later iterations stay short).
+    faces.erase(std::remove_if(faces.begin(), faces.end(), [](const Face& f) { return !f.live; }),
+                faces.end());
     for (const auto& e : horizon)
       if (!add(e[0], e[1], wi, tie)) return false;
     return !horizon.empty();

@@ -63,9 +63,12 @@ struct Query {
   DirectionCone within;               // D's directions that may hold the answer (world)
   int narrow_at[2] = {-1, -1};        // narrowed: A's and B's vertices supporting D along its axis
   double narrow_bound[2] = {0, 0};    // narrowed: cone_bound over `within` from A's and B's side
+  Vec3 narrow_y[2];                   // narrowed: own position minus the other's supporting point
+  Vec3 within_local[2];  // narrowed: `within`'s axis in A's and B's body frame (B's negated)
   std::vector<Candidate> kept;
   std::vector<Pending> heap;
   std::vector<KeptArc> arcs[2];  // A's and B's arcs that may hold the answer
+  std::vector<int> found, seen;  // the local search's vertices and faces
 
   // Nothing whose lower bound exceeds this can be within the tie margin of the answer: twice
   // the margin absorbs the round-off of the bounds themselves.
@@ -85,13 +88,21 @@ struct Query {
     }
     kept.push_back(c);
   }
-  void push(const Pending& p) {
-    heap.push_back(p);
+  void push(double bound, int tree, int node, int at_other) {
+    // Written field by field in place: a whole temporary copied in stalls on its narrower stores.
+    Pending& p = heap.emplace_back();
+    p.bound = bound;
+    p.tree = tree;
+    p.node = node;
+    p.at_other = at_other;
     // Narrowed, the few nodes left are taken depth first (no order to keep).
     if (within.whole) std::push_heap(heap.begin(), heap.end());
   }
   void search();
+  void local_search();
   void visit(const Pending& e);
+  void leaf_face(int tree, int item, const Vec3& y, int at);
+  void leaf_arc(int tree, int item, const Vec3& y);
   void face(int tree, int f, int at_other);
   void pair_arcs();
   void edge_pair(const KeptArc& ka, const KeptArc& kb);
@@ -101,7 +112,7 @@ void Query::search() {
   heap.clear();
   for (int t = kFacesA; t <= kArcsB; ++t) {
     const GaussMap& g = *side(t).map;
-    if (!(t < kArcsA ? g.face_tree : g.arc_tree).nodes.empty()) push({-kInf, t, 0, -1});
+    if (!(t < kArcsA ? g.face_tree : g.arc_tree).nodes.empty()) push(-kInf, t, 0, -1);
   }
   while (!heap.empty()) {
     if (within.whole) std::pop_heap(heap.begin(), heap.end());
@@ -130,50 +141,119 @@ void Query::visit(const Pending& e) {
   const Bvh& tree = faces ? g.face_tree : g.arc_tree;
   const std::vector<DirectionCone>& cones = faces ? g.face_cones : g.arc_cones;
   const std::vector<double>& lows = faces ? g.face_lows : g.arc_lows;
-  const Vec3 axis = own.r * cones[e.node].axis;
-  const double s = sign(e.tree);
-  if (cones_apart(s * axis, cones[e.node], within.axis, within)) return;
-  // Narrowed, only the directions of `within` count: the other shape's point that supports D
-  // along its axis serves every node, with one cone bound per tree.
+  // Narrowed, only the directions of `within` count (tested in the own body frame, where the
+  // node's cone lies), and the other shape's point that supports D along its axis serves every
+  // node, with one cone bound per tree.
   const bool narrowed = !within.whole;
-  int at = narrowed ? narrow_at[(e.tree + 1) % 2] : e.at_other;
-  if (!narrowed) other.support(-axis, at);
-  const Vec3 y = own.p - other.world(at);
+  const int side_of = e.tree % 2;
+  if (narrowed && cones_apart(cones[e.node].axis, cones[e.node], within_local[side_of], within))
+    return;
+  Vec3 axis = Vec3::Zero();
+  int at = e.at_other;
+  if (narrowed) {
+    at = narrow_at[1 - side_of];
+  } else {
+    axis = own.r * cones[e.node].axis;
+    other.support(-axis, at);
+  }
+  const Vec3 y = narrowed ? narrow_y[side_of] : Vec3(own.p - other.world(at));
   const double bound = std::max(
       e.bound,
-      lows[e.node] + (narrowed ? narrow_bound[e.tree % 2] : cone_bound(y, axis, cones[e.node])));
+      lows[e.node] + (narrowed ? narrow_bound[side_of] : cone_bound(y, axis, cones[e.node])));
   if (bound > threshold()) return;
   const BvhNode& node = tree.nodes[e.node];
   if (node.child >= 0) {
     for (const int c : {node.child, node.child + 1})
-      push({std::max(bound, lows[c] + (narrowed ? narrow_bound[e.tree % 2]
-                                                : cone_bound(y, own.r * cones[c].axis, cones[c]))),
-            e.tree, c, at});
+      push(std::max(bound, lows[c] + (narrowed ? narrow_bound[side_of]
+                                               : cone_bound(y, own.r * cones[c].axis, cones[c]))),
+           e.tree, c, at);
     return;
   }
   for (int i = node.begin; i < node.end; ++i) {
-    const int item = tree.order[i];
-    if (faces) {
-      // The same bound at the face's own normal, before its climb.
-      const GaussMap::Face& f = g.faces[item];
-      if (outside(s * (own.r * f.normal))) continue;
-      if (f.offset + y.dot(own.r * f.normal) > threshold()) continue;
-      face(e.tree, item, at);
-      continue;
+    if (faces)
+      leaf_face(e.tree, tree.order[i], y, at);
+    else
+      leaf_arc(e.tree, tree.order[i], y);
+  }
+}
+
+// A face of a leaf (or of the local enumeration), with the bound from the other's point y (the
+// one that `at` names): measured unless the bound or the narrowing rules it out.
+void Query::leaf_face(int tree, int item, const Vec3& y, int at) {
+  const Side& own = side(tree);
+  const GaussMap::Face& f = own.map->faces[item];
+  if (!within.whole && f.normal.dot(within_local[tree % 2]) < within.cos_angle - 1e-12) return;
+  // The same bound at the face's own normal, before its climb.
+  if (f.offset + y.dot(own.r * f.normal) > threshold()) return;
+  face(tree, item, at);
+}
+
+// An arc of a leaf (or of the local enumeration): kept for pairing unless its bound or the
+// narrowing rules it out.
+void Query::leaf_arc(int tree, int item, const Vec3& y) {
+  const Side& own = side(tree);
+  const GaussMap::Arc& arc = own.map->arcs[item];
+  if (!within.whole && cones_apart(arc.cone.axis, arc.cone, within_local[tree % 2], within)) return;
+  KeptArc k;
+  const Vec3 arc_axis = own.r * arc.cone.axis;
+  k.bound = arc.low + cone_bound(y, arc_axis, arc.cone);
+  if (k.bound > threshold()) return;
+  // For pairing, the arc on D's Gauss map (B's negated).
+  const double s = sign(tree);
+  k.axis = s * arc_axis;
+  k.n0 = s * (own.r * arc.n0);
+  k.n1 = s * (own.r * arc.n1);
+  k.cone = &arc.cone;
+  k.edge = arc.edge;
+  arcs[tree - kArcsA].push_back(k);
+}
+
+// The narrowed search without the trees, for a narrow cone: every candidate whose direction lies
+// in the cone has, on each shape, features supporting that direction, and every vertex that
+// supports some direction u of the cone reaches u at least as far as the vertex supporting the
+// cone's axis does. Those vertices are found by a walk over edges from that vertex (for each u
+// they form the cap above a plane through it, connected, and every cap holds it); their faces
+// and their edges to each other are then all the faces and arcs the cone can hold.
+void Query::local_search() {
+  for (int side_of = 0; side_of < 2; ++side_of) {
+    const Side& own = side_of == 0 ? a : b;
+    const GaussMap& g = *own.map;
+    const std::vector<Vec3>& v = own.shape->vertices();
+    const Vec3& u = within_local[side_of];
+    const int start = narrow_at[side_of];
+    // Round-off of the body-frame projections (coordinates of the shape's size).
+    const double slack = 1e-12 * (1.0 + g.radius);
+    auto reaches = [&](int w) {
+      const Vec3 x = v[w] - v[start];
+      const double along = x.dot(u), across = x.cross(u).norm();
+      // The furthest x . u' over the cone's directions u'.
+      const double best = along * within.cos_angle + across * within.sin_angle;
+      return std::max(best, along >= x.norm() * within.cos_angle ? x.norm() : best) >= -slack;
+    };
+    found.assign(1, start);
+    for (std::size_t k = 0; k < found.size(); ++k)
+      for (int e = g.neighbor_start[found[k]]; e < g.neighbor_start[found[k] + 1]; ++e) {
+        const int w = g.neighbors[e];
+        if (std::find(found.begin(), found.end(), w) == found.end() && reaches(w))
+          found.push_back(w);
+      }
+    const int face_tree = side_of == 0 ? kFacesA : kFacesB;
+    const Vec3& y = narrow_y[side_of];
+    const int at = narrow_at[1 - side_of];
+    seen.clear();
+    for (const int w : found) {
+      for (int k = g.vertex_triangle_start[w]; k < g.vertex_triangle_start[w + 1]; ++k) {
+        const int f = g.face_of_triangle[g.vertex_triangles[k]];
+        if (std::find(seen.begin(), seen.end(), f) != seen.end()) continue;
+        seen.push_back(f);
+        leaf_face(face_tree, f, y, at);
+      }
+      for (int e = g.neighbor_start[w]; e < g.neighbor_start[w + 1]; ++e) {
+        const int o = g.neighbors[e], arc = g.neighbor_arcs[e];
+        if (arc >= 0 && w < o && std::find(found.begin(), found.end(), o) != found.end())
+          leaf_arc(face_tree + 2, arc, y);
+      }
     }
-    const GaussMap::Arc& arc = g.arcs[item];
-    KeptArc k;
-    const Vec3 arc_axis = own.r * arc.cone.axis;
-    if (cones_apart(s * arc_axis, arc.cone, within.axis, within)) continue;
-    k.bound = arc.low + cone_bound(y, arc_axis, arc.cone);
-    if (k.bound > threshold()) continue;
-    // For pairing, the arc on D's Gauss map (B's negated).
-    k.axis = s * arc_axis;
-    k.n0 = s * (own.r * arc.n0);
-    k.n1 = s * (own.r * arc.n1);
-    k.cone = &arc.cone;
-    k.edge = arc.edge;
-    arcs[e.tree - kArcsA].push_back(k);
   }
 }
 
@@ -276,16 +356,25 @@ void search_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPo
     // other's supporting vertex.
     q.narrow_at[0] = out.within_a;
     q.narrow_at[1] = out.within_b;
-    const Vec3 ya = q.a.p - q.b.world(out.within_b), yb = q.b.p - q.a.world(out.within_a);
-    q.narrow_bound[0] = cone_bound(ya, q.within.axis, q.within);
-    q.narrow_bound[1] = cone_bound(yb, -q.within.axis, q.within);
+    q.narrow_y[0] = q.a.p - q.b.world(out.within_b);
+    q.narrow_y[1] = q.b.p - q.a.world(out.within_a);
+    q.narrow_bound[0] = cone_bound(q.narrow_y[0], q.within.axis, q.within);
+    q.narrow_bound[1] = cone_bound(q.narrow_y[1], -q.within.axis, q.within);
+    q.within_local[0] = q.a.rt * q.within.axis;
+    q.within_local[1] = q.b.rt * -q.within.axis;
   }
   // A known overlap bounds the least from the start (one tie margin more, as in the scan).
   if (out.known < kInf) {
     q.upper = out.known + q.tie;
     q.upper_normal = out.known_normal;
   }
-  q.search();
+  // A narrow cone (the polytope converged) is enumerated from its supporting vertices; a wide
+  // one searched in the trees.
+  constexpr double kLocalCone = 1e-2;  // rad
+  if (!q.within.whole && q.within.cos_angle >= std::cos(kLocalCone))
+    q.local_search();
+  else
+    q.search();
   q.pair_arcs();
   out.kept.swap(q.kept);
   out.tie = q.tie;

@@ -39,8 +39,8 @@ void extreme_indices(const plane_detail::Side& s, const Vec3& d, double eps,
 }
 
 // The same vertices, placed in the world.
-void extreme_feature(const plane_detail::Side& s, const Vec3& d, double eps,
-                     std::vector<Vec3>& out, int start = -1) {
+void extreme_feature(const plane_detail::Side& s, const Vec3& d, double eps, std::vector<Vec3>& out,
+                     int start = -1) {
   thread_local std::vector<int> found;
   extreme_indices(s, d, eps, found, start);
   out.clear();
@@ -81,7 +81,8 @@ std::vector<Vec2> clip_half(const std::vector<Vec2>& poly, const Vec2& w, double
     const Vec2 &x = poly[j], &y = poly[(j + 1) % poly.size()];
     const double fx = w.dot(x) - c, fy = w.dot(y) - c;
     if (fx <= tol) out.push_back(x);
-    if (poly.size() > 1 && ((fx <= tol) != (fy <= tol))) out.push_back(x + (y - x) * (fx / (fx - fy)));
+    if (poly.size() > 1 && ((fx <= tol) != (fy <= tol)))
+      out.push_back(x + (y - x) * (fx / (fx - fy)));
   }
   return out;
 }
@@ -201,11 +202,12 @@ void plane_frame(const Vec3& axis, Vec3& t1, Vec3& t2) {
 
 // An edge-pair axis: each shape's feature along the normal (an edge, to round-off), projected,
 // and the midpoint of their closest points, midway between them along the normal.
-Vec3 edge_pair_centre(const plane_detail::Side& sa, const plane_detail::Side& sb, const Vec3& n,
-                      double eps) {
+Vec3 edge_pair_centre(const plane_detail::Side& sa, const plane_detail::Side& sb,
+                      const ContactPlane& plane, double eps) {
+  const Vec3& n = plane.normal;
   thread_local std::vector<Vec3> fa, fb;
-  extreme_feature(sa, -n, eps, fa);
-  extreme_feature(sb, n, eps, fb);
+  extreme_feature(sa, -n, eps, fa, plane.vertex_a);
+  extreme_feature(sb, n, eps, fb, plane.vertex_b);
   // The frame of the sign-free axis, and the two features in an order of the geometry: the
   // same numbers in either body order.
   const Vec3 axis = plane_detail::canonical(n);
@@ -238,7 +240,7 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   const double eps = point_in_mesh_tolerance(a, b);
   if (plane.axis == PlaneAxis::EdgeEdge) {
     feature = "edge";
-    return edge_pair_centre(sa, sb, n, eps);
+    return edge_pair_centre(sa, sb, plane, eps);
   }
 
   // A face axis: the reference face (the face whose normal is the axis, outward m) and the
@@ -248,11 +250,13 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   const plane_detail::Side& is = ref_b ? sa : sb;
   const Vec3 m = ref_b ? n : Vec3(-n);
   thread_local std::vector<Vec3> ref_pts, inc_pts;
-  extreme_feature(rs, m, eps, ref_pts);
+  extreme_feature(rs, m, eps, ref_pts, ref_b ? plane.vertex_b : plane.vertex_a);
   const GaussMap& gi = *is.map;
-  const std::vector<Vec3>& vi = is.shape->vertices();
-  double deep_h = 0.0;
-  const int deep = gi.climb(vi, is.rt * -m, -1, deep_h);
+  // The deepest vertex: of several within the tolerance, the first by index (not the climb's,
+  // which depends on where it started).
+  thread_local std::vector<int> deepest;
+  extreme_indices(is, -m, eps, deepest, ref_b ? plane.vertex_a : plane.vertex_b);
+  const int deep = *std::min_element(deepest.begin(), deepest.end());
   const Vec3 m_local = is.rt * m;
   // The incident face: the most against m of the faces around the deepest vertex; several within
   // round-off of that (kTieCosine) give the feature they share instead (an edge, or the vertex),
@@ -277,19 +281,15 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
       inc_offset = pl.offset + nw.dot(is.p);
       continue;
     }
-    shared.erase(std::remove_if(shared.begin(), shared.end(),
-                                [&](int v) {
-                                  return std::find(face.begin(), face.end(), v) == face.end();
-                                }),
-                 shared.end());
+    shared.erase(
+        std::remove_if(shared.begin(), shared.end(),
+                       [&](int v) { return std::find(face.begin(), face.end(), v) == face.end(); }),
+        shared.end());
   }
   inc_pts.clear();
   for (const int v : shared) inc_pts.push_back(is.world(v));
-  // A single deepest vertex is a vertex contact (its neighbours all rise above it).
-  bool single = true;
-  for (int k = gi.neighbor_start[deep]; k < gi.neighbor_start[deep + 1]; ++k)
-    single = single && vi[gi.neighbors[k]].dot(-m_local) < deep_h - eps;
-  feature = single ? "vertex" : "face";
+  // A single deepest vertex is a vertex contact.
+  feature = deepest.size() == 1 ? "vertex" : "face";
 
   // The frame of the sign-free axis (so that parallel faces, below, get the same numbers in
   // either body order); `up` is m in it.

@@ -64,8 +64,9 @@ GaussMap GaussMap::build(const ConvexPolyhedron& s) {
   std::vector<DirectionCone> items;
   std::vector<double> angles;
   for (int f = 0; f < static_cast<int>(planes.size()); ++f) {
+    if (s.new_plane()[f]) g.faces.push_back({planes[f].normal, planes[f].offset, f});
+    g.face_of_triangle.push_back(static_cast<int>(g.faces.size()) - 1);
     if (!s.new_plane()[f]) continue;
-    g.faces.push_back({planes[f].normal, planes[f].offset, f});
     items.push_back(cone_of(planes[f].normal, 0.0));
     angles.push_back(0.0);
   }
@@ -119,9 +120,15 @@ GaussMap GaussMap::build(const ConvexPolyhedron& s) {
   }
   for (int v = 0; v < nv; ++v) g.neighbor_start[v + 1] += g.neighbor_start[v];
   g.neighbors.resize(g.neighbor_start.back());
+  g.neighbor_arcs.assign(g.neighbors.size(), -1);
+  std::vector<int> arc_of_edge(s.edges().size(), -1);
+  for (int k = 0; k < static_cast<int>(g.arcs.size()); ++k) arc_of_edge[g.arcs[k].edge] = k;
   std::vector<int> fill(g.neighbor_start.begin(), g.neighbor_start.end() - 1);
-  for (const Edge& e : s.edges()) {
+  for (int i = 0; i < static_cast<int>(s.edges().size()); ++i) {
+    const Edge& e = s.edges()[i];
+    g.neighbor_arcs[fill[e.a]] = arc_of_edge[i];
     g.neighbors[fill[e.a]++] = e.b;
+    g.neighbor_arcs[fill[e.b]] = arc_of_edge[i];
     g.neighbors[fill[e.b]++] = e.a;
   }
   // The triangles around each vertex (counting sort again).

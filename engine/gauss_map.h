@@ -53,6 +53,11 @@ struct GaussMap {
   /// The triangles around each vertex, compressed the same way: those of vertex v are
   /// vertex_triangles[vertex_triangle_start[v] .. vertex_triangle_start[v + 1]).
   std::vector<int> vertex_triangle_start, vertex_triangles;
+  /// Per triangle, the index in `faces` of its distinct plane.
+  std::vector<int> face_of_triangle;
+  /// Parallel to `neighbors`: the index in `arcs` of the edge to that neighbour, -1 for a flat
+  /// face's diagonal (no arc).
+  std::vector<int> neighbor_arcs;
   double radius = 0.0;  // m, the largest distance of a vertex from the body origin
   /// Start vertices for a climb with no vertex near its direction: the support vertex along each
   /// of 26 directions (the faces, edges and corners of a cube), so that no climb starts more

@@ -117,9 +117,9 @@ const Adapter& custom_adapter() {
       {
           with_budget(
               {"custom",
-               "rbx engine, extended: Moore & Wilhelms tests with the plane of least overlap, "
-               "contact manifolds, Coulomb friction, resting contact, time of impact for every "
-               "new contact",
+               "rbx engine, extended: the plane of least overlap, the contact region's centre "
+               "(Moore & Wilhelms tests where overlap is not proved), contact manifolds, Coulomb "
+               "friction, resting contact, time of impact for every new contact",
                custom_contact, custom_dynamics, nullptr, false},
               custom_budget()),
           {"custom-seed",

@@ -6,11 +6,13 @@
 
 namespace rbx {
 
-/// The engine's backends: `custom` (the Moore & Wilhelms tests find the contact and its point, the
-/// plane is the direction of least overlap, engine/contact_plane.h; the extended engine's
-/// dynamics: manifolds, Coulomb friction, resting contact, time of impact) with its "faithful"
-/// variant (the seed's loops over every primitive, the same answer), and `custom-seed` (the
-/// seed's algorithm: first hit, single-point frictionless impulse, no time of impact).
+/// The engine's backends: `custom` (the plane is the direction of least overlap,
+/// engine/contact_plane.h; the point the centre of the contact region for shapes proved to
+/// overlap, engine/contact_region.h, else the Moore & Wilhelms tests decide and give it; the
+/// extended engine's dynamics: manifolds, Coulomb friction, resting contact, time of impact)
+/// with its "faithful" variant (the seed's loops where a detector is needed, the same answer),
+/// and `custom-seed` (the seed's algorithm: first hit, single-point frictionless impulse, no time
+/// of impact).
 const Adapter& custom_adapter();
 /// `custom-seed` dynamics with each hit resolved by `response` (World::set_response): a
 /// researcher's own collision response over the seed's contacts.

@@ -68,7 +68,7 @@ TEST(ContactRegion, TheCentreIsTheSameFromEitherBodyOrder) {
   // them. (`rbx explore` scores the point against the exact oracle's manifold.)
   const std::vector<ConvexPolyhedron> all = {
       make_box(Vec3(1.0, 0.6, 0.3)), make_box(Vec3::Ones()), make_prism(0.5, 0.8, 6),
-      make_prism(0.4, 1.2, 24), make_icosphere(0.6, 1), make_icosphere(0.5, 3)};
+      make_prism(0.4, 1.2, 24),      make_icosphere(0.6, 1), make_icosphere(0.5, 3)};
   std::mt19937 rng(37);
   std::uniform_int_distribution<int> pick(0, static_cast<int>(all.size()) - 1);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
