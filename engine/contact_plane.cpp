@@ -55,6 +55,14 @@ std::optional<ContactPlane> choose(const ConvexPolyhedron& a, const Pose& pa,
   const std::size_t features = ga.faces.size() + ga.arcs.size() + gb.faces.size() + gb.arcs.size();
   if (method == PlaneMethod::Automatic)
     method = features <= kScanFeatures ? PlaneMethod::Scan : PlaneMethod::Search;
+  // Only a proof wanted: GJK first, which turns shapes apart or touching away in a few supports
+  // (the scan would measure every face before giving up).
+  if (proof_only && method == PlaneMethod::Scan) {
+    plane_detail::Side sa, sb;
+    sa.set(a, pa);
+    sb.set(b, pb);
+    if (!plane_detail::gjk_encloses_origin(sa, sb)) return std::nullopt;
+  }
   // The scan answers only for shapes it proves to overlap; the search for every pair.
   if (method == PlaneMethod::Scan && plane_detail::scan_candidates(a, pa, b, pb, found)) {
     found.proved = true;
