@@ -163,14 +163,17 @@ struct Polytope {
       f.live = false;
       // Each directed edge of a seen triangle, unless its reverse is one too (then interior).
       for (int e = 0; e < 3; ++e) {
-        const std::array<int, 2> edge{f.v[e], f.v[(e + 1) % 3]};
-        const auto rev = std::find_if(horizon.begin(), horizon.end(), [&](const auto& h) {
-          return h[0] == edge[1] && h[1] == edge[0];
-        });
-        if (rev != horizon.end())
+        const int from = f.v[e], to = f.v[(e + 1) % 3];
+        const auto rev = std::find_if(horizon.begin(), horizon.end(),
+                                      [&](const auto& h) { return h[0] == to && h[1] == from; });
+        if (rev != horizon.end()) {
           horizon.erase(rev);
-        else
-          horizon.push_back(edge);
+        } else {
+          // Written in place (a pair built aside and copied in stalls on its narrower stores).
+          auto& h = horizon.emplace_back();
+          h[0] = from;
+          h[1] = to;
+        }
       }
     }
     // The seen triangles go (the scans of later iterations stay short).
