@@ -227,6 +227,56 @@ Vec3 edge_pair_centre(const plane_detail::Side& sa, const plane_detail::Side& sb
   return centre.x() * t1 + centre.y() * t2 + (0.5 * (ref.height + inc.height)) * axis;
 }
 
+// The incident feature of a face contact: the face of shape `is` most against the reference
+// normal m (world) among the faces around its deepest vertex along -m; several within round-off
+// of that (kTieCosine) give the feature they share instead (an edge, or the vertex), so that no
+// choice among equals is made. Its vertices go to `pts`.
+struct Incident {
+  Vec3 normal = Vec3::Zero();  // world, the (first) incident face's outward normal
+  double offset = 0.0;         // m, that face's plane: normal . x = offset
+  bool single = false;         // one deepest vertex (a vertex contact)
+  int deep = -1;               // the deepest vertex (the first by index of several)
+};
+Incident incident_feature(const plane_detail::Side& is, const Vec3& m, double eps, int hint,
+                          std::vector<Vec3>& pts) {
+  const GaussMap& gi = *is.map;
+  // The deepest vertex: of several within the tolerance, the first by index (not the climb's,
+  // which depends on where it started).
+  thread_local std::vector<int> deepest;
+  extreme_indices(is, -m, eps, deepest, hint);
+  const int deep = *std::min_element(deepest.begin(), deepest.end());
+  const Vec3 m_local = is.rt * m;
+  const auto& planes = is.shape->planes();
+  double most = plane_detail::kInf;
+  for (int k = gi.vertex_triangle_start[deep]; k < gi.vertex_triangle_start[deep + 1]; ++k)
+    most = std::min(most, planes[gi.vertex_triangles[k]].normal.dot(m_local));
+  thread_local std::vector<int> shared, face;
+  shared.clear();
+  Incident out;
+  out.single = deepest.size() == 1;
+  out.deep = deep;
+  for (int k = gi.vertex_triangle_start[deep]; k < gi.vertex_triangle_start[deep + 1]; ++k) {
+    const Plane& pl = planes[gi.vertex_triangles[k]];
+    if (pl.normal.dot(m_local) > most + kTieCosine) continue;
+    const Vec3 nw = is.r * pl.normal;
+    if (nw == out.normal) continue;  // a coplanar triangle of a face already taken
+    extreme_indices(is, nw, eps, face, deep);
+    if (out.normal == Vec3::Zero()) {
+      shared = face;
+      out.normal = nw;
+      out.offset = pl.offset + nw.dot(is.p);
+      continue;
+    }
+    shared.erase(
+        std::remove_if(shared.begin(), shared.end(),
+                       [&](int v) { return std::find(face.begin(), face.end(), v) == face.end(); }),
+        shared.end());
+  }
+  pts.clear();
+  for (const int v : shared) pts.push_back(is.world(v));
+  return out;
+}
+
 }  // namespace
 
 Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
@@ -251,45 +301,12 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   const Vec3 m = ref_b ? n : Vec3(-n);
   thread_local std::vector<Vec3> ref_pts, inc_pts;
   extreme_feature(rs, m, eps, ref_pts, ref_b ? plane.vertex_b : plane.vertex_a);
-  const GaussMap& gi = *is.map;
-  // The deepest vertex: of several within the tolerance, the first by index (not the climb's,
-  // which depends on where it started).
-  thread_local std::vector<int> deepest;
-  extreme_indices(is, -m, eps, deepest, ref_b ? plane.vertex_a : plane.vertex_b);
-  const int deep = *std::min_element(deepest.begin(), deepest.end());
-  const Vec3 m_local = is.rt * m;
-  // The incident face: the most against m of the faces around the deepest vertex; several within
-  // round-off of that (kTieCosine) give the feature they share instead (an edge, or the vertex),
-  // so that no choice among equals is made.
-  const auto& planes = is.shape->planes();
-  double most = plane_detail::kInf;
-  for (int k = gi.vertex_triangle_start[deep]; k < gi.vertex_triangle_start[deep + 1]; ++k)
-    most = std::min(most, planes[gi.vertex_triangles[k]].normal.dot(m_local));
-  thread_local std::vector<int> shared, face;
-  shared.clear();
-  Vec3 inc_n = Vec3::Zero();
-  double inc_offset = 0.0;
-  for (int k = gi.vertex_triangle_start[deep]; k < gi.vertex_triangle_start[deep + 1]; ++k) {
-    const Plane& pl = planes[gi.vertex_triangles[k]];
-    if (pl.normal.dot(m_local) > most + kTieCosine) continue;
-    const Vec3 nw = is.r * pl.normal;
-    if (nw == inc_n) continue;  // a coplanar triangle of a face already taken
-    extreme_indices(is, nw, eps, face, deep);
-    if (inc_n == Vec3::Zero()) {
-      shared = face;
-      inc_n = nw;
-      inc_offset = pl.offset + nw.dot(is.p);
-      continue;
-    }
-    shared.erase(
-        std::remove_if(shared.begin(), shared.end(),
-                       [&](int v) { return std::find(face.begin(), face.end(), v) == face.end(); }),
-        shared.end());
-  }
-  inc_pts.clear();
-  for (const int v : shared) inc_pts.push_back(is.world(v));
+  const Incident inc_face =
+      incident_feature(is, m, eps, ref_b ? plane.vertex_a : plane.vertex_b, inc_pts);
+  const Vec3& inc_n = inc_face.normal;
+  const double inc_offset = inc_face.offset;
   // A single deepest vertex is a vertex contact.
-  feature = deepest.size() == 1 ? "vertex" : "face";
+  feature = inc_face.single ? "vertex" : "face";
 
   // The frame of the sign-free axis (so that parallel faces, below, get the same numbers in
   // either body order); `up` is m in it.
@@ -324,7 +341,7 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   for (const Vec2& p : clip_by(inc.hull, ref.hull, eps))
     if (inc_height(p) - ref.height <= eps) kept.push_back(p);
   if (kept.empty()) {
-    const Vec3 x = is.world(deep);
+    const Vec3 x = is.world(inc_face.deep);
     kept.emplace_back(x.dot(t1), x.dot(t2));
   }
   const Vec2 c = centroid2(hull2(kept), eps);

@@ -57,21 +57,20 @@ double find_time(const std::vector<NarrowRow>& rows, const std::string& backend,
 
 }  // namespace
 
-// The profiles behind the contact-query goals (perf: touching 2026-11-27, after the contact
-// plane's search; deep 2026-11-28, after the point-in-mesh test's cluster bounds; hulls of random
-// points on a sphere), each a measured cause.
+// The profiles behind the contact-query goals (perf, 2026-11-28, after the inner polytope and the
+// region's centre; hulls of random points on a sphere), each a measured cause.
 constexpr const char* kDetectorProfile =
-    "touching, the contact plane costs more than the tests: at N = 2048 its search is about 3/4 "
-    "of the query, a third of it the vertex climbs (one per cone opened, a few hundred per "
-    "query); at N = 32 the scan is about 3/4 (its per-query placing and sampling of both shapes, "
-    "then every face's bound). The tests alone are about 1x FCL (prebuilt).";
+    "touching, the tests no longer run for shapes the inner polytope proves to overlap: at N = 32 "
+    "the shapes' vertex climbs (GJK's and EPA's supports, the candidates' overlaps) are about a "
+    "quarter of the query, the narrowed search an eighth, EPA's own bookkeeping a tenth and the "
+    "region's centre about a fifth.";
 constexpr const char* kDeepProfile =
-    "deep, the tests cost more than the plane: at N = 8192 the seed's point-in-mesh tests on the "
-    "cap's candidates are about a third of the query (points deep inside the other shape are "
-    "certified by its inscribed ball; those near its surface take its tree) and finding the cap "
-    "(a fifth of the vertices lie within the other shape) about a fifth: the seed's face test "
-    "averages the centroids of every triangle inside, so the cap is walked whole. The contact "
-    "plane's search is about an eighth.";
+    "deep, small hulls: at N = 128 the vertex climbs are about 3/8 of the query (about 15 EPA "
+    "iterations, two supports each, before the polytope's nearest triangle lies on a face of the "
+    "Minkowski difference) and EPA's own bookkeeping (nearest triangle, seen triangles, new "
+    "faces) about 3/10; the narrowed search and the region's centre are about a twentieth and a "
+    "tenth. FCL's convex pairs run libccd's MPR, which estimates the depth without certifying the "
+    "least overlap.";
 
 // The profile behind the whole-step goal (perf, 2026-11-28, many_1000 over the bench's first 60
 // steps, with the broad phase's pairs kept from step to step), a measured cause.
