@@ -736,4 +736,20 @@ TEST(CliContacts, DisagreementsAreFlaggedAsCompareFlagsThem) {
   EXPECT_EQ(j["backends"]["ode"]["pairs"][0]["mark"], "");
 }
 
+TEST(CliContacts, ATiedNormalIsNotADisagreement) {
+  // Two concentric cubes, one inside the other: every face axis overlaps by the same depth, so
+  // custom's face (its keys take the smaller sign-free axis, z) is as right as the oracle's (x),
+  // as `rbx explore` and the scene checks count it; the table says so instead of flagging it.
+  const CmdResult r =
+      rbx("contacts scenes/external/mujoco_concentric_and_contained_boxes_1.toml --backends "
+          "exact,custom --json -");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const nlohmann::json& pair = j["backends"]["custom"]["pairs"][0];
+  EXPECT_NEAR(pair["normal_err_deg"].get<double>(), 90.0, 1e-9);
+  EXPECT_EQ(pair["mark"], "");
+  EXPECT_TRUE(j["disagreements"].empty()) << j["disagreements"];
+  EXPECT_NE(r.err.find("90 (tie)"), std::string::npos) << r.err;
+}
+
 }  // namespace
