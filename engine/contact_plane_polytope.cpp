@@ -14,8 +14,9 @@ namespace rbx::plane_detail {
 
 namespace {
 
-// Limits of the two loops: beyond them the polytope still bounds (every state does), only less
-// tightly, so the caps cost precision of the cone, never correctness.
+// Limits of the two loops. GJK beyond its cap gives up (the search then covers every direction);
+// EPA's cap leaves the polytope as it is, which still bounds (every state does), only less
+// tightly: neither cap costs correctness.
 constexpr int kGjkIterations = 64;
 constexpr int kEpaIterations = 96;
 
