@@ -5,7 +5,9 @@
 // position along n) and the other's is at least that of any one of its points, so a cone whose
 // bound exceeds the least overlap measured cannot hold the answer and is skipped with every face
 // and edge in it. docs/contact_plane.md derives the bound and says why no candidate within the tie
-// margin is ever skipped.
+// margin is ever skipped. When the inner polytope (engine/contact_plane_polytope.cpp) has narrowed
+// the directions to a cone, only the nodes, faces and arcs that meet it are opened, and a narrow
+// cone is enumerated from the vertices that support it, without the trees.
 #include <algorithm>
 #include <cmath>
 #include <vector>
