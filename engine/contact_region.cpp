@@ -53,13 +53,15 @@ bool lex_less(const Vec2& p, const Vec2& q) {
   return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y());
 }
 
-// The convex hull of points on the plane, counter-clockwise (Andrew's monotone chain): one point,
-// two (a segment) or a polygon without collinear corners.
-std::vector<Vec2> hull2(std::vector<Vec2> p) {
+// The convex hull of points on the plane, in place, counter-clockwise (Andrew's monotone chain):
+// one point, two (a segment) or a polygon without collinear corners. The lists of this file are
+// reused buffers (one query allocates nothing once they have grown).
+void hull2(std::vector<Vec2>& p) {
   std::sort(p.begin(), p.end(), lex_less);
   p.erase(std::unique(p.begin(), p.end()), p.end());
-  if (p.size() < 3) return p;
-  std::vector<Vec2> h(2 * p.size());
+  if (p.size() < 3) return;
+  thread_local std::vector<Vec2> h;
+  h.resize(2 * p.size());
   std::size_t k = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     while (k >= 2 && cross2(h[k - 1] - h[k - 2], p[i] - h[k - 2]) <= 0) --k;
@@ -69,14 +71,14 @@ std::vector<Vec2> hull2(std::vector<Vec2> p) {
     while (k >= t && cross2(h[k - 1] - h[k - 2], p[i] - h[k - 2]) <= 0) --k;
     h[k++] = p[i];
   }
-  h.resize(k - 1);
-  return h;
+  p.assign(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(k - 1));
 }
 
 // Sutherland-Hodgman on one half-plane: the part of `poly` (a polygon, a segment or a point)
-// where f(x) = w . x - c <= tol, for |w| = 1 (so that f is a distance).
-std::vector<Vec2> clip_half(const std::vector<Vec2>& poly, const Vec2& w, double c, double tol) {
-  std::vector<Vec2> out;
+// where f(x) = w . x - c <= tol, for |w| = 1 (so that f is a distance), into `out`.
+void clip_half(const std::vector<Vec2>& poly, const Vec2& w, double c, double tol,
+               std::vector<Vec2>& out) {
+  out.clear();
   for (std::size_t j = 0; j < poly.size(); ++j) {
     const Vec2 &x = poly[j], &y = poly[(j + 1) % poly.size()];
     const double fx = w.dot(x) - c, fy = w.dot(y) - c;
@@ -84,18 +86,19 @@ std::vector<Vec2> clip_half(const std::vector<Vec2>& poly, const Vec2& w, double
     if (poly.size() > 1 && ((fx <= tol) != (fy <= tol)))
       out.push_back(x + (y - x) * (fx / (fx - fy)));
   }
-  return out;
 }
 
-// The part of `poly` inside every edge of the counter-clockwise convex polygon `clip`.
-std::vector<Vec2> clip_by(std::vector<Vec2> poly, const std::vector<Vec2>& clip, double tol) {
+// `poly` cut, in place, to its part inside every edge of the counter-clockwise convex polygon
+// `clip`.
+void clip_by(std::vector<Vec2>& poly, const std::vector<Vec2>& clip, double tol) {
+  thread_local std::vector<Vec2> cut;
   for (std::size_t i = 0; i < clip.size() && !poly.empty(); ++i) {
     const Vec2 e = clip[(i + 1) % clip.size()] - clip[i];
     // The edge's outward normal (the polygon lies to the left of each edge).
     const Vec2 w = Vec2(e.y(), -e.x()).normalized();
-    poly = clip_half(poly, w, w.dot(clip[i]), tol);
+    clip_half(poly, w, w.dot(clip[i]), tol, cut);
+    poly.swap(cut);
   }
-  return poly;
 }
 
 // The midpoint of the closest points of two segments (or points) on the plane; for parallel
@@ -159,13 +162,14 @@ struct Projected {
   int vertices = 0;
 };
 
-Projected project(const std::vector<Vec3>& feature, const Vec3& t1, const Vec3& t2,
-                  const Vec3& axis) {
-  Projected out;
-  std::vector<Vec2> p;
-  std::vector<double> h;
+void project(const std::vector<Vec3>& feature, const Vec3& t1, const Vec3& t2, const Vec3& axis,
+             Projected& out) {
+  out.hull.clear();
+  out.height = 0.0;
+  thread_local std::vector<double> h;
+  h.clear();
   for (const Vec3& x : feature) {
-    p.emplace_back(x.dot(t1), x.dot(t2));
+    out.hull.emplace_back(x.dot(t1), x.dot(t2));
     h.push_back(x.dot(axis));
   }
   // The heights summed in a fixed order (sorted), so that the mean does not depend on the order
@@ -174,8 +178,7 @@ Projected project(const std::vector<Vec3>& feature, const Vec3& t1, const Vec3& 
   for (const double z : h) out.height += z;
   out.height /= static_cast<double>(h.size());
   out.vertices = static_cast<int>(feature.size());
-  out.hull = hull2(std::move(p));
-  return out;
+  hull2(out.hull);
 }
 
 // A geometric order of the two features (never the argument slot): the one with more hull
@@ -213,13 +216,17 @@ Vec3 edge_pair_centre(const plane_detail::Side& sa, const plane_detail::Side& sb
   const Vec3 axis = plane_detail::canonical(n);
   Vec3 t1, t2;
   plane_frame(axis, t1, t2);
-  const Projected pa = project(fa, t1, t2, axis), pb = project(fb, t1, t2, axis);
+  thread_local Projected pa, pb;
+  project(fa, t1, t2, axis, pa);
+  project(fb, t1, t2, axis, pb);
   const Projected& ref = before(pa, pb) ? pa : pb;
   const Projected& inc = &ref == &pa ? pb : pa;
   Vec2 centre;
   if (ref.hull.size() >= 3) {
     // Parallel faces within round-off of the axis: their overlap.
-    const std::vector<Vec2> region = clip_by(inc.hull, ref.hull, eps);
+    thread_local std::vector<Vec2> region;
+    region = inc.hull;
+    clip_by(region, ref.hull, eps);
     centre = centroid2(region.empty() ? inc.hull : region, eps);
   } else {
     centre = segments_meet(ref.hull, inc.hull);
@@ -314,14 +321,18 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   const double up = axis == m ? 1.0 : -1.0;
   Vec3 t1, t2;
   plane_frame(axis, t1, t2);
-  Projected ref = project(ref_pts, t1, t2, axis), inc = project(inc_pts, t1, t2, axis);
+  thread_local Projected ref, inc;
+  project(ref_pts, t1, t2, axis, ref);
+  project(inc_pts, t1, t2, axis, inc);
   // Parallel faces (the incident one within round-off of against m): the plane's keys may have
   // taken either as the reference, so the two are ordered by the geometry instead.
   if (1.0 + inc_n.dot(m) <= 1e-12) {
     const bool ref_first = !before(inc, ref);
     const Projected& x = ref_first ? ref : inc;
     const Projected& y = ref_first ? inc : ref;
-    const std::vector<Vec2> region = clip_by(y.hull, x.hull, eps);
+    thread_local std::vector<Vec2> region;
+    region = y.hull;
+    clip_by(region, x.hull, eps);
     const Vec2 c = centroid2(region.empty() ? y.hull : region, eps);
     return c.x() * t1 + c.y() * t2 + (0.5 * (x.height + y.height)) * axis;
   }
@@ -336,15 +347,18 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   // below the reference plane (the manifold's points, as Box2D keeps them); none left: the
   // deepest vertex. The centre is their centroid, midway between the incident surface and the
   // reference plane.
-  thread_local std::vector<Vec2> kept;
+  thread_local std::vector<Vec2> region, kept;
+  region = inc.hull;
+  clip_by(region, ref.hull, eps);
   kept.clear();
-  for (const Vec2& p : clip_by(inc.hull, ref.hull, eps))
+  for (const Vec2& p : region)
     if (inc_height(p) - ref.height <= eps) kept.push_back(p);
   if (kept.empty()) {
     const Vec3 x = is.world(inc_face.deep);
     kept.emplace_back(x.dot(t1), x.dot(t2));
   }
-  const Vec2 c = centroid2(hull2(kept), eps);
+  hull2(kept);
+  const Vec2 c = centroid2(kept, eps);
   return c.x() * t1 + c.y() * t2 + (0.5 * (inc_height(c) + ref.height)) * m;
 }
 
