@@ -227,10 +227,14 @@ void Query::local_search() {
     const double slack = 1e-12 * (1.0 + g.radius);
     auto reaches = [&](int w) {
       const Vec3 x = v[w] - v[start];
-      const double along = x.dot(u), across = x.cross(u).norm();
-      // The furthest x . u' over the cone's directions u'.
-      const double best = along * within.cos_angle + across * within.sin_angle;
-      return std::max(best, along >= x.norm() * within.cos_angle ? x.norm() : best) >= -slack;
+      // The furthest x . u' over the cone's directions u' is at least x . u (u is in the cone);
+      // below that, it is along * cos + across * sin at the cone's edge nearest x (the cone is
+      // narrow: x cannot lie inside it). Compared squared: no roots.
+      const double along = x.dot(u);
+      if (along >= -slack) return true;
+      const double need = -slack - along * within.cos_angle;
+      return need <= 0.0 ||
+             x.cross(u).squaredNorm() * (within.sin_angle * within.sin_angle) >= need * need;
     };
     found.assign(1, start);
     for (std::size_t k = 0; k < found.size(); ++k)
