@@ -471,6 +471,9 @@ CaseSet step_cases(const BenchPlan& plan, std::mt19937_64&) {
           if (!err.empty()) c->status = "error: " + err;
         };
         bc.min_time_s = plan.step_min_time;
+        // The whole-step rows carry a goal: on a full run, the fastest of several runs, as for
+        // the goal's narrow-phase cases (one run alone takes whatever load the machine has then).
+        bc.repetitions = plan.quick ? 1 : kBenchRepetitions;
         set.cases.push_back(bc);
       }
     }

@@ -275,9 +275,9 @@ std::string goals_markdown(const BenchPlan& plan, const BenchResults& results,
      << (plan.quick ? "quick run (fewer sizes and poses, short times). " : "full run. ")
      << "Google Benchmark: every case runs one untimed warm-up pass, then is timed for at least "
      << plan.min_time << " s (narrow phase), " << plan.crowd_min_time << " s (broad phase), "
-     << plan.step_min_time
-     << " s (whole step); the broad phase, the narrow-phase cases of up to "
-        "128 vertices and those behind the goals run "
+     << plan.step_min_time << " s (whole step); the broad phase, "
+     << (plan.quick ? "" : "the whole steps, ")
+     << "the narrow-phase cases of up to 128 vertices and those behind the goals run "
      << kBenchRepetitions
      << " times and keep the fastest (the machine is shared). Wall time of the timing: "
      << bench_num(timing_s, 3) << " s.\n\n";
