@@ -73,17 +73,37 @@ std::optional<ContactPlane> choose(const ConvexPolyhedron& a, const Pose& pa,
   if (proof_only && !found.proved) return std::nullopt;
 
   // Among the candidates within the tie margin of the least overlap: faces first, then the
-  // smaller sign-free axis, then the smaller overlap. Every key is the geometry's, not the slot's.
+  // smaller sign-free axis, then the smaller overlap. Every key so far is the geometry's, not the
+  // slot's. One tie is left: the two senses of one axis with the same overlap (shapes level with
+  // each other along it). No key of the geometry alone can reverse with the body order there (the
+  // swapped pose is the same pose turned), so the next key is the bodies': the normal from B
+  // toward A goes the way A's position lies from B's, or, level, points along the axis when A's
+  // pose is the lexicographically greater (position, then orientation). Last, a face of A and a
+  // face of B on one plane give the same contact: the lower PlaneAxis names it, whatever order
+  // the method kept them in.
+  const Vec3 apart = pa.position - pb.position;
+  const bool a_greater = pa.position != pb.position
+                             ? lex_less(pb.position, pa.position)
+                             : std::lexicographical_compare(pb.orientation.coeffs().data(),
+                                                            pb.orientation.coeffs().data() + 4,
+                                                            pa.orientation.coeffs().data(),
+                                                            pa.orientation.coeffs().data() + 4);
+  auto toward_a = [&](const Candidate& c) {
+    const double along = c.normal.dot(apart);
+    return along != 0 ? along > 0 : (c.normal == c.axis) == a_greater;
+  };
+  auto before = [&](const Candidate& c, const Candidate& p) {
+    if (c.kind != p.kind) return c.kind < p.kind;
+    if (c.axis != p.axis) return lex_less(c.axis, p.axis);
+    if (c.overlap != p.overlap) return c.overlap < p.overlap;
+    if (toward_a(c) != toward_a(p)) return toward_a(c);
+    return c.source < p.source;
+  };
   double best = plane_detail::kInf;
   for (const Candidate& c : found.kept) best = std::min(best, c.overlap);
   const Candidate* pick = nullptr;
-  for (const Candidate& c : found.kept) {
-    if (c.overlap > best + found.tie) continue;
-    if (!pick || c.kind < pick->kind ||
-        (c.kind == pick->kind &&
-         (lex_less(c.axis, pick->axis) || (c.axis == pick->axis && c.overlap < pick->overlap))))
-      pick = &c;
-  }
+  for (const Candidate& c : found.kept)
+    if (c.overlap <= best + found.tie && (!pick || before(c, *pick))) pick = &c;
   ContactPlane out;
   // No candidate kept: cannot happen (the least overlap is a candidate that no bound skips); the
   // search's upper bound keeps the answer finite should round-off prove otherwise.

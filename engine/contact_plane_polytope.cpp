@@ -107,27 +107,53 @@ bool tetrahedron_step(std::array<Point, 4>& s, int& n, Vec3& d) {
   return true;
 }
 
-// GJK: a tetrahedron of D's support points holding the origin, or false (apart, touching, or
-// degenerate).
-bool enclose(const Side& a, const Side& b, std::array<Point, 4>& s) {
-  Vec3 d = b.p - a.p;
-  if (!(d.squaredNorm() > 0)) d = Vec3::UnitX();
+// What GJK found: a tetrahedron holding the origin; a direction along which D reaches no further
+// than the origin (apart or touching); or neither (the origin on a segment of the simplex, no
+// progress, or the cap: a degenerate path, which another start direction may avoid).
+enum class Gjk { kEnclosed, kApart, kDegenerate };
+
+// GJK from direction d.
+Gjk enclose_from(const Side& a, const Side& b, Vec3 d, std::array<Point, 4>& s) {
   s[0] = support(a, b, d, Point{});
   int n = 1;
   d = -s[0].w;
   for (int it = 0; it < kGjkIterations; ++it) {
-    if (!(d.squaredNorm() > 0)) return false;  // the origin on the simplex: touching
+    // The origin on the simplex. On its first point, D's support along the start direction is
+    // zero: touching. On a segment, the origin lies in D, inside or on its boundary: any
+    // direction across the segment goes on (the tetrahedron then holds the origin on an edge,
+    // two flat triangles that EPA grows past, or finds D's boundary there).
+    if (!(d.squaredNorm() > 0)) {
+      if (n != 2) return n == 1 ? Gjk::kApart : Gjk::kDegenerate;
+      d = (s[1].w - s[0].w).unitOrthogonal();
+    }
     const Point w = support(a, b, d, s[n - 1]);
-    if (!(w.w.dot(d) > 0)) return false;  // no point of D beyond the origin along d
+    if (!(w.w.dot(d) > 0)) return Gjk::kApart;  // no point of D beyond the origin along d
     for (int k = 0; k < n; ++k)
-      if (s[k].ia == w.ia && s[k].ib == w.ib) return false;  // no progress: degenerate
+      if (s[k].ia == w.ia && s[k].ib == w.ib) return Gjk::kDegenerate;  // no progress
     s[n++] = w;
     if (n == 2)
       segment_step(s, n, d);
     else if (n == 3)
       triangle_step(s, n, d);
     else if (tetrahedron_step(s, n, d))
-      return true;
+      return Gjk::kEnclosed;
+  }
+  return Gjk::kDegenerate;
+}
+
+// GJK: a tetrahedron of D's support points holding the origin, or false (apart, touching, or
+// degenerate from every start). It starts along the line between the centres; poses of round
+// coordinates (stacked boxes, centred) can put the origin exactly on a segment of the simplex
+// from there, so a degenerate path is retried from a few directions aligned with no axis.
+bool enclose(const Side& a, const Side& b, std::array<Point, 4>& s) {
+  Vec3 d = b.p - a.p;
+  if (!(d.squaredNorm() > 0)) d = Vec3::UnitX();
+  const Gjk first = enclose_from(a, b, d, s);
+  if (first != Gjk::kDegenerate) return first == Gjk::kEnclosed;
+  for (const Vec3& retry :
+       {Vec3(0.31, 0.52, 0.79), Vec3(-0.67, 0.23, 0.71), Vec3(0.43, -0.86, 0.29)}) {
+    const Gjk again = enclose_from(a, b, retry, s);
+    if (again != Gjk::kDegenerate) return again == Gjk::kEnclosed;
   }
   return false;
 }
@@ -138,8 +164,9 @@ struct Polytope {
   std::vector<Face> faces;
   std::vector<std::array<int, 2>> horizon;
 
-  // A triangle of points i, j, k (wound outward); false when the origin is not strictly inside
-  // its plane, which the bound needs.
+  // A triangle of points i, j, k (wound outward); false when the origin lies beyond its plane by
+  // more than round-off. A flat triangle (the origin on its plane, to round-off: GJK's simplex on
+  // symmetric poses) is kept, and grown past before any bound is drawn from the polytope.
   bool add(int i, int j, int k, double tie) {
     Face f;
     f.v = {i, j, k};
@@ -149,7 +176,7 @@ struct Polytope {
     if (!(len > 0)) return false;
     f.n = m / len;
     f.dist = f.n.dot(p);
-    if (!(f.dist > tie)) return false;
+    if (!(f.dist > -tie)) return false;
     faces.push_back(f);
     return true;
   }
@@ -160,7 +187,11 @@ struct Polytope {
     const std::size_t count = faces.size();
     for (std::size_t g = 0; g < count; ++g) {
       Face& f = faces[g];
-      if (!f.live || !(f.n.dot(w) - f.dist > 0)) continue;
+      // Seen only from beyond the tie margin: w on the plane of coplanar triangles (points of D on
+      // one face of it) would be seen from some and not others by round-off, and the fan over
+      // their edge would fold inward. The nearest triangle is always seen (the loop grows it only
+      // when w is beyond it by more than the margin).
+      if (!f.live || !(f.n.dot(w) - f.dist > tie)) continue;
       f.live = false;
       // Each directed edge of a seen triangle, unless its reverse is one too (then interior).
       for (int e = 0; e < 3; ++e) {
@@ -226,8 +257,12 @@ bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& 
       upper_dir = n;
       upper_at = w;
     }
-    // Converged: the triangle lies on D's face (to round-off).
-    if (h - lower <= tie) break;
+    // Converged: the triangle lies on D's face (to round-off). On a flat triangle the origin is
+    // then on D's boundary: contact, not overlap, so no proof.
+    if (h - lower <= tie) {
+      if (!(lower > tie)) return false;
+      break;
+    }
     poly.points.push_back(w);
     if (!poly.expand(static_cast<int>(poly.points.size()) - 1, tie)) return false;
   }
@@ -239,9 +274,18 @@ bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& 
   // One circular cone holds all of those.
   const double limit = upper + 8.0 * tie;
   Vec3 axis = Vec3::Zero();
-  for (const Face& f : poly.faces)
-    if (f.live && f.dist <= limit) axis += f.n;
-  if (!(axis.squaredNorm() > 0)) return false;
+  for (const Face& f : poly.faces) {
+    if (!f.live || f.dist > limit) continue;
+    if (!(f.dist > tie)) return false;  // still flat at the cap: no proof
+    axis += f.n;
+  }
+  if (upper < out.known) {
+    out.known = upper;
+    out.known_normal = -upper_dir;  // D's direction u pushes A along -u
+  }
+  // Opposite triangles both at the least distance (a pose symmetric through the origin): no
+  // cone narrows the search, but the overlap is proved.
+  if (!(axis.squaredNorm() > 0)) return true;
   axis.normalize();
   double angle = 0.0;
   for (const Face& f : poly.faces)
@@ -250,10 +294,6 @@ bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& 
                                   std::acos(std::clamp(f.dist / limit, -1.0, 1.0)));
   // Round-off of the angles themselves (acos near 1 loses half the digits: ~1e-8 rad).
   const double cos_angle = std::cos(angle + 1e-7);
-  if (upper < out.known) {
-    out.known = upper;
-    out.known_normal = -upper_dir;  // D's direction u pushes A along -u
-  }
   // A cone of half a sphere or more narrows nothing worth the tests.
   if (!(cos_angle > 0.0)) return true;
   out.within.axis = axis;

@@ -329,5 +329,78 @@ TEST(ContactPlane, TheInnerPolytopeBoundsOverlappingShapesOnly) {
   EXPECT_EQ(narrowed, 100);
 }
 
+TEST(ContactPlane, TheInnerPolytopeProvesOverlapOnPosesOfRoundCoordinates) {
+  // Stacked axis-aligned boxes at offsets of round decimals, as scenes place them: GJK's
+  // tetrahedron then often has the origin exactly on a face plane, which the polytope must grow
+  // past rather than give up. Closed form: the overlap along z is the depth, the normal is +-z.
+  const ConvexPolyhedron b = make_box(Vec3(1.0, 1.0, 1.0));
+  int proved = 0, cases = 0;
+  for (const Vec3& size : {Vec3(1.0, 1.0, 1.0), Vec3(0.5, 0.8, 0.6), Vec3(2.0, 2.0, 0.3)}) {
+    const ConvexPolyhedron a = make_box(size);
+    for (int i = -3; i <= 3; ++i)
+      for (int j = -3; j <= 3; ++j)
+        for (const double depth : {0.05, 0.1})
+          for (const double up : {1.0, -1.0}) {
+            const double z = up * (0.5 * (size.z() + 1.0) - depth);
+            const Pose pa{Vec3(0.1 * i, 0.1 * j, z), Quat::Identity()}, pb{};
+            ++cases;
+            plane_detail::Side sa, sb;
+            sa.set(a, pa);
+            sb.set(b, pb);
+            plane_detail::Candidates out;
+            if (plane_detail::inner_polytope_bound(sa, sb, 1e-12 * 4.0, out)) ++proved;
+            for (const bool swap : {false, true}) {
+              const auto p =
+                  swap ? choose_overlap_plane(b, pb, a, pa) : choose_overlap_plane(a, pa, b, pb);
+              ASSERT_TRUE(p) << "offset " << i << " " << j << " depth " << depth;
+              // Round-off of coordinates of order 1 m.
+              EXPECT_NEAR(p->depth, depth, 1e-12);
+              EXPECT_NEAR(std::abs(p->normal.z()), 1.0, 1e-12);
+            }
+          }
+  }
+  EXPECT_EQ(proved, cases);
+}
+
+TEST(ContactPlane, LevelAndStackedPosesAreProvedAndReversedInEitherOrder) {
+  // Poses as scenes write them: shapes turned about z by multiples of 15 degrees, placed at
+  // decimal offsets, many level with each other (equal overlap along +z and -z) or centred on
+  // each other. Every pair that overlaps by more than round-off must be proved to overlap in
+  // both body orders (not left to the seed's detector) and give the normal reversed: where the
+  // two senses of an axis tie, the bodies' positions decide. Identical poses are skipped (there
+  // the two orders are the same query).
+  const std::vector<ConvexPolyhedron> all = {make_box(Vec3(1.0, 0.6, 0.3)), make_box(Vec3::Ones()),
+                                             make_prism(0.5, 0.8, 6), make_icosphere(0.6, 1)};
+  int overlapping = 0, level = 0;
+  for (const ConvexPolyhedron& a : all)
+    for (const ConvexPolyhedron& b : all)
+      for (int turn = 0; turn < 4; ++turn)
+        for (int i = -4; i <= 4; ++i)
+          for (int j = -4; j <= 4; j += 2)
+            for (int k = 0; k < 6; ++k) {
+              const Vec3 at =
+                  k < 4 ? Vec3(0.1 * i, 0.1 * j, 0.2 * k) : Vec3(0.2 * (k - 3), 0.1 * i, 0.05 * j);
+              const Pose pa{at, Quat(Eigen::AngleAxisd(turn * M_PI / 12, Vec3::UnitZ()))};
+              const Pose pb{};
+              if (turn == 0 && at == Vec3::Zero()) continue;
+              const ContactPlane whole =
+                  choose_contact_plane(a, pa, b, pb, PlaneMethod::WholeSearch);
+              if (!(whole.depth > 1e-9)) continue;
+              ++overlapping;
+              if (at.z() == 0) ++level;
+              const auto ab = choose_overlap_plane(a, pa, b, pb);
+              const auto ba = choose_overlap_plane(b, pb, a, pa);
+              ASSERT_TRUE(ab && ba) << "turn " << turn << " at " << at.transpose();
+              // Round-off: the two orders climb from different vertices (as in
+              // EitherBodyOrderGivesTheSameContactReversed).
+              EXPECT_NEAR((ab->normal + ba->normal).norm(), 0.0, 1e-9)
+                  << "turn " << turn << " at " << at.transpose();
+              EXPECT_NEAR(ab->depth, whole.depth, 1e-12);
+              EXPECT_NEAR(ba->depth, whole.depth, 1e-12);
+            }
+  EXPECT_GT(overlapping, 10000);
+  EXPECT_GT(level, 2000);
+}
+
 }  // namespace
 }  // namespace rbx
