@@ -72,10 +72,12 @@ struct Side {
     p = pose.position;
   }
   /// The support h(d) = max over the shape of x . d along a world direction, climbing from `at`
-  /// (left on a vertex that reaches it).
+  /// or from the cube map's start vertex for d, whichever is further along d (left in `at`: a
+  /// vertex that reaches it).
   double support(const Vec3& d, int& at) const {
+    const Vec3 local = rt * d;
     double h = 0.0;
-    at = map->climb(shape->vertices(), rt * d, at, h);
+    at = map->climb(shape->vertices(), local, map->better_start(shape->vertices(), local, at), h);
     return h + p.dot(d);
   }
   /// Vertex v in the world.

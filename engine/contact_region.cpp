@@ -20,7 +20,7 @@ using Vec2 = Eigen::Vector2d;
 constexpr double kTieCosine = 1e-10;
 
 // The vertices of a placed shape within `eps` of its furthest along d (world), by index, in the
-// order found: the climb's vertex (from `start`, or the map's start vertex when negative), then
+// order found: the climb's vertex (from `start` or the map's start vertex for d, the higher), then
 // every vertex reached over edges without dropping below that height (the vertices above a plane
 // of a convex polyhedron are connected by its edges).
 void extreme_indices(const plane_detail::Side& s, const Vec3& d, double eps,
@@ -29,7 +29,7 @@ void extreme_indices(const plane_detail::Side& s, const Vec3& d, double eps,
   const GaussMap& g = *s.map;
   const std::vector<Vec3>& v = s.shape->vertices();
   double h = 0.0;  // in the body frame
-  found.assign(1, g.climb(v, local, start, h));
+  found.assign(1, g.climb(v, local, g.better_start(v, local, start), h));
   for (std::size_t k = 0; k < found.size(); ++k)
     for (int e = g.neighbor_start[found[k]]; e < g.neighbor_start[found[k] + 1]; ++e) {
       const int o = g.neighbors[e];

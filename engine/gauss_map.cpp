@@ -142,29 +142,27 @@ GaussMap GaussMap::build(const ConvexPolyhedron& s) {
   for (int t = 0; t < static_cast<int>(tris.size()); ++t)
     for (const int v : tris[t]) g.vertex_triangles[fill[v]++] = t;
   for (const Vec3& v : s.vertices()) g.radius = std::max(g.radius, v.norm());
-  // The 26 start directions, each vertex found by a scan (once per shape).
-  for (int x = -1; x <= 1; ++x)
-    for (int y = -1; y <= 1; ++y)
-      for (int z = -1; z <= 1; ++z) {
-        if (x == 0 && y == 0 && z == 0) continue;
-        const Vec3 d = Vec3(x, y, z).normalized();
-        g.start_directions.push_back(d);
-        g.start_vertices.push_back(s.support_index(d));
+  // The cube map of start vertices, each cell's found by a climb from the cell before it (once
+  // per shape). Its size is capped: past a few thousand vertices a climb from a nearby cell is
+  // short anyway.
+  constexpr int kMaxCells = 64;
+  g.cells = std::clamp(static_cast<int>(std::ceil(std::sqrt(0.5 * nv))), 1, kMaxCells);
+  g.cell_vertices.reserve(6 * g.cells * g.cells);
+  int at = s.support_index(Vec3::UnitX());
+  for (int face = 0; face < 6; ++face) {
+    const int i = face / 2, j = i == 2 ? 0 : i + 1, k = j == 2 ? 0 : j + 1;
+    for (int u = 0; u < g.cells; ++u)
+      for (int w = 0; w < g.cells; ++w) {
+        Vec3 d = Vec3::Zero();
+        d[i] = face % 2 ? -1.0 : 1.0;
+        d[j] = (u + 0.5) * 2.0 / g.cells - 1.0;
+        d[k] = (w + 0.5) * 2.0 / g.cells - 1.0;
+        double h = 0.0;
+        at = g.climb(s.vertices(), d, at, h);
+        g.cell_vertices.push_back(at);
       }
-  return g;
-}
-
-int GaussMap::start_for(const Vec3& d) const {
-  int at = 0;
-  double along = -2.0;
-  for (std::size_t k = 0; k < start_directions.size(); ++k) {
-    const double c = start_directions[k].dot(d);
-    if (c > along) {
-      along = c;
-      at = start_vertices[k];
-    }
   }
-  return at;
+  return g;
 }
 
 int GaussMap::climb(const std::vector<Vec3>& vertices, const Vec3& d, int start,

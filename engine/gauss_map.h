@@ -5,6 +5,7 @@
 // Built once with the shape (which is immutable), for every shape.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "engine/bvh.h"
@@ -59,17 +60,32 @@ struct GaussMap {
   /// face's diagonal (no arc).
   std::vector<int> neighbor_arcs;
   double radius = 0.0;  // m, the largest distance of a vertex from the body origin
-  /// Start vertices for a climb with no vertex near its direction: the support vertex along each
-  /// of 26 directions (the faces, edges and corners of a cube), so that no climb starts more
-  /// than about 35 degrees from its answer.
-  std::vector<Vec3> start_directions;
-  std::vector<int> start_vertices;
+  /// Start vertices for a climb: a cube map of directions (six faces of `cells` x `cells` cells,
+  /// about one cell per two vertices), each cell holding the support vertex along its centre, so
+  /// that a climb from the cell of its direction starts at or next to its answer.
+  int cells = 0;
+  std::vector<int> cell_vertices;
 
   /// Builds the Gauss map of `shape` (its vertices, triangles, edges and planes must be set).
   static GaussMap build(const ConvexPolyhedron& shape);
 
-  /// The start vertex of the start direction nearest d (body frame).
-  int start_for(const Vec3& d) const;
+  /// The start vertex of the cube map's cell that holds direction d (body frame, any length).
+  int start_for(const Vec3& d) const {
+    const Vec3 m = d.cwiseAbs();
+    const int i = m.x() >= m.y() ? (m.x() >= m.z() ? 0 : 2) : (m.y() >= m.z() ? 1 : 2);
+    if (!(m[i] > 0)) return cell_vertices[0];  // zero or NaN: any vertex will do
+    const int j = i == 2 ? 0 : i + 1, k = j == 2 ? 0 : j + 1;
+    const double scale = 0.5 * cells / m[i], mid = 0.5 * cells;
+    const int u = std::clamp(static_cast<int>(d[j] * scale + mid), 0, cells - 1);
+    const int w = std::clamp(static_cast<int>(d[k] * scale + mid), 0, cells - 1);
+    return cell_vertices[((2 * i + (d[i] < 0 ? 1 : 0)) * cells + u) * cells + w];
+  }
+  /// Of `start` (-1: none) and the cube map's start vertex for d (body frame), the one further
+  /// along d: the better place to begin a climb over `vertices` (the shape's, body frame).
+  int better_start(const std::vector<Vec3>& vertices, const Vec3& d, int start) const {
+    const int cell = start_for(d);
+    return start < 0 || vertices[cell].dot(d) > vertices[start].dot(d) ? cell : start;
+  }
   /// The vertex of `vertices` furthest along d (body frame), climbing the vertex graph from
   /// `start` (a vertex with no higher neighbour is highest on a convex polyhedron), or from the
   /// start vertex of the nearest start direction when `start` is negative; its projection goes

@@ -6,8 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
+
+#include "engine/gauss_map.h"
 
 namespace rbx {
 namespace {
@@ -160,6 +163,41 @@ TEST(PolyhedronBuilders, TranslatedMovesVerticesPlanesAndBounds) {
 TEST(PolyhedronBuilders, SupportIndexIsTheFurthestVertex) {
   // Corner (+,+,-) of the box is index 1 + 2 = 3; direction (1, 1, -1) picks it.
   EXPECT_EQ(make_box(Vec3(1, 1, 1)).support_index(Vec3(1, 1, -1)), 3);
+}
+
+TEST(PolyhedronBuilders, ClimbsFromTheCubeMapReachTheFurthestVertex) {
+  // On a convex polyhedron a vertex with no higher neighbour is highest, so a climb from any
+  // start reaches the furthest projection: from the cube map's cell of the direction, and from
+  // the better of that and an arbitrary vertex. Directions at random, along the cube's axes and
+  // diagonals (cell boundaries), and a zero or NaN direction (any valid start).
+  std::mt19937 rng(3);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<Vec3> directions;
+  for (int k = 0; k < 2000; ++k) directions.push_back(Vec3(g(rng), g(rng), g(rng)));
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z) directions.push_back(Vec3(x, y, z));
+  for (const ConvexPolyhedron& s : {make_box(Vec3(1.0, 0.6, 0.3)), make_prism(0.4, 1.2, 24),
+                                    make_icosphere(0.5, 1), make_icosphere(0.5, 4)}) {
+    const GaussMap& map = s.gauss_map();
+    const int nv = static_cast<int>(s.vertices().size());
+    ASSERT_EQ(map.cell_vertices.size(), static_cast<std::size_t>(6 * map.cells * map.cells));
+    for (const Vec3& d : directions) {
+      const int cell = map.start_for(d);
+      ASSERT_TRUE(cell >= 0 && cell < nv);
+      if (d == Vec3::Zero()) continue;
+      double furthest = -1e300;
+      for (const Vec3& v : s.vertices()) furthest = std::max(furthest, v.dot(d));
+      double h = 0.0;
+      map.climb(s.vertices(), d, -1, h);
+      EXPECT_EQ(h, furthest);
+      const int start = std::uniform_int_distribution<int>(0, nv - 1)(rng);
+      map.climb(s.vertices(), d, map.better_start(s.vertices(), d, start), h);
+      EXPECT_EQ(h, furthest);
+    }
+    const int nan_start = map.start_for(Vec3::Constant(std::nan("")));
+    EXPECT_TRUE(nan_start >= 0 && nan_start < nv);
+  }
 }
 
 // ---- Validation -----------------------------------------------------------------------------
