@@ -76,9 +76,14 @@ struct GaussMap {
     if (!(m[i] > 0)) return cell_vertices[0];  // zero or NaN: any vertex will do
     const int j = i == 2 ? 0 : i + 1, k = j == 2 ? 0 : j + 1;
     const double scale = 0.5 * cells / m[i], mid = 0.5 * cells;
-    const int u = std::clamp(static_cast<int>(d[j] * scale + mid), 0, cells - 1);
-    const int w = std::clamp(static_cast<int>(d[k] * scale + mid), 0, cells - 1);
-    return cell_vertices[((2 * i + (d[i] < 0 ? 1 : 0)) * cells + u) * cells + w];
+    // The cell's column: |x| <= m[i] keeps it below `cells`, and a NaN falls in column 0 (never
+    // cast: that is undefined).
+    auto column = [&](double x) {
+      const double c = x * scale + mid;
+      return c >= 1.0 ? std::min(static_cast<int>(c), cells - 1) : 0;
+    };
+    return cell_vertices[((2 * i + (d[i] < 0 ? 1 : 0)) * cells + column(d[j])) * cells +
+                         column(d[k])];
   }
   /// Of `start` (-1: none) and the cube map's start vertex for d (body frame), the one further
   /// along d: the better place to begin a climb over `vertices` (the shape's, body frame).
@@ -88,7 +93,7 @@ struct GaussMap {
   }
   /// The vertex of `vertices` furthest along d (body frame), climbing the vertex graph from
   /// `start` (a vertex with no higher neighbour is highest on a convex polyhedron), or from the
-  /// start vertex of the nearest start direction when `start` is negative; its projection goes
+  /// cube map's start vertex for d when `start` is negative; its projection goes
   /// to `height`. `vertices` may be the shape's body-frame vertices or the same placed in the
   /// world (with d in the same frame; then `start` must not be negative): only the vertex graph
   /// is the map's.

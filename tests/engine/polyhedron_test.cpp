@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -169,7 +170,7 @@ TEST(PolyhedronBuilders, ClimbsFromTheCubeMapReachTheFurthestVertex) {
   // On a convex polyhedron a vertex with no higher neighbour is highest, so a climb from any
   // start reaches the furthest projection: from the cube map's cell of the direction, and from
   // the better of that and an arbitrary vertex. Directions at random, along the cube's axes and
-  // diagonals (cell boundaries), and a zero or NaN direction (any valid start).
+  // diagonals (cell boundaries), and a zero, NaN or infinite direction (any valid start).
   std::mt19937 rng(3);
   std::normal_distribution<double> g(0.0, 1.0);
   std::vector<Vec3> directions;
@@ -195,8 +196,12 @@ TEST(PolyhedronBuilders, ClimbsFromTheCubeMapReachTheFurthestVertex) {
       map.climb(s.vertices(), d, map.better_start(s.vertices(), d, start), h);
       EXPECT_EQ(h, furthest);
     }
-    const int nan_start = map.start_for(Vec3::Constant(std::nan("")));
-    EXPECT_TRUE(nan_start >= 0 && nan_start < nv);
+    const double nan = std::nan("");
+    for (const Vec3& d : {Vec3(nan, nan, nan), Vec3(nan, 1.0, 2.0), Vec3(1.0, nan, 0.0),
+                          Vec3(std::numeric_limits<double>::infinity(), 1.0, 1.0)}) {
+      const int start = map.start_for(d);
+      EXPECT_TRUE(start >= 0 && start < nv);
+    }
   }
 }
 
