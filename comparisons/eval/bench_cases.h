@@ -28,6 +28,10 @@ struct PoseKind {
 inline constexpr PoseKind kPoseKinds[] = {
     {"touching", -0.005}, {"deep", -0.2}, {"separated", 0.05}};
 
+/// Distinct poses per shape and pose kind, queried in turn across iterations: a cycle this long
+/// is not one a branch predictor learns, as it learns a handful of poses repeated.
+constexpr int kBenchPoseCycle = 256;
+
 /// Repetitions of the cheap cases and of those behind the goals (the fastest is kept).
 constexpr int kBenchRepetitions = 3;
 /// Size (m) of every benchmark shape: the unit box and hulls of points on a sphere of radius 0.5.
@@ -41,7 +45,8 @@ inline constexpr BroadPhaseMethod kBenchBroadPhaseMethods[] = {
 struct BenchPlan {
   bool quick = false;
   std::vector<int> hull_sizes;              // vertices of the hulls (the box is always included)
-  int poses = 3;                            // poses per kind
+  int poses = 3;                            // distinct poses per kind, queried in turn
+  int poses_per_iteration = 3;              // consecutive poses of the cycle in one iteration
   double min_time = 0.2;                    // s, minimum timed time per case
   std::vector<int> crowd_sizes;             // bodies in the broad-phase crowds
   double crowd_min_time = 0.2;              // s

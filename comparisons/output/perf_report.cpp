@@ -202,10 +202,13 @@ Json perf_json(const BenchPlan& plan, const BenchResults& results,
                                                                                  h, sizeof h - 1);
                                                                              return std::string(h);
                                                                            }()}};
-  j["settings"] = {
-      {"poses_per_kind", plan.poses},        {"min_time_s", plan.min_time},
-      {"shape_size_m", kBenchShapeSize},     {"touching_offset", kPoseKinds[0].offset},
-      {"deep_offset", kPoseKinds[1].offset}, {"separated_offset", kPoseKinds[2].offset}};
+  j["settings"] = {{"poses_per_kind", plan.poses},
+                   {"poses_per_iteration", plan.poses_per_iteration},
+                   {"min_time_s", plan.min_time},
+                   {"shape_size_m", kBenchShapeSize},
+                   {"touching_offset", kPoseKinds[0].offset},
+                   {"deep_offset", kPoseKinds[1].offset},
+                   {"separated_offset", kPoseKinds[2].offset}};
   j["rows"] = Json::array();
   for (const NarrowRow& r : results.narrow)
     j["rows"].push_back(
@@ -307,8 +310,11 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
         "touching distance along it is found by bisection with libccd, then B is placed "
      << -kPoseKinds[0].offset * 100 << "% of the size deep (*touching*), "
      << -kPoseKinds[1].offset * 100 << "% deep (*deep*) or with a " << kPoseKinds[2].offset * 100
-     << "% gap (*separated*); " << plan.poses
-     << " poses per kind, the time is the mean per query. Times include what each adapter "
+     << "% gap (*separated*); " << plan.poses << " distinct poses per kind, taken in turn, "
+     << plan.poses_per_iteration
+     << " per timed iteration, so that no backend is timed on a few poses its processor's branch "
+        "predictor has learned by heart (docs/bench.md); the time is the mean per query. Times "
+        "include what each adapter "
         "does per call (the references build their library's shape from the hull on every "
         "query, as the adapters are written; `custom` caches its hierarchies per shape "
         "and reuses one detection cache per thread, as the world reuses one per pair; "

@@ -72,6 +72,9 @@ TEST(BenchCases, EveryNarrowBackendHasAQueryAndTheQuickPlanIsPartOfTheFullOne) {
   for (int n : quick.hull_sizes)
     EXPECT_NE(std::find(full.hull_sizes.begin(), full.hull_sizes.end(), n), full.hull_sizes.end());
   EXPECT_LE(quick.poses, full.poses);
+  EXPECT_LE(quick.poses_per_iteration, full.poses_per_iteration);
+  // Both runs query a cycle of distinct poses many iterations long (docs/bench.md).
+  for (const BenchPlan& p : {quick, full}) EXPECT_GE(p.poses, 20 * p.poses_per_iteration);
 }
 
 }  // namespace
