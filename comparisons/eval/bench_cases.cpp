@@ -440,7 +440,6 @@ CaseSet step_cases(const BenchPlan& plan, std::mt19937_64&) {
     long steps = 0;
     SceneRun run;
     std::string status = "ok";
-    std::size_t next = 0;  // the pose the next query takes (modulo the cycle)
   };
   CaseSet set;
   std::vector<std::shared_ptr<State>> states;
