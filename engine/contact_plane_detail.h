@@ -58,7 +58,7 @@ struct Candidates {
 /// Shapes with at most this many vertices take their support by a scan, larger ones by a climb:
 /// the crossover measured on hulls of random points on a sphere, on poses the processor has not
 /// seen (docs/bench.md).
-constexpr std::size_t kScanSupport = 48;
+constexpr std::size_t kScanSupport = 96;
 
 /// One shape of a query: its Gauss map and its pose.
 struct Side {
@@ -82,23 +82,14 @@ struct Side {
   /// (left in `at`: a vertex that reaches it).
   double support(const Vec3& d, int& at) const {
     const Vec3 local = rt * d;
-    const std::vector<Vec3>& v = shape->vertices();
-    if (v.size() <= kScanSupport) {
-      // Selects, not branches: a climb's steps and a branchy scan's both depend on the pose, and
+    double h = 0.0;
+    if (shape->vertices().size() <= kScanSupport) {
+      // No branch on the data: a climb's steps and a branchy scan's both depend on the pose, and
       // on poses the processor has not seen their mispredictions cost more than the scan
       // (docs/bench.md).
-      double best = v[0].dot(local);
-      std::size_t arg = 0;
-      for (std::size_t i = 1; i < v.size(); ++i) {
-        const double h = v[i].dot(local);
-        const bool higher = h > best;
-        best = higher ? h : best;
-        arg = higher ? i : arg;
-      }
-      at = static_cast<int>(arg);
-      return best + p.dot(d);
+      at = map->scan_vertices(local, h);
+      return h + p.dot(d);
     }
-    double h = 0.0;
     at = map->climb(shape->vertices(), local, map->better_start(shape->vertices(), local, at), h);
     return h + p.dot(d);
   }

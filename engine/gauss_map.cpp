@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "engine/polyhedron.h"
 
@@ -142,6 +145,12 @@ GaussMap GaussMap::build(const ConvexPolyhedron& s) {
   for (int t = 0; t < static_cast<int>(tris.size()); ++t)
     for (const int v : tris[t]) g.vertex_triangles[fill[v]++] = t;
   for (const Vec3& v : s.vertices()) g.radius = std::max(g.radius, v.norm());
+  g.lane_vertices = nv;
+  g.lanes.resize(12 * ((nv + 3) / 4));
+  for (int i = 0; i < 4 * ((nv + 3) / 4); ++i) {
+    const Vec3& v = s.vertices()[i < nv ? i : 0];
+    for (int c = 0; c < 3; ++c) g.lanes[12 * (i / 4) + 4 * c + i % 4] = v[c];
+  }
   // The cube map of start vertices, each cell's found by a climb from the cell before it (once
   // per shape). Its size is capped: past a few thousand vertices a climb from a nearby cell is
   // short anyway.
@@ -185,6 +194,70 @@ int GaussMap::climb(const std::vector<Vec3>& vertices, const Vec3& d, int start,
   }
   height = best;
   return at;
+}
+
+int GaussMap::scan_vertices(const Vec3& d, double& height) const {
+  // Each lane keeps its own first highest vertex; the lanes are then merged by height, the
+  // lower index on a tie, which is the first highest of all. Every projection is summed as
+  // Vec3::dot sums it, (x dx + y dy) + z dz, so the values are the loop's to the bit. A padded
+  // copy of vertex 0 ties with vertex 0 and loses on the index.
+  const double* p = lanes.data();
+  const int blocks = (lane_vertices + 3) / 4;
+#if defined(__SSE2__)
+  const __m128d dx = _mm_set1_pd(d.x()), dy = _mm_set1_pd(d.y()), dz = _mm_set1_pd(d.z());
+  auto project = [&](const double* q) {
+    return _mm_add_pd(
+        _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(q), dx), _mm_mul_pd(_mm_loadu_pd(q + 4), dy)),
+        _mm_mul_pd(_mm_loadu_pd(q + 8), dz));
+  };
+  __m128d high[2] = {project(p), project(p + 2)};
+  __m128d index[2] = {_mm_set_pd(1, 0), _mm_set_pd(3, 2)};
+  __m128d at[2] = {index[0], index[1]};
+  const __m128d step = _mm_set1_pd(4);
+  for (int b = 1; b < blocks; ++b)
+    for (int j = 0; j < 2; ++j) {
+      at[j] = _mm_add_pd(at[j], step);
+      const __m128d h = project(p + 12 * b + 2 * j);
+      // Strictly higher: the lane keeps its first highest (and a NaN never replaces).
+      const __m128d higher = _mm_cmpgt_pd(h, high[j]);
+      high[j] = _mm_max_pd(h, high[j]);
+      index[j] = _mm_or_pd(_mm_and_pd(higher, at[j]), _mm_andnot_pd(higher, index[j]));
+    }
+  // The merge in the same registers (the compiler branches on a scalar one).
+  auto merge = [](__m128d& h, __m128d& i, const __m128d& h2, const __m128d& i2) {
+    const __m128d take =
+        _mm_or_pd(_mm_cmpgt_pd(h2, h), _mm_and_pd(_mm_cmpeq_pd(h2, h), _mm_cmplt_pd(i2, i)));
+    h = _mm_or_pd(_mm_and_pd(take, h2), _mm_andnot_pd(take, h));
+    i = _mm_or_pd(_mm_and_pd(take, i2), _mm_andnot_pd(take, i));
+  };
+  merge(high[0], index[0], high[1], index[1]);
+  merge(high[0], index[0], _mm_unpackhi_pd(high[0], high[0]), _mm_unpackhi_pd(index[0], index[0]));
+  height = _mm_cvtsd_f64(high[0]);
+  return _mm_cvttsd_si32(index[0]);
+#else
+  double best[4], arg[4];
+  for (int k = 0; k < 4; ++k) {
+    best[k] = (p[k] * d.x() + p[4 + k] * d.y()) + p[8 + k] * d.z();
+    arg[k] = k;
+  }
+  for (int b = 1; b < blocks; ++b)
+    for (int k = 0; k < 4; ++k) {
+      const double* q = p + 12 * b;
+      const double h = (q[k] * d.x() + q[4 + k] * d.y()) + q[8 + k] * d.z();
+      if (h > best[k]) {
+        best[k] = h;
+        arg[k] = 4 * b + k;
+      }
+    }
+  double top = best[0], first = arg[0];
+  for (int k = 1; k < 4; ++k) {
+    const bool take = best[k] > top || (best[k] == top && arg[k] < first);
+    top = take ? best[k] : top;
+    first = take ? arg[k] : first;
+  }
+  height = top;
+  return static_cast<int>(first);
+#endif
 }
 
 }  // namespace rbx

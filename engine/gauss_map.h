@@ -65,6 +65,10 @@ struct GaussMap {
   /// that a climb from the cell of its direction starts at or next to its answer.
   int cells = 0;
   std::vector<int> cell_vertices;
+  /// The vertices again, in blocks of four laid out as four x, four y, four z (the last block
+  /// padded with vertex 0), for `scan_vertices`.
+  std::vector<double> lanes;
+  int lane_vertices = 0;
 
   /// Builds the Gauss map of `shape` (its vertices, triangles, edges and planes must be set).
   static GaussMap build(const ConvexPolyhedron& shape);
@@ -98,6 +102,10 @@ struct GaussMap {
   /// world (with d in the same frame; then `start` must not be negative): only the vertex graph
   /// is the map's.
   int climb(const std::vector<Vec3>& vertices, const Vec3& d, int start, double& height) const;
+  /// The first vertex furthest along d (body frame) among all of them, its projection to
+  /// `height`: the same vertex and the same value, bit for bit, as a loop over the shape's
+  /// vertices in order, with four vertices at a time and no branch on the data.
+  int scan_vertices(const Vec3& d, double& height) const;
 };
 
 }  // namespace rbx

@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -203,6 +205,52 @@ TEST(PolyhedronBuilders, ClimbsFromTheCubeMapReachTheFurthestVertex) {
       EXPECT_TRUE(start >= 0 && start < nv);
     }
   }
+}
+
+TEST(PolyhedronBuilders, TheVertexScanIsTheLoopsFirstHighestBitForBit) {
+  // The lanes of scan_vertices must give what a plain loop over the vertices in order gives:
+  // the same height to the bit and, on a tie (a box's face along an axis, the padded copies of
+  // vertex 0), the first of the highest. Vertex counts of every remainder modulo four.
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<Vec3> directions;
+  for (int k = 0; k < 2000; ++k) directions.push_back(Vec3(g(rng), g(rng), g(rng)));
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z) directions.push_back(Vec3(x, y, z));
+  std::vector<ConvexPolyhedron> shapes = {make_box(Vec3(1.0, 0.6, 0.3)), make_prism(0.4, 1.2, 3),
+                                          make_prism(0.4, 1.2, 24), make_icosphere(0.5, 1)};
+  // Bipyramids over a k-gon: k + 2 vertices, odd counts the builders above do not make.
+  for (const int k : {3, 5, 31, 95}) {
+    std::vector<Vec3> v;
+    std::vector<std::array<int, 3>> t;
+    for (int i = 0; i < k; ++i) {
+      const double angle = 2.0 * M_PI * i / k;
+      v.emplace_back(std::cos(angle), std::sin(angle), 0.0);
+      t.push_back({i, (i + 1) % k, k});
+      t.push_back({(i + 1) % k, i, k + 1});
+    }
+    v.emplace_back(0.0, 0.0, 0.7);
+    v.emplace_back(0.0, 0.0, -0.7);
+    shapes.push_back(ConvexPolyhedron::from_triangles(v, t));
+  }
+  std::set<std::size_t> remainders;
+  for (const ConvexPolyhedron& s : shapes) {
+    remainders.insert(s.vertices().size() % 4);
+    for (const Vec3& d : directions) {
+      double furthest = s.vertices()[0].dot(d);
+      int first = 0;
+      for (int i = 1; i < static_cast<int>(s.vertices().size()); ++i)
+        if (s.vertices()[i].dot(d) > furthest) {
+          furthest = s.vertices()[i].dot(d);
+          first = i;
+        }
+      double h = 0.0;
+      ASSERT_EQ(s.gauss_map().scan_vertices(d, h), first);
+      ASSERT_EQ(h, furthest);
+    }
+  }
+  EXPECT_EQ(remainders.size(), 4u);
 }
 
 // ---- Validation -----------------------------------------------------------------------------
