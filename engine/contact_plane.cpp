@@ -14,11 +14,6 @@ namespace {
 
 using plane_detail::Candidate;
 
-// Pairs with at most this many faces and solid edges in all take the scan, larger ones the
-// search: the crossover measured on hulls of random points on a sphere (docs/contact_plane.md).
-// The sum is the same in either body order, so both orders take the same path.
-constexpr std::size_t kScanFeatures = 64;
-
 bool lex_less(const Vec3& p, const Vec3& q) {
   if (p.x() != q.x()) return p.x() < q.x();
   if (p.y() != q.y()) return p.y() < q.y();
@@ -51,18 +46,9 @@ std::optional<ContactPlane> choose(const ConvexPolyhedron& a, const Pose& pa,
   found.polytope = method != PlaneMethod::WholeSearch;
   found.proof_only = proof_only;
   found.proved = false;
-  const GaussMap &ga = a.gauss_map(), &gb = b.gauss_map();
-  const std::size_t features = ga.faces.size() + ga.arcs.size() + gb.faces.size() + gb.arcs.size();
-  if (method == PlaneMethod::Automatic)
-    method = features <= kScanFeatures ? PlaneMethod::Scan : PlaneMethod::Search;
-  // Only a proof wanted: GJK first, which turns shapes apart or touching away in a few supports
-  // (the scan would measure every face before giving up).
-  if (proof_only && method == PlaneMethod::Scan) {
-    plane_detail::Side sa, sb;
-    sa.set(a, pa);
-    sb.set(b, pb);
-    if (!plane_detail::gjk_encloses_origin(sa, sb)) return std::nullopt;
-  }
+  // The search on every pair: on poses the processor has not seen, it is the faster down to two
+  // boxes (docs/contact_plane.md); the scan stays as its independent check.
+  if (method == PlaneMethod::Automatic) method = PlaneMethod::Search;
   // The scan answers only for shapes it proves to overlap; the search for every pair.
   if (method == PlaneMethod::Scan && plane_detail::scan_candidates(a, pa, b, pb, found)) {
     found.proved = true;

@@ -42,7 +42,7 @@ struct ContactPlane {
 
 /// How the candidate axes are found; every method gives the same plane (to round-off).
 enum class PlaneMethod {
-  Automatic,   ///< the scan on small pairs, the search on large ones (the faster of the two)
+  Automatic,   ///< the search (the faster on every pair measured)
   Scan,        ///< every face measured, every solid edge near the other shape paired: linear;
                ///< for shapes it cannot prove to overlap (apart by a hair), the search
   Search,      ///< branch and bound over the shapes' Gauss maps: skips whole cones of them, and

@@ -142,10 +142,6 @@ inline bool cones_apart(const Vec3& axis0, const DirectionCone& c0, const Vec3& 
 /// degenerate polytope): then the search covers every direction.
 bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& out);
 
-/// GJK alone (engine/contact_plane_polytope.cpp): whether a tetrahedron of D's support points
-/// holds the origin (false for shapes apart, touching, or a degenerate simplex).
-bool gjk_encloses_origin(const Side& a, const Side& b);
-
 /// The search: branch and bound over both shapes' Gauss maps
 /// (engine/contact_plane_search.cpp).
 void search_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,

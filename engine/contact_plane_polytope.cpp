@@ -219,11 +219,6 @@ struct Polytope {
 
 }  // namespace
 
-bool gjk_encloses_origin(const Side& a, const Side& b) {
-  std::array<Point, 4> s;
-  return enclose(a, b, s);
-}
-
 bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& out) {
   std::array<Point, 4> s;
   if (!enclose(a, b, s)) return false;

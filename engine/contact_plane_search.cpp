@@ -70,7 +70,11 @@ struct Query {
   std::vector<Candidate> kept;
   std::vector<Pending> heap;
   std::vector<KeptArc> arcs[2];  // A's and B's arcs that may hold the answer
-  std::vector<int> found, seen;  // the local search's vertices and faces
+  std::vector<int> found;        // the local search's vertices
+  // Per vertex and per face of the shape searched, the local search that last took it (a count
+  // of searches, so that nothing is cleared between them).
+  std::vector<unsigned> vertex_mark, face_mark;
+  unsigned mark = 0;
 
   // Nothing whose lower bound exceeds this can be within the tie margin of the answer: twice
   // the margin absorbs the round-off of the bounds themselves.
@@ -236,28 +240,37 @@ void Query::local_search() {
       return need <= 0.0 ||
              x.cross(u).squaredNorm() * (within.sin_angle * within.sin_angle) >= need * need;
     };
+    // A new mark for this side's search; on wrap-around, every old mark is cleared.
+    if (++mark == 0) {
+      std::fill(vertex_mark.begin(), vertex_mark.end(), 0u);
+      std::fill(face_mark.begin(), face_mark.end(), 0u);
+      mark = 1;
+    }
+    if (vertex_mark.size() < v.size()) vertex_mark.resize(v.size(), 0u);
+    if (face_mark.size() < g.faces.size()) face_mark.resize(g.faces.size(), 0u);
     found.assign(1, start);
+    vertex_mark[start] = mark;
     for (std::size_t k = 0; k < found.size(); ++k)
       for (int e = g.neighbor_start[found[k]]; e < g.neighbor_start[found[k] + 1]; ++e) {
         const int w = g.neighbors[e];
-        if (std::find(found.begin(), found.end(), w) == found.end() && reaches(w))
+        if (vertex_mark[w] != mark && reaches(w)) {
+          vertex_mark[w] = mark;
           found.push_back(w);
+        }
       }
     const int face_tree = side_of == 0 ? kFacesA : kFacesB;
     const Vec3& y = narrow_y[side_of];
     const int at = narrow_at[1 - side_of];
-    seen.clear();
     for (const int w : found) {
       for (int k = g.vertex_triangle_start[w]; k < g.vertex_triangle_start[w + 1]; ++k) {
         const int f = g.face_of_triangle[g.vertex_triangles[k]];
-        if (std::find(seen.begin(), seen.end(), f) != seen.end()) continue;
-        seen.push_back(f);
+        if (face_mark[f] == mark) continue;
+        face_mark[f] = mark;
         leaf_face(face_tree, f, y, at);
       }
       for (int e = g.neighbor_start[w]; e < g.neighbor_start[w + 1]; ++e) {
         const int o = g.neighbors[e], arc = g.neighbor_arcs[e];
-        if (arc >= 0 && w < o && std::find(found.begin(), found.end(), o) != found.end())
-          leaf_arc(face_tree + 2, arc, y);
+        if (arc >= 0 && w < o && vertex_mark[o] == mark) leaf_arc(face_tree + 2, arc, y);
       }
     }
   }
