@@ -168,18 +168,25 @@ TEST(PolyhedronBuilders, SupportIndexIsTheFurthestVertex) {
   EXPECT_EQ(make_box(Vec3(1, 1, 1)).support_index(Vec3(1, 1, -1)), 3);
 }
 
-TEST(PolyhedronBuilders, ClimbsFromTheCubeMapReachTheFurthestVertex) {
-  // On a convex polyhedron a vertex with no higher neighbour is highest, so a climb from any
-  // start reaches the furthest projection: from the cube map's cell of the direction, and from
-  // the better of that and an arbitrary vertex. Directions at random, along the cube's axes and
-  // diagonals (cell boundaries), and a zero, NaN or infinite direction (any valid start).
-  std::mt19937 rng(3);
+// 2,000 directions at random, then the cube's axes and diagonals (and zero): the boundaries of
+// the cube map's cells, and directions along which a box's vertices tie.
+std::vector<Vec3> probe_directions(std::mt19937& rng) {
   std::normal_distribution<double> g(0.0, 1.0);
   std::vector<Vec3> directions;
   for (int k = 0; k < 2000; ++k) directions.push_back(Vec3(g(rng), g(rng), g(rng)));
   for (int x = -1; x <= 1; ++x)
     for (int y = -1; y <= 1; ++y)
       for (int z = -1; z <= 1; ++z) directions.push_back(Vec3(x, y, z));
+  return directions;
+}
+
+TEST(PolyhedronBuilders, ClimbsFromTheCubeMapReachTheFurthestVertex) {
+  // On a convex polyhedron a vertex with no higher neighbour is highest, so a climb from any
+  // start reaches the furthest projection: from the cube map's cell of the direction, and from
+  // the better of that and an arbitrary vertex. Directions at random, along the cube's axes and
+  // diagonals (cell boundaries), and a zero, NaN or infinite direction (any valid start).
+  std::mt19937 rng(3);
+  const std::vector<Vec3> directions = probe_directions(rng);
   for (const ConvexPolyhedron& s : {make_box(Vec3(1.0, 0.6, 0.3)), make_prism(0.4, 1.2, 24),
                                     make_icosphere(0.5, 1), make_icosphere(0.5, 4)}) {
     const GaussMap& map = s.gauss_map();
@@ -212,12 +219,7 @@ TEST(PolyhedronBuilders, TheVertexScanIsTheLoopsFirstHighestBitForBit) {
   // the same height to the bit and, on a tie (a box's face along an axis, the padded copies of
   // vertex 0), the first of the highest. Vertex counts of every remainder modulo four.
   std::mt19937 rng(5);
-  std::normal_distribution<double> g(0.0, 1.0);
-  std::vector<Vec3> directions;
-  for (int k = 0; k < 2000; ++k) directions.push_back(Vec3(g(rng), g(rng), g(rng)));
-  for (int x = -1; x <= 1; ++x)
-    for (int y = -1; y <= 1; ++y)
-      for (int z = -1; z <= 1; ++z) directions.push_back(Vec3(x, y, z));
+  const std::vector<Vec3> directions = probe_directions(rng);
   std::vector<ConvexPolyhedron> shapes = {make_box(Vec3(1.0, 0.6, 0.3)), make_prism(0.4, 1.2, 3),
                                           make_prism(0.4, 1.2, 24), make_icosphere(0.5, 1)};
   // Bipyramids over a k-gon: k + 2 vertices, odd counts the builders above do not make.
