@@ -68,7 +68,7 @@ struct GaussMap {
   /// The vertices again, in blocks of four laid out as four x, four y, four z (the last block
   /// padded with vertex 0), for `scan_vertices`.
   std::vector<double> lanes;
-  int lane_vertices = 0;
+  int lane_vertices = 0;  // the vertices in `lanes`, padding not counted
 
   /// Builds the Gauss map of `shape` (its vertices, triangles, edges and planes must be set).
   static GaussMap build(const ConvexPolyhedron& shape);
