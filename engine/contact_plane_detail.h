@@ -57,8 +57,10 @@ struct Candidates {
 
 /// Shapes with at most this many vertices take their support by a scan, larger ones by a climb:
 /// the crossover measured on hulls of random points on a sphere, on poses the processor has not
-/// seen (docs/bench.md).
-constexpr std::size_t kScanSupport = 96;
+/// seen, with the scan on AVX (docs/bench.md). One bound whatever the processor: on a tie, a
+/// climb may keep another of the highest vertices than the scan, and the same scene must give
+/// the same numbers on every machine.
+constexpr std::size_t kScanSupport = 160;
 
 /// One shape of a query: its Gauss map and its pose.
 struct Side {

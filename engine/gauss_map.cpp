@@ -5,6 +5,10 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define RBX_X86 1
+#endif
 
 #include "engine/polyhedron.h"
 
@@ -196,45 +200,17 @@ int GaussMap::climb(const std::vector<Vec3>& vertices, const Vec3& d, int start,
   return at;
 }
 
-int GaussMap::scan_vertices(const Vec3& d, double& height) const {
-  // Each lane keeps its own first highest vertex; the lanes are then merged by height, the
-  // lower index on a tie, which is the first highest of all. Every projection is summed as
-  // Vec3::dot sums it, (x dx + y dy) + z dz, so the values are the loop's to the bit. A padded
-  // copy of vertex 0 ties with vertex 0 and loses on the index.
-  const double* p = lanes.data();
-  const int blocks = (lane_vertices + 3) / 4;
-#if defined(__SSE2__)
-  const __m128d dx = _mm_set1_pd(d.x()), dy = _mm_set1_pd(d.y()), dz = _mm_set1_pd(d.z());
-  auto project = [&](const double* q) {
-    return _mm_add_pd(
-        _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(q), dx), _mm_mul_pd(_mm_loadu_pd(q + 4), dy)),
-        _mm_mul_pd(_mm_loadu_pd(q + 8), dz));
-  };
-  __m128d high[2] = {project(p), project(p + 2)};
-  __m128d index[2] = {_mm_set_pd(1, 0), _mm_set_pd(3, 2)};
-  __m128d at[2] = {index[0], index[1]};
-  const __m128d step = _mm_set1_pd(4);
-  for (int b = 1; b < blocks; ++b)
-    for (int j = 0; j < 2; ++j) {
-      at[j] = _mm_add_pd(at[j], step);
-      const __m128d h = project(p + 12 * b + 2 * j);
-      // Strictly higher: the lane keeps its first highest (and a NaN never replaces).
-      const __m128d higher = _mm_cmpgt_pd(h, high[j]);
-      high[j] = _mm_max_pd(h, high[j]);
-      index[j] = _mm_or_pd(_mm_and_pd(higher, at[j]), _mm_andnot_pd(higher, index[j]));
-    }
-  // The merge in the same registers (the compiler branches on a scalar one).
-  auto merge = [](__m128d& h, __m128d& i, const __m128d& h2, const __m128d& i2) {
-    const __m128d take =
-        _mm_or_pd(_mm_cmpgt_pd(h2, h), _mm_and_pd(_mm_cmpeq_pd(h2, h), _mm_cmplt_pd(i2, i)));
-    h = _mm_or_pd(_mm_and_pd(take, h2), _mm_andnot_pd(take, h));
-    i = _mm_or_pd(_mm_and_pd(take, i2), _mm_andnot_pd(take, i));
-  };
-  merge(high[0], index[0], high[1], index[1]);
-  merge(high[0], index[0], _mm_unpackhi_pd(high[0], high[0]), _mm_unpackhi_pd(index[0], index[0]));
-  height = _mm_cvtsd_f64(high[0]);
-  return _mm_cvttsd_si32(index[0]);
-#else
+namespace {
+
+// The lanes' scans: `p` the vertices in blocks of four (x, y, z), `blocks` of them, d the
+// direction. Each lane keeps its own first highest vertex; the lanes are then merged by height,
+// the lower index on a tie, which is the first highest of all. Every projection is summed as
+// Vec3::dot sums it, (x dx + y dy) + z dz, so the values are the plain loop's to the bit. A padded
+// copy of vertex 0 ties with vertex 0 and loses on the index. Masks select, never a blend
+// instruction: GCC turns a blend of a compare's mask back into branches.
+
+// The plain scan, on any processor.
+int scan_plain(const double* p, int blocks, const Vec3& d, double& height) {
   double best[4], arg[4];
   for (int k = 0; k < 4; ++k) {
     best[k] = (p[k] * d.x() + p[4 + k] * d.y()) + p[8 + k] * d.z();
@@ -257,7 +233,111 @@ int GaussMap::scan_vertices(const Vec3& d, double& height) const {
   }
   height = top;
   return static_cast<int>(first);
+}
+
+#if defined(__SSE2__)
+// Two lanes into the first: the higher, the lower index on a tie.
+inline void merge_lanes(__m128d& h, __m128d& i, const __m128d& h2, const __m128d& i2) {
+  const __m128d take =
+      _mm_or_pd(_mm_cmpgt_pd(h2, h), _mm_and_pd(_mm_cmpeq_pd(h2, h), _mm_cmplt_pd(i2, i)));
+  h = _mm_or_pd(_mm_and_pd(take, h2), _mm_andnot_pd(take, h));
+  i = _mm_or_pd(_mm_and_pd(take, i2), _mm_andnot_pd(take, i));
+}
+
+// Four lanes in two SSE2 registers, merged in the same registers (the compiler branches on a
+// scalar merge).
+int scan_sse2(const double* p, int blocks, const Vec3& d, double& height) {
+  const __m128d dx = _mm_set1_pd(d.x()), dy = _mm_set1_pd(d.y()), dz = _mm_set1_pd(d.z());
+  auto project = [&](const double* q) {
+    return _mm_add_pd(
+        _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(q), dx), _mm_mul_pd(_mm_loadu_pd(q + 4), dy)),
+        _mm_mul_pd(_mm_loadu_pd(q + 8), dz));
+  };
+  __m128d high[2] = {project(p), project(p + 2)};
+  __m128d index[2] = {_mm_set_pd(1, 0), _mm_set_pd(3, 2)};
+  __m128d at[2] = {index[0], index[1]};
+  const __m128d step = _mm_set1_pd(4);
+  for (int b = 1; b < blocks; ++b)
+    for (int j = 0; j < 2; ++j) {
+      at[j] = _mm_add_pd(at[j], step);
+      const __m128d h = project(p + 12 * b + 2 * j);
+      // Strictly higher: the lane keeps its first highest (and a NaN never replaces).
+      const __m128d higher = _mm_cmpgt_pd(h, high[j]);
+      high[j] = _mm_max_pd(h, high[j]);
+      index[j] = _mm_or_pd(_mm_and_pd(higher, at[j]), _mm_andnot_pd(higher, index[j]));
+    }
+  merge_lanes(high[0], index[0], high[1], index[1]);
+  merge_lanes(high[0], index[0], _mm_unpackhi_pd(high[0], high[0]),
+              _mm_unpackhi_pd(index[0], index[0]));
+  height = _mm_cvtsd_f64(high[0]);
+  return _mm_cvttsd_si32(index[0]);
+}
 #endif
+
+#if defined(RBX_X86)
+// Compiled for AVX whatever the build's target; called only when the processor has it. AVX has
+// no fused multiply-add (and none is asked for), so the sums are SSE2's.
+#define RBX_AVX __attribute__((target("avx")))
+
+// One block's four projections.
+RBX_AVX inline __m256d project_avx(const double* q, __m256d dx, __m256d dy, __m256d dz) {
+  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(q), dx),
+                                     _mm256_mul_pd(_mm256_loadu_pd(q + 4), dy)),
+                       _mm256_mul_pd(_mm256_loadu_pd(q + 8), dz));
+}
+
+// merge_lanes, in AVX's encoding (no switch between the two encodings inside the scan).
+RBX_AVX inline void merge_lanes_avx(__m128d& h, __m128d& i, __m128d h2, __m128d i2) {
+  const __m128d take =
+      _mm_or_pd(_mm_cmpgt_pd(h2, h), _mm_and_pd(_mm_cmpeq_pd(h2, h), _mm_cmplt_pd(i2, i)));
+  h = _mm_or_pd(_mm_and_pd(take, h2), _mm_andnot_pd(take, h));
+  i = _mm_or_pd(_mm_and_pd(take, i2), _mm_andnot_pd(take, i));
+}
+
+// Four lanes in one AVX register: half the instructions of the SSE2 scan per block.
+RBX_AVX int scan_avx(const double* p, int blocks, double x, double y, double z, double& height) {
+  const __m256d dx = _mm256_set1_pd(x), dy = _mm256_set1_pd(y), dz = _mm256_set1_pd(z);
+  __m256d high = project_avx(p, dx, dy, dz);
+  __m256d index = _mm256_set_pd(3, 2, 1, 0);
+  __m256d at = index;
+  const __m256d step = _mm256_set1_pd(4);
+  for (int b = 1; b < blocks; ++b) {
+    at = _mm256_add_pd(at, step);
+    const __m256d h = project_avx(p + 12 * b, dx, dy, dz);
+    const __m256d higher = _mm256_cmp_pd(h, high, _CMP_GT_OQ);
+    high = _mm256_max_pd(h, high);
+    index = _mm256_or_pd(_mm256_and_pd(higher, at), _mm256_andnot_pd(higher, index));
+  }
+  __m128d h0 = _mm256_castpd256_pd128(high), i0 = _mm256_castpd256_pd128(index);
+  merge_lanes_avx(h0, i0, _mm256_extractf128_pd(high, 1), _mm256_extractf128_pd(index, 1));
+  merge_lanes_avx(h0, i0, _mm_unpackhi_pd(h0, h0), _mm_unpackhi_pd(i0, i0));
+  height = _mm_cvtsd_f64(h0);
+  return _mm_cvttsd_si32(i0);
+}
+#endif
+
+#if defined(RBX_X86)
+// Read once, when the library loads (the processor's features first: no other constructor may
+// have asked yet). A scan run by another static's constructor before this one sees false and
+// takes SSE2: the same answer.
+const bool kHasAvx = (__builtin_cpu_init(), __builtin_cpu_supports("avx"));
+#else
+const bool kHasAvx = false;
+#endif
+
+}  // namespace
+
+int GaussMap::scan_vertices(const Vec3& d, double& height, ScanUnit unit) const {
+  const double* p = lanes.data();
+  const int blocks = (lane_vertices + 3) / 4;
+  if (unit == ScanUnit::Widest) unit = kHasAvx ? ScanUnit::Avx : ScanUnit::Sse2;
+#if defined(RBX_X86)
+  if (unit == ScanUnit::Avx && kHasAvx) return scan_avx(p, blocks, d.x(), d.y(), d.z(), height);
+#endif
+#if defined(__SSE2__)
+  if (unit != ScanUnit::Plain) return scan_sse2(p, blocks, d, height);
+#endif
+  return scan_plain(p, blocks, d, height);
 }
 
 }  // namespace rbx

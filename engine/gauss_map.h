@@ -102,10 +102,15 @@ struct GaussMap {
   /// world (with d in the same frame; then `start` must not be negative): only the vertex graph
   /// is the map's.
   int climb(const std::vector<Vec3>& vertices, const Vec3& d, int start, double& height) const;
+  /// The instructions `scan_vertices` runs on: the widest the processor has, or one named (the
+  /// tests compare each with a loop over the vertices). One the processor lacks falls back to
+  /// the next narrower.
+  enum class ScanUnit { Widest, Avx, Sse2, Plain };
   /// The first vertex furthest along d (body frame) among all of them, its projection to
   /// `height`: the same vertex and the same value, bit for bit, as a loop over the shape's
-  /// vertices in order, with four vertices at a time and no branch on the data.
-  int scan_vertices(const Vec3& d, double& height) const;
+  /// vertices in order, with four vertices at a time and no branch on the data (whichever
+  /// `unit` runs it).
+  int scan_vertices(const Vec3& d, double& height, ScanUnit unit = ScanUnit::Widest) const;
 };
 
 }  // namespace rbx

@@ -247,9 +247,13 @@ TEST(PolyhedronBuilders, TheVertexScanIsTheLoopsFirstHighestBitForBit) {
           furthest = s.vertices()[i].dot(d);
           first = i;
         }
-      double h = 0.0;
-      ASSERT_EQ(s.gauss_map().scan_vertices(d, h), first);
-      ASSERT_EQ(h, furthest);
+      // Every unit the processor runs (one it lacks would only repeat the next narrower).
+      for (const auto unit : {GaussMap::ScanUnit::Widest, GaussMap::ScanUnit::Avx,
+                              GaussMap::ScanUnit::Sse2, GaussMap::ScanUnit::Plain}) {
+        double h = 0.0;
+        ASSERT_EQ(s.gauss_map().scan_vertices(d, h, unit), first) << static_cast<int>(unit);
+        ASSERT_EQ(h, furthest) << static_cast<int>(unit);
+      }
     }
   }
   EXPECT_EQ(remainders.size(), 4u);
