@@ -57,20 +57,21 @@ double find_time(const std::vector<NarrowRow>& rows, const std::string& backend,
 
 }  // namespace
 
-// The profiles behind the contact-query goals (perf, 2026-11-28, after the inner polytope and the
-// region's centre; hulls of random points on a sphere), each a measured cause.
+// The profiles behind the contact-query goals (perf and cachegrind, 2026-11-28, after the inner
+// polytope, the region's centre and the scan on AVX; hulls of random points on a sphere), each a
+// measured cause.
 constexpr const char* kDetectorProfile =
     "touching, the tests no longer run for shapes the inner polytope proves to overlap: at N = 32 "
     "the shapes' vertex climbs (GJK's and EPA's supports, the candidates' overlaps) are about a "
     "quarter of the query, the narrowed search an eighth, EPA's own bookkeeping a tenth and the "
     "region's centre about a fifth.";
 constexpr const char* kDeepProfile =
-    "deep, small hulls: at N = 128 the vertex climbs are about 3/8 of the query (about 15 EPA "
-    "iterations, two supports each, before the polytope's nearest triangle lies on a face of the "
-    "Minkowski difference) and EPA's own bookkeeping (nearest triangle, seen triangles, new "
-    "faces) about 3/10; the narrowed search and the region's centre are about a twentieth and a "
-    "tenth. FCL's convex pairs run libccd's MPR, which estimates the depth without certifying the "
-    "least overlap.";
+    "deep, small hulls: at N = 128 the shapes' supports (a scan of every vertex, four at a time) "
+    "are about 3/10 of the query's instructions (about 15 EPA iterations, two supports each, "
+    "before the polytope's nearest triangle lies on a face of the Minkowski difference), EPA's "
+    "own bookkeeping (nearest triangle, seen triangles, new faces) about a quarter, the narrowed "
+    "search about a fifth and the region's centre about a twentieth. FCL's convex pairs run "
+    "libccd's MPR, which estimates the depth without certifying the least overlap.";
 
 // The profile behind the whole-step goal (perf, 2026-11-28, many_1000 over the bench's first 60
 // steps, with the broad phase's pairs kept from step to step), a measured cause.
