@@ -5,7 +5,7 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
-#if defined(__x86_64__) || defined(__i386__)
+#if defined(__SSE2__) && (defined(__x86_64__) || defined(__i386__))
 #include <immintrin.h>
 #define RBX_X86 1
 #endif
@@ -286,14 +286,6 @@ RBX_AVX inline __m256d project_avx(const double* q, __m256d dx, __m256d dy, __m2
                        _mm256_mul_pd(_mm256_loadu_pd(q + 8), dz));
 }
 
-// merge_lanes, in AVX's encoding (no switch between the two encodings inside the scan).
-RBX_AVX inline void merge_lanes_avx(__m128d& h, __m128d& i, __m128d h2, __m128d i2) {
-  const __m128d take =
-      _mm_or_pd(_mm_cmpgt_pd(h2, h), _mm_and_pd(_mm_cmpeq_pd(h2, h), _mm_cmplt_pd(i2, i)));
-  h = _mm_or_pd(_mm_and_pd(take, h2), _mm_andnot_pd(take, h));
-  i = _mm_or_pd(_mm_and_pd(take, i2), _mm_andnot_pd(take, i));
-}
-
 // Four lanes in one AVX register: half the instructions of the SSE2 scan per block.
 RBX_AVX int scan_avx(const double* p, int blocks, double x, double y, double z, double& height) {
   const __m256d dx = _mm256_set1_pd(x), dy = _mm256_set1_pd(y), dz = _mm256_set1_pd(z);
@@ -309,8 +301,9 @@ RBX_AVX int scan_avx(const double* p, int blocks, double x, double y, double z, 
     index = _mm256_or_pd(_mm256_and_pd(higher, at), _mm256_andnot_pd(higher, index));
   }
   __m128d h0 = _mm256_castpd256_pd128(high), i0 = _mm256_castpd256_pd128(index);
-  merge_lanes_avx(h0, i0, _mm256_extractf128_pd(high, 1), _mm256_extractf128_pd(index, 1));
-  merge_lanes_avx(h0, i0, _mm_unpackhi_pd(h0, h0), _mm_unpackhi_pd(i0, i0));
+  // merge_lanes inlined here takes AVX's encoding (no switch between the two inside the scan).
+  merge_lanes(h0, i0, _mm256_extractf128_pd(high, 1), _mm256_extractf128_pd(index, 1));
+  merge_lanes(h0, i0, _mm_unpackhi_pd(h0, h0), _mm_unpackhi_pd(i0, i0));
   height = _mm_cvtsd_f64(h0);
   return _mm_cvttsd_si32(i0);
 }
