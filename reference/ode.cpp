@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -113,7 +114,10 @@ ConvexData make_convex_data(const ConvexPolyhedron& hull) {
   for (const Vec3& p : v) c.points.insert(c.points.end(), {p.x(), p.y(), p.z()});
   double size = 0.0;
   for (const Vec3& p : v) size = std::max(size, p.norm());
-  const double tol = 1e-9 * std::max(size, 1.0);
+  // Coplanar: every corner within round-off of the plane, relative to the shape's own size (an
+  // absolute tolerance merges a millimetre sliver's triangles that really bend, into a
+  // non-convex polygon).
+  const double tol = 1e-9 * size;
 
   // Group triangles by plane.
   const auto& tris = hull.triangles();
@@ -123,9 +127,10 @@ ConvexData make_convex_data(const ConvexPolyhedron& hull) {
   for (size_t t = 0; t < tris.size(); ++t) {
     for (size_t g = 0; g < group_plane.size() && group[t] < 0; ++g) {
       const Plane& p = planes[group_plane[g]];
-      if (planes[t].normal.dot(p.normal) > 1.0 - 1e-9 &&
-          std::abs(planes[t].offset - p.offset) < tol)
-        group[t] = static_cast<int>(g);
+      const bool on_plane = std::all_of(tris[t].begin(), tris[t].end(), [&](int k) {
+        return std::abs(p.normal.dot(v[k]) - p.offset) < tol;
+      });
+      if (planes[t].normal.dot(p.normal) > 1.0 - 1e-9 && on_plane) group[t] = static_cast<int>(g);
     }
     if (group[t] < 0) {
       group[t] = static_cast<int>(group_plane.size());
@@ -149,6 +154,20 @@ ConvexData make_convex_data(const ConvexPolyhedron& hull) {
       loop.push_back(static_cast<unsigned>(at));
       at = next.at(at);
     } while (at != start && loop.size() <= next.size());
+    // ODE checks a polygon's winding on its first three corners (p0 . (p1 x p2) > 0, printing a
+    // warning to stdout otherwise): the loop starts at the corner where that is largest, not at
+    // one where three corners are collinear to round-off.
+    const size_t count = loop.size();
+    size_t first = 0;
+    double most = -std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < count; ++k) {
+      const double turn = v[loop[k]].dot(v[loop[(k + 1) % count]].cross(v[loop[(k + 2) % count]]));
+      if (turn > most) {
+        most = turn;
+        first = k;
+      }
+    }
+    std::rotate(loop.begin(), loop.begin() + static_cast<std::ptrdiff_t>(first), loop.end());
     const Plane& p = planes[group_plane[g]];
     c.planes.insert(c.planes.end(), {p.normal.x(), p.normal.y(), p.normal.z(), p.offset});
     c.polygons.push_back(static_cast<unsigned>(loop.size()));

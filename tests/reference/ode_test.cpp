@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <utility>
 
@@ -118,6 +119,43 @@ TEST(OdeContact, MergedFacesOfAPyramidOnABox) {
     EXPECT_GE(c.point.z(), -kRoundOff);
     EXPECT_LE(c.point.z(), 0.02 + kRoundOff);
   }
+}
+
+TEST(OdeContact, NearlyFlatSliverReachesOdeAsConvexCounterClockwisePolygons) {
+  // A hull of 7 points about 3 mm across and 3 um thick, as `rbx explore` draws slivers. Its top
+  // has triangles tilted by a few 1e-5 rad from each other, with plane offsets 5e-10 m apart:
+  // coplanar by an absolute tolerance of 1e-9 m, not by one relative to the shape. Merged, two of
+  // them made a non-convex quadrilateral, and dCreateConvex printed to stdout that a polygon is
+  // not counter-clockwise (its check: p0 . (p1 x p2) > 0 for a polygon's first three corners).
+  BodySpec spec;
+  spec.name = "S";
+  spec.shape_kind = ShapeKind::Convex;
+  spec.shape = std::make_shared<const ConvexPolyhedron>(ConvexPolyhedron::from_triangles(
+      {Vec3(-0.00050624730299864314, -0.0010045729554208052, -1.3909764092413178e-06),
+       Vec3(0.0011520936311120705, 0.0010855223275445765, -4.6887027687722172e-07),
+       Vec3(-0.0007372764498091973, 0.00064420018367305739, -8.8195048308778018e-09),
+       Vec3(-0.00052355330548399699, -0.0012895705862706333, 7.9729038403467692e-07),
+       Vec3(0.00039414437936716011, -0.00015765879620640918, -8.9602408192083343e-07),
+       Vec3(0.00073055807241739572, 0.00054282559162919521, 1.3861975309348615e-06),
+       Vec3(-0.00034368866788662798, -0.00022789830171101119, 6.4160518746510833e-07)},
+      {{0, 2, 1},
+       {0, 3, 2},
+       {4, 0, 1},
+       {4, 3, 0},
+       {5, 1, 2},
+       {5, 4, 1},
+       {5, 3, 4},
+       {6, 2, 3},
+       {6, 5, 2},
+       {6, 3, 5}}));
+  const RigidBody sliver = make_body(spec);
+  const RigidBody box = make_body(box_spec("B", Vec3::Constant(0.002), Vec3(0, 0, -0.0009)));
+  testing::internal::CaptureStdout();
+  const ContactResult r = ode_hull.contact(sliver, box);
+  std::fflush(stdout);
+  EXPECT_EQ(testing::internal::GetCapturedStdout(), "");
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_FALSE(r.contacts.empty());
 }
 
 TEST(OdeKnownBehaviour, ConvexConvexReturnsOnePoint) {
