@@ -528,6 +528,10 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
   // A swept budget (ode_budget) steps with the iterative quick step; otherwise the exact step.
   const int budget = opt.budget;
   if (budget > 0) dWorldSetQuickStepNumIterations(w.world, budget);
+  // The quick step shuffles its constraints with ODE's one random generator, shared by the whole
+  // process: seeded here (ODE's own start value), a run gives the same answer whatever ran
+  // before it in this process.
+  dRandSetSeed(0);
   std::vector<dBodyID> ode_bodies;
   if (std::string error = add_bodies(w, bodies, settings, ode_bodies); !error.empty()) {
     r.status = Status::Error;
