@@ -38,10 +38,11 @@ class ParallelRun {
   /// Runs item(i) for i in [0, n) over all ranks and threads; every rank must call it. Returns
   /// the n results in index order on rank 0, an empty vector on the other ranks. An exception
   /// thrown by an item is rethrown on the rank that ran it (the first in index order per rank).
-  /// Each thread's items run in a supervised child process (reference/isolate.h), so a library
-  /// that aborts or loops fails that backend in that item only; an item must therefore return
-  /// everything it computes (what it writes to this process's memory is lost). `done(i)` is
-  /// called in this process, on the thread that ran the item, as item i finishes.
+  /// Items run in chunks of consecutive indices, each in a supervised child process
+  /// (reference/isolate.h) on whichever thread is free, so a library that aborts or loops fails
+  /// that backend in that item only; an item must therefore return everything it computes (what
+  /// it writes to this process's memory is lost). `done(i)` is called in this process, on the
+  /// thread that ran the item, as item i finishes.
   std::vector<std::string> map(size_t n, const std::function<std::string(size_t)>& item,
                                const std::function<void(size_t)>& done = {}) const;
 
@@ -54,6 +55,10 @@ class ParallelRun {
   int threads_ = 1;
   bool mpi_ = false;
 };
+
+/// How many threads may fork supervised children at once: `wanted` (0: every core), or 1 in a
+/// build with AddressSanitizer (parallel.cpp says why).
+int forking_threads(int wanted);
 
 /// True when this build can use MPI (configured with RBX_WITH_MPI).
 bool built_with_mpi();

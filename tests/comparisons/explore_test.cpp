@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "comparisons/cli/commands.h"
@@ -81,6 +82,26 @@ TEST(ExploreParallel, MapGivesTheSameResultsOnAnyNumberOfThreads) {
   const std::vector<std::string> three = ParallelRun(3).map(45, item);
   ASSERT_EQ(one.size(), 45u);
   EXPECT_EQ(one, three);
+}
+
+TEST(ExploreParallel, MapRethrowsTheFirstFailureInIndexOrder) {
+  // 101 items cut into chunks that two threads take as they come free: items 80 and 7 throw (in
+  // different chunks, 7 taken first or not); the failure reported is item 7's whatever the
+  // timing, and with no failure every index holds its own item's result.
+  auto item = [](size_t i) {
+    if (i == 7 || i == 80) throw std::runtime_error("item " + std::to_string(i));
+    return std::to_string(i * i);
+  };
+  try {
+    ParallelRun(2).map(101, item);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("item 7"), std::string::npos) << e.what();
+  }
+  const std::vector<std::string> squares =
+      ParallelRun(2).map(101, [](size_t i) { return std::to_string(i * i); });
+  ASSERT_EQ(squares.size(), 101u);
+  for (size_t i = 0; i < squares.size(); ++i) EXPECT_EQ(squares[i], std::to_string(i * i));
 }
 
 TEST(ExploreCommand, SameJsonAndScenesWithOneAndThreeThreads) {
