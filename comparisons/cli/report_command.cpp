@@ -120,7 +120,7 @@ int report_command(const ReportOptions& opt) {
     in.views_ok = views_ok;
     // Real impacts: every tosses data set under the inputs (comparisons/output/tosses_report.cpp).
     for (const std::string& dir : find_toss_datasets(opt.inputs))
-      in.tosses += tosses_report_section(dir, tmp.string(), opt.backends);
+      in.tosses += tosses_report_section(dir, tmp.string(), opt.backends, par.threads());
     const std::string summary = report_summary_markdown(scenes, evs, in);
     const std::string details = report_details_markdown(scenes, evs, figures_ok, views_ok);
     write_text((tmp / "report.md").string(), summary);

@@ -1,11 +1,14 @@
 // The tosses study: which backends run, both parameter sets over every toss, the study's JSON,
 // the ranking and the parameter file (`rbx tosses` and the report's "Real impacts" section).
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <thread>
 
+#include "comparisons/eval/parallel.h"
 #include "comparisons/eval/select_backends.h"
 #include "comparisons/eval/tosses.h"
 #include "comparisons/scene/repo_path.h"
@@ -63,16 +66,31 @@ std::vector<const Backend*> select_toss_backends(const std::string& list) {
 
 TossEvaluation evaluate_tosses(const std::vector<const Backend*>& chosen,
                                const std::vector<Toss>& tosses,
-                               const std::vector<std::pair<std::string, ContactParams>>& stored) {
+                               const std::vector<std::pair<std::string, ContactParams>>& stored,
+                               int threads) {
+  // Job 2k is backend k at its stored parameters, 2k + 1 at the published ones. Each toss of a
+  // job forks its supervised child (isolated_dynamics_fn), so the jobs run on several threads,
+  // taken as they come free, and land in their own slots.
+  const size_t jobs = 2 * chosen.size();
+  std::vector<BackendTosses> done(jobs);
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t j = next++; j < jobs; j = next++) {
+      const Backend& b = *chosen[j / 2];
+      std::string source = "published";
+      const ContactParams p =
+          j % 2 == 0 ? stored_params(stored, b.name, &source) : kPublishedParams;
+      done[j] = evaluate_backend(b, tosses, p);
+      done[j].params_source = source;
+    }
+  };
+  const size_t count = std::min(jobs, static_cast<size_t>(forking_threads(threads)));
+  std::vector<std::thread> pool;
+  for (size_t t = 1; t < count; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& th : pool) th.join();
   TossEvaluation ev;
-  for (const Backend* b : chosen) {
-    std::string source;
-    const ContactParams p = stored_params(stored, b->name, &source);
-    ev.stored.push_back(evaluate_backend(*b, tosses, p));
-    ev.stored.back().params_source = source;
-    ev.published.push_back(evaluate_backend(*b, tosses, kPublishedParams));
-    ev.published.back().params_source = "published";
-  }
+  for (size_t j = 0; j < jobs; ++j) (j % 2 == 0 ? ev.stored : ev.published).push_back(done[j]);
   return ev;
 }
 

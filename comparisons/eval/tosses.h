@@ -164,10 +164,12 @@ struct TossEvaluation {
 };
 
 /// Runs `chosen` over `tosses` at the parameters in `stored` (the published ones where a
-/// backend has none) and at the published parameters.
+/// backend has none) and at the published parameters, each backend at each set on one of
+/// `threads` threads (0: every core); the result does not depend on their number.
 TossEvaluation evaluate_tosses(const std::vector<const Backend*>& chosen,
                                const std::vector<Toss>& tosses,
-                               const std::vector<std::pair<std::string, ContactParams>>& stored);
+                               const std::vector<std::pair<std::string, ContactParams>>& stored,
+                               int threads = 0);
 
 /// The study's JSON (`rbx tosses --json`, the report's tosses.json): the data, the cube model,
 /// the parameter file and every backend at both parameter sets.

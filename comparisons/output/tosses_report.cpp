@@ -186,7 +186,7 @@ std::string error_over_time_table(const TossEvaluation& ev, const std::vector<si
 }  // namespace
 
 std::string tosses_report_section(const std::string& dir, const std::string& out_dir,
-                                  const std::string& backend_list) {
+                                  const std::string& backend_list, int threads) {
   const fs::path d(dir);
   const std::string data = toss_test_split(dir);
   const std::vector<Toss> tosses = read_tosses(data);
@@ -199,7 +199,7 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
   if (chosen.empty()) return "";
 
   Stopwatch clock;
-  const TossEvaluation ev = evaluate_tosses(chosen, tosses, stored);
+  const TossEvaluation ev = evaluate_tosses(chosen, tosses, stored, threads);
   const double eval_s = clock.seconds();
   const fs::path out(out_dir);
   write_json((out / "tosses.json").string(), toss_evaluation_json(data, tosses, params_path, ev));
