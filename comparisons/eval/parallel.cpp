@@ -112,6 +112,27 @@ int forking_threads(int wanted) {
   return wanted > 0 ? wanted : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
+void run_jobs(size_t jobs, int threads, const std::function<void(size_t)>& job) {
+  std::vector<std::exception_ptr> errors(jobs);
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t j = next++; j < jobs; j = next++) {
+      try {
+        job(j);
+      } catch (...) {
+        errors[j] = std::current_exception();
+      }
+    }
+  };
+  const size_t count = std::min(jobs, static_cast<size_t>(forking_threads(threads)));
+  std::vector<std::thread> pool;
+  for (size_t t = 1; t < count; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& th : pool) th.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
 std::vector<std::string> ParallelRun::map(size_t n, const std::function<std::string(size_t)>& item,
                                           const std::function<void(size_t)>& done) const {
   // This rank's block, cut into chunks that the threads take as they come free: the items' costs
@@ -124,27 +145,12 @@ std::vector<std::string> ParallelRun::map(size_t n, const std::function<std::str
       kForkFromOneThread ? 1 : std::max<size_t>(1, std::min<size_t>(threads_, count));
   constexpr size_t kChunksPerThread = 16;
   const size_t chunk = std::max<size_t>(1, count / (nthreads * kChunksPerThread));
-  const size_t chunks = (count + chunk - 1) / chunk;
-  std::vector<std::exception_ptr> errors(chunks);
-  std::atomic<size_t> next{0};
-  auto work = [&] {
-    for (size_t c = next++; c < chunks; c = next++) {
-      const size_t a = c * chunk, b = std::min(count, a + chunk);
-      try {
-        std::vector<std::string> mine = run_items_isolated(lo + a, lo + b, item, done);
-        for (size_t i = a; i < b; ++i) local[i] = std::move(mine[i - a]);
-      } catch (...) {
-        errors[c] = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (size_t t = 1; t < nthreads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& th : pool) th.join();
-  // The first failure in index order (chunks are in index order).
-  for (const std::exception_ptr& e : errors)
-    if (e) std::rethrow_exception(e);
+  // Chunks are in index order, so the failure rethrown is the first in index order.
+  run_jobs((count + chunk - 1) / chunk, static_cast<int>(nthreads), [&](size_t c) {
+    const size_t a = c * chunk, b = std::min(count, a + chunk);
+    std::vector<std::string> mine = run_items_isolated(lo + a, lo + b, item, done);
+    for (size_t i = a; i < b; ++i) local[i] = std::move(mine[i - a]);
+  });
   if (!mpi_ || ranks_ == 1) return local;
 
 #ifdef RBX_WITH_MPI

@@ -60,6 +60,10 @@ class ParallelRun {
 /// build with AddressSanitizer (parallel.cpp says why).
 int forking_threads(int wanted);
 
+/// Runs job(j) for j in [0, jobs) on forking_threads(threads) threads, each taking the next job
+/// as it comes free; then rethrows the exception of the first job (in job order) that threw.
+void run_jobs(size_t jobs, int threads, const std::function<void(size_t)>& job);
+
 /// True when this build can use MPI (configured with RBX_WITH_MPI).
 bool built_with_mpi();
 

@@ -1,13 +1,10 @@
 // The tosses study: which backends run, both parameter sets over every toss, the study's JSON,
 // the ranking and the parameter file (`rbx tosses` and the report's "Real impacts" section).
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <thread>
 
 #include "comparisons/eval/parallel.h"
 #include "comparisons/eval/select_backends.h"
@@ -74,30 +71,13 @@ TossEvaluation evaluate_tosses(const std::vector<const Backend*>& chosen,
   // taken as they come free, and land in their own slots.
   const size_t jobs = 2 * chosen.size();
   std::vector<BackendTosses> done(jobs);
-  std::vector<std::exception_ptr> errors(jobs);
-  std::atomic<size_t> next{0};
-  auto work = [&] {
-    for (size_t j = next++; j < jobs; j = next++) {
-      try {
-        const Backend& b = *chosen[j / 2];
-        std::string source = "published";
-        const ContactParams p =
-            j % 2 == 0 ? stored_params(stored, b.name, &source) : kPublishedParams;
-        done[j] = evaluate_backend(b, tosses, p);
-        done[j].params_source = source;
-      } catch (...) {
-        errors[j] = std::current_exception();
-      }
-    }
-  };
-  const size_t count = std::min(jobs, static_cast<size_t>(forking_threads(threads)));
-  std::vector<std::thread> pool;
-  for (size_t t = 1; t < count; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& th : pool) th.join();
-  // As when the jobs ran one after the other: the first job's exception reaches the caller.
-  for (const std::exception_ptr& e : errors)
-    if (e) std::rethrow_exception(e);
+  run_jobs(jobs, threads, [&](size_t j) {
+    const Backend& b = *chosen[j / 2];
+    std::string source = "published";
+    const ContactParams p = j % 2 == 0 ? stored_params(stored, b.name, &source) : kPublishedParams;
+    done[j] = evaluate_backend(b, tosses, p);
+    done[j].params_source = source;
+  });
   TossEvaluation ev;
   for (size_t j = 0; j < jobs; ++j) (j % 2 == 0 ? ev.stored : ev.published).push_back(done[j]);
   return ev;
