@@ -101,7 +101,7 @@ int report_command(const ReportOptions& opt) {
   try {
     write_report_tables(tmp.string(), scenes, evs);
     std::string figures_msg;
-    const bool figures_ok = draw_report_figures(tmp.string(), figures_msg);
+    const bool figures_ok = draw_report_figures(tmp.string(), par.threads(), figures_msg);
     // --- replay pages (view-report): views/SLUG.html ---
     bool views_ok = true;
     try {

@@ -1,9 +1,9 @@
 #include "comparisons/output/ensemble_report.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 
+#include "comparisons/output/figure_script.h"
 #include "comparisons/output/table.h"
 
 namespace rbx {
@@ -65,25 +65,10 @@ void print_ensemble(std::ostream& out, const EnsembleResult& r) {
   }
 }
 
-namespace {
-
-// `text` as one single-quoted shell word.
-std::string shell_quoted(const std::string& text) {
-  std::string q = "'";
-  for (char c : text) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-}  // namespace
-
 bool draw_ensemble_figures(const std::string& dir) {
   namespace fs = std::filesystem;
-  const std::string script =
-      std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/ensemble_plots.py";
-  if (!fs::exists("/usr/bin/python3")) return false;
-  const std::string cmd = "/usr/bin/python3 " + shell_quoted(script) + " " + shell_quoted(dir) +
-                          " > " + shell_quoted((fs::path(dir) / "figures.log").string()) + " 2>&1";
-  return std::system(cmd.c_str()) == 0;
+  return run_figure_script("ensemble_plots.py", {dir}, (fs::path(dir) / "figures.log").string()) ==
+         0;
 }
 
 }  // namespace rbx

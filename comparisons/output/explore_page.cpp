@@ -2,10 +2,10 @@
 // explore_campaign.h).
 #include "comparisons/output/explore_page.h"
 
-#include <cstdlib>
 #include <filesystem>
 #include <sstream>
 
+#include "comparisons/output/figure_script.h"
 #include "comparisons/output/table.h"
 #include "comparisons/scene/repo_path.h"
 #include "engine/format.h"
@@ -150,12 +150,8 @@ std::string explore_markdown(const Json& j, bool have_figure) {
 }
 
 bool draw_explore_figure(const std::string& dir) {
-  const std::string script =
-      std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/explore_plots.py";
-  if (!fs::exists("/usr/bin/python3")) return false;
-  const std::string cmd = "/usr/bin/python3 '" + script + "' '" + dir + "' > '" +
-                          (fs::path(dir) / "figures.log").string() + "' 2>&1";
-  return std::system(cmd.c_str()) == 0;
+  return run_figure_script("explore_plots.py", {dir}, (fs::path(dir) / "figures.log").string()) ==
+         0;
 }
 
 }  // namespace rbx

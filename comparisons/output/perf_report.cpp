@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "comparisons/eval/json_io.h"
+#include "comparisons/output/figure_script.h"
 #include "engine/format.h"
 
 namespace rbx {
@@ -443,20 +444,16 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
   try {
     write_json((tmp / "perf.json").string(), j);
     write_text((tmp / "perf.csv").string(), csv.str());
-    const std::string script =
-        std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/bench_plots.py";
-    std::string figures_note;
-    if (!fs::exists("/usr/bin/python3")) {
-      figures_note = "Figures not drawn: /usr/bin/python3 not found.";
-    } else {
-      const std::string cmd = "/usr/bin/python3 '" + script + "' '" + tmp.string() + "' > '" +
-                              (tmp / "figures.log").string() + "' 2>&1";
-      if (std::system(cmd.c_str()) != 0) {
-        std::ifstream log(tmp / "figures.log");
-        std::stringstream text;
-        text << log.rdbuf();
-        figures_note = "Figures not drawn: bench_plots.py failed:\n\n```\n" + text.str() + "```";
-      }
+    std::string figures_note, why;
+    const int rc =
+        run_figure_script("bench_plots.py", {tmp.string()}, (tmp / "figures.log").string(), &why);
+    if (rc < 0) {
+      figures_note = "Figures not drawn: " + why + ".";
+    } else if (rc != 0) {
+      std::ifstream log(tmp / "figures.log");
+      std::stringstream text;
+      text << log.rdbuf();
+      figures_note = "Figures not drawn: bench_plots.py failed:\n\n```\n" + text.str() + "```";
     }
     if (!figures_note.empty()) md << figures_note << "\n";
     write_text((tmp / "perf.md").string(), md.str());

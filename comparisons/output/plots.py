@@ -4,12 +4,13 @@ family (law_plots.py), per-scene velocity bars, a 3-D picture of each contact sc
 every backend's contact point and normal, and each ensemble's final positions
 (ensemble_plots.py).
 
-Usage: plots.py REPORT_DIR  (reads results.json, sweep.csv and laws.csv, writes figures/*.png
-and *.svg)
+Usage: plots.py REPORT_DIR [JOBS]  (reads results.json, sweep.csv and laws.csv, writes
+figures/*.png and *.svg; JOBS processes share the figures, default 1)
 """
 import csv
 import json
 import math
+import multiprocessing
 import os
 import sys
 import tomllib
@@ -370,20 +371,41 @@ def contact_picture(scene, out):
     save(fig, out, f"contact_{slug(scene)}")
 
 
-def main():
-    report = sys.argv[1]
-    out = os.path.join(report, "figures")
-    os.makedirs(out, exist_ok=True)
+def figures(report, out):
+    """Every figure of the report as (function, arguments), each drawn on its own, the family
+    figures (the longest) first."""
     results = json.load(open(os.path.join(report, "results.json")))
-    error_vs_runtime(report, out)
-    contact_laws(report, out)
+    todo = [(error_vs_runtime, (report, out)), (contact_laws, (report, out))]
     for scene in results["scenes"]:
         if "contact" in scene["checks"]:
-            contact_picture(scene, out)
+            todo.append((contact_picture, (scene, out)))
         if "impulse" in scene["checks"]:
-            velocity_bars(scene, out)
+            todo.append((velocity_bars, (scene, out)))
         if "ensemble" in scene:
-            ensemble_scatter(scene["ensemble"], out, f"ensemble_{slug(scene)}")
+            todo.append((ensemble_scatter, (scene["ensemble"], out, f"ensemble_{slug(scene)}")))
+    return todo
+
+
+def draw(figure):
+    """Draws one (function, arguments) of figures()."""
+    function, args = figure
+    function(*args)
+
+
+def main():
+    report = sys.argv[1]
+    jobs = int(sys.argv[2]) if len(sys.argv) > 2 else 1
+    out = os.path.join(report, "figures")
+    os.makedirs(out, exist_ok=True)
+    todo = figures(report, out)
+    if jobs <= 1:
+        for figure in todo:
+            draw(figure)
+        return
+    # The figures are independent: `jobs` processes share them, one at a time each, in order. A
+    # figure that fails fails the whole script, as when they are drawn in turn.
+    with multiprocessing.get_context("fork").Pool(jobs) as pool:
+        pool.map(draw, todo, chunksize=1)
 
 
 if __name__ == "__main__":

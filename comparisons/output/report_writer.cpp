@@ -4,7 +4,6 @@
 #include "comparisons/output/report_writer.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -12,6 +11,7 @@
 
 #include "comparisons/eval/budgets.h"
 #include "comparisons/eval/trajectory.h"
+#include "comparisons/output/figure_script.h"
 #include "comparisons/output/law_report.h"
 #include "comparisons/output/scorecard.h"
 #include "comparisons/output/table.h"
@@ -585,24 +585,17 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
   write_text((tmp / "laws.csv").string(), laws_csv(scenes, evs, report_columns(evs)));
 }
 
-bool draw_report_figures(const std::string& dir, std::string& message) {
+bool draw_report_figures(const std::string& dir, int jobs, std::string& message) {
   const fs::path tmp(dir);
-  // Figures: matplotlib from Debian, through /usr/bin/python3.
-  const std::string script = std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/plots.py";
-  bool figures_ok = false;
-  if (!fs::exists("/usr/bin/python3")) {
-    message = "/usr/bin/python3 not found";
-  } else {
-    const std::string cmd = "/usr/bin/python3 '" + script + "' '" + tmp.string() + "' > '" +
-                            (tmp / "figures.log").string() + "' 2>&1";
-    const int rc = std::system(cmd.c_str());
-    figures_ok = rc == 0;
-    if (!figures_ok)
-      message = "plots.py failed (see figures.log)";
-    else
-      fs::remove(tmp / "figures.log");
+  // Figures: matplotlib from Debian, the figures shared among `jobs` processes.
+  const int rc = run_figure_script("plots.py", {tmp.string(), std::to_string(std::max(1, jobs))},
+                                   (tmp / "figures.log").string(), &message);
+  if (rc == 0) {
+    fs::remove(tmp / "figures.log");
+    return true;
   }
-  return figures_ok;
+  if (rc > 0) message = "plots.py failed (see figures.log)";
+  return false;
 }
 
 }  // namespace rbx

@@ -42,7 +42,7 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
                          const std::vector<SceneEvaluation>& evs);
 
 /// The report's figures into dir/figures through comparisons/output/plots.py and Debian's
-/// python3; false with `message` set when they could not be drawn.
-bool draw_report_figures(const std::string& dir, std::string& message);
+/// python3, drawn by `jobs` processes; false with `message` set when they could not be drawn.
+bool draw_report_figures(const std::string& dir, int jobs, std::string& message);
 
 }  // namespace rbx

@@ -3,13 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
 
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/trajectory.h"
+#include "comparisons/output/figure_script.h"
 #include "comparisons/output/view_page.h"
 #include "comparisons/scene/repo_path.h"
 
@@ -143,13 +143,9 @@ std::vector<std::string> write_picked_tosses(const fs::path& out,
 
 // Figures through matplotlib (the report's own figures need the same python3).
 bool draw_tosses_figures(const std::string& out_dir) {
-  const std::string script =
-      std::string(RBX_DEFAULT_SOURCE_DIR) + "/comparisons/output/tosses_plots.py";
-  if (!fs::exists("/usr/bin/python3")) return false;
   const fs::path out(out_dir);
-  const std::string cmd = "/usr/bin/python3 '" + script + "' '" + out_dir + "' > '" +
-                          (out / "tosses_figures.log").string() + "' 2>&1";
-  const bool ok = std::system(cmd.c_str()) == 0;
+  const bool ok =
+      run_figure_script("tosses_plots.py", {out_dir}, (out / "tosses_figures.log").string()) == 0;
   if (ok) fs::remove(out / "tosses_figures.log");
   return ok;
 }
