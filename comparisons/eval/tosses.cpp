@@ -16,6 +16,8 @@
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/format.h"
+#include "reference/isolate.h"
+#include "reference/result_codec.h"
 
 namespace fs = std::filesystem;
 
@@ -267,6 +269,18 @@ Spread spread_of(std::vector<double> v) {
   return s;
 }
 
+namespace {
+
+// A toss's errors, written and read by one field list (reference/result_codec.h).
+template <class Io, class E>
+void toss_error_fields(Io& io, E& e) {
+  io.io(e.toss_id, e.position, e.orientation_deg, e.final_position, e.final_orientation_deg);
+  io.io_list(e.position_by_sample, [](Io& i, auto& x) { i.io(x); });
+  io.io_list(e.horizontal_by_sample, [](Io& i, auto& x) { i.io(x); });
+}
+
+}  // namespace
+
 BackendTosses evaluate_backend(const Backend& backend, const std::vector<Toss>& tosses,
                                const ContactParams& params, const CubeTossModel& model) {
   BackendTosses out;
@@ -278,14 +292,40 @@ BackendTosses evaluate_backend(const Backend& backend, const std::vector<Toss>& 
     return out;
   }
   Stopwatch clock;
+  // One toss as bytes: its status and message, then its errors when it ran.
+  auto one = [&](size_t i) {
+    const TossRun run = simulate_toss(isolated_dynamics_fn(backend), tosses[i], params, model);
+    ByteWriter w;
+    w.io(run.status, run.message);
+    if (run.status == Status::Ok) {
+      const TossErrors e = toss_errors(tosses[i], run.track, 2.0 * model.half_width);
+      toss_error_fields(w, e);
+    }
+    return w.str();
+  };
+  // The tosses run one after another in one supervised child (reference/isolate.h), each library
+  // run still a supervised call: a child of its own per toss cost more than the toss (every child
+  // resolved the libraries' symbols and faulted their memory in anew). Already in such a child,
+  // they run here.
+  std::vector<std::string> bytes;
+  if (in_isolated_child()) {
+    for (size_t i = 0; i < tosses.size(); ++i) bytes.push_back(one(i));
+  } else {
+    bytes = run_items_isolated(0, tosses.size(), one);
+  }
   int failed = 0;
-  for (const Toss& t : tosses) {
-    const TossRun run = simulate_toss(isolated_dynamics_fn(backend), t, params, model);
-    if (run.status != Status::Ok) {
-      if (failed++ == 0) out.message = run.message;
+  for (const std::string& b : bytes) {
+    ByteReader r(b);
+    Status status = Status::Ok;
+    std::string message;
+    r.io(status, message);
+    if (status != Status::Ok) {
+      if (failed++ == 0) out.message = message;
       continue;
     }
-    out.tosses.push_back(toss_errors(t, run.track, 2.0 * model.half_width));
+    TossErrors e;
+    toss_error_fields(r, e);
+    out.tosses.push_back(std::move(e));
   }
   out.runtime_s = clock.seconds();
   if (failed > 0) {

@@ -9,11 +9,13 @@
 #include <zlib.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "comparisons/scene/scene_file.h"
 
@@ -239,6 +241,52 @@ TEST(TossesSimulation, FlatCubeDroppedFromRestFallsFreelyInEveryBackend) {
     ++ran;
   }
   EXPECT_GE(ran, 4);  // custom, bullet, mujoco, ode at least
+}
+
+TEST(TossesEvaluate, ALibraryAbortingOnOneTossFailsThatTossAloneAndTheOthersAreKept) {
+  // Three tosses in one supervised child; a library backend that aborts on the second (ODE's
+  // dynamics behind it otherwise). The abort is that toss's failure; the other two come back
+  // through the child with the errors an unsupervised run of ODE gives, to the bit.
+  const CubeTossModel model;
+  std::vector<Toss> tosses;
+  for (long id = 1; id <= 3; ++id) {
+    Toss t;
+    t.id = id;
+    for (int i = 0; i < 20; ++i) {
+      const double time = i / model.sample_rate, z = 0.2 + 0.05 * id;
+      t.samples.push_back({time, Vec3(0, 0, z - 0.5 * model.gravity * time * time),
+                           Quat::Identity(), Vec3(0, 0, -model.gravity * time), Vec3::Zero()});
+    }
+    tosses.push_back(t);
+  }
+  const Backend* ode = find_backend("ode");
+  ASSERT_NE(ode, nullptr);
+  Backend aborting = *ode;
+  aborting.name = "ode-aborting";
+  aborting.library = true;
+  aborting.dynamics = [ode](const Scene& scene, const DynamicsOptions& opt) {
+    if (scene.name == "cube toss 2") std::abort();
+    return ode->dynamics(scene, opt);
+  };
+  const ContactParams params{0.5, 0.5};
+  const BackendTosses r = evaluate_backend(aborting, tosses, params, model);
+  EXPECT_EQ(r.status, Status::Error);
+  EXPECT_NE(r.message.find("1 of 3 tosses failed"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("Aborted"), std::string::npos) << r.message;
+  ASSERT_EQ(r.tosses.size(), 2u);
+  for (const TossErrors& e : r.tosses) {
+    const Toss& t = tosses[static_cast<size_t>(e.toss_id - 1)];
+    const TossRun direct = simulate_toss(ode->dynamics, t, params, model);
+    ASSERT_EQ(direct.status, Status::Ok) << direct.message;
+    const TossErrors d = toss_errors(t, direct.track, 2 * model.half_width);
+    EXPECT_EQ(e.position, d.position) << e.toss_id;
+    EXPECT_EQ(e.orientation_deg, d.orientation_deg) << e.toss_id;
+    EXPECT_EQ(e.final_position, d.final_position) << e.toss_id;
+    EXPECT_EQ(e.position_by_sample, d.position_by_sample) << e.toss_id;
+    EXPECT_EQ(e.horizontal_by_sample, d.horizontal_by_sample) << e.toss_id;
+  }
+  EXPECT_EQ(r.tosses[0].toss_id, 1);
+  EXPECT_EQ(r.tosses[1].toss_id, 3);
 }
 
 TEST(TossesFit, RecoversTheParametersThatGeneratedATossOnTheGrid) {
