@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "comparisons/eval/json_io.h"
+#include "engine/detect.h"
 #include "reference/isolate.h"
 
 namespace rbx {
@@ -71,6 +72,13 @@ const ContactPoint* deepest(const ContactResult& r) {
   for (const ContactPoint& c : r.contacts)
     if (!best || c.depth > best->depth) best = &c;
   return best;
+}
+
+bool ties_true_depth(const RigidBody& a, const RigidBody& b, const Vec3& normal, double true_depth,
+                     double size) {
+  if (!normal.allFinite() || !(normal.norm() > 0.5)) return false;
+  const double along = overlap_along(*a.shape, a.pose(), *b.shape, b.pose(), normal.normalized());
+  return std::abs(along - true_depth) <= 1e-12 * size;
 }
 
 double angle_deg(const Vec3& u, const Vec3& v) {

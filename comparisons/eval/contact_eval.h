@@ -34,4 +34,11 @@ const ContactPoint* deepest(const ContactResult& r);
 /// Angle between two directions, degrees in [0, 180].
 double angle_deg(const Vec3& u, const Vec3& v);
 
+/// The harness's rule for ties, as the scene checks, `rbx explore` and `rbx contacts` apply it:
+/// true when A and B overlap along `normal` by `true_depth` within round-off (1e-12 of `size`,
+/// the smaller body's). Where several directions give the same least overlap (a cube on
+/// another's diagonal), any of them is as right as the truth's own normal.
+bool ties_true_depth(const RigidBody& a, const RigidBody& b, const Vec3& normal, double true_depth,
+                     double size);
+
 }  // namespace rbx

@@ -81,13 +81,10 @@ ContactsRow compare_row(const std::string& name, const ContactRun& run, const Co
     row.angle = fmt_num(pair["normal_err_deg"].get<double>(), 3);
     row.depth_diff = fmt_num(pair["depth_err"].get<double>(), 3);
     const double size = 2.0 * std::min(bounding_sphere(a).radius, bounding_sphere(b).radius);
-    // The harness's rule for ties (as `rbx explore` and the scene checks apply it): a normal
-    // along which the overlap equals the true depth (within round-off, 1e-12 of the body size)
-    // is as right as the oracle's, and is marked as such.
+    // The harness's rule for ties: a tied normal is as right as the oracle's, and is marked as
+    // such.
     double angle = pair["normal_err_deg"].get<double>();
-    if (angle > 0 && c->normal.allFinite() && c->normal.norm() > 0.5 &&
-        std::abs(overlap_along(*a.shape, a.pose(), *b.shape, b.pose(), c->normal.normalized()) -
-                 t->depth) <= 1e-12 * size) {
+    if (angle > 0 && ties_true_depth(a, b, c->normal, t->depth, size)) {
       angle = 0.0;
       row.angle += " (tie)";
     }

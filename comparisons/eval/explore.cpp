@@ -346,13 +346,9 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
       out.backends.push_back(o);
       continue;
     }
-    // The harness's rule for ties: a normal along which the overlap equals the true depth
-    // (within round-off, 1e-12 of the body size) is as right as the oracle's.
+    // The harness's rule for ties: a tied normal is as right as the oracle's.
     double angle = angle_deg(c->normal, sat.normal);
-    if (angle > 0 && c->normal.allFinite() && c->normal.norm() > 0.5 &&
-        std::abs(overlap_along(*a.shape, a.pose(), *b.shape, b.pose(), c->normal.normalized()) -
-                 true_depth) <= 1e-12 * size)
-      angle = 0.0;
+    if (angle > 0 && ties_true_depth(a, b, c->normal, true_depth, size)) angle = 0.0;
     o.measured = true;
     o.normal_err_deg = angle;
     o.depth_err_rel = std::abs(c->depth - true_depth) / size;

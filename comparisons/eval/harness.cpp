@@ -268,9 +268,7 @@ class Evaluator {
       // Ties: where several directions give the same minimum translation (a cube on another's
       // diagonal: x, y and z), any of them is right. Against the oracle, a normal along which
       // the overlap equals the true depth (within round-off) has no angle error.
-      if (!have_normal && angle > 0 && c->normal.allFinite() && c->normal.norm() > 0.5 &&
-          std::abs(overlap_along(*a.shape, a.pose(), *b.shape, b.pose(), c->normal.normalized()) -
-                   true_depth) <= 1e-12 * size)
+      if (!have_normal && angle > 0 && ties_true_depth(a, b, c->normal, true_depth, size))
         angle = 0.0;
       const double derr = std::abs(c->depth - true_depth);
       metric("contact", name, pair, "normal_err_deg", angle, normal_src);
