@@ -17,8 +17,8 @@ namespace {
 
 // A folder whose name a shell would split, unquote and run a command from.
 fs::path awkward_dir() {
-  const fs::path p = fs::temp_directory_path() / ("rbx it's $(touch pwned_" +
-                                                  std::to_string(getpid()) + ") `x` dir");
+  const fs::path p = fs::temp_directory_path() /
+                     ("rbx it's $(touch pwned_" + std::to_string(getpid()) + ") `x` dir");
   fs::remove_all(p);
   fs::create_directories(p);
   return p;
