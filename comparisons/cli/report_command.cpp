@@ -12,6 +12,7 @@
 #include "comparisons/eval/ensemble.h"
 #include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/parallel.h"
+#include "comparisons/eval/regression_check.h"
 #include "comparisons/eval/scene_batch.h"
 #include "comparisons/eval/tosses.h"
 #include "comparisons/output/report_pages.h"
@@ -46,6 +47,36 @@ class Progress {
   bool on_;
 };
 
+// `--check`: the regression check from this report's own runs, the same metrics rbx check
+// measures (the scenes at their own step, explore's fixed samples, and the tosses when the whole
+// library ran), compared and printed as rbx check prints them; 1 when any is worse.
+int check_report_run(const ReportOptions& opt, const Json& baseline,
+                     const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs,
+                     const std::vector<ExploreCheckMetric>& explore, const Stopwatch& clock) {
+  CheckSettings set;
+  set.explore = opt.explore || opt.inputs.empty();
+  set.tosses = opt.inputs.empty();
+  CheckRun run;
+  add_scene_metrics(scenes, evs, set, run);
+  add_explore_metrics(explore, set, run);
+  if (set.tosses) add_toss_metrics(set, run);
+  run.runtime_s = clock.seconds();
+  const CheckDiff d = print_check(baseline, run, set, scenes.size());
+  return d.worse + d.missing > 0 ? 1 : 0;
+}
+
+// --check: the baseline, read before anything runs (a bad one is bad input); every backend runs,
+// as the baseline's metrics were measured (one backend's metrics can depend on the others': rbx
+// check runs them all too).
+Json check_baseline_first(const ReportOptions& opt) {
+  if (!opt.check) return Json();
+  if (!opt.backends.empty() && opt.backends != "all")
+    throw InputError(
+        "rbx report: --check compares every backend's metrics; drop --backends (or "
+        "run rbx check --backends LIST)");
+  return read_baseline(check_baseline_path(opt), false);
+}
+
 }  // namespace
 
 int report_command(const ReportOptions& opt) {
@@ -54,6 +85,7 @@ int report_command(const ReportOptions& opt) {
   std::vector<Scene> scenes;
   for (const std::string& f : files) scenes.push_back(load_scene(f));
   const std::string out = opt.out.empty() ? default_repo_path("reports/latest") : opt.out;
+  const Json baseline = check_baseline_first(opt);
 
   HarnessOptions hopt;
   hopt.backends = opt.backends;
@@ -122,7 +154,8 @@ int report_command(const ReportOptions& opt) {
     for (const std::string& dir : find_toss_datasets(opt.inputs))
       in.tosses += tosses_report_section(dir, tmp.string(), opt.backends, par.threads());
     const std::string summary = report_summary_markdown(scenes, evs, in);
-    const std::string details = report_details_markdown(scenes, evs, figures_ok, views_ok);
+    const std::string details =
+        report_details_markdown(scenes, evs, tmp.string(), figures_ok, views_ok);
     write_text((tmp / "report.md").string(), summary);
     write_text((tmp / "details.md").string(), details);
     write_report_pages(tmp.string(), scenes, evs, summary, details, views_ok);
@@ -149,7 +182,7 @@ int report_command(const ReportOptions& opt) {
             << fmt_num(clock.seconds(), 3) << " s; " << disagreeing
             << " scenes with a disagreeing backend; " << failed << " [expect] failures; "
             << par.ranks() << " rank(s) x " << par.threads() << " thread(s))\n";
-  return 0;
+  return opt.check ? check_report_run(opt, baseline, scenes, evs, in.explore, clock) : 0;
 }
 
 }  // namespace rbx

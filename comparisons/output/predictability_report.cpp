@@ -1,5 +1,6 @@
 #include "comparisons/output/predictability_report.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
@@ -21,6 +22,30 @@ std::string verdict_text(const Json& b) {
   const std::string v = b["step_test"].value("verdict", "none");
   return v == "physics" ? "the physics'" : v == "engine" ? "the engine's" : "-";
 }
+
+// The figure line of a scene's ensemble, when the figure was drawn.
+std::string figure_line(const std::string& title, const std::string& slug,
+                        const std::string& report_dir, bool figures_ok) {
+  const std::string file = "figures/ensemble_" + slug + ".png";
+  if (!figures_ok || !std::filesystem::exists(std::filesystem::path(report_dir) / file)) return "";
+  return "![final positions of the copies, " + md_escape(title) + "](" + file + ")\n\n";
+}
+
+// What the section measures, as both versions open it.
+const char* kIntro =
+    "How far each engine's outcome spreads when the start is nudged by a tiny random "
+    "amount (Chung & Pollard 2016: a tuned engine can take another sequence of contacts, "
+    "and end elsewhere, after a change far below any measurement). Each scene with an "
+    "`[ensemble]` table runs that many nudged copies through every dynamics backend "
+    "(docs/ensemble.md). *Spread*: the root mean square distance of the copies' final "
+    "states from their mean, the largest over the moving bodies; *amplification*: that "
+    "spread over the input's (order 1: the outcome is as smooth as the nudge; thousands: a "
+    "discontinuity was crossed); *contact sequences*: the distinct orders in which pairs "
+    "and features (face, edge, vertex) first touch; *clusters*: groups of final positions. "
+    "With the step test the same copies run at a ten times smaller step: a spread that "
+    "stays (ratio 0.5 to 2) is the physics' (the truth itself is that sensitive), one that "
+    "changes is the engine's. The scorecard's *predictability* is the median position "
+    "amplification over a family's ensembles.\n\n";
 
 // One scene's part: its nudges, the table, the sequences and the figure.
 std::string scene_part(const std::string& title, const std::string& slug, const Json& e,
@@ -82,14 +107,54 @@ std::string scene_part(const std::string& title, const std::string& slug, const 
     md << "`" << md_escape(first.value("sequence", "")) << "` (" << first.value("copies", 0L)
        << ")\n";
   }
-  md << "\n";
-  const std::string file = "figures/ensemble_" + slug + ".png";
-  if (figures_ok && std::filesystem::exists(std::filesystem::path(report_dir) / file))
-    md << "![final positions of the copies, " << md_escape(title) << "](" << file << ")\n\n";
+  md << "\n" << figure_line(title, slug, report_dir, figures_ok);
   return md.str();
 }
 
 }  // namespace
+
+std::string predictability_summary_markdown(const std::vector<Scene>& scenes,
+                                            const std::vector<SceneEvaluation>& evs,
+                                            const std::string& report_dir, bool figures_ok) {
+  std::vector<size_t> with;        // scenes with an ensemble
+  std::vector<std::string> names;  // backends, in the order the ensembles list them
+  for (size_t i = 0; i < scenes.size() && i < evs.size(); ++i) {
+    if (!evs[i].json.contains("ensemble")) continue;
+    with.push_back(i);
+    for (const auto& [name, b] : evs[i].json["ensemble"]["backends"].items())
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  }
+  if (with.empty()) return "";
+  std::vector<std::string> header = {"backend"};
+  for (size_t i : with) header.push_back(md_escape(evs[i].family + "/" + scenes[i].name));
+  Table t(header);
+  for (const std::string& name : names) {
+    std::vector<std::string> cells = {"**" + md_escape(name) + "**"};
+    for (size_t i : with) {
+      const Json& bs = evs[i].json["ensemble"]["backends"];
+      if (!bs.contains(name)) {
+        cells.push_back("·");
+        continue;
+      }
+      const Json& b = bs[name];
+      const std::string verdict = verdict_text(b);
+      cells.push_back(num(b, "amplification") + (verdict == "-" ? "" : ", " + verdict));
+    }
+    t.add(cells);
+  }
+  std::ostringstream md;
+  md << "## Predictability\n\n"
+     << kIntro
+     << "Each cell: the position amplification and, where the scene asks for the step test, "
+        "whose spread it is. Every scene's table (spreads, copies failed, contact sequences, "
+        "clusters, the ratio at dt / 10) and each backend's most frequent contact sequence: "
+        "[details.md](details.md) (its section *Predictability*).\n\n"
+     << t.markdown() << "\n";
+  for (size_t i : with)
+    md << figure_line(evs[i].family + "/" + scenes[i].name,
+                      scene_slug(evs[i].family, scenes[i].file), report_dir, figures_ok);
+  return md.str();
+}
 
 std::string predictability_markdown(const std::vector<Scene>& scenes,
                                     const std::vector<SceneEvaluation>& evs,
@@ -102,21 +167,7 @@ std::string predictability_markdown(const std::vector<Scene>& scenes,
                         report_dir, figures_ok);
   }
   if (parts.str().empty()) return "";
-  return "## Predictability\n\n"
-         "How far each engine's outcome spreads when the start is nudged by a tiny random "
-         "amount (Chung & Pollard 2016: a tuned engine can take another sequence of contacts, "
-         "and end elsewhere, after a change far below any measurement). Each scene with an "
-         "`[ensemble]` table runs that many nudged copies through every dynamics backend "
-         "(docs/ensemble.md). *Spread*: the root mean square distance of the copies' final "
-         "states from their mean, the largest over the moving bodies; *amplification*: that "
-         "spread over the input's (order 1: the outcome is as smooth as the nudge; thousands: a "
-         "discontinuity was crossed); *contact sequences*: the distinct orders in which pairs "
-         "and features (face, edge, vertex) first touch; *clusters*: groups of final positions. "
-         "With the step test the same copies run at a ten times smaller step: a spread that "
-         "stays (ratio 0.5 to 2) is the physics' (the truth itself is that sensitive), one that "
-         "changes is the engine's. The scorecard's *predictability* is the median position "
-         "amplification over a family's ensembles.\n\n" +
-         parts.str();
+  return std::string("## Predictability\n\n") + kIntro + parts.str();
 }
 
 }  // namespace rbx

@@ -20,4 +20,12 @@ std::string predictability_markdown(const std::vector<Scene>& scenes,
                                     const std::vector<SceneEvaluation>& evs,
                                     const std::string& report_dir, bool figures_ok);
 
+/// The same section as report.md's summary shows it: one table, a row per backend and a column
+/// per scene with an ensemble, each cell the position amplification and, with the step test,
+/// whose spread it is; then the scenes' figures; the full tables are named in details.md. ""
+/// when no scene has an ensemble.
+std::string predictability_summary_markdown(const std::vector<Scene>& scenes,
+                                            const std::vector<SceneEvaluation>& evs,
+                                            const std::string& report_dir, bool figures_ok);
+
 }  // namespace rbx

@@ -186,10 +186,10 @@ std::string report_summary_markdown(const std::vector<Scene>& scenes,
         "[laws.csv](laws.csv), [results.json](results.json).\n\n";
   md << glance_markdown(rows);
   // The causes name one scene each here; details.md names every one.
-  md << scorecard_markdown(rows) << causes_markdown(causes, true, in.views_ok);
+  md << scorecard_matrix_markdown(rows) << causes_markdown(causes, true, in.views_ok);
   md << error_vs_runtime_markdown(evs, in.report_dir, in.figures_ok, in.figures_msg);
   md << contact_laws_markdown(scenes, evs, cols, in.report_dir, in.figures_ok);
-  md << predictability_markdown(scenes, evs, in.report_dir, in.figures_ok);
+  md << predictability_summary_markdown(scenes, evs, in.report_dir, in.figures_ok);
   md << explore_markdown(in.explore, in.explore_set);
   md << in.tosses;
   md << backends_markdown(cols);

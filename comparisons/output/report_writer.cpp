@@ -13,6 +13,7 @@
 #include "comparisons/eval/trajectory.h"
 #include "comparisons/output/figure_script.h"
 #include "comparisons/output/law_report.h"
+#include "comparisons/output/predictability_report.h"
 #include "comparisons/output/scorecard.h"
 #include "comparisons/output/table.h"
 #include "engine/format.h"
@@ -448,7 +449,10 @@ std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs,
     if (figures_ok && std::filesystem::exists(std::filesystem::path(report_dir) / file))
       md << "![error against run time, " << f << "](" << file << ")\n\n";
   }
-  md << solver_budgets_markdown(evs);
+  if (!budget_rows(evs).empty())
+    md << "Along each solver's iteration budget (the right-hand panels): the smallest budget "
+          "that reaches each backend's own converged error, per family, is in "
+          "[details.md](details.md) (its section *Solver budgets*; docs/solver_budgets.md).\n\n";
   return md.str();
 }
 
@@ -456,10 +460,11 @@ std::string solver_budgets_markdown(const std::vector<SceneEvaluation>& evs) {
   const std::vector<BudgetRow> rows = budget_rows(evs);
   if (rows.empty()) return "";
   std::ostringstream md;
-  md << "### Solver budgets\n\n"
+  md << "## Solver budgets\n\n"
         "Each dynamics backend with an iteration budget is also run at the scene's own step "
-        "along that budget (the right-hand panel of each figure above; `sweep.csv`, kind "
-        "`budget`), measured against the same truth as the step sweep. A backend's own "
+        "along that budget (the right-hand panel of each error-against-run-time figure in "
+        "report.md; `sweep.csv`, kind `budget`), measured against the same truth as the step "
+        "sweep. A backend's own "
         "converged error on a scene is its error at the largest budget; the table gives the "
         "smallest budget from which every larger one is within "
      << fmt_num(100 * kBudgetConvergedRel, 3) << " % of it (or both are round-off, under "
@@ -510,8 +515,8 @@ Json geometry_json(const Scene& scene) {
 }
 
 std::string report_details_markdown(const std::vector<Scene>& scenes,
-                                    const std::vector<SceneEvaluation>& evs, bool figures_ok,
-                                    bool views_ok) {
+                                    const std::vector<SceneEvaluation>& evs,
+                                    const std::string& report_dir, bool figures_ok, bool views_ok) {
   std::ostringstream md;
   const std::vector<std::string> cols = report_columns(evs);
   md << "# rbx accuracy report: every table\n\n"
@@ -526,7 +531,9 @@ std::string report_details_markdown(const std::vector<Scene>& scenes,
      << disagreement_section(scenes, evs, cols);
   if (const std::string q = query_time_markdown(evs, cols); !q.empty())
     md << "## Contact query time\n\n" << q;
+  md << solver_budgets_markdown(evs);
   md << stability_section(scenes, evs) << contact_laws_details_markdown(scenes, evs, cols)
+     << predictability_markdown(scenes, evs, report_dir, figures_ok)
      << scene_details_section(scenes, evs, figures_ok, views_ok);
   return md.str();
 }

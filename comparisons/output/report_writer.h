@@ -30,12 +30,13 @@ std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs,
 std::string solver_budgets_markdown(const std::vector<SceneEvaluation>& evs);
 
 /// details.md: the scorecard with every failing scene named, the summary of every scene for
-/// every backend, contact phase, who disagrees and why, contact query time, stability and every
-/// scene's detail.
-/// `figures_ok` and `views_ok` say whether the figures and replay pages were written.
+/// every backend, contact phase, who disagrees and why, contact query time, solver budgets,
+/// stability, contact laws, every ensemble's table (predictability) and every scene's detail.
+/// `figures_ok` and `views_ok` say whether the figures (in `report_dir`) and replay pages were
+/// written.
 std::string report_details_markdown(const std::vector<Scene>& scenes,
-                                    const std::vector<SceneEvaluation>& evs, bool figures_ok,
-                                    bool views_ok);
+                                    const std::vector<SceneEvaluation>& evs,
+                                    const std::string& report_dir, bool figures_ok, bool views_ok);
 
 /// results.json, metrics.csv, sweep.csv and stability.csv into `dir`.
 void write_report_tables(const std::string& dir, const std::vector<Scene>& scenes,

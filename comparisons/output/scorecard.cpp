@@ -11,6 +11,7 @@
 #include "comparisons/eval/law_residuals.h"
 #include "comparisons/output/table.h"
 #include "engine/format.h"
+#include "reference/backend.h"
 
 namespace rbx {
 
@@ -332,6 +333,70 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
     md << t.markdown() << "\n";
     k = end;
   }
+  return md.str();
+}
+
+std::string scorecard_matrix_markdown(const std::vector<ScoreRow>& rows) {
+  // Groups in scorecard order; in each, a backend's rank is its row's place.
+  std::vector<std::pair<size_t, size_t>> groups;  // [begin, end) of each group's rows
+  for (size_t k = 0; k < rows.size();) {
+    size_t end = k;
+    while (end < rows.size() && rows[end].family == rows[k].family &&
+           rows[end].measure == rows[k].measure)
+      ++end;
+    groups.emplace_back(k, end);
+    k = end;
+  }
+  // Backends in the registry's order (those registered at run time after, by name).
+  std::vector<std::string> names;
+  for (const ScoreRow& r : rows)
+    if (std::find(names.begin(), names.end(), r.backend) == names.end()) names.push_back(r.backend);
+  auto registry_index = [](const std::string& name) {
+    const std::vector<Backend>& table = backends();
+    for (size_t i = 0; i < table.size(); ++i)
+      if (table[i].name == name) return i;
+    return table.size();
+  };
+  std::stable_sort(names.begin(), names.end(), [&](const std::string& a, const std::string& b) {
+    return std::make_tuple(registry_index(a), a) < std::make_tuple(registry_index(b), b);
+  });
+  std::vector<std::string> header = {"backend"};
+  for (const auto& [begin, end] : groups)
+    header.push_back(md_escape(rows[begin].family) + " (" +
+                     (rows[begin].measure == Measure::Contact ? "contacts"
+                      : rows[begin].measure == Measure::Mass  ? "mass"
+                                                              : "dynamics") +
+                     ")");
+  Table t(header);
+  for (const std::string& name : names) {
+    std::vector<std::string> cells = {"**" + md_escape(name) + "**"};
+    for (const auto& [begin, end] : groups) {
+      std::string cell = "";
+      for (size_t r = begin; r < end; ++r) {
+        if (rows[r].backend != name) continue;
+        const ScoreRow& row = rows[r];
+        std::string median = "-";
+        if (!row.error.empty())
+          median = row.measure == Measure::Contact ? fmt_err(median_of(row.error), "°") + " / " +
+                                                         fmt_err(median_of(row.depth_error), "")
+                                                   : fmt_err(median_of(row.error), "");
+        cell = "#" + std::to_string(r - begin + 1) + " " + median + ", " +
+               std::to_string(row.within) + "/" + std::to_string(row.run);
+      }
+      cells.push_back(cell.empty() ? "·" : cell);
+    }
+    t.add(cells);
+  }
+  std::ostringstream md;
+  md << "## Scorecard\n\n"
+        "Each cell: the backend's rank in its family (by median error against the truth, then "
+        "scenes within tolerance, worst error and run time), its median error (contacts: normal "
+        "angle / depth in m; dynamics: post-impact velocity error, kinetic-energy norm; mass: "
+        "relative error) and its scenes within tolerance of those it ran; · where it ran none. "
+        "Each family's ranked table, with the worst error, the run time (and with the library's "
+        "shapes prebuilt), the worst contact-law residual and the predictability, is in "
+        "[details.md](details.md) (its section *Scorecard*).\n\n"
+     << t.markdown() << "\n";
   return md.str();
 }
 

@@ -72,8 +72,13 @@ std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
 /// The heading of a row's group: the family, and the measure with its unit.
 std::string group_title(const ScoreRow& row);
 
-/// The scorecard in Markdown: one ranked table per group.
+/// The scorecard in Markdown: one ranked table per group (details.md).
 std::string scorecard_markdown(const std::vector<ScoreRow>& rows);
+
+/// The scorecard at a glance (report.md): one table, a row per backend and a column per group,
+/// each cell the backend's rank in that group, its median error and its scenes within tolerance
+/// of those run. Its length grows with the backends, not with the scenes or the families' rows.
+std::string scorecard_matrix_markdown(const std::vector<ScoreRow>& rows);
 
 /// The measured causes of the failures: every cause with every scene, or `compact`, one line
 /// per backend with each cause's count and one scene; scenes link their replay pages when

@@ -77,6 +77,31 @@ TEST(Predictability, EachSceneHasItsTableWithTheStepTestsVerdictAndItsTextStaysT
   EXPECT_EQ(predictability_markdown(none_s, none_e, "", false), "");
 }
 
+TEST(Predictability, TheSummaryIsOneRowPerBackendWithTheDetailsOneLinkAway) {
+  std::vector<Scene> scenes;
+  std::vector<SceneEvaluation> evs;
+  add_scene(scenes, evs, "seed", "plain", {});
+  add_scene(scenes, evs, "seed", "edge_*drop*", {{"custom", 130.0}, {"ode", 250.0}}, "engine");
+  add_scene(scenes, evs, "friction", "spin", {{"custom", 2.0}});
+  const std::string md = predictability_summary_markdown(scenes, evs, "", false);
+  EXPECT_NE(md.find("## Predictability"), std::string::npos);
+  // A column per scene with an ensemble (its name as text), a row per backend; a backend the
+  // scene did not run gets a dot; the step test's verdict where the scene has one.
+  EXPECT_NE(md.find("| backend | seed/edge\\_\\*drop\\* | friction/spin |"), std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| **custom** | 1.3e+02, the engine's | 2 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| **ode** | 2.5e+02, the engine's | · |"), std::string::npos) << md;
+  // No per-scene tables or sequences: those are in details.md, linked.
+  EXPECT_EQ(md.find("###"), std::string::npos) << md;
+  EXPECT_EQ(md.find("A-B:edge"), std::string::npos) << md;
+  EXPECT_NE(md.find("[details.md](details.md) (its section *Predictability*)"), std::string::npos)
+      << md;
+  std::vector<Scene> none_s;
+  std::vector<SceneEvaluation> none_e;
+  add_scene(none_s, none_e, "seed", "plain", {});
+  EXPECT_EQ(predictability_summary_markdown(none_s, none_e, "", false), "");
+}
+
 TEST(Predictability, TheScorecardShowsTheMedianAmplificationOfAFamilysEnsembles) {
   // friction: three ensembles (custom 10, 30, 1000: median 30) and a scene without one; seed:
   // none, so its table has no predictability column.

@@ -123,9 +123,24 @@ TEST(ReportPages, LinksResolveUnitsFollowTheMetricAndSceneTextStaysText) {
                 .find("\"colour\":\"" + backend_colour("custom") + "\""),
             std::string::npos);
 
-  // The unit of a row follows what it measures.
-  const std::string md = read(out / "report.md");
-  // One family, two measures: one ranked table each, in its own unit.
+  // The unit of a row follows what it measures. The summary's scorecard: one column per family
+  // and measure, the contact column in degrees, the dynamics one not.
+  const std::string summary = read(out / "report.md");
+  const size_t header = summary.find("| backend | mixed (contacts) | mixed (dynamics) |");
+  ASSERT_NE(header, std::string::npos) << summary;
+  const size_t custom_row = summary.find("\n| **custom** | #", header);
+  ASSERT_NE(custom_row, std::string::npos) << summary;
+  const std::string cells =
+      summary.substr(custom_row + 16, summary.find('\n', custom_row + 1) - custom_row - 16);
+  const size_t split = cells.find(" | ");
+  ASSERT_NE(split, std::string::npos) << cells;
+  const std::string dynamics_cell =
+      cells.substr(split + 3, cells.find(" | ", split + 3) - split - 3);
+  EXPECT_NE(cells.substr(0, split).find("°"), std::string::npos) << cells;
+  EXPECT_NE(dynamics_cell.find("#"), std::string::npos) << cells;
+  EXPECT_EQ(dynamics_cell.find("°"), std::string::npos) << cells;
+  // details.md: one family, two measures: one ranked table each, in its own unit.
+  const std::string md = read(out / "details.md");
   const size_t contacts = md.find("### mixed — contacts:");
   const size_t dynamics = md.find("### mixed — dynamics:");
   ASSERT_NE(contacts, std::string::npos) << md;

@@ -1,0 +1,67 @@
+// The scorecard at a glance (output/scorecard.h): report.md's one table, a row per backend and a
+// column per family and measure, each cell the rank, the median error and the scenes within
+// tolerance, in the unit of its column.
+#include "comparisons/output/scorecard.h"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace rbx {
+namespace {
+
+ScoreRow row(const std::string& backend, const std::string& family, Measure m,
+             std::vector<double> error, int run, int within) {
+  ScoreRow r;
+  r.backend = backend;
+  r.family = family;
+  r.measure = m;
+  r.error = std::move(error);
+  if (m == Measure::Contact) r.depth_error.assign(r.error.size(), 1e-3);
+  r.run = run;
+  r.within = within;
+  return r;
+}
+
+// The table's line that starts with `start`.
+std::string line_of(const std::string& md, const std::string& start) {
+  std::istringstream in(md);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(start, 0) == 0) return line;
+  return "";
+}
+
+TEST(ScorecardMatrix, OneRowPerBackendInRegistryOrderAndEachCellInItsColumnsUnit) {
+  // Rows as score_rows ranks them: per group, best first. `bullet` ran no mass scene; the
+  // registry lists `custom` before `bullet` whatever the ranks.
+  const std::vector<ScoreRow> rows = {
+      row("bullet", "contact", Measure::Contact, {0.5, 1.5}, 2, 1),
+      row("custom", "contact", Measure::Contact, {2.0, 4.0}, 2, 2),
+      row("custom", "seed", Measure::Dynamics, {1e-15}, 3, 3),
+      row("bullet", "seed", Measure::Dynamics, {0.25}, 3, 0),
+      row("custom", "mass", Measure::Mass, {}, 1, 1),
+  };
+  const std::string md = scorecard_matrix_markdown(rows);
+  EXPECT_NE(md.find("## Scorecard"), std::string::npos);
+  EXPECT_NE(md.find("| backend | contact (contacts) | seed (dynamics) | mass (mass) |"),
+            std::string::npos)
+      << md;
+  EXPECT_LT(md.find("| **custom** |"), md.find("| **bullet** |"));
+  // custom: second on contacts (median 3 degrees, 1 mm), first on seed, no truth on mass.
+  EXPECT_EQ(line_of(md, "| **custom** |"),
+            "| **custom** | #2 3° / 0.001, 2/2 | #1 1e-15, 3/3 | #1 -, 1/1 |")
+      << md;
+  EXPECT_EQ(line_of(md, "| **bullet** |"), "| **bullet** | #1 1° / 0.001, 1/2 | #2 0.25, 0/3 | · |")
+      << md;
+  // The full ranked tables are one link away.
+  EXPECT_NE(md.find("[details.md](details.md) (its section *Scorecard*)"), std::string::npos);
+  // A backend name is text, not markup.
+  const std::string odd =
+      scorecard_matrix_markdown({row("my_*x*", "seed", Measure::Dynamics, {0.1}, 1, 1)});
+  EXPECT_NE(odd.find("| **my\\_\\*x\\*** | #1 0.1, 1/1 |"), std::string::npos) << odd;
+}
+
+}  // namespace
+}  // namespace rbx
