@@ -132,9 +132,54 @@ Json trajectory_json(const std::vector<StateSample>& samples, const std::vector<
   return {{"time", jt}, {"bodies", bodies}};
 }
 
+namespace {
+
+// The scene's `bodies`: per body and mass property, the value most backends report (ties: the
+// first backend's); each backend's body entry then drops the properties equal to it.
+void share_mass_properties(Json& scene) {
+  Json shared = Json::object();
+  for (const auto& [backend, b] : scene["backends"].items()) {
+    if (!b.contains("bodies") || !b["bodies"].is_object()) continue;
+    for (const auto& [body, entry] : b["bodies"].items())
+      for (const char* key : kMassProperties) {
+        if (!entry.contains(key)) continue;
+        if (!shared.contains(body)) shared[body] = Json::object();
+        if (shared[body].contains(key)) continue;
+        // Count, over every backend, who reports this value; keep the first value with the most.
+        size_t best = 0;
+        Json best_value;
+        for (const auto& [first, fb] : scene["backends"].items()) {
+          if (!fb.contains("bodies") || !fb["bodies"].contains(body) ||
+              !fb["bodies"][body].contains(key))
+            continue;
+          const Json& v = fb["bodies"][body][key];
+          size_t n = 0;
+          for (const auto& [other, ob] : scene["backends"].items())
+            n += ob.contains("bodies") && ob["bodies"].contains(body) &&
+                 ob["bodies"][body].contains(key) && ob["bodies"][body][key] == v;
+          if (n > best) best = n, best_value = v;
+        }
+        shared[body][key] = best_value;
+      }
+  }
+  if (shared.empty()) return;
+  for (auto& [backend, b] : scene["backends"].items()) {
+    if (!b.contains("bodies") || !b["bodies"].is_object()) continue;
+    for (auto& [body, entry] : b["bodies"].items())
+      for (const char* key : kMassProperties)
+        if (entry.contains(key) && entry[key] == shared[body][key]) entry.erase(key);
+  }
+  scene["bodies"] = shared;
+}
+
+}  // namespace
+
 Json results_scene_json(const Json& scene_result) {
   Json j = scene_result;
+  j.erase("metrics");
+  j.erase("sweep");
   if (!j.contains("backends")) return j;
+  share_mass_properties(j);
   for (auto& [name, b] : j["backends"].items()) {
     if (!b.contains("contacts") || !b["contacts"].is_array()) continue;
     const size_t total = b["contacts"].size();

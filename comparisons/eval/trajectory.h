@@ -39,11 +39,21 @@ Json trajectory_json(const std::vector<StateSample>& samples, const std::vector<
 
 /// Events kept per backend in results.json: a resting stack reports a contact every step
 /// (16 000 for Bullet), which made results.json 27.8 MB; the count is kept as `contacts_total`.
-/// 50 keeps the library's results under 5 MB; `rbx run SCENE --json` writes every event.
-constexpr size_t kResultsMaxEvents = 50;
+/// The first 20 show how each backend's contacts begin; `rbx run SCENE --json` writes every
+/// event.
+constexpr size_t kResultsMaxEvents = 20;
 
-/// A scene's result object for results.json: each backend's `contacts` cut to the first
-/// kResultsMaxEvents (with `contacts_total`, and `contacts_truncated` when cut).
+/// The mass properties a body entry may carry (bodies.NAME.*, docs/contract.md).
+inline constexpr const char* kMassProperties[] = {"mass", "static", "center_of_mass", "inertia"};
+
+/// A scene's result object for results.json, the report's data, kept within its size budget
+/// without losing a number:
+/// - `metrics` and `sweep` are left out: metrics.csv and sweep.csv hold every one of them;
+/// - the scene's `bodies` holds each body's mass properties as most backends report them (ties:
+///   the first backend's), and a backend's body entry keeps only the properties that differ
+///   from them (its `final` state always);
+/// - each backend's `contacts` are cut to the first kResultsMaxEvents (with `contacts_total`,
+///   and `contacts_truncated` when cut).
 Json results_scene_json(const Json& scene_result);
 
 }  // namespace rbx

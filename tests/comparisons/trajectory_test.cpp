@@ -114,5 +114,50 @@ TEST(Trajectory, ResultsKeepTheFirstEventsAndTheirCount) {
   EXPECT_FALSE(out["backends"]["few"].contains("contacts_truncated"));
 }
 
+TEST(Trajectory, ResultsShareTheMassPropertiesMostBackendsReportAndKeepEveryOtherValue) {
+  // Three backends on two bodies: `seed` simulates A with another inertia (a point-mass model);
+  // every final state stays with its backend.
+  const Json inertia = Json::array({{1, 0, 0}, {0, 1, 0}, {0, 0, 1}});
+  const Json other = Json::array({{2, 0, 0}, {0, 2, 0}, {0, 0, 2}});
+  auto body = [](double mass, const Json& i, double x) {
+    return Json{{"mass", mass},
+                {"static", false},
+                {"center_of_mass", {x, 0, 0}},
+                {"inertia", i},
+                {"final", {{"position", {x + 1, 0, 0}}}}};
+  };
+  const Json scene = {
+      {"metrics", Json::array({{{"name", "velocity_err_ke"}}})},
+      {"sweep", Json::array({{{"dt", 0.01}}})},
+      {"backends",
+       {{"custom", {{"bodies", {{"A", body(1, inertia, 0)}, {"B", body(2, inertia, 5)}}}}},
+        {"seed", {{"bodies", {{"A", body(1, other, 0)}, {"B", body(2, inertia, 5)}}}}},
+        {"ode", {{"bodies", {{"A", body(1, inertia, 0)}, {"B", body(2, inertia, 5.5)}}}}}}}};
+  const Json out = results_scene_json(scene);
+  // metrics.csv and sweep.csv hold these.
+  EXPECT_FALSE(out.contains("metrics"));
+  EXPECT_FALSE(out.contains("sweep"));
+  // The scene's block: what most backends report.
+  EXPECT_EQ(out["bodies"]["A"]["inertia"], inertia);
+  EXPECT_EQ(out["bodies"]["B"]["center_of_mass"], Json::array({5, 0, 0}));
+  EXPECT_EQ(out["bodies"]["B"]["mass"], 2);
+  // Each backend keeps what differs, and its final state.
+  EXPECT_EQ(out["backends"]["seed"]["bodies"]["A"]["inertia"], other);
+  EXPECT_FALSE(out["backends"]["seed"]["bodies"]["A"].contains("mass"));
+  EXPECT_EQ(out["backends"]["ode"]["bodies"]["B"]["center_of_mass"], Json::array({5.5, 0, 0}));
+  EXPECT_FALSE(out["backends"]["custom"]["bodies"]["A"].contains("inertia"));
+  for (const char* b : {"custom", "seed", "ode"})
+    for (const char* name : {"A", "B"})
+      EXPECT_TRUE(out["backends"][b]["bodies"][name].contains("final")) << b << " " << name;
+  // Reading it back: a backend's value is its own where it has one, else the scene's.
+  for (const auto& [b, entry] : scene["backends"].items())
+    for (const auto& [name, original] : entry["bodies"].items())
+      for (const char* key : kMassProperties) {
+        const Json& mine = out["backends"][b]["bodies"][name];
+        EXPECT_EQ(mine.contains(key) ? mine[key] : out["bodies"][name][key], original[key])
+            << b << " " << name << " " << key;
+      }
+}
+
 }  // namespace
 }  // namespace rbx
