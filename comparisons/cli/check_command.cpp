@@ -32,9 +32,30 @@ void print_changes(const CheckDiff& d, const CheckRun& run) {
 
 }  // namespace
 
+std::string check_baseline_path(const ReportOptions& opt) {
+  return opt.baseline.empty() ? default_repo_path("reports/baseline.json") : opt.baseline;
+}
+
+CheckDiff print_check(const Json& base, const CheckRun& run, const CheckSettings& set,
+                      size_t scenes) {
+  const CheckDiff d = diff_check(base, run, set);
+  print_changes(d, run);
+  const double base_rt = base.value("runtime_s", 0.0);
+  std::cout << "check: " << run.now.size() << " metrics over " << scenes
+            << " scenes: " << d.worse + d.missing << " worse, " << d.better << " better, "
+            << d.added << " new; run time " << fmt_num(run.runtime_s, 3) << " s (baseline "
+            << fmt_num(base_rt, 3) << " s; timings never fail the check";
+  if (!run.cache_dir.empty() && run.cacheable > 0)
+    std::cout << "; " << run.cached << " of " << run.cacheable << " reference runs from the cache, "
+              << run.cache_dir;
+  std::cout << ")\n";
+  if (d.better > 0 && d.worse + d.missing == 0)
+    std::cout << "check: some errors shrank; rbx check --update records them\n";
+  return d;
+}
+
 int check_command(const ReportOptions& opt) {
-  const std::string baseline_path =
-      opt.baseline.empty() ? default_repo_path("reports/baseline.json") : opt.baseline;
+  const std::string baseline_path = check_baseline_path(opt);
   std::vector<Scene> scenes;
   for (const std::string& f : collect_scene_files(opt.inputs)) scenes.push_back(load_scene(f));
   // With --backends only those backends' metrics are compared (and merged by --update).
@@ -46,28 +67,14 @@ int check_command(const ReportOptions& opt) {
   // The measured tosses when the whole library is checked.
   set.tosses = opt.tosses || opt.inputs.empty();
   set.use_cache = !opt.no_cache;
+  set.threads = opt.threads;
   set.registry = opt.registry;
 
   const CheckRun run = measure_check(scenes, set);
   const Json base = read_baseline(baseline_path, opt.update);
-  const CheckDiff d = diff_check(base, run, set);
-  print_changes(d, run);
-  const double base_rt = base.value("runtime_s", 0.0);
-  std::cout << "check: " << run.now.size() << " metrics over " << scenes.size()
-            << " scenes: " << d.worse + d.missing << " worse, " << d.better << " better, "
-            << d.added << " new; run time " << fmt_num(run.runtime_s, 3) << " s (baseline "
-            << fmt_num(base_rt, 3) << " s; timings never fail the check";
-  if (!run.cache_dir.empty() && run.cacheable > 0)
-    std::cout << "; " << run.cached << " of " << run.cacheable << " reference runs from the cache, "
-              << run.cache_dir;
-  std::cout << ")\n";
-
+  const CheckDiff d = print_check(base, run, set, scenes.size());
   const int worse = d.worse + d.missing;
-  if (!opt.update) {
-    if (d.better > 0 && worse == 0)
-      std::cout << "check: some errors shrank; rbx check --update records them\n";
-    return worse > 0 ? 1 : 0;
-  }
+  if (!opt.update) return worse > 0 ? 1 : 0;
   // --update: refused while anything is worse, unless the researcher accepts it explicitly.
   if (worse > 0 && !opt.accept_worse) {
     std::cout

@@ -63,6 +63,10 @@ void add_library_commands(CLI::App& app, Options& o) {
   report->add_option("--out", o.report.out, "output folder");
   report->add_option("--backends", o.report.backends, "comma-separated backend names");
   report->add_option("--threads", o.report.threads, "threads per rank (default: every core)");
+  report->add_flag("--check", o.report.check,
+                   "also compare this report's runs with reports/baseline.json as rbx check "
+                   "does (every backend); exit 1 when a metric is worse");
+  report->add_option("--baseline", o.report.baseline, "with --check: the baseline file");
   report->add_flag("--explore", o.report.explore,
                    "also summarise explore's fixed random samples (contact and impact kinds, seed "
                    "1): the default when no scene is named");
@@ -82,6 +86,8 @@ void add_library_commands(CLI::App& app, Options& o) {
                   "also run explore's fixed random samples (contact and impact kinds, seed 1): "
                   "the default when no scene is named");
   check->add_flag("--no-cache", o.check.no_cache, "rerun every reference library (no build/cache)");
+  check->add_option("--threads", o.check.threads,
+                    "threads the scenes spread over (default: every core)");
   CLI::App* bench = app.add_subcommand(
       "bench", "performance comparison (default: reports/latest, and reports/perf.md)");
   bench->add_option("--out", o.bench.out, "output folder");

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "comparisons/eval/explore_check.h"
+#include "comparisons/eval/regression_check.h"
 #include "comparisons/eval/select_backends.h"
 #include "comparisons/scene/scene_collection.h"
 #include "engine/scene.h"
@@ -61,12 +62,20 @@ struct ReportOptions {
   std::string backends;  // --backends LIST
   bool quiet = false;    // no progress line
   int threads = 0;       // report: threads per rank (0: the cores of the node, divided among ranks)
+  bool check = false;    // report --check: also compare this run with the baseline (rbx check)
 };
 
 /// `rbx report`: accuracy report over a scene library.
 int report_command(const ReportOptions& opt);
 /// `rbx check`: regression check of every accuracy metric against the baseline.
 int check_command(const ReportOptions& opt);
+/// The baseline a check compares with: --baseline, else reports/baseline.json.
+std::string check_baseline_path(const ReportOptions& opt);
+/// Compares a check's run with the baseline and prints what `rbx check` prints: every changed
+/// metric under its scene and backend, then the one-line verdict (`rbx check`, `rbx report
+/// --check`).
+CheckDiff print_check(const Json& base, const CheckRun& run, const CheckSettings& set,
+                      size_t scenes);
 
 /// The scene library as a markdown table (family, scene, description, checks, backends).
 std::string scene_table_markdown(const std::vector<std::string>& inputs);

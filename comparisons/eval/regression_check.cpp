@@ -12,7 +12,9 @@
 #include <map>
 
 #include "comparisons/eval/explore_check.h"
+#include "comparisons/eval/parallel.h"
 #include "comparisons/eval/result_cache.h"
+#include "comparisons/eval/scene_batch.h"
 #include "comparisons/eval/select_backends.h"
 #include "comparisons/eval/tosses.h"
 #include "comparisons/scene/scene_file.h"
@@ -92,7 +94,7 @@ bool known_failure_passes(const Scene& s, const SceneEvaluation& ev, std::string
 
 // Explore's fixed random samples: what no scene of the library shows (random poses, impacts at
 // a random phase). Every backend of the family (`selected` narrows it), the oracle aside.
-void measure_explore(const CheckSettings& set, CheckRun& run) {
+void measure_explore(const CheckSettings& set, const ParallelRun& par, CheckRun& run) {
   const std::vector<Backend>& table = set.registry ? *set.registry : backends();
   std::vector<std::string> contact, impact;
   for (const Backend& b : table) {
@@ -100,18 +102,17 @@ void measure_explore(const CheckSettings& set, CheckRun& run) {
     if (b.contact) contact.push_back(b.name);
     if (b.dynamics) impact.push_back(b.name);
   }
-  for (const ExploreCheckMetric& m :
-       explore_check_metrics(contact, impact, set.explore_samples, set.registry)) {
-    run.scene_in_run.insert(m.scene);
-    run.now[key_of(m.scene, m.metric)] = m.metric.value;
-  }
+  add_explore_metrics(
+      explore_check_metrics(contact, impact, set.explore_samples, set.registry, &par), set, run);
 }
+
+}  // namespace
 
 // The measured cube tosses' test split of every data set under scenes/: per dynamics backend at
 // its stored (fitted) parameters, as the report's first toss table, the median and 90th
 // percentile of the position error per toss and the median angle error, under the pseudo-scene
 // "tosses/FOLDER". The simulations are deterministic, so the metrics are exact repeats.
-void measure_tosses(const CheckSettings& set, CheckRun& run) {
+void add_toss_metrics(const CheckSettings& set, CheckRun& run) {
   const std::vector<Backend>& table = set.registry ? *set.registry : backends();
   for (const std::string& dir : find_toss_datasets({})) {
     const std::vector<Toss> tosses = read_tosses(toss_test_split(dir));
@@ -136,7 +137,34 @@ void measure_tosses(const CheckSettings& set, CheckRun& run) {
   }
 }
 
-}  // namespace
+void add_scene_metrics(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs,
+                       const CheckSettings& set, CheckRun& run) {
+  for (size_t i = 0; i < scenes.size() && i < evs.size(); ++i) {
+    const Scene& s = scenes[i];
+    const SceneEvaluation& ev = evs[i];
+    const std::string scene = scene_family(s.file) + "/" + s.name;
+    run.scene_in_run.insert(scene);
+    for (const Metric& m : ev.metrics)
+      if (m.name.find("err") != std::string::npos && set.selected(m.backend))
+        run.now[key_of(scene, m)] = m.value;
+    for (const auto& [name, bj] : ev.json["backends"].items())
+      if (ResultCache::caches(name)) {
+        ++run.cacheable;
+        run.cached += bj.value("cached", false) ? 1 : 0;
+      }
+    std::string subject;
+    if (known_failure_passes(s, ev, subject)) run.now_passing.push_back({scene, s.file, subject});
+  }
+}
+
+void add_explore_metrics(const std::vector<ExploreCheckMetric>& metrics, const CheckSettings& set,
+                         CheckRun& run) {
+  for (const ExploreCheckMetric& m : metrics) {
+    if (!set.selected(m.metric.backend)) continue;
+    run.scene_in_run.insert(m.scene);
+    run.now[key_of(m.scene, m.metric)] = m.metric.value;
+  }
+}
 
 bool CheckSettings::selected(const std::string& backend) const {
   return only.empty() || std::find(only.begin(), only.end(), backend) != only.end();
@@ -154,23 +182,13 @@ CheckRun measure_check(const std::vector<Scene>& scenes, const CheckSettings& se
   // A test's own table may name a broken copy like a library: it never reads or fills the cache.
   if (set.use_cache && !set.registry) run.cache_dir = hopt.cache_dir = ResultCache::default_dir();
   Stopwatch clock;
-  for (const Scene& s : scenes) {
-    const std::string scene = scene_family(s.file) + "/" + s.name;
-    run.scene_in_run.insert(scene);
-    const SceneEvaluation ev = evaluate_scene(s, hopt);
-    for (const Metric& m : ev.metrics)
-      if (m.name.find("err") != std::string::npos && set.selected(m.backend))
-        run.now[key_of(scene, m)] = m.value;
-    for (const auto& [name, bj] : ev.json["backends"].items())
-      if (ResultCache::caches(name)) {
-        ++run.cacheable;
-        run.cached += bj.value("cached", false) ? 1 : 0;
-      }
-    std::string subject;
-    if (known_failure_passes(s, ev, subject)) run.now_passing.push_back({scene, s.file, subject});
-  }
-  if (set.explore) measure_explore(set, run);
-  if (set.tosses) measure_tosses(set, run);
+  // Scenes spread over threads as the report spreads them; the evaluations come back in scene
+  // order, so the run is the same for any number of threads.
+  ParallelRun par(set.threads);
+  const std::vector<SceneEvaluation> evs = evaluate_scenes(par, scenes, hopt, [](size_t) {});
+  add_scene_metrics(scenes, evs, set, run);
+  if (set.explore) measure_explore(set, par, run);
+  if (set.tosses) add_toss_metrics(set, run);
   run.runtime_s = clock.seconds();
   return run;
 }

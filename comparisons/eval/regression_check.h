@@ -20,6 +20,7 @@ struct CheckSettings {
   ExploreCheckSet explore_samples;  // which samples (the baseline's set unless a test narrows it)
   bool tosses = false;              // also the measured cube tosses' test split (scenes/)
   bool use_cache = true;            // reference results from the cache
+  int threads = 0;                  // threads the scenes spread over (0: every core)
   /// Backends to choose from (nullptr: the registry); tests pass a table with a broken engine.
   const std::vector<Backend>* registry = nullptr;
   /// True when `backend`'s metrics are compared.
@@ -44,6 +45,16 @@ struct CheckRun {
 /// Runs every scene (and, with `set.explore`, explore's fixed samples; with `set.tosses`, the
 /// measured tosses).
 CheckRun measure_check(const std::vector<Scene>& scenes, const CheckSettings& set);
+
+/// The parts of a check, for a run whose scenes (or samples) were evaluated elsewhere (`rbx
+/// report --check` compares its own runs): every error metric of the scenes' evaluations (and
+/// the known failures that pass now), explore's fixed-sample metrics, and the measured tosses
+/// (run here: the report's toss tables keep no per-toss errors).
+void add_scene_metrics(const std::vector<Scene>& scenes, const std::vector<SceneEvaluation>& evs,
+                       const CheckSettings& set, CheckRun& run);
+void add_explore_metrics(const std::vector<ExploreCheckMetric>& metrics, const CheckSettings& set,
+                         CheckRun& run);
+void add_toss_metrics(const CheckSettings& set, CheckRun& run);
 
 /// The baseline file (InputError when unreadable or malformed; an absent one is an empty
 /// baseline when `may_be_absent`).
