@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # rbx: one entry point. First use installs missing Debian packages, configures CMake (Release,
 # build/), builds incrementally, then runs the compiled `rbx` with the same arguments.
-# `./rbx test [--sanitize]` builds and runs the whole test suite with ctest.
+# `./rbx test [--quick | --sanitize] [CTEST ARGS...]` builds and runs the test suite with ctest:
+# every tier (unit, scene, e2e: tests/CMakeLists.txt); --quick, the unit tier only (the one to run
+# while editing); --sanitize, the unit and scene tiers under ASan and UBSan in build-sanitize/.
+# Further arguments go to ctest (for example -R NAME).
 # `./rbx python [ARGS...]` builds the Python module and runs python3 with `import rbx` working.
 # `./rbx format [--check]` applies (or checks) clang-format on every tracked C++ source.
 # `./rbx fuzz [SECONDS]` builds the libFuzzer targets (tests/fuzz) with clang, ASan and UBSan in
@@ -163,12 +166,24 @@ targets=(--target rbx)  # the scene commands need the rbx executable only; `test
 if [ "${1:-}" = "python" ]; then
   targets=(--target _rbx)
 fi
+ctest_args=()
 if [ "${1:-}" = "test" ]; then
   targets=()
-  if [ "${2:-}" = "--sanitize" ]; then
-    build_dir=build-sanitize
-    cmake_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DRBX_SANITIZE=ON)
-  fi
+  shift
+  case "${1:-}" in
+    --sanitize)
+      build_dir=build-sanitize
+      cmake_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DRBX_SANITIZE=ON "-DRBX_TEST_TIERS=unit;scene")
+      ctest_args=(-L '^(unit|scene)$')
+      shift
+      ;;
+    --quick)
+      ctest_args=(-L '^unit$')
+      shift
+      ;;
+  esac
+  ctest_args+=("$@")
+  set -- test
 fi
 mkdir -p "$build_dir"
 log="$build_dir/rbx-build.log"
@@ -208,7 +223,7 @@ quiet cmake --build "$build_dir" -j "$jobs" "${targets[@]}"
 
 if [ "${1:-}" = "test" ]; then
   cd "$build_dir"
-  exec ctest --output-on-failure -j "$jobs"
+  exec ctest --output-on-failure -j "$jobs" "${ctest_args[@]}"
 fi
 cd "$caller"
 # `./rbx python [ARGS...]`: Debian's python3 (its numpy and matplotlib) with the module rbx
