@@ -313,6 +313,38 @@ TEST(Cli, CheckPassesOnItsOwnBaselineAndFailsOnOneClaimingSmallerErrors) {
   fs::remove_all(dir);
 }
 
+TEST(Cli, ReportCheckGivesTheChecksVerdictFromTheReportsOwnRuns) {
+  const fs::path dir = temp_dir("report_check");
+  const std::string base = (dir / "baseline.json").string();
+  const std::string scenes = "scenes/contact/axis_x.toml scenes/analytic/headon_e05.toml";
+  ASSERT_EQ(rbx("check " + scenes + " --baseline '" + base + "' --update").code, 0);
+  // The report's runs measure the same numbers as rbx check: nothing moved.
+  const CmdResult same = rbx("report " + scenes + " --check --baseline '" + base + "' --out '" +
+                             (dir / "same").string() + "'");
+  EXPECT_EQ(same.code, 0) << same.out << same.err;
+  EXPECT_NE(same.out.find(": 0 worse, 0 better, 0 new;"), std::string::npos) << same.out;
+  // Halve every non-zero error in the baseline: the report is written, and its check fails
+  // naming the worse metrics as rbx check names them.
+  nlohmann::json b;
+  std::ifstream(base) >> b;
+  for (auto& [k, v] : b["metrics"].items())
+    if (v.is_number() && v.get<double>() > 1e-9) v = v.get<double>() * 0.5;
+  std::ofstream(base) << b.dump(2);
+  const CmdResult worse = rbx("report " + scenes + " --check --baseline '" + base + "' --out '" +
+                              (dir / "worse").string() + "'");
+  EXPECT_EQ(worse.code, 1) << worse.out << worse.err;
+  EXPECT_NE(worse.out.find("    worse   "), std::string::npos) << worse.out;
+  EXPECT_TRUE(fs::exists(dir / "worse" / "report.md"));
+  // --check compares every backend's metrics: --backends beside it is bad input, and nothing
+  // is written.
+  const CmdResult narrowed = rbx("report " + scenes + " --check --backends custom --out '" +
+                                 (dir / "narrowed").string() + "'");
+  EXPECT_EQ(narrowed.code, 2);
+  EXPECT_NE(narrowed.err.find("--check"), std::string::npos) << narrowed.err;
+  EXPECT_FALSE(fs::exists(dir / "narrowed"));
+  fs::remove_all(dir);
+}
+
 TEST(LibraryContainment, AnAssertingLibraryIsItsBackendsErrorAndEveryOtherAnswerIsKept) {
   // FCL 0.7's EPA fails an assertion on this pose (compiled into rbx from FCL's headers, so no
   // library error hook sees it). It used to end rbx with SIGABRT (exit 134) and print nothing.
