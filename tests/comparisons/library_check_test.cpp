@@ -32,30 +32,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr size_t kMaxSummaryLines = 300;
-constexpr std::uintmax_t kMaxResultsBytes = 5'000'000;
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// "lines  heading" of each level-2 section of a Markdown text, longest first.
-std::string section_lengths(const std::string& md) {
-  std::vector<std::pair<size_t, std::string>> sections = {{0, "(before the first section)"}};
-  std::istringstream in(md);
-  for (std::string line; std::getline(in, line);) {
-    if (line.rfind("## ", 0) == 0) sections.emplace_back(0, line.substr(3));
-    ++sections.back().first;
-  }
-  std::sort(sections.rbegin(), sections.rend());
-  std::ostringstream out;
-  for (const auto& [n, heading] : sections) out << "  " << n << "  " << heading << "\n";
-  return out.str();
-}
-
 #ifdef __SANITIZE_ADDRESS__
 TEST(LibraryCheck, EveryMetricOfTheSceneFamiliesIsNoWorseThanTheBaseline) {
   // The sanitizer build checks the scene families only, without the external cases, the random
@@ -70,6 +46,30 @@ TEST(LibraryCheck, EveryMetricOfTheSceneFamiliesIsNoWorseThanTheBaseline) {
   EXPECT_EQ(check_command(opt), 0);
 }
 #else
+constexpr size_t kMaxSummaryLines = 300;
+constexpr std::uintmax_t kMaxResultsBytes = 5'000'000;
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// "lines  heading" of each level-2 section of a Markdown text, longest first.
+std::string section_lengths(const std::string& md) {
+  std::vector<std::pair<size_t, std::string> > sections = {{0, "(before the first section)"}};
+  std::istringstream in(md);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("## ", 0) == 0) sections.emplace_back(0, line.substr(3));
+    ++sections.back().first;
+  }
+  std::sort(sections.rbegin(), sections.rend());
+  std::ostringstream out;
+  for (const auto& [n, heading] : sections) out << "  " << n << "  " << heading << "\n";
+  return out.str();
+}
+
 TEST(LibraryCheck, EveryMetricIsNoWorseThanTheBaselineAndTheReportKeepsItsBudgets) {
   ReportOptions opt;
   opt.out = std::string(RBX_BINARY_DIR) + "/tests/full_report";
