@@ -158,8 +158,8 @@ std::string backends_markdown(const std::vector<std::string>& names) {
       t.add({"**" + md_escape(n) + "**", md_escape(b->description)});
   return "## Backends\n\nPlain names are the libraries as their own experts configure them; "
          "`-hull`, the same convex hulls the custom engine gets; `custom-seed`, the seed "
-         "document's algorithm; `exact`, the oracle (README: every setting and its "
-         "measurement).\n\n" +
+         "document's algorithm; `exact`, the oracle (docs/backends.md: every setting "
+         "and its measurement).\n\n" +
          t.markdown() + "\n";
 }
 
