@@ -47,6 +47,23 @@ class Progress {
   bool on_;
 };
 
+// Wall time of each part of a report, in the order they ran: where a slow report spends it.
+class PartTimes {
+ public:
+  void end(const char* part) {
+    const double now = clock_.seconds();
+    if (!line_.empty()) line_ += ", ";
+    line_ += std::string(part) + " " + fmt_num(now - last_, 3) + " s";
+    last_ = now;
+  }
+  const std::string& line() const { return line_; }
+
+ private:
+  Stopwatch clock_;
+  double last_ = 0.0;
+  std::string line_;
+};
+
 // `--check`: the regression check from this report's own runs, the same metrics rbx check
 // measures (the scenes at their own step, explore's fixed samples, and the tosses when the whole
 // library ran), compared and printed as rbx check prints them; 1 when any is worse.
@@ -96,13 +113,16 @@ int report_command(const ReportOptions& opt) {
   std::mutex progress_mutex;
   size_t finished = 0;
   Stopwatch clock;
+  PartTimes parts;
   std::vector<SceneEvaluation> evs = evaluate_scenes(par, scenes, hopt, [&](size_t i) {
     const std::lock_guard<std::mutex> lock(progress_mutex);
     progress.show(++finished, scenes.size(), scenes[i].file, clock.seconds());
   });
   progress.done();
+  parts.end("scenes");
   // The Predictability section: the nudged copies of every scene with an [ensemble] table.
   run_scene_ensembles(scenes, opt.backends, evs, par);
+  parts.end("ensembles");
   // Explore's fixed random samples (the whole library, or --explore), on every rank.
   SummaryInputs in;
   if (opt.explore || opt.inputs.empty()) {
@@ -118,6 +138,7 @@ int report_command(const ReportOptions& opt) {
       if (b.dynamics) impact.push_back(b.name);
     }
     in.explore = explore_check_metrics(contact, impact, in.explore_set, nullptr, &par);
+    parts.end("explore");
   }
   if (!par.root()) return 0;  // rank 0 writes everything
   // The contact pictures draw the bodies at t = 0.
@@ -132,8 +153,10 @@ int report_command(const ReportOptions& opt) {
   fs::create_directories(tmp / "figures");
   try {
     write_report_tables(tmp.string(), scenes, evs);
+    parts.end("tables");
     std::string figures_msg;
     const bool figures_ok = draw_report_figures(tmp.string(), par.threads(), figures_msg);
+    parts.end("figures");
     // --- replay pages (view-report): views/SLUG.html ---
     bool views_ok = true;
     try {
@@ -143,6 +166,7 @@ int report_command(const ReportOptions& opt) {
       std::cerr << "report: no replay pages: " << e.what() << "\n";
     }
     // --- end replay pages ---
+    parts.end("views");
     // report.md is the summary (with the real tosses), details.md every table; index.html and
     // details.html are the same as pages.
     in.report_dir = tmp.string();
@@ -153,12 +177,14 @@ int report_command(const ReportOptions& opt) {
     // Real impacts: every tosses data set under the inputs (comparisons/output/tosses_report.cpp).
     for (const std::string& dir : find_toss_datasets(opt.inputs))
       in.tosses += tosses_report_section(dir, tmp.string(), opt.backends, par.threads());
+    parts.end("tosses");
     const std::string summary = report_summary_markdown(scenes, evs, in);
     const std::string details =
         report_details_markdown(scenes, evs, tmp.string(), figures_ok, views_ok);
     write_text((tmp / "report.md").string(), summary);
     write_text((tmp / "details.md").string(), details);
     write_report_pages(tmp.string(), scenes, evs, summary, details, views_ok);
+    parts.end("pages");
     // `rbx bench` output in the old folder is kept (its own command, not this report's).
     std::error_code ec;
     for (const char* f : {"perf.md", "perf.json", "perf.csv"})
@@ -182,6 +208,7 @@ int report_command(const ReportOptions& opt) {
             << fmt_num(clock.seconds(), 3) << " s; " << disagreeing
             << " scenes with a disagreeing backend; " << failed << " [expect] failures; "
             << par.ranks() << " rank(s) x " << par.threads() << " thread(s))\n";
+  if (!opt.quiet) std::cout << "report: time by part: " << parts.line() << "\n";
   return opt.check ? check_report_run(opt, baseline, scenes, evs, in.explore, clock) : 0;
 }
 

@@ -392,6 +392,13 @@ TEST(Cli, ReportWritesEverythingIntoItsFolder) {
   for (const char* f : {"report.md", "details.md", "index.html", "details.html", "results.json",
                         "metrics.csv", "sweep.csv", "stability.csv"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
+  // Where the time went, each part in the order it ran (explore's samples run for the whole
+  // library only).
+  EXPECT_TRUE(std::regex_search(
+      r.out, std::regex("\nreport: time by part: scenes [0-9.e-]+ s, ensembles [0-9.e-]+ s, "
+                        "tables [0-9.e-]+ s, figures [0-9.e-]+ s, views [0-9.e-]+ s, "
+                        "tosses [0-9.e-]+ s, pages [0-9.e-]+ s\n")))
+      << r.out;
   // The why-list comes from the evaluation's measured causes, whichever thread or rank ran the
   // scene: bullet-hull's one-point manifold on the seed's face-face impact.
   std::stringstream md;
