@@ -99,7 +99,7 @@ namespace {
 // seconds hanging until the test's deadline, now and then). There every block runs on this
 // thread, one supervised child at a time; the answers are the same by design (the outputs are
 // identical for any number of threads), so only the speed differs.
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(RBX_SANITIZE)
 constexpr bool kForkFromOneThread = true;
 #else
 constexpr bool kForkFromOneThread = false;
@@ -138,8 +138,11 @@ std::vector<std::string> ParallelRun::map(size_t n, const std::function<std::str
   // This rank's block, cut into chunks that the threads take as they come free: the items' costs
   // differ by orders of magnitude (a scene of one contact query, a scene of a thousand bodies),
   // so fixed shares left one core idle for most of a run. One supervised child per chunk.
-  const auto [lo, hi] = block(n, ranks_, rank_);
-  const size_t count = hi - lo;
+  // Plain variables, not a structured binding: the lambda below captures lo, which C++17 does
+  // not allow of a binding (clang refuses it).
+  const std::pair<size_t, size_t> range = block(n, ranks_, rank_);
+  const size_t lo = range.first;
+  const size_t count = range.second - lo;
   std::vector<std::string> local(count);
   const size_t nthreads =
       kForkFromOneThread ? 1 : std::max<size_t>(1, std::min<size_t>(threads_, count));

@@ -104,7 +104,11 @@ std::vector<std::string> write_picked_tosses(const fs::path& out,
   traj << "pick,toss,source,t,z,angle_deg\n";
   std::vector<std::string> replays;
   const fs::path views = out / "views";
-  for (const auto& [label, id] : picks) {
+  for (const auto& pick : picks) {
+    // Named copies, not a structured binding: the lambda below captures id (C++17 does not
+    // allow capturing a binding; clang refuses it).
+    const std::string& label = pick.first;
+    const long id = pick.second;
     const Toss& t =
         *std::find_if(tosses.begin(), tosses.end(), [&](const Toss& x) { return x.id == id; });
     const Quat q0 = t.samples.front().orientation;

@@ -16,7 +16,7 @@
 
 #include "comparisons/cli/commands.h"
 
-#ifdef __SANITIZE_ADDRESS__
+#ifdef RBX_SANITIZE
 // LeakSanitizer's suppressions for this test. ODE 0.16: one 80-byte block allocated inside ODE's
 // self-threading implementation (dxtemplateThreadingImplementation) is reported once at the end
 // of a whole library check. No single scene through `ode` or `ode-hull` reproduces it (each scene
@@ -32,7 +32,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-#ifdef __SANITIZE_ADDRESS__
+#ifdef RBX_SANITIZE
 TEST(LibraryCheck, EveryMetricOfTheSceneFamiliesIsNoWorseThanTheBaseline) {
   // The sanitizer build checks the scene families only, without the external cases, the random
   // samples, the tosses and the report around them: those run the same contact and dynamics

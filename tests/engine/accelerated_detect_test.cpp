@@ -87,10 +87,10 @@ void compare_at(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedro
                 where + " feature " + to_string(feature));
 }
 
-// Under the sanitizers (GCC's __SANITIZE_ADDRESS__) a third of the random poses: there they look
+// Under the sanitizers (RBX_SANITIZE, CMakeLists.txt) a third of the random poses: there they look
 // for memory errors and undefined behaviour, which the same code paths meet at a third of the
 // count, while the seed oracle's tests cost ten times more; the Release pass runs every pose.
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(RBX_SANITIZE)
 constexpr int kPoseDivisor = 3;
 #else
 constexpr int kPoseDivisor = 1;

@@ -15,15 +15,8 @@
 
 #include "tests/common/fixtures.h"
 
-// LeakSanitizer in the sanitizer build (GCC defines __SANITIZE_ADDRESS__, clang has the feature).
-#if defined(__SANITIZE_ADDRESS__)
-#define RBX_HAS_LSAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define RBX_HAS_LSAN 1
-#endif
-#endif
-#ifdef RBX_HAS_LSAN
+// LeakSanitizer in the sanitizer build (RBX_SANITIZE, CMakeLists.txt).
+#ifdef RBX_SANITIZE
 #include <sanitizer/lsan_interface.h>
 #endif
 
@@ -338,7 +331,7 @@ TEST(MujocoErrors, EveryFailedAllocationIsAStatusError) {
   const long n = clean.calls;
   ASSERT_LT(n, 1000);
   int through_compiler = 0, through_handler = 0;
-#ifdef RBX_HAS_LSAN
+#ifdef RBX_SANITIZE
   // When a failed allocation makes MuJoCo's compiler give up inside its convex-hull step, the
   // Qhull state it had set up (qh_memsetup, plain malloc, outside mju_user_malloc) is abandoned:
   // MuJoCo's leak on an error path this test provokes on purpose, about 130 KB per failure. Not
