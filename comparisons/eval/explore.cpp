@@ -57,6 +57,11 @@ Vec3 SampleRng::direction() {
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
+Vec3 SampleRng::uniform3(double lo, double hi) {
+  const double z = uniform(lo, hi), y = uniform(lo, hi), x = uniform(lo, hi);
+  return Vec3(x, y, z);
+}
+
 Quat SampleRng::rotation() {
   const double u1 = uniform(), u2 = uniform(0.0, 2.0 * M_PI), u3 = uniform(0.0, 2.0 * M_PI);
   const double a = std::sqrt(1.0 - u1), b = std::sqrt(u1);
@@ -103,11 +108,11 @@ double support(const ConvexPolyhedron& shape, const Quat& q, const Vec3& n) {
 std::vector<Vec3> hull_points(SampleRng& r, int n, double scale) {
   const int style = r.integer(0, 2);
   Vec3 axes = Vec3::Ones();
-  if (style == 1) axes = Vec3(r.uniform(0.3, 1.0), r.uniform(0.3, 1.0), r.uniform(0.3, 1.0));
+  if (style == 1) axes = r.uniform3(0.3, 1.0);
   std::vector<Vec3> p;
   for (int i = 0; i < n; ++i) {
     if (style == 2)
-      p.push_back(0.5 * scale * Vec3(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1)));
+      p.push_back(0.5 * scale * r.uniform3(-1, 1));
     else
       p.push_back(0.5 * scale * r.direction().cwiseProduct(axes));
   }
@@ -163,7 +168,7 @@ ContactSample make_contact_sample(uint64_t seed, uint64_t index) {
   s.b = random_body(r, small_first ? scale_a : scale_b);
   s.a.orientation = r.rotation();
   s.b.orientation = r.rotation();
-  s.a.position = Vec3(r.uniform(-1, 1), r.uniform(-1, 1), r.uniform(-1, 1));
+  s.a.position = r.uniform3(-1, 1);
 
   const auto shape_a = build_shape(s.a), shape_b = build_shape(s.b);
   const double small = std::min(shape_size(*shape_a), shape_size(*shape_b));

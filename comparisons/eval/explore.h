@@ -32,6 +32,10 @@ class SampleRng {
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
   /// Uniform integer in [lo, hi].
   int integer(int lo, int hi);
+  /// A point with each coordinate uniform in [lo, hi), drawn z first, then y, then x (the order
+  /// GCC gave the samples drawn before this existed; C++ leaves the order of a call's arguments
+  /// unspecified, so `Vec3(uniform(), uniform(), uniform())` differs between compilers).
+  Vec3 uniform3(double lo, double hi);
   /// Uniform direction on the unit sphere.
   Vec3 direction();
   /// Uniform random rotation (Shoemake's method).

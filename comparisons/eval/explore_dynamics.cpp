@@ -422,7 +422,10 @@ ImpactSample make_impact_sample(uint64_t seed, uint64_t index) {
         }
         // First contact 2 to 5 steps ahead, at a random phase of its step; then at least 50 ms of
         // flight, to a whole number of steps (a scene's duration is one).
-        s.contact_time = (r.integer(2, 5) + r.uniform(0.02, 0.98)) * s.dt;
+        // The step count first, then the phase: two statements, since the order of a sum's
+        // operands is the compiler's.
+        const int steps_ahead = r.integer(2, 5);
+        s.contact_time = (steps_ahead + r.uniform(0.02, 0.98)) * s.dt;
         s.duration = std::ceil((s.contact_time + 0.05) / s.dt) * s.dt;
         return realize_impact(s);
       });
