@@ -300,8 +300,12 @@ TEST(ExploreImpact, ShrunkSceneReproducesThroughTheHarness) {
 
 TEST(ExploreCommand, ImpactSameJsonWithOneAndThreeThreads) {
   const fs::path base = fs::temp_directory_path() / ("rbx_explore_i_" + std::to_string(getpid()));
+  // The sanitizer build forks from one thread whatever is asked (eval/parallel.cpp), so a second
+  // run there would repeat the first: it runs the command once, and the comparison is the
+  // unsanitized build's.
+  const int runs = forking_threads(3) > 1 ? 2 : 1;
   std::string json[2];
-  for (int k = 0; k < 2; ++k) {
+  for (int k = 0; k < runs; ++k) {
     ExploreOptions o;
     o.kind = "impact";
     o.count = 8;
@@ -318,7 +322,9 @@ TEST(ExploreCommand, ImpactSameJsonWithOneAndThreeThreads) {
         EXPECT_EQ(read(f.path()), read(base / "1" / "scenes" / f.path().filename()));
     }
   }
-  EXPECT_EQ(json[0], json[1]);
+  if (runs == 2) {
+    EXPECT_EQ(json[0], json[1]);
+  }
   const Json j = Json::parse(json[0]);
   EXPECT_EQ(j["kind"], "impact");
   EXPECT_EQ(j["backends"]["mujoco"]["samples"], 8);
