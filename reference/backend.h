@@ -43,6 +43,11 @@ struct ContactResult {
 /// zero distance; a nanometre is far above both and far below any depth a scene states.
 constexpr double kTouchingDepth = 1e-9;
 
+/// Tangential slip (m/s) below which a contact has no slip direction to follow (its components
+/// are round-off): the adapters that point a friction pyramid's first direction along the slip
+/// (ODE, DART) leave the library's own basis there, which at stick holds the body as any would.
+constexpr double kStickSpeed = 1e-9;
+
 /// A library answer of "touching" whose normal is zero or not finite defines no contact
 /// normal. Returns `r` unchanged when every normal is a unit vector; status Touching when such
 /// a contact has (nearly) zero depth, the libraries' convention at exact touching; else status

@@ -4,7 +4,8 @@
 // bodies are all boxes runs on DART's own detector (its box-box test, up to 4 points), any other
 // on DART's FCL detector (DART's own collides no meshes). `dart-hull`: every body a MeshShape on
 // the FCL detector. The world steps with DART's boxed LCP solver (Dantzig, PGS when Dantzig
-// fails), one constraint per contact point with a friction pyramid of two directions.
+// fails), one constraint per contact point with a friction pyramid of two directions, the first
+// turned along each moving body's slip before every step (follow_slip).
 //
 // Conventions: DART's contact normal points from the second collision object to the first and
 // its `force` (filled by the constraint solver) acts on the first; with A first both are ours.
@@ -299,6 +300,43 @@ void pair_events(const std::vector<StepContact>& contacts, const std::vector<Rig
   append_pair_events(points, bodies, step, dt, events);
 }
 
+// DART's friction is a pyramid of two rows per contact, each bounded by mu times the normal
+// impulse; with its basis fixed, a slip along neither row meets a friction force of up to
+// sqrt(2) mu N that is not against the slip. Its first direction is a per-shape setting,
+// read when a step builds its contact constraints, so before each step every moving body's
+// shape gets the slip at its contacts at this step's positions (the sum over them of its
+// tangential velocity relative to the other body): a sliding body's first row then runs against
+// its slip. Below kStickSpeed the setting is cleared (DART's own basis). One direction per
+// shape: a body that slips different ways at different contacts (spinning on its patch, pressed
+// between two others) gets their sum, and the pyramid's error stays there.
+void follow_slip(dart::simulation::World& world, const std::vector<DartBody>& dbodies,
+                 const std::map<const dd::ShapeFrame*, int>& index,
+                 const std::vector<BodyFinal>& now) {
+  dc::CollisionResult result;
+  auto* solver = world.getConstraintSolver();
+  solver->getCollisionGroup()->collide(solver->getCollisionOption(), &result);
+  std::vector<Vec3> slip(dbodies.size(), Vec3::Zero());
+  for (const dc::Contact& c : result.getContacts()) {
+    const int i1 = index.at(c.collisionObject1->getShapeFrame());
+    const int i2 = index.at(c.collisionObject2->getShapeFrame());
+    auto velocity = [&](int i) {
+      return Vec3(now[i].velocity + now[i].angular_velocity.cross(c.point - now[i].position));
+    };
+    const Vec3 n = c.normal.normalized();
+    const Vec3 relative = velocity(i1) - velocity(i2);
+    const Vec3 tangential = relative - relative.dot(n) * n;
+    slip[i1] += tangential;
+    slip[i2] -= tangential;
+  }
+  for (std::size_t i = 0; i < dbodies.size(); ++i) {
+    if (!dbodies[i].skeleton->isMobile()) continue;
+    auto* aspect = dbodies[i].node->getShapeNode(0)->getDynamicsAspect();
+    aspect->setFirstFrictionDirectionFrame(dd::Frame::World());
+    aspect->setFirstFrictionDirection(slip[i].norm() > kStickSpeed ? Vec3(slip[i].normalized())
+                                                                   : Vec3::Zero());
+  }
+}
+
 DynamicsResult dart_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
                                   const DartSettings& settings) {
   // ContactConstraint's parameters are process-wide statics: one DART world at a time.
@@ -351,6 +389,8 @@ DynamicsResult dart_dynamics_with(const Scene& scene, const DynamicsOptions& opt
     for (long step = 0; step < steps; ++step) {
       recorder.before_step(r.events);
       const std::vector<BodyFinal> before = read_states();
+      if (settings.friction_along_slip && scene.sim.friction > 0.0)
+        follow_slip(*world, dbodies, index, before);
       world->step();
       const std::vector<StepContact> contacts = step_contacts(*world, index, before, dt, feature);
       pair_events(contacts, bodies, step, dt, r.events);

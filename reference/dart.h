@@ -25,6 +25,9 @@ struct DartSettings {
   double cfm =
       1e-9;          // ContactConstraint's constraint force mixing (DART's default 1e-5; its floor)
   double erp = 0.0;  // ContactConstraint's error reduction parameter (DART's default 0.01)
+  // Each moving shape's first friction direction set, before every step, to the slip at its
+  // contacts; false: DART's own basis (fixed whatever the slip).
+  bool friction_along_slip = true;
 };
 
 /// `dart-hull`: every body a MeshShape of its hull, on the mesh detector.

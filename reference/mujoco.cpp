@@ -123,6 +123,9 @@ struct ModelOptions {
   ContactParams contact;
   bool box_geoms = false;  // box geoms for the (all box) bodies; false: mesh geoms
   bool multiccd = false;   // multi-point convex collision for mesh pairs
+  bool elliptic_cone = false;
+  double impratio = 1.0;
+  int noslip_iterations = 0;
 };
 
 // Prints a double so that it reads back exactly (17 significant digits).
@@ -190,7 +193,9 @@ std::string build_mjcf(const std::vector<RigidBody>& bodies, bool all_free,
   // MPR tolerance tightened from 1e-6 so that depths are limited by MuJoCo's float vertices,
   // not by the iteration stopping early.
   s << "<option timestep=\"" << num(opt.dt) << "\" gravity=\"" << vec_text(opt.gravity)
-    << "\" integrator=\"Euler\" mpr_tolerance=\"1e-12\" mpr_iterations=\"500\">"
+    << "\" integrator=\"Euler\" mpr_tolerance=\"1e-12\" mpr_iterations=\"500\""
+    << " cone=\"" << (opt.elliptic_cone ? "elliptic" : "pyramidal") << "\" impratio=\""
+    << num(opt.impratio) << "\" noslip_iterations=\"" << opt.noslip_iterations << "\">"
     << (opt.multiccd ? "<flag multiccd=\"enable\"/>" : "") << "</option>\n";
   // Contact buffers: 8 points per pair for small scenes; for many bodies, where a body touches
   // only its neighbours, 16 per body (8 per pair over all pairs of 100 bodies is more memory
@@ -571,6 +576,9 @@ ModelOptions model_options(const Scene& scene, double dt, const std::vector<Rigi
   mo.contact.friction = scene.sim.friction;
   mo.box_geoms = use_box_geoms(bodies, settings);
   mo.multiccd = settings.multiccd;
+  mo.elliptic_cone = settings.elliptic_cone;
+  mo.impratio = settings.impratio;
+  mo.noslip_iterations = settings.noslip_iterations;
   // Box-box depth is reported halved (see the file comment): the stiffness makes up for it, so
   // that the contact force per true penetration is the mesh's.
   if (mo.box_geoms) mo.contact.stiffness *= settings.box_stiffness_factor;

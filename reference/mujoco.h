@@ -13,6 +13,9 @@ struct MujocoSettings {
   bool box_geoms = true;              // box geoms when every body is a box (all pairs box-box)
   double box_stiffness_factor = 2.0;  // dynamics with box geoms: makes up for the halved depth
   bool multiccd = true;               // mesh pairs: multi-point convex collision
+  bool elliptic_cone = true;          // friction: elliptic cone (false: MuJoCo's default pyramid)
+  double impratio = 1.0;              // frictional-to-normal impedance ratio (MuJoCo's default)
+  int noslip_iterations = 0;          // noslip passes after the main solve (0: MuJoCo's default)
 };
 
 /// `mujoco-hull`: every body a mesh geom, single-point MPR.

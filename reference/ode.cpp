@@ -252,6 +252,7 @@ struct CollideContext {
   dJointGroupID group = nullptr;
   double restitution = 1.0;
   double friction = 0.0;
+  bool friction_along_slip = false;  // OdeSettings::friction_along_slip
   std::vector<StepContact> contacts;
   std::deque<dJointFeedback> feedback;  // deque: stable addresses while growing
 };
@@ -294,6 +295,19 @@ void near_callback(void* data, dGeomID o1, dGeomID o2) {
     // (getInfo1), so the flag changes nothing for frictionless scenes.
     // No dContactSoftERP / dContactSoftCFM: the world's ERP and CFM apply (see ode_dynamics).
     c.surface.mode = dContactBounce | dContactApprox1;
+    const Vec3 n_ours(c.geom.normal[0], c.geom.normal[1], c.geom.normal[2]);
+    const Vec3 relative = point_velocity(b1, c.geom.pos) - point_velocity(b2, c.geom.pos);
+    // Each pyramid row is bounded by mu N alone, so with fixed axes a slip along neither axis
+    // meets a friction force of up to sqrt(2) mu N, not against the slip: the path bends. ODE's
+    // manual gives the first direction along the motion as the remedy; the second row then
+    // carries no slip. At stick (no measurable slip) there is no direction to follow and
+    // dPlaneSpace's axes stay.
+    const Vec3 slip = relative - relative.dot(n_ours) * n_ours;
+    if (ctx->friction_along_slip && ctx->friction > 0.0 && slip.norm() > kStickSpeed) {
+      const Vec3 dir = slip.normalized();
+      c.surface.mode |= dContactFDir1;
+      for (int k = 0; k < 3; ++k) c.fdir1[k] = dir[k];
+    }
     c.surface.mu = ctx->friction;         // the scene's Coulomb coefficient; 0: frictionless
     c.surface.bounce = ctx->restitution;  // the scene's coefficient of restitution e
     // Bounce at any approach speed: ODE bounces only when the approach speed exceeds
@@ -308,8 +322,7 @@ void near_callback(void* data, dGeomID o1, dGeomID o2) {
     sc.b = scene_index(o2);
     sc.geom = c.geom;
     sc.feature = pair_feature(o1, o2);
-    const Vec3 n_ours(c.geom.normal[0], c.geom.normal[1], c.geom.normal[2]);
-    sc.approach = (point_velocity(b1, c.geom.pos) - point_velocity(b2, c.geom.pos)).dot(n_ours);
+    sc.approach = relative.dot(n_ours);
     sc.feedback = &ctx->feedback.back();
     ctx->contacts.push_back(sc);
   }
@@ -550,6 +563,7 @@ DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
   ctx.group = w.contacts;
   ctx.restitution = scene.sim.restitution;
   ctx.friction = scene.sim.friction;
+  ctx.friction_along_slip = settings.friction_along_slip;
   t_trap.clear_warning();
   t_trap.warning_count = 0;
   long first_message_step = -1;

@@ -12,6 +12,9 @@ struct OdeSettings {
   bool native_boxes = true;  // dCreateBox for is_native_box bodies; false: every body convex
   double cfm = 1e-10;        // world constraint force mixing (ODE's default)
   double erp = 0.2;          // world error reduction parameter (ODE's default)
+  // First friction direction along the contact's tangential slip (dContactFDir1), where there
+  // is slip; false: both directions from dPlaneSpace (ODE's default), fixed whatever the slip.
+  bool friction_along_slip = true;
 };
 
 /// `ode-hull`: every body a dCreateConvex geom, ODE's default world.

@@ -111,12 +111,16 @@ Scene sliding_cube(const Vec3& v) { return sliding_on_floor(Vec3::Ones(), v, 0.5
 
 TEST(DartDynamics, FrictionPyramidIsExactAlongItsDirectionsAndStrongerAcross) {
   // DART bounds each of its two friction directions by mu times the normal impulse (a boxed
-  // LCP: a pyramid, not Coulomb's cone). Along a direction the cube stops where Coulomb's law
-  // puts it; across them (45 deg) the pyramid's corner holds up to sqrt(2) mu, so it stops short.
+  // LCP: a pyramid, not Coulomb's cone). With its own basis (the adapter's slip-following off)
+  // along a direction the cube stops where Coulomb's law puts it; across them (45 deg) the
+  // pyramid's corner holds up to sqrt(2) mu, so it stops short. The adapter's default turns the
+  // first direction along the slip, and the diagonal slide stops where Coulomb's law puts it.
   const double truth = 1.0 / (2 * 0.5 * 9.81);  // m, at 1 m/s
+  DartSettings own_basis;
+  own_basis.friction_along_slip = false;
   double along = 0, across = 0;
   for (const Vec3& dir : {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0).normalized()}) {
-    const DynamicsResult r = dart.dynamics(sliding_cube(dir), {});
+    const DynamicsResult r = dart_at_settings().dynamics(sliding_cube(dir), {}, own_basis);
     ASSERT_EQ(r.status, Status::Ok) << r.message;
     const double travelled = r.finals[0].position.dot(dir);
     std::printf("[measured] dart cube sliding along (%.3g %.3g): %.6g m (Coulomb %.6g m)\n",
@@ -131,6 +135,14 @@ TEST(DartDynamics, FrictionPyramidIsExactAlongItsDirectionsAndStrongerAcross) {
   EXPECT_LT(along, 0.01);
   // Across: decelerating at up to sqrt(2) mu g, it travels as little as truth / sqrt(2).
   EXPECT_LT(across, 0.95 * truth);
+  const Vec3 diagonal = Vec3(1, 1, 0).normalized();
+  const DynamicsResult r = dart.dynamics(sliding_cube(diagonal), {});
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  std::printf(
+      "[measured] dart, first direction along the slip, sliding along (0.707 0.707): "
+      "%.6g m\n",
+      r.finals[0].position.dot(diagonal));
+  EXPECT_LT(std::abs(r.finals[0].position.dot(diagonal) - truth) / truth, 0.01);  // as along
 }
 
 TEST(DartDynamics, BoxedFrictionBoundsComeFromAFrictionlessPass) {

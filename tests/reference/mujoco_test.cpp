@@ -13,6 +13,7 @@
 #include <set>
 #include <utility>
 
+#include "reference/contact_laws.h"
 #include "tests/common/fixtures.h"
 
 // LeakSanitizer in the sanitizer build (RBX_SANITIZE, CMakeLists.txt).
@@ -24,7 +25,10 @@ namespace rbx {
 namespace {
 
 // The backends under test, by their registry names.
+const Backend& mujoco = mujoco_adapter().backend("mujoco");
 const Backend& mujoco_hull = mujoco_adapter().backend("mujoco-hull");
+
+constexpr double kPi = 3.14159265358979323846;
 
 using test::box_spec;
 using test::diagonal_along_x;
@@ -225,6 +229,68 @@ TEST(MujocoKnownDefect, BoxBoxReportsHalfTheDepth) {
   }
   mj_deleteData(d);
   mj_deleteModel(m);
+}
+
+TEST(MujocoKnownDefect, BoxBoxAddsAPointAtTheBigBoxsCorner) {
+  // A 0.97 x 0.87 x 1.01 box 1 mm deep on a 4 x 4 x 1 box, both free bodies, the small one
+  // first (as rbx's contact queries build them), as box geoms. Beside the small box's four
+  // corners (at half the depth, BoxBoxReportsHalfTheDepth), MuJoCo 2.2.2's box-box collider
+  // returns a fifth point at the big box's corner (-2, -2), 2 m outside the small box, at the
+  // same depth and normal (with the big box first, or a world geom, the four corners only). Pinned:
+  // if it fails, the library changed and docs/references.md with it.
+  mjModel* m = load_mjcf(R"(<mujoco><worldbody>
+      <body pos="0 0 0.504"><freejoint/><geom type="box" size="0.485 0.435 0.505"/></body>
+      <body pos="0 0 -0.5"><freejoint/><geom type="box" size="2 2 0.5"/></body>
+      </worldbody></mujoco>)");
+  ASSERT_NE(m, nullptr);
+  mjData* d = mj_makeData(m);
+  mj_forward(m, d);
+  int inside = 0, at_corner = 0;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjtNum* p = d->contact[i].pos;
+    // Box geoms are stored in double: round-off only.
+    if (std::abs(p[0]) <= 0.485 + 1e-12 && std::abs(p[1]) <= 0.435 + 1e-12) ++inside;
+    if (std::abs(p[0] + 2) < 1e-12 && std::abs(p[1] + 2) < 1e-12) ++at_corner;
+    EXPECT_NEAR(-d->contact[i].dist, 0.0005, 1e-12) << "contact " << i;
+  }
+  EXPECT_EQ(inside, 4);
+  EXPECT_EQ(at_corner, 1);
+  EXPECT_EQ(d->ncon, 5);
+  mj_deleteData(d);
+  mj_deleteModel(m);
+}
+
+TEST(MujocoKnownDefect, BoxBoxReturnsMetresDeepPointsUnderABoxAt45Degrees) {
+  // rbx explore --kind landing --seed 2718, sample 222 shrunk: a 0.97 x 0.87 x 1.01 box turned
+  // 45 deg about z lands flat at 1 m/s on a static 4 x 4 x 1 floor, e = 0, mu = 0.5, and rests
+  // 0.26 mm deep (half-depth points). At step 101 MuJoCo 2.2.2's box-box collider returns,
+  // beside the four corners, three points 2.3 to 2.8 m deep (no such overlap exists: the box is
+  // 1.01 m tall), and the box leaves at some 76 m/s. Pinned through the adapter's contact-law
+  // record (the penetration law's worst is the deepest point MuJoCo reported); the same box
+  // unturned stays at rest.
+  Scene s;
+  s.sim.duration = 0.103;
+  s.sim.gravity = Vec3(0, 0, -9.81);
+  s.sim.restitution = 0;
+  s.sim.friction = 0.5;
+  const auto landing = [&](double yaw_deg) {
+    BodySpec floor = box_spec("floor", Vec3(4, 4, 1), Vec3(0, 0, -0.5));
+    floor.is_static = true;
+    BodySpec box = box_spec("box", Vec3(0.97, 0.87, 1.01), Vec3(0, 0, 0.50753065625), 1.0,
+                            Quat(Eigen::AngleAxisd(yaw_deg * kPi / 180, Vec3::UnitZ())));
+    box.velocity = Vec3(0, 0, -1);
+    s.bodies = {box, floor};
+    return mujoco.dynamics(s, {});
+  };
+  const DynamicsResult turned = landing(45);
+  ASSERT_EQ(turned.status, Status::Ok) << turned.message;
+  ASSERT_TRUE(turned.laws.measured);
+  EXPECT_GT(turned.laws.residuals[static_cast<int>(Law::Penetration)].worst, 2.0);
+  EXPECT_GT(turned.finals[0].velocity.norm(), 10.0);
+  const DynamicsResult straight = landing(0);
+  ASSERT_EQ(straight.status, Status::Ok) << straight.message;
+  EXPECT_LT(straight.laws.residuals[static_cast<int>(Law::Penetration)].worst, 1e-3);
+  EXPECT_LT(straight.finals[0].velocity.norm(), 0.01);
 }
 
 // --- Errors: mju_error becomes Status::Error -------------------------------------------------
