@@ -95,8 +95,10 @@ std::unique_ptr<btConvexShape> make_shape(const RigidBody& body, const Mat3& fra
   if (!native_box(body, settings))
     return make_hull(body.shape->vertices(), frame, settings.polyhedral_hulls,
                      settings.hull_margin);
-  // The constructor keeps Bullet's default margin (0.04 m), lowered to a tenth of the smallest
-  // half extent for small boxes (setSafeMargin); the margin is inside the box either way.
+  // The constructor sets Bullet's default margin (0.04 m), lowered to a tenth of the smallest
+  // half extent for small boxes (setSafeMargin); the margin is inside the box either way. A set
+  // margin overrides that lowering: a margin wider than a thin box's half extent turns its
+  // contacts' normals (BulletSettingsMeasured.BoxMarginAsTheConstructorSetsIt).
   auto box = std::make_unique<btBoxShape>(to_bt(0.5 * body.box_size));
   if (settings.box_margin >= 0) box->setMargin(settings.box_margin);
   // Polyhedral features let a box meet a polyhedral hull through SAT (box-box pairs use the
@@ -320,6 +322,20 @@ BulletBody make_bullet_body(const RigidBody& rb, int i, const Scene& scene,
     // breaking threshold, i.e. before touching), so the impulse acts at contact.
     bb.body->setContactProcessingThreshold(settings.processing_threshold);
   }
+  // Continuous collision as Bullet's own CCD demo sets it for its cubes (a motion threshold of
+  // the half extent, a swept sphere of 0.9 of it), here from the hull's inscribed radius about
+  // the centre of mass, so that the sphere stays inside any hull. A body moving further in a
+  // step is swept from its centre; at a hit it is moved to the hit and keeps its velocity, and
+  // the next step's contact responds.
+  if (!rb.is_static && settings.ccd_motion_fraction > 0) {
+    double inscribed = INFINITY;
+    for (const Plane& p : rb.shape->planes())
+      inscribed = std::min(inscribed, -p.distance(Vec3::Zero()));
+    if (inscribed > 0 && std::isfinite(inscribed)) {
+      bb.body->setCcdMotionThreshold(settings.ccd_motion_fraction * inscribed);
+      bb.body->setCcdSweptSphereRadius(settings.ccd_sphere_fraction * inscribed);
+    }
+  }
   return bb;
 }
 
@@ -477,6 +493,7 @@ BulletSettings bullet_hull_settings() {
 BulletSettings bullet_default_world_settings() {
   BulletSettings s = bullet_hull_settings();
   s.fair_world = false;
+  s.ccd_motion_fraction = 0;
   return s;
 }
 

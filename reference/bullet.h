@@ -13,12 +13,19 @@ struct BulletSettings {
   bool native_boxes = true;      // btBoxShape for is_native_box bodies; false: every body a hull
   bool polyhedral_hulls = true;  // initializePolyhedralFeatures: hulls clipped (manifolds)
   bool sat_convex = false;       // polyhedral hulls: the axis by SAT (false: by GJK + EPA)
-  double box_margin = 0.04;      // m, btBoxShape's margin (inside the box: extents unchanged)
-  double hull_margin = 0.0;      // m, btConvexHullShape's margin (outside the hull: inflates it)
-  bool fair_world = true;        // the solver settings below; false: Bullet's defaults throughout
+  // m, btBoxShape's margin (inside the box: extents unchanged); < 0: the constructor's, Bullet's
+  // 0.04 lowered to a tenth of the smallest half extent for small boxes (setSafeMargin)
+  double box_margin = -1.0;
+  double hull_margin = 0.0;  // m, btConvexHullShape's margin (outside the hull: inflates it)
+  bool fair_world = true;    // the solver settings below; false: Bullet's defaults throughout
   double split_impulse_threshold = 1e30;  // m; Bullet splits where distance < this (BT_LARGE_FLOAT)
   double restitution_threshold = 0.0;     // m/s; no bounce below this approach speed
   double processing_threshold = 0.0;      // m; contacts solved once closer than this
+  // Continuous collision (Bullet's CCD): a body moving more than this fraction of its inscribed
+  // radius in a step is swept, as a sphere of `ccd_sphere_fraction` of that radius, and stopped
+  // at the first hit; 0: off (Bullet's default).
+  double ccd_motion_fraction = 1.0;
+  double ccd_sphere_fraction = 0.9;
 };
 
 /// `bullet`: native boxes, polyhedral hulls (GJK + EPA axis, clipped manifold), zero hull

@@ -346,6 +346,84 @@ TEST(BulletSettingsMeasured, ContactsSolvedOnlyOnceTheyOverlap) {
   EXPECT_LT(hull_zero, hull_default);
 }
 
+/// A fast projectile against a thin static slab, frictionless: a box of full extents `size`
+/// (its thin side along x) leaves x = -0.3 at `velocity` (its x component positive, so it
+/// strikes the slab's face x = 0.995 face on, flat) and no step of `dt` ever sees it overlap the
+/// 1 cm slab. The closed form is one impulse along the normal: v_x' = -e v_x, the rest kept, no
+/// spin (the normal passes through the centre of mass).
+Case projectile(const std::string& name, const Vec3& size, const Vec3& velocity, double e,
+                double dt) {
+  Case c;
+  c.name = name;
+  c.scene.sim.dt = dt;
+  // Until three steps after the strike (at t = 1.295 m / v_x for the box's front face).
+  c.scene.sim.duration = (std::ceil(1.295 / velocity.x() / dt) + 3) * dt;
+  c.scene.sim.restitution = e;
+  BodySpec slab = box("B", Vec3(0.01, 20, 20), 1, Vec3(1, 0, 0), Vec3::Zero());
+  slab.is_static = true;
+  c.scene.bodies = {box("A", size, 1, Vec3(-0.3, 0, 0), velocity), slab};
+  c.velocity = {Vec3(-e * velocity.x(), velocity.y(), velocity.z()), Vec3::Zero()};
+  c.angular_velocity = {Vec3::Zero(), Vec3::Zero()};
+  return c;
+}
+
+/// stress/tunnel_thin_wall (a 1 cm plate at 100 m/s, dt = 0.01 s, e = 1) and three more that
+/// cross the slab between two steps: another thickness, speed, step, e and an oblique path.
+std::vector<Case> projectile_cases() {
+  return {projectile("stress/tunnel_thin_wall", Vec3(0.01, 1, 1), Vec3(100, 0, 0), 1.0, 0.01),
+          projectile("2 cm cube-ish plate at 60 m/s, e = 0.5", Vec3(0.02, 0.3, 0.5), Vec3(60, 0, 0),
+                     0.5, 0.005),
+          projectile("5 mm plate at 300 m/s, e = 0.8, dt = 2 ms", Vec3(0.005, 0.2, 0.2),
+                     Vec3(300, 0, 0), 0.8, 0.002),
+          projectile("1 cm plate at 100 m/s, 30 deg off the normal", Vec3(0.01, 0.5, 0.5),
+                     Vec3(86.6, 50, 0), 1.0, 0.01)};
+}
+
+TEST(BulletSettingsMeasured, ContinuousCollisionOnFastBodies) {
+  // Bullet's CCD as its own demo sets it (motion threshold the half extent, swept sphere 0.9 of
+  // it; here of the inscribed radius): a body moving further in a step is swept and moved to
+  // the first hit, and the next step's contact bounces it. Against CCD off (Bullet's default),
+  // where every projectile passes the slab untouched; a sphere half as wide gives the same.
+  // Predictive contacts (Bullet's CCD contacts, which carry no restitution) need a processing
+  // threshold above 0; at 0 (ContactsSolvedOnlyOnceTheyOverlap) the motion clamp alone acts.
+  BulletSettings off, half_sphere;
+  off.ccd_motion_fraction = 0;
+  half_sphere.ccd_sphere_fraction = 0.5;
+  for (const Case& c : projectile_cases()) {
+    EXPECT_LT(measured("bullet CCD", c, ke_error(c, bullet.dynamics(c.scene, {}))), kExact)
+        << c.name;
+    // The one-point hull bounces back, with its one-point error (as on headon_e05).
+    const DynamicsResult hull = bullet_hull.dynamics(c.scene, {});
+    measured("bullet-hull CCD", c, ke_error(c, hull));
+    ASSERT_EQ(hull.status, Status::Ok) << hull.message;
+    EXPECT_LT(hull.finals[0].velocity.x(), 0) << c.name;
+    EXPECT_LT(measured("bullet CCD, sphere 0.5", c,
+                       ke_error(c, bullet_at_settings().dynamics(c.scene, {}, half_sphere))),
+              kExact)
+        << c.name;
+    EXPECT_GT(measured("bullet CCD off (default)", c,
+                       ke_error(c, bullet_at_settings().dynamics(c.scene, {}, off))),
+              kWrong)
+        << c.name;
+  }
+}
+
+TEST(BulletSettingsMeasured, BoxMarginAsTheConstructorSetsIt) {
+  // btBoxShape's constructor lowers Bullet's default margin (0.04 m) to a tenth of the smallest
+  // half extent; setting 0.04 after it leaves a 1 cm plate a margin 8 times its half
+  // thickness, and the plate moved by CCD onto the slab gets a contact across its face
+  // (it slides off sideways at 1.8 m/s instead of bouncing).
+  BulletSettings forced;
+  forced.box_margin = 0.04;
+  const Case c = projectile_cases()[0];
+  EXPECT_LT(
+      measured("bullet box margin as constructed", c, ke_error(c, bullet.dynamics(c.scene, {}))),
+      kExact);
+  EXPECT_GT(measured("bullet box margin set to 0.04", c,
+                     ke_error(c, bullet_at_settings().dynamics(c.scene, {}, forced))),
+            kWrong);
+}
+
 // ---------------------------------------------------------------------------------------------
 // ODE
 
