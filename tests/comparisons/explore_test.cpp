@@ -397,16 +397,16 @@ TEST(ExploreLanding, CustomPassesTheExpectOfSampleScenes) {
 }
 
 TEST(ExploreLanding, ShrinkKeepsTheSignature) {
-  // MuJoCo's soft contact rests more than 1 mm off on many sliding samples; shrinking rounds the
-  // design while the harness still shows it on the scene, and the check can fail: custom rests
-  // where the closed form says on the same scene.
+  // The one-point hull variant of MuJoCo (MPR, one contact point per step) rests more than
+  // 1 mm off on some landings; shrinking rounds the design while the harness still shows it on
+  // the scene, and the check can fail: custom rests where the closed form says on the same scene.
   for (uint64_t i = 0; i < 20; ++i) {
     const LandingSample s = make_landing_sample(1, i);
-    const SampleOutcome o = evaluate_landing_sample(s, {"mujoco"});
+    const SampleOutcome o = evaluate_landing_sample(s, {"mujoco-hull"});
     ASSERT_EQ(o.backends.size(), 1u);
     if (o.backends[0].error != "position") continue;
     const std::string sig = signature(o, o.backends[0]);
-    const LandingShrinkResult r = shrink_landing(s, "mujoco", sig, 30);
+    const LandingShrinkResult r = shrink_landing(s, "mujoco-hull", sig, 30);
     ASSERT_EQ(r.outcome.backends.size(), 1u);
     EXPECT_EQ(signature(r.outcome, r.outcome.backends[0]), sig);
     EXPECT_GT(r.steps_accepted, 0);
@@ -419,7 +419,7 @@ TEST(ExploreLanding, ShrinkKeepsTheSignature) {
     EXPECT_FALSE(harness_reproduces(r.sample.text, "shrunk.toml", custom, &detail)) << detail;
     return;
   }
-  FAIL() << "no sample among the first 20 where mujoco rests more than 1 mm off";
+  FAIL() << "no sample among the first 20 where mujoco-hull rests more than 1 mm off";
 }
 
 TEST(ExploreCommand, LandingSameJsonWithOneAndThreeThreads) {
