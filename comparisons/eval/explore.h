@@ -252,8 +252,8 @@ bool realize_landing(LandingSample& s);
 /// Runs the sample's scene through each named dynamics backend against its closed form:
 /// status error, then a turn above kLandingTurnMark, then a position above
 /// kLandingPositionMark.
-SampleOutcome evaluate_landing_sample(const LandingSample& s,
-                                      const std::vector<std::string>& names);
+SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<std::string>& names,
+                                      const std::vector<Backend>* table = nullptr);
 
 /// Landing groups shrunk toward round designs (unit mass, no yaw, a slide along x, rounder mu,
 /// sizes, speeds and phase) while `backend` keeps signature `sig`.

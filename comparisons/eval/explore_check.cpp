@@ -28,6 +28,8 @@ void tally(const std::string& scene, const std::vector<std::string>& encoded,
       values[b.backend]["normal_err_deg"].push_back(b.normal_err_deg);
       values[b.backend]["depth_err_rel"].push_back(b.depth_err_rel);
       values[b.backend]["velocity_err_ke"].push_back(b.velocity_err_ke);
+      values[b.backend]["position_err_m"].push_back(b.position_err_m);
+      values[b.backend]["turn_rad"].push_back(b.turn_rad);
     }
   }
   for (const auto& [backend, n] : samples) {
@@ -72,6 +74,14 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
                                                          impact_backends, table));
                   }),
           {"velocity_err_ke"}, "analytic", out);
+  if (!impact_backends.empty() && set.landing > 0)
+    tally("explore/landing",
+          run.map(static_cast<size_t>(set.landing),
+                  [&](size_t i) {
+                    return encode(evaluate_landing_sample(make_landing_sample(set.seed, i),
+                                                          impact_backends, table));
+                  }),
+          {"position_err_m", "turn_rad"}, "analytic", out);
   return out;
 }
 

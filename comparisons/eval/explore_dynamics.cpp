@@ -699,8 +699,8 @@ LandingSample make_landing_sample(uint64_t seed, uint64_t index) {
       });
 }
 
-SampleOutcome evaluate_landing_sample(const LandingSample& s,
-                                      const std::vector<std::string>& names) {
+SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<std::string>& names,
+                                      const std::vector<Backend>* table) {
   SampleOutcome out;
   out.index = s.index;
   out.pose_class = "landing";
@@ -715,7 +715,7 @@ SampleOutcome evaluate_landing_sample(const LandingSample& s,
   const std::vector<std::optional<RefState>> ref = {RefState{Vec3::Zero(), Vec3::Zero()},
                                                     std::nullopt};
   // Every step sampled: the time to rest is read from the samples.
-  run_dynamics_subjects(scene, names, DynamicsOptions{0.0, 1}, nullptr, out,
+  run_dynamics_subjects(scene, names, DynamicsOptions{0.0, 1}, table, out,
                         [&](BackendOutcome& o, const DynamicsResult& run) {
                           const BodyFinal& f = run.finals[0];
                           o.position_err_m = (f.position - s.expect_position).head<2>().norm();

@@ -97,8 +97,8 @@ std::string glance_markdown(const std::vector<ScoreRow>& rows) {
   return md.str();
 }
 
-// Explore's fixed samples: per family (contact pairs, impacts) one table, backends by their
-// disagreement rate, with the median and 90th percentile of their errors.
+// Explore's fixed samples: per family (contact pairs, impacts, landings) one table, backends by
+// their disagreement rate, with the median and 90th percentile of their errors.
 std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
                              const ExploreCheckSet& set) {
   if (metrics.empty()) return "";
@@ -107,9 +107,13 @@ std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
         "What no scene of the library shows: `rbx explore`'s fixed samples (seed "
      << set.seed << "; the ones `rbx check` compares), " << set.contact
      << " random convex pairs against the `exact` oracle and " << set.impact
-     << " random vertex-on-face impacts at a random phase against their closed form. "
+     << " random vertex-on-face impacts at a random phase and " << set.landing
+     << " random landings of a box sliding on a floor with friction (any direction, speed, mu "
+        "and yaw), against their closed forms. "
         "*Disagreement*: a sample a backend answers clearly wrong (normal > 1°, depth > 1 % of "
-        "the smaller body, velocity error > 0.1 %, a missed or false contact, an error). Errors "
+        "the smaller body, velocity error > 0.1 %, a landing at rest more than 1 mm from where "
+        "Coulomb's law puts it or turned by more than 1e-3 rad, a missed or false contact, an "
+        "error). Errors "
         "are the median and 90th percentile over the samples where both touch. "
         "`rbx explore` shrinks every disagreement to a scene.\n\n";
   struct Family {
@@ -122,7 +126,11 @@ std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
        "contact pairs",
        {{"normal_err_deg", "normal error (deg) p50 / p90"},
         {"depth_err_rel", "depth error / smaller size p50 / p90"}}},
-      {"explore/impact", "impacts", {{"velocity_err_ke", "velocity error (KE norm) p50 / p90"}}}};
+      {"explore/impact", "impacts", {{"velocity_err_ke", "velocity error (KE norm) p50 / p90"}}},
+      {"explore/landing",
+       "landings with friction",
+       {{"position_err_m", "position at rest error (m) p50 / p90"},
+        {"turn_rad", "turn (rad) p50 / p90"}}}};
   for (const Family& f : families) {
     std::map<std::string, std::map<std::string, double>> by;  // backend -> metric -> value
     for (const ExploreCheckMetric& m : metrics)

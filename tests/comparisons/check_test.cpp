@@ -223,6 +223,7 @@ TEST(Check, AChangeThatOnlyBreaksRandomPosesIsNamedByTheExploreSamples) {
   // share of random poses, so 400 of them name it as surely (and the sanitizer pass stays short).
   opt.explore_samples.contact = 400;
   opt.explore_samples.impact = 0;
+  opt.explore_samples.landing = 0;
   opt.baseline = (dir / "baseline.json").string();
   opt.update = true;
   ASSERT_EQ(run_check(opt).code, 0);
