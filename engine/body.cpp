@@ -35,7 +35,7 @@ RigidBody make_body(const BodySpec& spec) {
   b.shape = std::make_shared<const ConvexPolyhedron>(spec.shape->translated(-mp.center_of_mass));
   b.shape_origin_offset = -mp.center_of_mass;
   b.mass = mp.mass;
-  b.inertia_body = mp.inertia;
+  b.inertia_body = spec.inertia ? *spec.inertia : mp.inertia;
   if (spec.is_static) {
     // seed correction 5 (world-frame inverse inertia, static bodies zero): static bodies have zero
     // inverse mass and inverse inertia.
@@ -43,7 +43,7 @@ RigidBody make_body(const BodySpec& spec) {
     b.inverse_inertia_body.setZero();
   } else {
     b.inverse_mass = 1.0 / mp.mass;
-    b.inverse_inertia_body = mp.inertia.inverse();
+    b.inverse_inertia_body = b.inertia_body.inverse();
   }
   b.orientation = spec.orientation.normalized();
   b.position = spec.position + b.orientation * mp.center_of_mass;

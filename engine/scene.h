@@ -82,6 +82,9 @@ struct BodySpec {
   double mass = 1.0;                              // kg
   bool is_static = false;
   MassModel mass_model = MassModel::Solid;
+  // kg m^2 about the centre of mass, in the shape's local axes, where a body's inertia was
+  // measured rather than follows from its shape (unset: from the shape and mass_model).
+  std::optional<Mat3> inertia;
   Vec3 position = Vec3::Zero();  // m, world position of the shape's local origin
   Quat orientation = Quat::Identity();
   Vec3 velocity = Vec3::Zero();          // m/s, of the centre of mass

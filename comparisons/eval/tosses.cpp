@@ -166,6 +166,7 @@ Scene toss_scene(const Toss& toss, const ContactParams& params, const CubeTossMo
   cube.box_size = Vec3::Constant(2.0 * model.half_width);
   cube.shape = std::make_shared<const ConvexPolyhedron>(make_box(cube.box_size));
   cube.mass = model.mass;
+  cube.inertia = model.inertia * Mat3::Identity();
   cube.position = s0.position;
   cube.orientation = s0.orientation;
   cube.velocity = s0.velocity;

@@ -63,6 +63,21 @@ TEST(Body, MovingBodyKeepsItsStateAndInvertsItsInertia) {
   EXPECT_LT((b.inverse_inertia_world() - r * b.inverse_inertia_body * r.transpose()).norm(), 1e-15);
 }
 
+TEST(Body, AMeasuredInertiaReplacesTheShapes) {
+  // A measured inertia (the tossed cube's) is taken as given; the centre of mass and the pose
+  // still come from the shape.
+  BodySpec spec = pyramid_spec(MassModel::Solid, false);
+  const Mat3 measured = Vec3(0.4, 0.5, 0.6).asDiagonal();
+  spec.inertia = measured;
+  const RigidBody b = make_body(spec);
+  const RigidBody from_shape = make_body(pyramid_spec(MassModel::Solid, false));
+  EXPECT_EQ(b.inertia_body, measured);
+  EXPECT_LT((b.inverse_inertia_body * measured - Mat3::Identity()).norm(), 1e-15);
+  EXPECT_GT((from_shape.inertia_body - measured).norm(), 0.1);
+  EXPECT_EQ(b.position, from_shape.position);
+  EXPECT_DOUBLE_EQ(b.mass, 2.0);
+}
+
 TEST(Body, StaticBodyHasZeroInversesAndNoMotion) {
   // seed correction 5 (world-frame inverse inertia, static bodies zero): static bodies have inverse
   // mass and inverse inertia zero; the velocities a scene gives them are dropped (an immovable body
