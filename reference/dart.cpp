@@ -308,7 +308,9 @@ void pair_events(const std::vector<StepContact>& contacts, const std::vector<Rig
 // tangential velocity relative to the other body): a sliding body's first row then runs against
 // its slip. Below kStickSpeed the setting is cleared (DART's own basis). One direction per
 // shape: a body that slips different ways at different contacts (spinning on its patch, pressed
-// between two others) gets their sum, and the pyramid's error stays there.
+// between two others) gets their sum, and the pyramid's error stays there. The world is collided
+// here, once more than the step does, rather than reusing the last step's contacts: a landing's
+// first contact step would otherwise run on DART's own basis.
 void follow_slip(dart::simulation::World& world, const std::vector<DartBody>& dbodies,
                  const std::map<const dd::ShapeFrame*, int>& index,
                  const std::vector<BodyFinal>& now) {
