@@ -50,8 +50,9 @@ constexpr double kStickSpeed = 1e-9;
 
 /// A library answer of "touching" whose normal is zero or not finite defines no contact
 /// normal. Returns `r` unchanged when every normal is a unit vector; status Touching when such
-/// a contact has (nearly) zero depth, the libraries' convention at exact touching; else status
-/// Error saying which query, at what depth. This labels a library's answer; it corrects nothing.
+/// a contact has (nearly) zero depth, the libraries' convention at exact touching (the harness
+/// scores it against the true depth: a miss where the pair penetrates); else status Error saying
+/// which query, at what depth. This labels a library's answer; it corrects nothing.
 inline ContactResult reject_undefined_normals(ContactResult r, const std::string& query) {
   for (const ContactPoint& c : r.contacts) {
     const double n = c.normal.norm();
@@ -59,7 +60,7 @@ inline ContactResult reject_undefined_normals(ContactResult r, const std::string
     if (std::abs(c.depth) <= kTouchingDepth)
       return {Status::Touching,
               query + " reports the pair touching (depth " + std::to_string(c.depth) +
-                  ") with no normal, its convention at zero depth",
+                  ") with no normal",
               {}};
     return {Status::Error,
             query + " reported a contact (depth " + std::to_string(c.depth) +

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <string>
 #include <vector>
 
 #include "comparisons/eval/json_io.h"
 #include "engine/detect.h"
+#include "engine/format.h"
 #include "reference/isolate.h"
 
 namespace rbx {
@@ -86,6 +88,34 @@ double angle_deg(const Vec3& u, const Vec3& v) {
   // atan2 of |u x v| and u.v is accurate near 0 and 180 degrees, where acos is not.
   const double s = u.normalized().cross(v.normalized()).norm();
   return std::atan2(s, c) * 180.0 / M_PI;
+}
+
+// Violations of [expect.contact] by one subject's answer: touching, then (where it touches)
+// the normal and the depth, each within the scene's tolerance.
+void expect_contact_failures(const std::string& who, const ExpectContact& ex, bool touch,
+                             const Vec3& normal, double depth, double tol,
+                             std::vector<std::string>& failures) {
+  if (ex.touching && touch != *ex.touching)
+    failures.push_back(who + ": touching is " + (touch ? "true" : "false"));
+  if (!touch) {
+    if (!ex.touching && (ex.normal || ex.depth))
+      failures.push_back(who + ": no contact, where [expect.contact] gives one");
+    return;
+  }
+  const Vec3 want = ex.normal ? ex.normal->normalized() : Vec3::Zero();
+  const double off = ex.either_sign ? std::min((normal - want).norm(), (normal + want).norm())
+                                    : (normal - want).norm();
+  if (ex.normal && off > tol)
+    failures.push_back(who + ": contact normal " + fmt_vec(normal, 8) + ", expected " +
+                       fmt_vec(ex.normal->normalized(), 8));
+  if (ex.depth && std::abs(depth - *ex.depth) > tol)
+    failures.push_back(who + ": contact depth " + fmt_num(depth, 10) + ", expected " +
+                       fmt_num(*ex.depth, 10));
+}
+
+Vec3 centres_direction(const RigidBody& a, const RigidBody& b) {
+  const Vec3 d = a.position - b.position;
+  return d.norm() > 0 ? Vec3(d.normalized()) : Vec3::Zero();
 }
 
 }  // namespace rbx

@@ -41,4 +41,14 @@ double angle_deg(const Vec3& u, const Vec3& v);
 bool ties_true_depth(const RigidBody& a, const RigidBody& b, const Vec3& normal, double true_depth,
                      double size);
 
+/// Violations of [expect.contact] by one subject's (`who`'s) answer, appended to `failures` as
+/// "who: what": touching, then (where it touches) the normal and the depth, each within `tol`.
+void expect_contact_failures(const std::string& who, const ExpectContact& ex, bool touch,
+                             const Vec3& normal, double depth, double tol,
+                             std::vector<std::string>& failures);
+
+/// The unit direction from B's centre of mass toward A's (zero where they coincide): the ray
+/// along which MPR searches.
+Vec3 centres_direction(const RigidBody& a, const RigidBody& b);
+
 }  // namespace rbx

@@ -332,10 +332,11 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
       out.backends.push_back(o);
       continue;
     }
-    // Touching with no normal: a false contact where the pair is clearly apart, else an answer
-    // with nothing to score (kept apart from errors).
+    // Touching with no normal: a false contact where the pair is clearly apart, a miss where it
+    // clearly penetrates, else an answer at zero depth with nothing to score.
     if (run.result.status == Status::Touching) {
       if (!sat.touching && sat.depth < -band) o.error = "false_contact";
+      if (sat.touching && sat.depth > band) o.error = "no_normal";
       out.backends.push_back(o);
       continue;
     }
@@ -603,6 +604,9 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
   } else if (b.error == "misses") {
     ok = said("misses a contact");
     d << (ok ? "misses a contact" : "no missed contact");
+  } else if (b.error == "no_normal") {
+    ok = said("touching with no normal on a pair");
+    d << (ok ? "touching with no normal on a penetrating pair" : "no touching answer");
   } else if (b.error == "false_contact") {
     ok = said("reports a contact where there is none");
     d << (ok ? "reports a contact where there is none" : "no false contact");

@@ -102,6 +102,7 @@ std::string describe(const BackendOutcome& b) {
     return "status " + b.error + ": " + m;
   }
   if (b.error == "misses") return "misses a contact";
+  if (b.error == "no_normal") return "reports touching with no normal on a penetrating pair";
   if (b.error == "false_contact") return "reports a contact where there is none";
   if (b.error == "missed") return "the body flew on untouched (no impulse)";
   if (b.error == "impulse" || b.error == "spin")

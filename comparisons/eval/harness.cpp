@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "comparisons/eval/budgets.h"
+#include "comparisons/eval/contact_cause.h"
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/impact_cause.h"
 #include "comparisons/eval/measures.h"
@@ -83,7 +84,8 @@ class Evaluator {
     j["metrics"] = metrics;
     Json causes = Json::array();
     for (const Cause& c : out_.causes)
-      causes.push_back({{"backend", c.backend}, {"kind", c.kind}, {"detail", c.detail}});
+      causes.push_back(
+          {{"backend", c.backend}, {"check", c.check}, {"kind", c.kind}, {"detail", c.detail}});
     j["causes"] = causes;
     Json sweep = Json::array();
     for (const SweepPoint& s : out_.sweep) {
@@ -218,7 +220,8 @@ class Evaluator {
     // [expect.contact] binds the oracle, whatever backends run: if the exact answer (computed
     // here anyway) disagrees with the closed form, the derivation or the oracle is wrong.
     if (ex)
-      check_expect_contact("exact", *ex, sat.touching, sat.normal, std::max(sat.depth, 0.0), tol);
+      expect_contact_failures("exact", *ex, sat.touching, sat.normal, std::max(sat.depth, 0.0), tol,
+                              out_.expect_failures);
     if (ex) expect_contact_bound_ = true;
     // A stated point is one model's representative point of the contact (on A, on B or between
     // them): it is right when it lies in the true contact region, where every backend's point is
@@ -241,14 +244,10 @@ class Evaluator {
       if (run.cached) bj["cached"] = true;
       for (const ContactPoint& p : run.result.contacts)
         bj["contacts"].push_back(contact_json(a.name, b.name, 0.0, p));
-      // Touching with no normal (a library's convention at zero depth): right when the pair
-      // does touch, a false contact when it does not; no normal or depth to score.
+      const ContactTruth truth{true_touch, true_normal, true_depth, size, centres_direction(a, b)};
       if (run.result.status == Status::Touching) {
-        metric("contact", name, pair, "touching_err", true_touch ? 0.0 : 1.0,
-               ex && ex->touching ? stated : "exact");
-        if (!true_touch)
-          out_.disagreements.push_back(name + " on " + pair +
-                                       ": reports a contact where there is none");
+        touching_answer(name, pair, run.result, truth, std::max(tol, 1e-6 * size),
+                        ex && ex->touching ? stated : "exact", depth_src);
         continue;
       }
       if (run.result.status != Status::Ok) continue;
@@ -257,10 +256,13 @@ class Evaluator {
       const bool touch = c != nullptr;
       metric("contact", name, pair, "touching_err", touching_error(run.result, true_touch),
              ex && ex->touching ? stated : "exact");
-      if (touch != true_touch)
+      if (touch != true_touch) {
         out_.disagreements.push_back(
             name + " on " + pair + ": " +
             (touch ? "reports a contact where there is none" : "misses a contact"));
+        if (auto cause = contact_cause(name, scene_.name, run.result, truth, 0.0))
+          out_.causes.push_back(*cause);
+      }
       if (!touch || !true_touch) continue;
       double angle = angle_deg(c->normal, true_normal);
       // A closed form that accepts either sign (a tie by symmetry): the nearer one.
@@ -300,34 +302,33 @@ class Evaluator {
           << " deg, depth off by " << fmt_num(derr, 3) << " m (against " << normal_src << ")";
         const bool clear = angle > kMarkAngleDeg || derr > kMarkDepthRel * size;
         (clear ? out_.disagreements : out_.deviations).push_back(s.str());
+        if (auto cause = contact_cause(name, scene_.name, run.result, truth, angle))
+          out_.causes.push_back(*cause);
       }
       // [expect.contact] binds the engine under test too, like [expect.body]: a violation
       // fails the scene unless the scene documents it as a known failure.
       if (name == "custom" && ex)
-        check_expect_contact("custom", *ex, touch, c->normal, c->depth, tol);
+        expect_contact_failures("custom", *ex, touch, c->normal, c->depth, tol,
+                                out_.expect_failures);
     }
   }
 
-  // Violations of [expect.contact] by one subject's answer: touching, then (where it touches)
-  // the normal and the depth, each within the scene's tolerance.
-  void check_expect_contact(const std::string& who, const ExpectContact& ex, bool touch,
-                            const Vec3& normal, double depth, double tol) {
-    if (ex.touching && touch != *ex.touching)
-      out_.expect_failures.push_back(who + ": touching is " + (touch ? "true" : "false"));
-    if (!touch) {
-      if (!ex.touching && (ex.normal || ex.depth))
-        out_.expect_failures.push_back(who + ": no contact, where [expect.contact] gives one");
-      return;
-    }
-    const Vec3 want = ex.normal ? ex.normal->normalized() : Vec3::Zero();
-    const double off = ex.either_sign ? std::min((normal - want).norm(), (normal + want).norm())
-                                      : (normal - want).norm();
-    if (ex.normal && off > tol)
-      out_.expect_failures.push_back(who + ": contact normal " + fmt_vec(normal, 8) +
-                                     ", expected " + fmt_vec(ex.normal->normalized(), 8));
-    if (ex.depth && std::abs(depth - *ex.depth) > tol)
-      out_.expect_failures.push_back(who + ": contact depth " + fmt_num(depth, 10) + ", expected " +
-                                     fmt_num(*ex.depth, 10));
+  // A touching answer with no normal: a library's convention at zero depth, right when the pair
+  // touches there; a false contact when it does not; a miss when the pair penetrates beyond
+  // `depth_tol` (its depth, zero, is scored as such; there is no normal to score).
+  void touching_answer(const std::string& name, const std::string& pair, const ContactResult& r,
+                       const ContactTruth& t, double depth_tol, const std::string& touch_src,
+                       const std::string& depth_src) {
+    metric("contact", name, pair, "touching_err", t.touching ? 0.0 : 1.0, touch_src);
+    if (!t.touching)
+      out_.disagreements.push_back(name + " on " + pair +
+                                   ": reports a contact where there is none");
+    if (t.touching) metric("contact", name, pair, "depth_err", t.depth, depth_src);
+    if (t.touching && t.depth > depth_tol)
+      (t.depth > kMarkDepthRel * t.size ? out_.disagreements : out_.deviations)
+          .push_back(name + " on " + pair + ": reports touching with no normal on a pair " +
+                     fmt_num(t.depth, 3) + " m deep (a miss)");
+    if (auto c = contact_cause(name, scene_.name, r, t, 0.0)) out_.causes.push_back(*c);
   }
 
   // -- impulse, trajectory, stability ----------------------------------------------------------

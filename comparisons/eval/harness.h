@@ -31,13 +31,15 @@ struct HarnessOptions {
   bool phases = true;
 };
 
-/// A measured explanation of a backend's miss on an impact: what its first impulse saw against
-/// the exact oracle at the same poses.
+/// A measured explanation of a backend's miss: on an impact, what its first impulse saw against
+/// the exact oracle at the same poses (impact_cause.h); on a contact query, the first sign on
+/// its answer (contact_cause.h).
 struct Cause {
   std::string backend;
   std::string scene;
   std::string kind;    // the first measured sign (one line, shared by scenes with that sign)
   std::string detail;  // the measurements behind it
+  std::string check = "impulse";  // the check it explains: "impulse" or "contact"
 };
 
 /// One measured number.

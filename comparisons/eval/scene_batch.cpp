@@ -25,7 +25,8 @@ std::string encode_evaluation(const SceneEvaluation& ev) {
   j["disagreements"] = ev.disagreements;
   j["deviations"] = ev.deviations;
   j["causes"] = Json::array();
-  for (const Cause& c : ev.causes) j["causes"].push_back({c.backend, c.scene, c.kind, c.detail});
+  for (const Cause& c : ev.causes)
+    j["causes"].push_back({c.backend, c.scene, c.kind, c.detail, c.check});
   return j.dump();
 }
 
@@ -43,7 +44,7 @@ SceneEvaluation decode_evaluation(const std::string& text) {
   ev.expect_known = j["expect_known"];
   ev.disagreements = j["disagreements"].get<std::vector<std::string>>();
   ev.deviations = j["deviations"].get<std::vector<std::string>>();
-  for (const Json& c : j["causes"]) ev.causes.push_back({c[0], c[1], c[2], c[3]});
+  for (const Json& c : j["causes"]) ev.causes.push_back({c[0], c[1], c[2], c[3], c[4]});
   return ev;
 }
 

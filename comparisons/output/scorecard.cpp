@@ -8,6 +8,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "comparisons/eval/contact_cause.h"
 #include "comparisons/eval/law_residuals.h"
 #include "comparisons/output/table.h"
 #include "engine/format.h"
@@ -44,6 +45,11 @@ std::string cause(const SceneEvaluation& ev, const std::string& backend) {
     if (msg.size() > 120) msg = msg.substr(0, msg.rfind(' ', 117)) + " ...";
     return bj["status"].get<std::string>() + ": " + msg;
   }
+  // A marked contact answer: the first sign measured on it (contact_cause.h).
+  for (const Cause& c : ev.causes)
+    if (c.check == "contact" && c.backend == backend &&
+        c.kind != std::string(contact_sign::kTouchingAtZeroDepth))
+      return c.kind;
   if (truth_metric(ev, backend, "touching_err") > 0)
     return "misses a contact or reports a false one";
   const double angle = truth_metric(ev, backend, "normal_err_deg");

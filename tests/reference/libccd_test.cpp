@@ -7,10 +7,12 @@
 // product), independent of every rbx backend.
 #include "reference/libccd.h"
 
+#include <ccd/ccd.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <random>
@@ -95,6 +97,69 @@ TEST(Libccd, TouchingGjkHasNoDirectionPinned) {
   EXPECT_EQ(r.epa.status, Status::Touching);
   EXPECT_NE(r.epa.message.find("ccdGJKPenetration"), std::string::npos) << r.epa.message;
   EXPECT_TRUE(r.epa.contacts.empty());
+}
+
+// Axis-aligned boxes as plain libccd objects, for calling the library without the adapter: with
+// the support libccd documents for boxes (ccdSign: a component of the direction within its
+// epsilon of zero gives the centre of that face or edge), or with a strict vertex support.
+struct PlainBox {
+  double centre[3], half[3];
+  bool documented;  // libccd's documented box support, else a vertex
+};
+void plain_support(const void* obj, const ccd_vec3_t* dir, ccd_vec3_t* out) {
+  const PlainBox* b = static_cast<const PlainBox*>(obj);
+  for (int i = 0; i < 3; ++i)
+    out->v[i] = b->centre[i] + (b->documented ? ccdSign(dir->v[i]) * b->half[i]
+                                              : (dir->v[i] >= 0 ? b->half[i] : -b->half[i]));
+}
+void plain_center(const void* obj, ccd_vec3_t* out) {
+  const PlainBox* b = static_cast<const PlainBox*>(obj);
+  ccdVec3Set(out, b->centre[0], b->centre[1], b->centre[2]);
+}
+
+TEST(Libccd, PenetratingFacePairGetsNoDirectionFromTheLibraryItself) {
+  // MuJoCo's BoxBoxMultiCCD pair (scenes/external/mujoco_box_box_multi_ccd.toml): a 2 m cube
+  // 0.1 m into a 20 x 20 x 2 slab, true depth 0.1 along z. libccd 2.1's ccdGJKPenetration,
+  // called here directly (no adapter code) with the box support libccd documents, returns
+  // "intersecting" with depth 0 and no direction, at libccd's default tolerances and at the
+  // adapter's: the library's miss on a penetrating pair, not a convention at zero depth. With a
+  // strict vertex support the same call finds 0.1 along z: the face-centre support points its
+  // documented box support returns are what EPA fails on. The adapter, which uses the documented
+  // support, passes the answer on as Touching; the harness scores it as a miss.
+  for (const bool documented : {true, false})
+    for (const double tol : {-1.0, 1e-10}) {
+      const PlainBox cube{{0, 0, 1.9}, {1, 1, 1}, documented};
+      const PlainBox slab{{0, 0, 0}, {10, 10, 1}, documented};
+      ccd_t ccd;
+      CCD_INIT(&ccd);
+      ccd.support1 = ccd.support2 = plain_support;
+      ccd.center1 = ccd.center2 = plain_center;
+      if (tol > 0) ccd.epa_tolerance = ccd.mpr_tolerance = ccd.dist_tolerance = tol;
+      ccd_real_t depth = -1;
+      ccd_vec3_t dir, pos;
+      ccdVec3Set(&dir, 0, 0, 0);
+      ccdVec3Set(&pos, 0, 0, 0);
+      const int code = ccdGJKPenetration(&cube, &slab, &ccd, &depth, &dir, &pos);
+      std::printf(
+          "[measured] libccd GJK+EPA alone, %s support, tolerance %s: code %d, depth "
+          "%.17g, dir (%g %g %g)\n",
+          documented ? "documented box" : "vertex", tol > 0 ? "1e-10" : "default", code, depth,
+          dir.v[0], dir.v[1], dir.v[2]);
+      EXPECT_EQ(code, 0);  // it reports the pair intersecting
+      const bool has_dir = std::isfinite(dir.v[0]) && std::isfinite(dir.v[1]) &&
+                           std::isfinite(dir.v[2]) && ccdVec3Len2(&dir) > 0.25;
+      if (documented) {
+        EXPECT_LE(std::abs(depth), kTouchingDepth);  // at zero depth, where the truth is 0.1
+        EXPECT_FALSE(has_dir);                       // and with no direction
+      } else {
+        // Exact face: round-off of unit-scale coordinates (kRoundOff).
+        EXPECT_NEAR(depth, 0.1, kRoundOff);
+        EXPECT_TRUE(has_dir);
+      }
+    }
+  const ContactResult r = libccd_epa.contact(box_at("A", Vec3(2, 2, 2), Vec3(0, 0, 1.9)),
+                                             box_at("B", Vec3(20, 20, 2), Vec3::Zero()));
+  EXPECT_EQ(r.status, Status::Touching) << r.message;
 }
 
 TEST(Libccd, DiagonalCubeMprWrongEpaRight) {
