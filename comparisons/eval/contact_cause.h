@@ -32,10 +32,10 @@ inline constexpr const char* kTooShallow = "too shallow, normal right";
 /// The truth a contact answer is measured against, and the pair's geometry the signs need.
 struct ContactTruth {
   bool touching = false;
-  Vec3 normal = Vec3::UnitZ();  // from B toward A, as ContactPoint's
-  double depth = 0.0;           // >= 0
-  double size = 1.0;            // the smaller body's size: the scale of the marks
-  Vec3 centres = Vec3::UnitZ(); // unit, from B's centre of mass toward A's (zero if they meet)
+  Vec3 normal = Vec3::UnitZ();   // from B toward A, as ContactPoint's
+  double depth = 0.0;            // >= 0
+  double size = 1.0;             // the smaller body's size: the scale of the marks
+  Vec3 centres = Vec3::UnitZ();  // unit, from B's centre of mass toward A's (zero if they meet)
 };
 
 /// The first measured sign on backend `backend`'s answer `r` to a pair whose truth is `t`, with

@@ -88,13 +88,13 @@ TEST(ContactCause, NormalSigns) {
   // The same wrong normal where the centres lie along the truth: just a wrong normal.
   EXPECT_EQ(sign_of(answer({point(diagonal, 0.26)}), face_truth(false), off), s::kWrongNormal);
   // A side face's normal on some points, the true one on others (DART's triangle pairs).
-  EXPECT_EQ(sign_of(answer({point(Vec3::UnitX(), 0.8), point(Vec3::UnitZ(), 0.1)}),
-                    face_truth(), 90.0),
-            s::kMixedNormals);
+  EXPECT_EQ(
+      sign_of(answer({point(Vec3::UnitX(), 0.8), point(Vec3::UnitZ(), 0.1)}), face_truth(), 90.0),
+      s::kMixedNormals);
   // Every point with the same wrong normal is not "mixed".
-  EXPECT_EQ(sign_of(answer({point(Vec3::UnitX(), 0.8), point(Vec3::UnitX(), 0.8)}),
-                    face_truth(), 90.0),
-            s::kWrongNormal);
+  EXPECT_EQ(
+      sign_of(answer({point(Vec3::UnitX(), 0.8), point(Vec3::UnitX(), 0.8)}), face_truth(), 90.0),
+      s::kWrongNormal);
 }
 
 // --- Through the harness and the report -------------------------------------------------------
@@ -151,8 +151,9 @@ TEST(ContactCauseReport, TouchingOnAPenetratingPairIsAMarkedMiss) {
   const std::string md = details_for(scaled_exact("libccd-epa", 1.0, true), deep, ev);
   bool miss = false;
   for (const std::string& d : ev.disagreements)
-    miss = miss || d.find("libccd-epa on A-B: reports touching with no normal on a pair 0.1 m "
-                          "deep (a miss)") != std::string::npos;
+    miss = miss || d.find(
+                       "libccd-epa on A-B: reports touching with no normal on a pair 0.1 m "
+                       "deep (a miss)") != std::string::npos;
   EXPECT_TRUE(miss);
   double depth_err = -1;
   for (const Metric& m : ev.metrics)

@@ -37,6 +37,36 @@ bool first_disagreement(const std::string& backend, const std::string& error, Co
   return false;
 }
 
+TEST(ExploreContact, TouchingWithNoNormalIsAMissOnAPenetratingPair) {
+  // A backend that answers every pair "touching, no normal": a miss (no_normal) where the pair
+  // penetrates beyond the band, a false contact where it is clearly apart, and nothing to score
+  // where it touches within the band.
+  const std::vector<Backend> table = {
+      *find_backend("exact"), Backend{"toucher", "test: touching with no normal on every pair",
+                                      [](const RigidBody&, const RigidBody&) {
+                                        return ContactResult{Status::Touching, "no normal", {}};
+                                      },
+                                      nullptr}};
+  const double band = 1e-9;  // explore's touch band, relative to the smaller body (explore.cpp)
+  int deep = 0, apart = 0;
+  for (uint64_t i = 0; i < 100; ++i) {
+    const SampleOutcome o = evaluate_contact_sample(make_contact_sample(1, i), {"toucher"}, &table);
+    ASSERT_EQ(o.backends.size(), 1u);
+    const std::string& e = o.backends[0].error;
+    if (o.touching && o.depth_rel > band) {
+      EXPECT_EQ(e, "no_normal") << i;
+      ++deep;
+    } else if (!o.touching && o.depth_rel < -band) {
+      EXPECT_EQ(e, "false_contact") << i;
+      ++apart;
+    } else {
+      EXPECT_EQ(e, "") << i;
+    }
+  }
+  EXPECT_GT(deep, 0);
+  EXPECT_GT(apart, 0);
+}
+
 std::string read(const fs::path& p) {
   std::ifstream in(p);
   std::stringstream ss;
