@@ -49,9 +49,9 @@ int explore_command(const ExploreOptions& opt) {
   ParallelRun par(opt.threads);
   if (opt.count <= 0)
     throw InputError("rbx explore: --count: must be > 0, got " + std::to_string(opt.count));
-  if (opt.kind != "contact" && opt.kind != "impact" && opt.kind != "landing")
-    throw InputError("rbx explore: --kind: must be contact, impact or landing, got '" + opt.kind +
-                     "'");
+  if (opt.kind != "contact" && opt.kind != "impact" && opt.kind != "landing" && opt.kind != "slide")
+    throw InputError("rbx explore: --kind: must be contact, impact, landing or slide, got '" +
+                     opt.kind + "'");
   ExploreSettings set;
   set.kind = opt.kind;
   set.seed = opt.seed;

@@ -265,4 +265,82 @@ struct LandingShrinkResult {
 LandingShrinkResult shrink_landing(const LandingSample& s, const std::string& backend,
                                    const std::string& sig, int max_evaluations = 120);
 
+// ---------------------------------------------------------------------------------------------
+// Slide kind: a box already resting on a floor or an incline (a static slab), in contact at
+// t = 0, with a speed along the surface; friction mu, e = 0. On a floor it slides along its
+// launch direction decelerating at mu g; on an incline it slides down or up the fall line
+// decelerating at g (mu cos(theta) -/+ sin(theta)), or starts at rest and sticks (mu is drawn
+// above tan(theta)); then static friction holds it. Closed form: the stop distance v^2 / (2 a)
+// along the launch, the time to rest v / a, no turn (the box is drawn so that it cannot tip:
+// mu sz < min(sx, sy)). The derivation is written in each scene.
+
+/// A slide's time-to-rest mark: the rest is read as the first sampled time the speed along the
+/// surface is below 1e-3 m/s, the box then staying put (measured_rest_time), which at the least
+/// deceleration drawn (0.98 m/s^2) is up to 1 ms early, and sampling every step adds up to one
+/// step (1 ms); 3 ms is
+/// above both and below what a wrong law does (a deceleration 1 % off moves the rest by 1 % of
+/// the slide's time, 5 to 1,500 ms here). Position and turn: the landing's marks.
+constexpr double kSlideRestTimeMark = 3e-3;  // s
+
+/// One random slide: its design (drawn) and the closed form (derived by realize_slide).
+struct SlideSample {
+  uint64_t seed = 0;
+  uint64_t index = 0;
+  // Design.
+  Vec3 size = Vec3::Ones();  // m, full extents of the box
+  double mass = 1.0;         // kg
+  double yaw_deg = 0.0;      // the box's turn about the surface normal
+  double incline_deg = 0.0;  // theta: 0 is a floor
+  double azimuth_deg = 0.0;  // heading of the incline's fall line, degrees from +x toward +y
+  double heading_deg = 0.0;  // floor: the launch direction, degrees from +x toward +y
+  int along_fall_line = 1;   // incline: +1 launched down the slope, -1 up it, 0 at rest
+  double speed = 1.0;        // m/s, launch speed along the surface (0 on an incline at rest)
+  double friction = 0.5;     // Coulomb mu
+  double dt = 1e-3;          // s
+  // The closed form (realize_slide).
+  double deceleration = 0.0;    // m/s^2, a
+  double stop_distance = 0.0;   // m, v^2 / (2 a)
+  double rest_time = 0.0;       // s, v / a
+  double duration = 0.0;        // s, a whole number of steps past the rest
+  Vec3 normal = Vec3::UnitZ();  // the surface's, up
+  Vec3 start_position = Vec3::Zero(), velocity = Vec3::Zero();  // t = 0
+  Vec3 expect_position = Vec3::Zero();                          // m, centre at t = duration
+  std::string text;  // the scene with its derivation and [expect] block (empty: invalid design)
+};
+
+/// "floor", "down", "up" or "sticks": the slide's case (its samples' feature).
+std::string slide_case(const SlideSample& s);
+
+/// Sample `index` of `seed` (slide kind): a pure function of the two.
+SlideSample make_slide_sample(uint64_t seed, uint64_t index);
+
+/// The closed form and the scene of a slide design: false when it is not a slide of the closed
+/// form (a box that could tip, an incline it would not stick on, a speed out of range).
+bool realize_slide(SlideSample& s);
+
+/// The closed-form time to rest (s) of a slide scene as written: its first body launched along
+/// the top of its second (a static slab), under the scene's gravity and friction.
+double slide_rest_time(const Scene& scene);
+
+/// Time (s) at which the first body stopped in a run's samples: the earliest sample whose speed
+/// along `normal`'s plane is below 1e-3 m/s and from which it never moves more than 0.1 mm
+/// along that plane; `end` when there is none.
+double measured_rest_time(const std::vector<StateSample>& samples, const Vec3& normal, double end);
+
+/// Runs the sample's scene through each named dynamics backend against its closed form:
+/// status error, then a turn above kLandingTurnMark, then a position along the surface above
+/// kLandingPositionMark, then a time to rest above kSlideRestTimeMark.
+SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std::string>& names,
+                                    const std::vector<Backend>* table = nullptr);
+
+/// Slide groups shrunk toward round designs (unit mass, no yaw, axis directions, rounder mu,
+/// sizes, speed and angle) while `backend` keeps signature `sig`.
+struct SlideShrinkResult {
+  SlideSample sample;
+  SampleOutcome outcome;
+  int steps_accepted = 0, evaluations = 0;
+};
+SlideShrinkResult shrink_slide(const SlideSample& s, const std::string& backend,
+                               const std::string& sig, int max_evaluations = 120);
+
 }  // namespace rbx

@@ -27,7 +27,7 @@ const char* const kMetrics[] = {"normal_err_deg",  "depth_err_rel",   "point_err
 // The metrics of one kind of sample.
 std::vector<std::string> metrics_of(const std::string& kind) {
   if (kind == "impact") return {"velocity_err_ke", "momentum_err_ke"};
-  if (kind == "landing")
+  if (kind == "landing" || kind == "slide")
     return {"position_err_m", "turn_rad", "velocity_err_ke", "rest_time_err_s"};
   return {"normal_err_deg", "depth_err_rel", "point_err_rel"};
 }
@@ -111,9 +111,10 @@ std::string describe(const BackendOutcome& b) {
            (b.error == "impulse" ? "the impulse is wrong"
                                  : "the impulse is right, the spin after it is not") +
            ")";
-  if (b.error == "position" || b.error == "turn")
+  if (b.error == "position" || b.error == "turn" || b.error == "rest_time")
     return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
-           fmt_num(b.turn_rad, 3) + " rad";
+           fmt_num(b.turn_rad, 3) + " rad, its time to rest off by " +
+           fmt_num(b.rest_time_err_s, 3) + " s";
   o << "normal off by " << fmt_num(b.normal_err_deg, 3) << " deg, depth off by "
     << fmt_num(b.depth_err_rel, 3) << " and point off by " << fmt_num(b.point_err_rel, 3)
     << " of the smaller body";
@@ -238,6 +239,22 @@ std::string shrink_landing_group(const Json& g, uint64_t seed, long count, int b
       });
 }
 
+// A slide's box, too: its shrink moves numbers toward round ones.
+std::string shrink_slide_group(const Json& g, uint64_t seed, long count, int budget) {
+  return shrink_closed_form_group(
+      "slide", g, seed, count, budget, make_slide_sample, shrink_slide,
+      [](const SlideShrinkResult& r) {
+        return "toward round numbers (" + std::to_string(r.steps_accepted) +
+               " simplifications kept, " + std::to_string(r.evaluations) + " tried)";
+      },
+      [](const SlideShrinkResult& r, const BackendOutcome& found) {
+        return Json{{"evaluations", r.evaluations},
+                    {"position_err_m", found.position_err_m},
+                    {"turn_rad", found.turn_rad},
+                    {"rest_time_err_s", found.rest_time_err_s}};
+      });
+}
+
 // Every sample, spread over ranks and threads; encoded outcomes in index order on rank 0.
 // `bench`: contact samples with a hull of 100+ points are left out (encoded as "").
 std::vector<std::string> sample_all(const ExploreSettings& set,
@@ -251,6 +268,8 @@ std::vector<std::string> sample_all(const ExploreSettings& set,
         return encode(evaluate_impact_sample(make_impact_sample(set.seed, i), names));
       if (set.kind == "landing")
         return encode(evaluate_landing_sample(make_landing_sample(set.seed, i), names));
+      if (set.kind == "slide")
+        return encode(evaluate_slide_sample(make_slide_sample(set.seed, i), names));
       const ContactSample s = make_contact_sample(set.seed, i);
       if (bench && (s.a.points.size() >= 100 || s.b.points.size() >= 100)) return "";
       o = evaluate_contact_sample(s, names);
@@ -339,6 +358,8 @@ std::vector<std::string> shrink_groups(const Json& groups, const ExploreSettings
       if (set.kind == "landing")
         return shrink_landing_group(groups[k], set.seed, set.count,
                                     std::min(set.shrink_budget, 60));
+      if (set.kind == "slide")
+        return shrink_slide_group(groups[k], set.seed, set.count, std::min(set.shrink_budget, 60));
       return shrink_contact_group(groups[k], set.seed, set.count, set.shrink_budget);
     } catch (const std::exception& e) {
       return Json{{"ok", false}, {"message", e.what()}}.dump();
@@ -405,6 +426,10 @@ Json group_json(const std::string& sig, long count, const BackendTally& t, const
                          {"turn_rad", r["turn_rad"]},
                          {"rest_time_err_s", r["rest_time_err_s"]},
                          {"phase", r["phase"]}};
+  } else if (kind == "slide") {
+    g["shrunk_error"] = {{"position_err_m", r["position_err_m"]},
+                         {"turn_rad", r["turn_rad"]},
+                         {"rest_time_err_s", r["rest_time_err_s"]}};
   } else {
     g["shrunk_error"] = {{"normal_err_deg", r["normal_err_deg"]},
                          {"depth_err_rel", r["depth_err_rel"]},
@@ -425,7 +450,7 @@ Json backend_json(BackendTally& t, const std::string& kind, const Json& groups,
   b["disagreements"] = t.disagreements;
   b["rate"] = t.samples ? static_cast<double>(t.disagreements) / t.samples : 0.0;
   b["errors"] = error_distributions(t, kind);
-  if (kind != "contact") b["by_phase_quarter"] = phase_quarters(t);
+  if (kind == "impact" || kind == "landing") b["by_phase_quarter"] = phase_quarters(t);
   b["groups"] = Json::array();
   std::vector<std::pair<long, std::string>> order;
   for (const auto& [sig, c] : t.by_signature) order.push_back({-c, sig});

@@ -82,6 +82,14 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
                                                           impact_backends, table));
                   }),
           {"position_err_m", "turn_rad"}, "analytic", out);
+  if (!impact_backends.empty() && set.slide > 0)
+    tally("explore/slide",
+          run.map(static_cast<size_t>(set.slide),
+                  [&](size_t i) {
+                    return encode(evaluate_slide_sample(make_slide_sample(set.seed, i),
+                                                        impact_backends, table));
+                  }),
+          {"position_err_m", "turn_rad", "rest_time_err_s"}, "analytic", out);
   return out;
 }
 

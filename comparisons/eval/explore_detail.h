@@ -1,13 +1,19 @@
-// What explore.cpp (contact kind) and explore_dynamics.cpp (impact and landing kinds) share:
-// bodies built as the scene loader builds them, random bodies, scene text, and the rounding
-// used while shrinking. Internal to comparisons/eval/explore*.cpp.
+// What explore.cpp (contact kind), explore_dynamics.cpp (impact and landing kinds) and
+// explore_slide.cpp (slide kind) share: bodies built as the scene loader builds them, random
+// bodies, scene text, dynamics runs judged against a closed form, and the shrinking. Internal to
+// comparisons/eval/explore*.cpp.
 #pragma once
 
+#include <functional>
+#include <initializer_list>
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "comparisons/eval/explore.h"
 #include "engine/body.h"
+#include "reference/backend.h"
 
 namespace rbx::explore_detail {
 
@@ -36,5 +42,124 @@ Vec3 euler_deg(const Quat& q);
 double round_to(double x, double grid);
 /// Each coordinate to the nearest multiple of grid (as above).
 Vec3 round_to(const Vec3& v, double grid);
+
+/// A body of a dynamics sample (impact, landing, slide): its [[body]] table, its mass, and
+/// either its velocity or `static = true`.
+std::string dynamic_body_text(const ExploreBody& e, const std::string& name, double mass,
+                              const Vec3& velocity, bool is_static);
+
+/// Runs each named dynamics backend on `scene` (those without dynamics, or unsupported, left
+/// out) and appends one outcome each to `out`: a status error, or a run returning the wrong
+/// number of final states, as `error`; a finished run measured and classified by `judge`.
+/// Backends are looked up in `table` (null: the registry).
+void run_dynamics_subjects(
+    const Scene& scene, const std::vector<std::string>& names, const DynamicsOptions& options,
+    const std::vector<Backend>* table, SampleOutcome& out,
+    const std::function<void(BackendOutcome&, const DynamicsResult&)>& judge);
+
+/// The [expect] block of a box that ends at rest at `position`, unturned (landing and slide
+/// kinds), the slide's discretisation bound written with the speed's name and value.
+std::string box_at_rest_expect(const std::string& speed_name, double speed, double dt,
+                               const Vec3& position);
+
+/// A random box of the landing and slide kinds: mu in [0.1, 1], footprint sides 0.2 to 2 m,
+/// a height up to 3 footprints with mu sz <= `no_tip_margin` min(sx, sy), mass 0.1 to 10 kg,
+/// yaw 0 to 90 degrees.
+void draw_box(SampleRng& r, double& friction, Vec3& size, double& mass, double& yaw_deg,
+              double no_tip_margin);
+
+// The first of up to `attempts` draws from the sample's own stream that `draw` realizes (draw
+// fills the sample and says whether it is valid); throws when none is.
+template <class Sample, class Draw>
+Sample first_realized(uint64_t seed, uint64_t index, int attempts, const char* what, Draw draw) {
+  SampleRng r(seed, index);
+  for (int attempt = 0; attempt < attempts; ++attempt) {
+    Sample s;
+    s.seed = seed;
+    s.index = index;
+    if (draw(r, s)) return s;
+  }
+  throw std::runtime_error(std::string("no valid ") + what + " found in " +
+                           std::to_string(attempts) + " attempts");
+}
+
+// Greedy shrinking of a closed-form sample's design (impact, landing and slide kinds): a candidate
+// is realized (its closed form and scene rebuilt) and kept while `backend` still shows signature
+// `sig` on it; at most `max_evaluations` tries.
+template <class Sample>
+struct DesignShrinker {
+  Sample sample;  // the simplest kept so far
+  std::vector<std::string> names;
+  std::string sig;
+  int max_evaluations = 0, evaluations = 0, steps_accepted = 0;
+  bool (*realize)(Sample&) = nullptr;
+  SampleOutcome (*evaluate)(const Sample&, const std::vector<std::string>&) = nullptr;
+
+  DesignShrinker(const Sample& start, const std::string& backend, const std::string& signature,
+                 int budget, bool (*realize_fn)(Sample&),
+                 SampleOutcome (*evaluate_fn)(const Sample&, const std::vector<std::string>&))
+      : sample(start),
+        names{backend},
+        sig(signature),
+        max_evaluations(budget),
+        realize(realize_fn),
+        evaluate(evaluate_fn) {}
+
+  // True (and c, realized, becomes the sample) when c still shows the signature.
+  bool keeps(Sample c, SampleOutcome* out = nullptr) {
+    if (evaluations >= max_evaluations) return false;
+    ++evaluations;
+    try {
+      if (!realize(c)) return false;
+      const SampleOutcome o = evaluate(c, names);
+      for (const BackendOutcome& b : o.backends)
+        if (!b.error.empty() && signature(o, b) == sig) {
+          if (out) *out = o;
+          sample = c;
+          return true;
+        }
+    } catch (const std::exception&) {
+      // A candidate the loader rejects is simply not simpler.
+    }
+    return false;
+  }
+  // keeps(c), counted as a simplification when it does.
+  bool accept(const Sample& c) {
+    if (!keeps(c)) return false;
+    ++steps_accepted;
+    return true;
+  }
+  // The design number `field` set to `first`, else toward rounder values on `grids`, coarsest
+  // first; a grid that leaves it as it is, or is kept, ends that number's search.
+  void round_down(double Sample::*field, double first, std::initializer_list<double> grids) {
+    Sample c = sample;
+    c.*field = first;
+    if (c.*field == sample.*field || accept(c)) return;
+    for (double g : grids) {
+      Sample r = sample;
+      r.*field = round_to(r.*field, g);
+      if (r.*field == sample.*field || accept(r)) break;
+    }
+  }
+  // A box design's sides (`size`): a unit cube, else rounder sides, coarsest grid first.
+  void round_size() {
+    Sample cube = sample;
+    cube.size = Vec3::Ones();
+    if (cube.size == sample.size || accept(cube)) return;
+    for (double g : {1.0, 0.5, 0.1, 0.05, 0.01}) {
+      Sample c = sample;
+      c.size = round_to(c.size, g);
+      if (c.size == sample.size || accept(c)) break;
+    }
+  }
+  // The kept sample evaluated once more, past the budget: what is reported for it.
+  SampleOutcome finish() {
+    SampleOutcome o;
+    ++max_evaluations;
+    const Sample last = sample;
+    keeps(last, &o);
+    return o;
+  }
+};
 
 }  // namespace rbx::explore_detail

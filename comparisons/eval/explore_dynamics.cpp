@@ -24,6 +24,74 @@ namespace rbx {
 
 using namespace explore_detail;
 
+namespace explore_detail {
+
+std::string dynamic_body_text(const ExploreBody& e, const std::string& name, double mass,
+                              const Vec3& velocity, bool is_static) {
+  std::string t = body_text(e, name);
+  std::ostringstream o;
+  o << "mass = " << num(mass) << "\n";
+  if (is_static)
+    o << "static = true\n";
+  else
+    o << "velocity = " << vec(velocity) << "\n";
+  return t + o.str();
+}
+
+void run_dynamics_subjects(
+    const Scene& scene, const std::vector<std::string>& names, const DynamicsOptions& options,
+    const std::vector<Backend>* table, SampleOutcome& out,
+    const std::function<void(BackendOutcome&, const DynamicsResult&)>& judge) {
+  for (const std::string& name : names) {
+    const Backend* be = find_backend(name, table);
+    if (!be || !be->dynamics) continue;
+    DynamicsResult run = run_dynamics_isolated(*be, scene, options).result;
+    if (run.status == Status::Unsupported) continue;
+    BackendOutcome o;
+    o.backend = name;
+    if (run.status == Status::Ok && run.finals.size() != scene.bodies.size()) {
+      run.status = Status::Error;
+      run.message = "returned " + std::to_string(run.finals.size()) + " final states";
+    }
+    if (run.status == Status::Error || run.status == Status::Timeout) {
+      o.error = to_string(run.status);
+      o.message = run.message;
+    } else {
+      o.measured = true;
+      judge(o, run);
+    }
+    out.backends.push_back(o);
+  }
+}
+
+std::string box_at_rest_expect(const std::string& speed_name, double speed, double dt,
+                               const Vec3& position) {
+  std::ostringstream o;
+  o << "[expect]\nknown_failure = \"custom-seed: the seed omits friction and resting contact "
+       "(seed correction 12 (what the seed admits it lacks)): the box slides on, or sinks\"\n"
+       "# 1 mm (position; the explore mark), 1e-3 m/s and rad/s (at rest): a time-stepped slide\n"
+       "# falls short of the integral by at most "
+    << speed_name << " dt / 2 = " << num(0.5 * speed * dt)
+    << " m.\ntolerance = " << num(kLandingPositionMark)
+    << "\n[expect.body.box]\nposition = " << vec(position)
+    << "\nvelocity = [0.0, 0.0, 0.0]\nangular_velocity = [0.0, 0.0, 0.0]\n";
+  return o.str();
+}
+
+void draw_box(SampleRng& r, double& friction, Vec3& size, double& mass, double& yaw_deg,
+              double no_tip_margin) {
+  friction = r.uniform(0.1, 1.0);
+  // Footprint sides 0.2 to 2 m; height up to 3 footprints, kept clear of tipping.
+  size.x() = std::pow(10.0, r.uniform(-0.7, 0.3));
+  size.y() = std::pow(10.0, r.uniform(-0.7, 0.3));
+  const double footprint = std::min(size.x(), size.y());
+  size.z() = footprint * r.uniform(0.1, std::min(3.0, no_tip_margin / friction));
+  mass = std::pow(10.0, r.uniform(-1.0, 1.0));
+  yaw_deg = r.uniform(0.0, 90.0);  // a box's yaw repeats every 90 degrees
+}
+
+}  // namespace explore_detail
+
 // ---------------------------------------------------------------------------------------------
 // Impact kind
 
@@ -53,20 +121,6 @@ Quat free_rotation(const Mat3& inverse_inertia_body, Quat q, const Vec3& L, doub
   return Quat(c[3], c[0], c[1], c[2]).normalized();
 }
 
-// A body of a dynamics sample (impact, landing): its shape and pose, mass, and either its
-// velocity or `static = true`.
-std::string dynamic_body_text(const ExploreBody& e, const std::string& name, double mass,
-                              const Vec3& velocity, bool is_static) {
-  std::string t = body_text(e, name);
-  std::ostringstream o;
-  o << "mass = " << num(mass) << "\n";
-  if (is_static)
-    o << "static = true\n";
-  else
-    o << "velocity = " << vec(velocity) << "\n";
-  return t + o.str();
-}
-
 std::string impact_text(const ImpactSample& s, const std::string& header, const std::string& tail) {
   std::ostringstream o;
   o << header;
@@ -92,92 +146,6 @@ std::vector<RigidBody> at_time(std::vector<RigidBody> bodies, double t) {
 int impact_points(const ImpactSample& s) {
   return (s.a.shape_class == "box" ? 8 : static_cast<int>(s.a.points.size())) + 8;
 }
-
-// Runs each named dynamics backend on `scene` (those without dynamics, or unsupported, left
-// out) and appends one outcome each to `out`: a status error, or a run returning the wrong
-// number of final states, as `error`; a finished run measured and classified by `judge`.
-// Backends are looked up in `table` (null: the registry).
-void run_dynamics_subjects(
-    const Scene& scene, const std::vector<std::string>& names, const DynamicsOptions& options,
-    const std::vector<Backend>* table, SampleOutcome& out,
-    const std::function<void(BackendOutcome&, const DynamicsResult&)>& judge) {
-  for (const std::string& name : names) {
-    const Backend* be = find_backend(name, table);
-    if (!be || !be->dynamics) continue;
-    DynamicsResult run = run_dynamics_isolated(*be, scene, options).result;
-    if (run.status == Status::Unsupported) continue;
-    BackendOutcome o;
-    o.backend = name;
-    if (run.status == Status::Ok && run.finals.size() != scene.bodies.size()) {
-      run.status = Status::Error;
-      run.message = "returned " + std::to_string(run.finals.size()) + " final states";
-    }
-    if (run.status == Status::Error || run.status == Status::Timeout) {
-      o.error = to_string(run.status);
-      o.message = run.message;
-    } else {
-      o.measured = true;
-      judge(o, run);
-    }
-    out.backends.push_back(o);
-  }
-}
-
-// Greedy shrinking of a closed-form sample's design (impact and landing kinds): a candidate is
-// realized (its closed form and scene rebuilt) and kept while `backend` still shows signature
-// `sig` on it; at most `max_evaluations` tries.
-template <class Sample>
-struct DesignShrinker {
-  Sample sample;  // the simplest kept so far
-  std::vector<std::string> names;
-  std::string sig;
-  int max_evaluations = 0, evaluations = 0, steps_accepted = 0;
-  bool (*realize)(Sample&) = nullptr;
-  SampleOutcome (*evaluate)(const Sample&, const std::vector<std::string>&) = nullptr;
-
-  DesignShrinker(const Sample& start, const std::string& backend, const std::string& signature,
-                 int budget, bool (*realize_fn)(Sample&),
-                 SampleOutcome (*evaluate_fn)(const Sample&, const std::vector<std::string>&))
-      : sample(start),
-        names{backend},
-        sig(signature),
-        max_evaluations(budget),
-        realize(realize_fn),
-        evaluate(evaluate_fn) {}
-
-  // True (and c, realized, becomes the sample) when c still shows the signature.
-  bool keeps(Sample c, SampleOutcome* out = nullptr) {
-    if (evaluations >= max_evaluations) return false;
-    ++evaluations;
-    try {
-      if (!realize(c)) return false;
-      const SampleOutcome o = evaluate(c, names);
-      for (const BackendOutcome& b : o.backends)
-        if (!b.error.empty() && signature(o, b) == sig) {
-          if (out) *out = o;
-          sample = c;
-          return true;
-        }
-    } catch (const std::exception&) {
-      // A candidate the loader rejects is simply not simpler.
-    }
-    return false;
-  }
-  // keeps(c), counted as a simplification when it does.
-  bool accept(const Sample& c) {
-    if (!keeps(c)) return false;
-    ++steps_accepted;
-    return true;
-  }
-  // The kept sample evaluated once more, past the budget: what is reported for it.
-  SampleOutcome finish() {
-    SampleOutcome o;
-    ++max_evaluations;
-    const Sample last = sample;
-    keeps(last, &o);
-    return o;
-  }
-};
 
 // The closed form of a single-point impact with restitution e at point p (ra, rb from the
 // centres) and normal n from B toward A (seed corrections: world-frame inverse inertia,
@@ -261,21 +229,6 @@ std::string impact_expect(const ImpactSample& s, double speed, const SinglePoint
     x << "[expect.body.B]\nvelocity = " << vec(imp.vb)
       << "\nangular_velocity = " << vec(s.expect_angular_velocity[1]) << "\n";
   return x.str();
-}
-
-// The first of up to `attempts` draws from the sample's own stream that `draw` realizes (draw
-// fills the sample and says whether it is valid); throws when none is.
-template <class Sample, class Draw>
-Sample first_realized(uint64_t seed, uint64_t index, int attempts, const char* what, Draw draw) {
-  SampleRng r(seed, index);
-  for (int attempt = 0; attempt < attempts; ++attempt) {
-    Sample s;
-    s.seed = seed;
-    s.index = index;
-    if (draw(r, s)) return s;
-  }
-  throw std::runtime_error(std::string("no valid ") + what + " found in " +
-                           std::to_string(attempts) + " attempts");
 }
 
 }  // namespace
@@ -569,10 +522,6 @@ constexpr double kGravity = 9.81;  // m/s^2, down (-z)
 constexpr double kNoTipMargin = 0.8;
 // After the closed-form rest, the run goes on this long (s): a backend's rest is seen at rest.
 constexpr double kSettleTime = 0.1;
-// Below this horizontal speed (m/s) a body counts as at rest when the time to rest is measured:
-// at the least deceleration drawn (mu g = 0.98 m/s^2) the slide takes about 1 ms (a step) from
-// this speed to rest, so the measured time is late by about one step at most.
-constexpr double kRestSpeed = 1e-3;
 
 // The box and the floor of a landing as scene bodies (box first: A, then B as impact).
 ExploreBody landing_box(const LandingSample& s) {
@@ -594,16 +543,6 @@ ExploreBody landing_floor(const LandingSample& s, double travel) {
   e.box_size = Vec3(2.0 * reach, 2.0 * reach, 1.0);
   e.position = Vec3(0.0, 0.0, -0.5);
   return e;
-}
-
-// Time (s) after which the first body's horizontal speed stays below kRestSpeed in the run's
-// samples; `end` when it never does.
-double measured_rest_time(const std::vector<StateSample>& samples, double end) {
-  double t = samples.empty() ? end : 0.0;
-  for (size_t k = 0; k < samples.size(); ++k)
-    if (!(samples[k].bodies[0].velocity.head<2>().norm() < kRestSpeed))
-      t = k + 1 < samples.size() ? samples[k + 1].time : end;
-  return t;
 }
 
 }  // namespace
@@ -666,13 +605,7 @@ bool realize_landing(LandingSample& s) {
     << num(mu * s.size.z()) << " < " << num(footprint) << ").\n"
     << "# At t = duration: at rest, centre " << vec(s.expect_position)
     << ", orientation unchanged.\n";
-  o << "[expect]\nknown_failure = \"custom-seed: the seed omits friction and resting contact "
-       "(seed correction 12 (what the seed admits it lacks)): the box slides on, or sinks\"\n"
-       "# 1 mm (position; the explore mark), 1e-3 m/s and rad/s (at rest): a time-stepped slide\n"
-       "# falls short of the integral by at most |v_h'| dt / 2 = "
-    << num(0.5 * s.speed_after * s.dt) << " m.\ntolerance = " << num(kLandingPositionMark)
-    << "\n[expect.body.box]\nposition = " << vec(s.expect_position)
-    << "\nvelocity = [0.0, 0.0, 0.0]\nangular_velocity = [0.0, 0.0, 0.0]\n";
+  o << box_at_rest_expect("|v_h'|", s.speed_after, s.dt, s.expect_position);
   s.text = o.str();
   return true;
 }
@@ -680,14 +613,7 @@ bool realize_landing(LandingSample& s) {
 LandingSample make_landing_sample(uint64_t seed, uint64_t index) {
   return first_realized<LandingSample>(
       seed, index, 10, "landing", [](SampleRng& r, LandingSample& s) {
-        s.friction = r.uniform(0.1, 1.0);
-        // Footprint sides 0.2 to 2 m; height up to 3 footprints, kept clear of tipping.
-        s.size.x() = std::pow(10.0, r.uniform(-0.7, 0.3));
-        s.size.y() = std::pow(10.0, r.uniform(-0.7, 0.3));
-        const double footprint = std::min(s.size.x(), s.size.y());
-        s.size.z() = footprint * r.uniform(0.1, std::min(3.0, kNoTipMargin / s.friction));
-        s.mass = std::pow(10.0, r.uniform(-1.0, 1.0));
-        s.yaw_deg = r.uniform(0.0, 90.0);  // a box's yaw repeats every 90 degrees
+        draw_box(r, s.friction, s.size, s.mass, s.yaw_deg, kNoTipMargin);
         // Slide speeds to 1.5 m/s (kLandingPositionMark says why), falls of 0.2 to 2 m/s.
         s.slide_speed = r.uniform(0.05, 1.5);
         s.heading_deg = r.uniform(0.0, 360.0);
@@ -715,19 +641,20 @@ SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<
   const std::vector<std::optional<RefState>> ref = {RefState{Vec3::Zero(), Vec3::Zero()},
                                                     std::nullopt};
   // Every step sampled: the time to rest is read from the samples.
-  run_dynamics_subjects(scene, names, DynamicsOptions{0.0, 1}, table, out,
-                        [&](BackendOutcome& o, const DynamicsResult& run) {
-                          const BodyFinal& f = run.finals[0];
-                          o.position_err_m = (f.position - s.expect_position).head<2>().norm();
-                          o.turn_rad = rotation_angle(inputs[0].orientation, f.orientation);
-                          o.velocity_err_ke = ke_norm_error(inputs, run.finals, ref, e0);
-                          o.rest_time_err_s =
-                              std::abs(measured_rest_time(run.samples, s.duration) - s.rest_time);
-                          if (!(o.turn_rad <= kLandingTurnMark))
-                            o.error = "turn";
-                          else if (!(o.position_err_m <= kLandingPositionMark))
-                            o.error = "position";
-                        });
+  run_dynamics_subjects(
+      scene, names, DynamicsOptions{0.0, 1}, table, out,
+      [&](BackendOutcome& o, const DynamicsResult& run) {
+        const BodyFinal& f = run.finals[0];
+        o.position_err_m = (f.position - s.expect_position).head<2>().norm();
+        o.turn_rad = rotation_angle(inputs[0].orientation, f.orientation);
+        o.velocity_err_ke = ke_norm_error(inputs, run.finals, ref, e0);
+        o.rest_time_err_s =
+            std::abs(measured_rest_time(run.samples, Vec3::UnitZ(), s.duration) - s.rest_time);
+        if (!(o.turn_rad <= kLandingTurnMark))
+          o.error = "turn";
+        else if (!(o.position_err_m <= kLandingPositionMark))
+          o.error = "position";
+      });
   return out;
 }
 
@@ -738,41 +665,22 @@ LandingShrinkResult shrink_landing(const LandingSample& start, const std::string
       [](const LandingSample& s, const std::vector<std::string>& names) {
         return evaluate_landing_sample(s, names);
       });
-  // Each design number set to `first`, else toward rounder values, coarsest grid first; a grid
-  // that leaves it as it is, or is kept, ends that number's search.
-  auto round_down = [&k](double LandingSample::*field, double first,
-                         std::initializer_list<double> grids) {
-    LandingSample c = k.sample;
-    c.*field = first;
-    if (c.*field == k.sample.*field || k.accept(c)) return;
-    for (double g : grids) {
-      LandingSample c = k.sample;
-      c.*field = round_to(c.*field, g);
-      if (c.*field == k.sample.*field || k.accept(c)) break;
-    }
-  };
+
   // 1. Unit mass, no yaw, a slide along x (else an axis), the first touch two steps ahead.
-  round_down(&LandingSample::mass, 1.0, {});
-  round_down(&LandingSample::yaw_deg, 0.0, {90, 45, 15, 5, 1});
-  round_down(&LandingSample::heading_deg, 0.0, {90, 45, 15, 5, 1});
+  k.round_down(&LandingSample::mass, 1.0, {});
+  k.round_down(&LandingSample::yaw_deg, 0.0, {90, 45, 15, 5, 1});
+  k.round_down(&LandingSample::heading_deg, 0.0, {90, 45, 15, 5, 1});
   {
     LandingSample c = k.sample;
     c.steps_before = 2;
     if (c.steps_before != k.sample.steps_before) k.accept(c);
   }
   // 2. Rounder mu, sizes, speeds and phase.
-  round_down(&LandingSample::friction, 0.5, {0.1, 0.05, 0.01});
-  LandingSample cube = k.sample;
-  cube.size = Vec3::Ones();
-  if (cube.size != k.sample.size && !k.accept(cube))
-    for (double g : {1.0, 0.5, 0.1, 0.05, 0.01}) {
-      LandingSample c = k.sample;
-      c.size = round_to(c.size, g);
-      if (c.size == k.sample.size || k.accept(c)) break;
-    }
-  round_down(&LandingSample::slide_speed, 1.0, {0.5, 0.1, 0.01});
-  round_down(&LandingSample::fall_speed, 1.0, {0.5, 0.1, 0.01});
-  round_down(&LandingSample::phase, 0.5, {0.1, 0.01});
+  k.round_down(&LandingSample::friction, 0.5, {0.1, 0.05, 0.01});
+  k.round_size();
+  k.round_down(&LandingSample::slide_speed, 1.0, {0.5, 0.1, 0.01});
+  k.round_down(&LandingSample::fall_speed, 1.0, {0.5, 0.1, 0.01});
+  k.round_down(&LandingSample::phase, 0.5, {0.1, 0.01});
   LandingShrinkResult r;
   r.outcome = k.finish();
   r.sample = k.sample;

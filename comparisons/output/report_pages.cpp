@@ -107,13 +107,16 @@ std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
         "What no scene of the library shows: `rbx explore`'s fixed samples (seed "
      << set.seed << "; the ones `rbx check` compares), " << set.contact
      << " random convex pairs against the `exact` oracle and " << set.impact
-     << " random vertex-on-face impacts at a random phase and " << set.landing
+     << " random vertex-on-face impacts at a random phase, " << set.landing
      << " random landings of a box sliding on a floor with friction (any direction, speed, mu "
-        "and yaw), against their closed forms. "
+        "and yaw) and "
+     << set.slide
+     << " random slides of a box resting on a floor or an incline (launched along it or left "
+        "at rest), against their closed forms. "
         "*Disagreement*: a sample a backend answers clearly wrong (normal > 1°, depth > 1 % of "
-        "the smaller body, velocity error > 0.1 %, a landing at rest more than 1 mm from where "
-        "Coulomb's law puts it or turned by more than 1e-3 rad, a missed or false contact, an "
-        "error). Errors "
+        "the smaller body, velocity error > 0.1 %, a landing or slide at rest more than 1 mm "
+        "from where Coulomb's law puts it or turned by more than 1e-3 rad, a slide coming to rest "
+        "more than 3 ms off its time, a missed or false contact, an error). Errors "
         "are the median and 90th percentile over the samples where both touch. "
         "`rbx explore` shrinks every disagreement to a scene.\n\n";
   struct Family {
@@ -130,6 +133,11 @@ std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
       {"explore/landing",
        "landings with friction",
        {{"position_err_m", "position at rest error (m) p50 / p90"},
+        {"turn_rad", "turn (rad) p50 / p90"}}},
+      {"explore/slide",
+       "slides on floors and inclines",
+       {{"position_err_m", "position at rest error (m) p50 / p90"},
+        {"rest_time_err_s", "time to rest error (s) p50 / p90"},
         {"turn_rad", "turn (rad) p50 / p90"}}}};
   for (const Family& f : families) {
     std::map<std::string, std::map<std::string, double>> by;  // backend -> metric -> value
