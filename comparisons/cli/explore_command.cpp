@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <set>
+#include <string>
 
 #include "comparisons/cli/commands.h"
 #include "comparisons/eval/explore_campaign.h"
@@ -49,9 +51,11 @@ int explore_command(const ExploreOptions& opt) {
   ParallelRun par(opt.threads);
   if (opt.count <= 0)
     throw InputError("rbx explore: --count: must be > 0, got " + std::to_string(opt.count));
-  if (opt.kind != "contact" && opt.kind != "impact" && opt.kind != "landing" && opt.kind != "slide")
-    throw InputError("rbx explore: --kind: must be contact, impact, landing or slide, got '" +
-                     opt.kind + "'");
+  const std::set<std::string> kinds = {"contact", "impact", "landing", "slide", "tunnel"};
+  if (!kinds.count(opt.kind))
+    throw InputError(
+        "rbx explore: --kind: must be contact, impact, landing, slide or tunnel, got '" + opt.kind +
+        "'");
   ExploreSettings set;
   set.kind = opt.kind;
   set.seed = opt.seed;

@@ -343,4 +343,59 @@ struct SlideShrinkResult {
 SlideShrinkResult shrink_slide(const SlideSample& s, const std::string& backend,
                                const std::string& sig, int max_evaluations = 120);
 
+// ---------------------------------------------------------------------------------------------
+// Tunnel kind: a box projectile flies face-on at a thin static wall (any direction, no gravity,
+// no friction, restitution e), so fast that in one step it may travel from 0.2 to 20 times the
+// wall's thickness plus its own depth, first touch 2 to 5 steps ahead at a random phase. Closed
+// form: the face-on impact through the centre reverses the normal velocity times e and keeps
+// the tangential one (no spin); the box stays on the near side. A backend without continuous
+// collision can let it through.
+
+/// One random fast projectile: its design (drawn) and the closed form (realize_tunnel).
+struct TunnelSample {
+  uint64_t seed = 0;
+  uint64_t index = 0;
+  // Design.
+  Vec3 size = Vec3::Constant(0.1);  // m, the projectile box's full extents (z along the normal)
+  double mass = 1.0;                // kg
+  double yaw_deg = 0.0;             // the box's turn about the wall's normal
+  double wall_thickness = 0.05;     // m
+  Vec3 normal = Vec3::UnitZ();      // the wall's near face's, toward the projectile
+  double travel_ratio = 1.0;        // normal travel per step / (wall thickness + box depth)
+  double tangential = 0.0;          // tangential speed / normal speed, along the wall's x axis
+  double restitution = 0.5;
+  double dt = 1e-3;
+  int steps_before = 2;  // k: first touch in step k (counting from 0)
+  double phase = 0.5;    // where in that step: t_c = (k + phase) dt
+  // The closed form (realize_tunnel).
+  double speed = 0.0;                                                  // m/s, normal approach speed
+  double contact_time = 0.0;                                           // s
+  double duration = 0.0;                                               // s
+  Vec3 velocity = Vec3::Zero(), velocity_after = Vec3::Zero();         // m/s
+  Vec3 start_position = Vec3::Zero(), expect_position = Vec3::Zero();  // m, t = 0 and the end
+  std::string text;  // the scene with its derivation and [expect] block (empty: invalid design)
+};
+
+/// Sample `index` of `seed` (tunnel kind): a pure function of the two.
+TunnelSample make_tunnel_sample(uint64_t seed, uint64_t index);
+
+/// The closed form and the scene of a projectile design: false when it is not one (sizes,
+/// speeds or phase out of range).
+bool realize_tunnel(TunnelSample& s);
+
+/// Runs the sample's scene through each named dynamics backend against its closed form: status
+/// error, then a centre past the wall's near face at the end (tunnel), then a velocity error
+/// above kMarkVelocityErr in the energy norm (velocity).
+SampleOutcome evaluate_tunnel_sample(const TunnelSample& s, const std::vector<std::string>& names,
+                                     const std::vector<Backend>* table = nullptr);
+
+/// Tunnel groups shrunk toward round designs while `backend` keeps signature `sig`.
+struct TunnelShrinkResult {
+  TunnelSample sample;
+  SampleOutcome outcome;
+  int steps_accepted = 0, evaluations = 0;
+};
+TunnelShrinkResult shrink_tunnel(const TunnelSample& s, const std::string& backend,
+                                 const std::string& sig, int max_evaluations = 120);
+
 }  // namespace rbx

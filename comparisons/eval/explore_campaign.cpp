@@ -29,6 +29,7 @@ std::vector<std::string> metrics_of(const std::string& kind) {
   if (kind == "impact") return {"velocity_err_ke", "momentum_err_ke"};
   if (kind == "landing" || kind == "slide")
     return {"position_err_m", "turn_rad", "velocity_err_ke", "rest_time_err_s"};
+  if (kind == "tunnel") return {"velocity_err_ke", "position_err_m"};
   return {"normal_err_deg", "depth_err_rel", "point_err_rel"};
 }
 
@@ -105,6 +106,13 @@ std::string describe(const BackendOutcome& b) {
   if (b.error == "no_normal") return "reports touching with no normal on a penetrating pair";
   if (b.error == "false_contact") return "reports a contact where there is none";
   if (b.error == "missed") return "the body flew on untouched (no impulse)";
+  if (b.error == "tunnel")
+    return "ends past the wall's near face (through it or inside), " +
+           fmt_num(b.position_err_m, 3) + " m from the closed form, velocity error " +
+           fmt_num(b.velocity_err_ke, 3);
+  if (b.error == "velocity")
+    return "bounces off the wall with velocity error " + fmt_num(b.velocity_err_ke, 3) +
+           " (energy norm)";
   if (b.error == "impulse" || b.error == "spin")
     return "velocity error " + fmt_num(b.velocity_err_ke, 3) + ", momentum error " +
            fmt_num(b.momentum_err_ke, 3) + " (energy norm; " +
@@ -255,6 +263,22 @@ std::string shrink_slide_group(const Json& g, uint64_t seed, long count, int bud
       });
 }
 
+// A projectile's box keeps its 8 points: its shrink moves numbers toward round ones.
+std::string shrink_tunnel_group(const Json& g, uint64_t seed, long count, int budget) {
+  return shrink_closed_form_group(
+      "tunnel", g, seed, count, budget, make_tunnel_sample, shrink_tunnel,
+      [](const TunnelShrinkResult& r) {
+        return "toward round numbers (" + std::to_string(r.steps_accepted) +
+               " simplifications kept, " + std::to_string(r.evaluations) + " tried)";
+      },
+      [](const TunnelShrinkResult& r, const BackendOutcome& found) {
+        return Json{{"evaluations", r.evaluations},
+                    {"phase", r.sample.phase},
+                    {"velocity_err_ke", found.velocity_err_ke},
+                    {"position_err_m", found.position_err_m}};
+      });
+}
+
 // Every sample, spread over ranks and threads; encoded outcomes in index order on rank 0.
 // `bench`: contact samples with a hull of 100+ points are left out (encoded as "").
 std::vector<std::string> sample_all(const ExploreSettings& set,
@@ -270,6 +294,8 @@ std::vector<std::string> sample_all(const ExploreSettings& set,
         return encode(evaluate_landing_sample(make_landing_sample(set.seed, i), names));
       if (set.kind == "slide")
         return encode(evaluate_slide_sample(make_slide_sample(set.seed, i), names));
+      if (set.kind == "tunnel")
+        return encode(evaluate_tunnel_sample(make_tunnel_sample(set.seed, i), names));
       const ContactSample s = make_contact_sample(set.seed, i);
       if (bench && (s.a.points.size() >= 100 || s.b.points.size() >= 100)) return "";
       o = evaluate_contact_sample(s, names);
@@ -360,6 +386,8 @@ std::vector<std::string> shrink_groups(const Json& groups, const ExploreSettings
                                     std::min(set.shrink_budget, 60));
       if (set.kind == "slide")
         return shrink_slide_group(groups[k], set.seed, set.count, std::min(set.shrink_budget, 60));
+      if (set.kind == "tunnel")
+        return shrink_tunnel_group(groups[k], set.seed, set.count, std::min(set.shrink_budget, 60));
       return shrink_contact_group(groups[k], set.seed, set.count, set.shrink_budget);
     } catch (const std::exception& e) {
       return Json{{"ok", false}, {"message", e.what()}}.dump();
@@ -426,6 +454,10 @@ Json group_json(const std::string& sig, long count, const BackendTally& t, const
                          {"turn_rad", r["turn_rad"]},
                          {"rest_time_err_s", r["rest_time_err_s"]},
                          {"phase", r["phase"]}};
+  } else if (kind == "tunnel") {
+    g["shrunk_error"] = {{"velocity_err_ke", r["velocity_err_ke"]},
+                         {"position_err_m", r["position_err_m"]},
+                         {"phase", r["phase"]}};
   } else if (kind == "slide") {
     g["shrunk_error"] = {{"position_err_m", r["position_err_m"]},
                          {"turn_rad", r["turn_rad"]},
@@ -450,7 +482,8 @@ Json backend_json(BackendTally& t, const std::string& kind, const Json& groups,
   b["disagreements"] = t.disagreements;
   b["rate"] = t.samples ? static_cast<double>(t.disagreements) / t.samples : 0.0;
   b["errors"] = error_distributions(t, kind);
-  if (kind == "impact" || kind == "landing") b["by_phase_quarter"] = phase_quarters(t);
+  if (kind == "impact" || kind == "landing" || kind == "tunnel")
+    b["by_phase_quarter"] = phase_quarters(t);
   b["groups"] = Json::array();
   std::vector<std::pair<long, std::string>> order;
   for (const auto& [sig, c] : t.by_signature) order.push_back({-c, sig});

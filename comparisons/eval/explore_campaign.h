@@ -16,7 +16,7 @@ namespace rbx {
 
 /// What a campaign runs.
 struct ExploreSettings {
-  std::string kind = "contact";  // contact | impact | landing | slide
+  std::string kind = "contact";  // contact | impact | landing | slide | tunnel
   uint64_t seed = 1;             // sample k of seed s depends on (s, k) only
   long count = 20000;            // samples
   std::string backends;          // --backends LIST ("" or "all": every subject backend)

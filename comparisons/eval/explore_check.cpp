@@ -90,6 +90,14 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
                                                         impact_backends, table));
                   }),
           {"position_err_m", "turn_rad", "rest_time_err_s"}, "analytic", out);
+  if (!impact_backends.empty() && set.tunnel > 0)
+    tally("explore/tunnel",
+          run.map(static_cast<size_t>(set.tunnel),
+                  [&](size_t i) {
+                    return encode(evaluate_tunnel_sample(make_tunnel_sample(set.seed, i),
+                                                         impact_backends, table));
+                  }),
+          {"velocity_err_ke"}, "analytic", out);
   return out;
 }
 

@@ -1,6 +1,6 @@
 // The fixed random samples `rbx check` runs beside the scene library: a change that breaks
-// random poses, impacts at a random phase, landings or slides with friction, which no scene of
-// the library shows, moves these metrics and fails the check.
+// random poses, impacts at a random phase, landings or slides with friction or fast projectiles,
+// which no scene of the library shows, moves these metrics and fails the check.
 #pragma once
 
 #include <string>
@@ -12,19 +12,20 @@
 
 namespace rbx {
 
-/// Which samples: explore's own families (contact, impact, landing and slide kinds), from one
-/// seed.
+/// Which samples: explore's own families (contact, impact, landing, slide and tunnel kinds),
+/// from one seed.
 struct ExploreCheckSet {
   uint64_t seed = 1;
   int contact = 2000;  // contact-kind samples
   int impact = 300;    // impact-kind samples
   int landing = 300;   // landing-kind samples
   int slide = 200;     // slide-kind samples
+  int tunnel = 200;    // tunnel-kind samples
 };
 
 /// One metric of the sample set, under a pseudo-scene name ("explore/contact",
-/// "explore/impact", "explore/landing", "explore/slide") so that it takes its place beside the
-/// scenes' metrics.
+/// "explore/impact", "explore/landing", "explore/slide", "explore/tunnel") so that it takes its
+/// place beside the scenes' metrics.
 struct ExploreCheckMetric {
   std::string scene;
   Metric metric;
@@ -32,8 +33,8 @@ struct ExploreCheckMetric {
 
 /// Per backend: the disagreement rate and the median and 90th percentile of its errors (contact:
 /// normal_err_deg, depth_err_rel; impact: velocity_err_ke; landing: position_err_m, turn_rad;
-/// slide: those and rest_time_err_s), over the samples, exactly as `rbx explore` classifies
-/// them. Impacts, landings and slides run the
+/// slide: those and rest_time_err_s; tunnel: velocity_err_ke), over the samples, exactly as
+/// `rbx explore` classifies them. Impacts, landings, slides and tunnels run the
 /// dynamics backends. Backends are looked up in `table` (null: the registry). The samples
 /// run on `run`'s ranks and threads (null: a run of its own); every rank must call it, the
 /// metrics come back on rank 0.

@@ -152,6 +152,17 @@ struct DesignShrinker {
       if (c.size == sample.size || accept(c)) break;
     }
   }
+  // The shrink's result (a kind's ShrinkResult): the kept sample, its outcome evaluated once
+  // more, the counts.
+  template <class Result>
+  Result result() {
+    Result r;
+    r.outcome = finish();
+    r.sample = sample;
+    r.steps_accepted = steps_accepted;
+    r.evaluations = evaluations;
+    return r;
+  }
   // The kept sample evaluated once more, past the budget: what is reported for it.
   SampleOutcome finish() {
     SampleOutcome o;

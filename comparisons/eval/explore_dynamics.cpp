@@ -681,12 +681,7 @@ LandingShrinkResult shrink_landing(const LandingSample& start, const std::string
   k.round_down(&LandingSample::slide_speed, 1.0, {0.5, 0.1, 0.01});
   k.round_down(&LandingSample::fall_speed, 1.0, {0.5, 0.1, 0.01});
   k.round_down(&LandingSample::phase, 0.5, {0.1, 0.01});
-  LandingShrinkResult r;
-  r.outcome = k.finish();
-  r.sample = k.sample;
-  r.steps_accepted = k.steps_accepted;
-  r.evaluations = k.evaluations;
-  return r;
+  return k.template result<LandingShrinkResult>();
 }
 
 }  // namespace rbx

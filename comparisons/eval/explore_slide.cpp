@@ -267,12 +267,7 @@ SlideShrinkResult shrink_slide(const SlideSample& start, const std::string& back
   k.round_down(&SlideSample::friction, 0.5, {0.1, 0.05, 0.01});
   k.round_size();
   k.round_down(&SlideSample::speed, 1.0, {0.5, 0.1, 0.01});
-  SlideShrinkResult r;
-  r.outcome = k.finish();
-  r.sample = k.sample;
-  r.steps_accepted = k.steps_accepted;
-  r.evaluations = k.evaluations;
-  return r;
+  return k.template result<SlideShrinkResult>();
 }
 
 }  // namespace rbx

@@ -154,9 +154,42 @@ std::string markdown_slide(const Json& j) {
   return o.str();
 }
 
+std::string markdown_tunnel(const Json& j) {
+  std::ostringstream o;
+  o << "# rbx explore: " << j["count"] << " random fast projectiles at thin walls, seed "
+    << j["seed"] << "\n\n"
+    << "Every sample is a box (sides 0.05 to 0.5 m, mass 0.1 to 10 kg) flying face-on at a static "
+       "wall 1 to 10 cm thick, facing any way, with restitution e in [0, 1], no friction, no "
+       "gravity, a tangential speed up to half the normal one, and a normal speed that carries it "
+       "0.2 to 20 times the wall's thickness plus its own depth in one step (log-uniform: "
+       "`fast` above 1, where a step can jump the wall), first touch 2 to 5 steps ahead at a "
+       "random phase of its step. The closed form (the normal velocity reversed times e, the "
+       "tangential kept, no spin, the box on the near side) is the truth 10 steps after the "
+       "contact's step. A disagreement: a status error, a centre past the wall's near face at "
+       "the end (tunnel: through the wall or inside it), or a velocity error above 0.1 % in the "
+       "energy norm (velocity). Libraries with continuous collision (Bullet's, as the backend "
+       "table says) should not tunnel; those without it can.\n\n## Backends\n\n";
+  Table t({"backend", "samples", "disagreements", "rate", "velocity err p50/p90/p99",
+           "position err p50/p90/p99 (m)"});
+  for (const auto& [name, b] : j["backends"].items())
+    t.add({name, std::to_string(b["samples"].get<long>()),
+           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
+           three(b["errors"], "velocity_err_ke"), three(b["errors"], "position_err_m")});
+  o << t.markdown();
+  o << "\n## Disagreement rate by the phase of the first touch within its step\n\n";
+  o << phase_table(j);
+  o << "\n## Disagreement groups\n\nSignature: backend, box-wall, whether one step can carry "
+       "the box past the wall (fast) or not (slow), the kind of error. Each group's first sample "
+       "was shrunk to the scene named; `reproduced` says whether `rbx compare` shows the "
+       "velocity error on it.\n\n";
+  o << groups_table(j);
+  return o.str();
+}
+
 }  // namespace
 
 std::string explore_markdown(const Json& j, bool have_figure) {
+  if (j["kind"] == "tunnel") return markdown_tunnel(j);
   if (j["kind"] == "impact") return markdown_impact(j);
   if (j["kind"] == "landing") return markdown_landing(j);
   if (j["kind"] == "slide") return markdown_slide(j);

@@ -112,11 +112,15 @@ std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
         "and yaw) and "
      << set.slide
      << " random slides of a box resting on a floor or an incline (launched along it or left "
-        "at rest), against their closed forms. "
+        "at rest) and "
+     << set.tunnel
+     << " random fast projectiles at thin walls (up to 20 times the wall per step), against "
+        "their closed forms. "
         "*Disagreement*: a sample a backend answers clearly wrong (normal > 1°, depth > 1 % of "
         "the smaller body, velocity error > 0.1 %, a landing or slide at rest more than 1 mm "
         "from where Coulomb's law puts it or turned by more than 1e-3 rad, a slide coming to rest "
-        "more than 3 ms off its time, a missed or false contact, an error). Errors "
+        "more than 3 ms off its time, a projectile through or into its wall, a missed or false "
+        "contact, an error). Errors "
         "are the median and 90th percentile over the samples where both touch. "
         "`rbx explore` shrinks every disagreement to a scene.\n\n";
   struct Family {
@@ -138,7 +142,10 @@ std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
        "slides on floors and inclines",
        {{"position_err_m", "position at rest error (m) p50 / p90"},
         {"rest_time_err_s", "time to rest error (s) p50 / p90"},
-        {"turn_rad", "turn (rad) p50 / p90"}}}};
+        {"turn_rad", "turn (rad) p50 / p90"}}},
+      {"explore/tunnel",
+       "fast projectiles at thin walls",
+       {{"velocity_err_ke", "velocity error (KE norm) p50 / p90"}}}};
   for (const Family& f : families) {
     std::map<std::string, std::map<std::string, double>> by;  // backend -> metric -> value
     for (const ExploreCheckMetric& m : metrics)

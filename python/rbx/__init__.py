@@ -281,8 +281,8 @@ def explore(count=20000, seed=1, kind="contact", backends=None, out=None, thread
     """`rbx explore`: random samples against the exact oracle, disagreements grouped and each
     group shrunk to a scene under OUT/scenes/. Returns explore.json (as a dict) with "out" set to
     the folder (default reports/explore, as the command's)."""
-    if kind not in ("contact", "impact", "landing", "slide"):
-        raise ValueError("kind: contact, impact, landing or slide")
+    if kind not in ("contact", "impact", "landing", "slide", "tunnel"):
+        raise ValueError("kind: contact, impact, landing, slide or tunnel")
     args = ["explore", "--count", int(count), "--seed", int(seed), "--kind", kind,
             *_names(backends), "--threads", int(threads)]
     if out is not None:

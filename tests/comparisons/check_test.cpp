@@ -225,6 +225,7 @@ TEST(Check, AChangeThatOnlyBreaksRandomPosesIsNamedByTheExploreSamples) {
   opt.explore_samples.impact = 0;
   opt.explore_samples.landing = 0;
   opt.explore_samples.slide = 0;
+  opt.explore_samples.tunnel = 0;
   opt.baseline = (dir / "baseline.json").string();
   opt.update = true;
   ASSERT_EQ(run_check(opt).code, 0);
