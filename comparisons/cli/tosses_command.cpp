@@ -13,7 +13,10 @@ namespace rbx {
 
 int tosses_command(const TossesOptions& opt) {
   // Everything is read and validated before anything runs or is written.
-  const std::vector<Toss> tosses = read_tosses(opt.data);
+  const std::vector<Toss> all = read_tosses(opt.data);
+  // Tosses that gain energy across an impact are left out of every fit and score.
+  const std::vector<EnergyGain> flagged = energy_gains(all);
+  const std::vector<Toss> tosses = without_energy_gains(all, flagged);
   const std::vector<const Backend*> chosen = select_toss_backends(opt.backends);
   const std::string params_path =
       opt.params.empty() ? default_toss_params_path(opt.data) : opt.params;
@@ -41,11 +44,15 @@ int tosses_command(const TossesOptions& opt) {
   }
 
   const TossEvaluation ev = evaluate_tosses(chosen, tosses, stored);
-  const Json j = toss_evaluation_json(opt.data, tosses, params_path, ev);
+  Json j = toss_evaluation_json(opt.data, tosses, params_path, ev);
+  j["energy_gain"] = energy_gains_json(flagged, tosses.size());
   if (!opt.json.empty()) write_json(opt.json, j);
   if (opt.json != "-") {
-    std::cout << opt.data << ": " << tosses.size() << " tosses\n\nAt the stored parameters ("
-              << params_path << "):\n";
+    std::cout << opt.data << ": " << tosses.size() << " tosses scored, " << flagged.size() << " of "
+              << all.size()
+              << " left out for an energy gain across an impact beyond the tracking noise"
+              << energy_gains_list(flagged) << "\n\nAt the stored parameters (" << params_path
+              << "):\n";
     toss_results_table(ev.stored, false).print(std::cout);
     std::cout << "\nAt the published parameters (e = 0.125, mu = 0.18):\n";
     toss_results_table(ev.published, false).print(std::cout);

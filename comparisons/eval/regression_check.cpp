@@ -115,7 +115,8 @@ void measure_explore(const CheckSettings& set, const ParallelRun& par, CheckRun&
 void add_toss_metrics(const CheckSettings& set, CheckRun& run) {
   const std::vector<Backend>& table = set.registry ? *set.registry : backends();
   for (const std::string& dir : find_toss_datasets({})) {
-    const std::vector<Toss> tosses = read_tosses(toss_test_split(dir));
+    const std::vector<Toss> all = read_tosses(toss_test_split(dir));
+    const std::vector<Toss> tosses = without_energy_gains(all, energy_gains(all));
     const auto stored = read_params_file((fs::path(dir) / "params.json").string());
     const std::string scene = "tosses/" + fs::path(dir).filename().string();
     run.scene_in_run.insert(scene);

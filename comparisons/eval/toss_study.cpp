@@ -62,6 +62,75 @@ std::vector<const Backend*> select_toss_backends(const std::string& list) {
   return out;
 }
 
+std::vector<EnergyGain> energy_gains(const std::vector<Toss>& tosses, const CubeTossModel& model) {
+  std::vector<EnergyGain> out;
+  const double h = model.half_width;
+  for (const Toss& t : tosses) {
+    // Energy and flight at each sample; flights as [begin, end) runs of samples.
+    std::vector<double> energy;
+    std::vector<std::pair<size_t, size_t>> flights;
+    for (size_t k = 0; k < t.samples.size(); ++k) {
+      const TossSample& s = t.samples[k];
+      energy.push_back(0.5 * model.mass * s.velocity.squaredNorm() +
+                       0.5 * model.inertia * s.angular_velocity.squaredNorm() +
+                       model.mass * model.gravity * s.position.z());
+      // The lowest corner: the centre's height less the half widths along each rotated axis.
+      const Mat3 r = s.orientation.toRotationMatrix();
+      const double lowest = s.position.z() - h * r.row(2).cwiseAbs().sum();
+      const bool flying = lowest > kFlightClearance;
+      if (flying && (flights.empty() || flights.back().second != k)) flights.push_back({k, k});
+      if (flying) flights.back().second = k + 1;
+    }
+    EnergyGain g;
+    g.toss_id = t.id;
+    g.noise = 0.01;
+    for (const auto& [b, e] : flights) {
+      const auto [lo, hi] = std::minmax_element(energy.begin() + b, energy.begin() + e);
+      g.noise = std::max(g.noise, (*hi - *lo) / std::abs(*hi));
+    }
+    for (size_t f = 1; f < flights.size(); ++f) {
+      const double before = energy[flights[f - 1].second - 1];
+      const double after =
+          *std::max_element(energy.begin() + flights[f].first, energy.begin() + flights[f].second);
+      g.ratio = std::max(g.ratio, after / before);
+    }
+    if (g.ratio > 1.0 + g.noise) out.push_back(g);
+  }
+  return out;
+}
+
+std::vector<Toss> without_energy_gains(const std::vector<Toss>& tosses,
+                                       const std::vector<EnergyGain>& flagged) {
+  std::vector<Toss> kept;
+  for (const Toss& t : tosses)
+    if (std::none_of(flagged.begin(), flagged.end(),
+                     [&](const EnergyGain& g) { return g.toss_id == t.id; }))
+      kept.push_back(t);
+  return kept;
+}
+
+std::string energy_gains_list(const std::vector<EnergyGain>& flagged) {
+  std::string s;
+  for (const EnergyGain& g : flagged)
+    s += (s.empty() ? " (toss " : "; toss ") + std::to_string(g.toss_id) + ": energy x" +
+         fmt_num(g.ratio, 3) + ", noise " + fmt_num(g.noise, 2);
+  return s.empty() ? s : s + ")";
+}
+
+Json energy_gains_json(const std::vector<EnergyGain>& flagged, size_t scored) {
+  Json j;
+  j["rule"] =
+      "left out of every fit and score: a toss whose energy (m v^2/2 + I w^2/2 + m g z, from the "
+      "data's states) in a flight after a contact exceeds that at the end of the flight before "
+      "it by more than the tracking noise (the largest relative swing of its energy within one "
+      "flight, at least 1 %); flight: the lowest corner more than 3 mm above the floor";
+  j["flagged"] = Json::array();
+  for (const EnergyGain& g : flagged)
+    j["flagged"].push_back({{"toss", g.toss_id}, {"ratio", g.ratio}, {"noise", g.noise}});
+  j["scored"] = scored;
+  return j;
+}
+
 TossEvaluation evaluate_tosses(const std::vector<const Backend*>& chosen,
                                const std::vector<Toss>& tosses,
                                const std::vector<std::pair<std::string, ContactParams>>& stored,

@@ -63,6 +63,35 @@ std::vector<Toss> read_tosses(const std::string& path);
 /// The same from text in memory (`path` is used in messages).
 std::vector<Toss> parse_tosses(const std::string& text, const std::string& path);
 
+/// A toss whose mechanical energy rises across an impact beyond the tracking noise (the data's
+/// source reports such tosses). Energy: m |v|^2 / 2 + I |w|^2 / 2 + m g z from the data's own
+/// states (the cube's inertia is isotropic). Flight: the samples whose lowest corner is more
+/// than kFlightClearance above the floor. For each contact between two flights, `ratio` is the
+/// largest energy of the later flight over the last of the earlier one; `noise` is the toss's
+/// tracking noise, the largest relative swing of its energy within one flight (where it is
+/// constant), at least 1 %. Flagged when ratio > 1 + noise.
+struct EnergyGain {
+  long toss_id = 0;
+  double ratio = 0.0;  // the largest over the toss's impacts
+  double noise = 0.0;
+};
+constexpr double kFlightClearance = 3e-3;  // m: the tracking's millimetres, above a resting cube
+
+/// Every toss that gains energy across an impact (see EnergyGain), in data order.
+std::vector<EnergyGain> energy_gains(const std::vector<Toss>& tosses,
+                                     const CubeTossModel& model = {});
+
+/// The tosses without the flagged ones: every fit and score runs on these.
+std::vector<Toss> without_energy_gains(const std::vector<Toss>& tosses,
+                                       const std::vector<EnergyGain>& flagged);
+
+/// The flagged tosses for a sentence: "" when none, else " (toss 12: energy x1.08, noise 0.02;
+/// ...)".
+std::string energy_gains_list(const std::vector<EnergyGain>& flagged);
+
+/// {"rule", "flagged": [{toss, ratio, noise}], "scored"}: what was left out and why.
+Json energy_gains_json(const std::vector<EnergyGain>& flagged, size_t scored);
+
 /// Contact parameters of one backend.
 struct ContactParams {
   double restitution = 0.125;  // e in [0, 1]

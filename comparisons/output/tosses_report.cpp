@@ -189,7 +189,9 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
                                   const std::string& backend_list, int threads) {
   const fs::path d(dir);
   const std::string data = toss_test_split(dir);
-  const std::vector<Toss> tosses = read_tosses(data);
+  const std::vector<Toss> all = read_tosses(data);
+  const std::vector<EnergyGain> flagged = energy_gains(all);
+  const std::vector<Toss> tosses = without_energy_gains(all, flagged);
   const std::string params_path = (d / "params.json").string();
   const auto stored = read_params_file(params_path);
   // Backends without dynamics named in the report's --backends are simply not tossed.
@@ -202,7 +204,9 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
   const TossEvaluation ev = evaluate_tosses(chosen, tosses, stored, threads);
   const double eval_s = clock.seconds();
   const fs::path out(out_dir);
-  write_json((out / "tosses.json").string(), toss_evaluation_json(data, tosses, params_path, ev));
+  Json study = toss_evaluation_json(data, tosses, params_path, ev);
+  study["energy_gain"] = energy_gains_json(flagged, tosses.size());
+  write_json((out / "tosses.json").string(), study);
   write_per_toss_csv(out, ev);
   write_error_time_csv(out, ev);
   const std::vector<size_t> order = toss_ranking(ev.stored);
@@ -218,7 +222,10 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
   md << "## Real impacts: measured cube tosses\n\n";
   md << tosses.size() << " test tosses (" << samples << " samples) of a real 10.48 cm, 0.37 kg "
      << "cube onto a floor, tracked by motion capture at 148 Hz (ContactNets data, "
-     << "`" << data << "`; the split and the source are in the README beside it). "
+     << "`" << data << "`; the split and the source are in the README beside it); "
+     << flagged.size() << " of its " << all.size()
+     << " tosses left out for an energy gain across an impact beyond the tracking noise"
+     << energy_gains_list(flagged) << ". "
      << "Each toss is simulated from its first measured sample (pose, velocity, angular "
      << "velocity) for its recorded duration, dt = 1/1480 s (10 substeps per sample), and "
      << "compared at every sample: **position error** = mean |p_sim - p_real| over the toss in "
