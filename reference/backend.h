@@ -203,6 +203,26 @@ using DynamicsFn = std::function<DynamicsResult(const Scene& scene, const Dynami
 using MassFn = std::function<MassResult(const RigidBody& body)>;
 
 /// One row of the registry.
+/// One contact-softness parameter a library's experts tune (MuJoCo's contact time constant,
+/// ODE's and DART's error reduction and constraint force mixing): its name (as in params.json),
+/// what it is, the backend's own value, its valid range and the values a fit tries.
+struct SoftParameter {
+  std::string name;
+  std::string meaning;  // one line
+  double value = 0.0;   // the backend as configured
+  double lo = 0.0, hi = 0.0;
+  std::vector<double> grid;
+};
+
+/// A backend's contact softness: its parameters and its dynamics with them set (`values` in the
+/// order of `parameters`). Empty `parameters`: none to tune.
+struct SoftContact {
+  std::vector<SoftParameter> parameters;
+  std::function<DynamicsResult(const Scene& scene, const DynamicsOptions& opt,
+                               const std::vector<double>& values)>
+      dynamics;
+};
+
 struct Backend {
   std::string name;          // as in JSON and reports
   std::string description;   // one line: library, algorithm
@@ -213,7 +233,14 @@ struct Backend {
   bool friction = true;      // its dynamics apply Coulomb friction (false: mu is ignored)
   bool user = false;         // registered at run time (register_backend): never cached
   SolverBudget budget = {};  // the solver's iteration budget, when it has one
+  SoftContact soft = {};     // its contact softness, when it has some to tune
 };
+
+/// `b` with its contact softness.
+inline Backend with_soft(Backend b, SoftContact soft) {
+  b.soft = std::move(soft);
+  return b;
+}
 
 /// `b` with its solver budget (adapters' tables name the other fields in order).
 inline Backend with_budget(Backend b, SolverBudget budget) {

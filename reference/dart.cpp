@@ -488,19 +488,46 @@ const AtSettings<DartSettings>& dart_at_settings() {
   return entries;
 }
 
+// The contact softness DART's ContactConstraint exposes, from `base`'s settings: its error
+// reduction (ERP) and constraint force mixing (CFM, floored by DART at 1e-9).
+SoftContact dart_soft(const DartSettings& base) {
+  return {{{"erp",
+            "ContactConstraint's error reduction parameter",
+            base.erp,
+            0.0,
+            1.0,
+            {0.0, 0.01, 0.1, 0.2, 0.4}},
+           {"cfm",
+            "ContactConstraint's constraint force mixing (its floor 1e-9)",
+            base.cfm,
+            1e-9,
+            1.0,
+            {1e-9, 1e-7, 1e-5, 1e-3}}},
+          [base](const Scene& scene, const DynamicsOptions& opt, const std::vector<double>& v) {
+            DartSettings s = base;
+            s.erp = v.at(0);
+            s.cfm = v.at(1);
+            return dart_dynamics_with(scene, opt, s);
+          }};
+}
+
 const Adapter& dart_adapter() {
   static const Adapter adapter = {
       {
-          with_budget(
-              {"dart",
-               "DART 6.12 BoxShape on DART's detector (all boxes) or MeshShape on FCL; "
-               "boxed LCP (Dantzig)",
-               dart_contact, dart_dynamics, [](const RigidBody& b) { return mass_of(b, true); }},
-              dart_budget()),
-          with_budget({"dart-hull", "DART 6.12 MeshShape of the hull on FCL; boxed LCP (Dantzig)",
-                       dart_hull_contact, dart_hull_dynamics,
-                       [](const RigidBody& b) { return mass_of(b, false); }},
-                      dart_budget()),
+          with_soft(
+              with_budget({"dart",
+                           "DART 6.12 BoxShape on DART's detector (all boxes) or MeshShape on FCL; "
+                           "boxed LCP (Dantzig)",
+                           dart_contact, dart_dynamics,
+                           [](const RigidBody& b) { return mass_of(b, true); }},
+                          dart_budget()),
+              dart_soft(DartSettings{})),
+          with_soft(with_budget(
+                        {"dart-hull", "DART 6.12 MeshShape of the hull on FCL; boxed LCP (Dantzig)",
+                         dart_hull_contact, dart_hull_dynamics,
+                         [](const RigidBody& b) { return mass_of(b, false); }},
+                        dart_budget()),
+                    dart_soft(dart_hull_settings())),
       },
       {
           {"dart", "prebuilt", "each pair's shapes, detector and groups built once and kept",

@@ -69,12 +69,12 @@ static void rbx_mujoco_on_warning(const char* msg) {
 namespace rbx {
 namespace {
 
-// Soft-contact duration in time steps: the stiffness is chosen so that an undamped contact
-// lasts this many steps (see contact_stiffness()), whatever dt, so the integration stays stable
-// and the time-discretisation error of one impact is fixed (measured: 1e-4 in e at e = 1,
-// e within 0.485..0.517 for a target of 0.5 depending on the entry phase) while the
-// penetration, about v * 25 dt / pi, shrinks with dt.
-constexpr double kContactSteps = 25.0;
+// Soft-contact duration in time steps (MujocoSettings::contact_steps, 25 unless a fit sets it):
+// the stiffness is chosen so that an undamped contact lasts this many steps (see
+// contact_stiffness()), whatever dt, so the integration stays stable and the
+// time-discretisation error of one impact is fixed (measured at 25: 1e-4 in e at e = 1, e within
+// 0.485..0.517 for a target of 0.5 depending on the entry phase) while the penetration, about
+// v * 25 dt / pi, shrinks with dt.
 // Constant impedance d for contacts (solimp dmin = dmax): MuJoCo's largest, 1 - 1e-4. Then
 // the solver's acceleration is aref to within 1e-4, whatever its diagonal approximation.
 constexpr double kImpedance = 0.9999;
@@ -391,10 +391,10 @@ ContactPoint convert_contact(const mjContact& c, bool geom1_is_a) {
   return p;
 }
 
-// Stiffness (1/s^2, per unit effective mass) for a contact lasting kContactSteps steps when
-// undamped: half period pi / sqrt(k) = kContactSteps * dt.
-double contact_stiffness(double dt) {
-  const double w = M_PI / (kContactSteps * dt);
+// Stiffness (1/s^2, per unit effective mass) for a contact lasting `steps` steps when
+// undamped: half period pi / sqrt(k) = steps * dt.
+double contact_stiffness(double dt, double steps) {
+  const double w = M_PI / (steps * dt);
   return w * w;
 }
 
@@ -405,8 +405,8 @@ double contact_stiffness(double dt) {
 // deep. Semi-implicit Euler with aref explicit in x and v, as mj_step does:
 //   a = max(0, -b x' - k x),  x' += a,  x += x'   (x = dist, < 0 inside)
 // until the body is out (x >= 0); the returned separation speed is e.
-double soft_contact_restitution(double zeta, double entry_phase) {
-  const double w = M_PI / kContactSteps;  // sqrt(k0) * dt
+double soft_contact_restitution(double zeta, double entry_phase, double steps) {
+  const double w = M_PI / steps;  // sqrt(k0) * dt
   const double k = w * w, b = 2.0 * zeta * w;
   double v = -1.0, x = -entry_phase;
   for (int it = 0; it < 1000000 && x < 0.0; ++it) {
@@ -437,7 +437,7 @@ double soft_contact_restitution(double zeta, double entry_phase) {
 //   zeta = 1: e = exp(-2)
 //   zeta > 1: e = ((zeta - s)/(zeta + s))^(zeta/s), s = sqrt(zeta^2 - 1)
 //
-// Discrete correction (what we invert). At kContactSteps = 25 steps per contact the explicit
+// Discrete correction (what we invert). At 25 steps per contact (`steps`) the explicit
 // damping factor (1 - b0 dt) per step, against exp(-b0 dt), lowers e by a few percent (e = 0.1
 // came out 0.072 in MuJoCo with the continuous map, exactly as the recursion predicts). So we
 // invert soft_contact_restitution() at the mean entry phase 1/2 by bisection (e decreases
@@ -445,15 +445,15 @@ double soft_contact_restitution(double zeta, double entry_phase) {
 // returned e lies between 0.485 and 0.517 for a target of 0.5. zeta is capped where b0 dt = 1
 // (more explicit damping would overshoot); e below what the cap reaches is not representable
 // and gets the cap (the result's message says so).
-double restitution_damping_ratio(double e) {
-  const double zeta_max = kContactSteps / (2.0 * M_PI);  // b0 dt = 2 zeta pi / kContactSteps = 1
+double restitution_damping_ratio(double e, double steps) {
+  const double zeta_max = steps / (2.0 * M_PI);  // b0 dt = 2 zeta pi / steps = 1
   constexpr double kEntryPhase = 0.5;
   if (e >= 1.0) return 0.0;
-  if (e <= soft_contact_restitution(zeta_max, kEntryPhase)) return zeta_max;
+  if (e <= soft_contact_restitution(zeta_max, kEntryPhase, steps)) return zeta_max;
   double lo = 0.0, hi = zeta_max;
   for (int it = 0; it < 100; ++it) {
     const double mid = 0.5 * (lo + hi);
-    (soft_contact_restitution(mid, kEntryPhase) > e ? lo : hi) = mid;
+    (soft_contact_restitution(mid, kEntryPhase, steps) > e ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }
@@ -570,8 +570,8 @@ ModelOptions model_options(const Scene& scene, double dt, const std::vector<Rigi
   ModelOptions mo;
   mo.dt = dt;
   mo.gravity = scene.sim.gravity;
-  const double zeta = restitution_damping_ratio(scene.sim.restitution);
-  mo.contact.stiffness = contact_stiffness(dt);
+  const double zeta = restitution_damping_ratio(scene.sim.restitution, settings.contact_steps);
+  mo.contact.stiffness = contact_stiffness(dt, settings.contact_steps);
   mo.contact.damping = 2.0 * zeta * std::sqrt(mo.contact.stiffness);
   mo.contact.friction = scene.sim.friction;
   mo.box_geoms = use_box_geoms(bodies, settings);
@@ -582,7 +582,7 @@ ModelOptions model_options(const Scene& scene, double dt, const std::vector<Rigi
   // Box-box depth is reported halved (see the file comment): the stiffness makes up for it, so
   // that the contact force per true penetration is the mesh's.
   if (mo.box_geoms) mo.contact.stiffness *= settings.box_stiffness_factor;
-  if (const double reached = soft_contact_restitution(zeta, 0.5);
+  if (const double reached = soft_contact_restitution(zeta, 0.5, settings.contact_steps);
       reached > scene.sim.restitution + 1e-9)
     note = "restitution " + num(scene.sim.restitution) +
            " below what the soft contact can reach; used " + num(reached);
@@ -811,18 +811,39 @@ SolverBudget mujoco_budget() {
   return {"opt.iterations (Newton solver)", {1, 3, 10, 100}, 100, 100};
 }
 
+// The contact softness MuJoCo's users tune (solref's time constant), from `base`'s settings: the
+// undamped contact's duration in steps; a fit tries from 5 (MuJoCo's documented floor for
+// solref's time constant is 2 dt) to 60 steps.
+SoftContact mujoco_soft(const MujocoSettings& base) {
+  return {{{"contact_steps",
+            "undamped soft-contact duration in steps (solref's time constant over dt; the damping "
+            "follows from e)",
+            base.contact_steps,
+            3.0,
+            1000.0,
+            {5, 10, 15, 25, 40, 60}}},
+          [base](const Scene& scene, const DynamicsOptions& opt, const std::vector<double>& v) {
+            MujocoSettings s = base;
+            s.contact_steps = v.at(0);
+            return mujoco_dynamics_with(scene, opt, s);
+          }};
+}
+
 const Adapter& mujoco_adapter() {
   static const Adapter adapter = {
       {
-          with_budget(
-              {"mujoco",
-               "MuJoCo 2.2.2 box geoms (box-box) or mesh + multiccd; mj_step, negative solref",
-               mujoco_contact, mujoco_dynamics, mujoco_mass},
-              mujoco_budget()),
-          with_budget(
-              {"mujoco-hull", "MuJoCo 2.2.2 mesh geoms (MPR, one point); mj_step, negative solref",
-               mujoco_hull_contact, mujoco_hull_dynamics, mujoco_hull_mass},
-              mujoco_budget()),
+          with_soft(with_budget({"mujoco",
+                                 "MuJoCo 2.2.2 box geoms (box-box) or mesh + multiccd; mj_step, "
+                                 "negative solref",
+                                 mujoco_contact, mujoco_dynamics, mujoco_mass},
+                                mujoco_budget()),
+                    mujoco_soft(MujocoSettings{})),
+          with_soft(with_budget({"mujoco-hull",
+                                 "MuJoCo 2.2.2 mesh geoms (MPR, one point); mj_step, negative "
+                                 "solref",
+                                 mujoco_hull_contact, mujoco_hull_dynamics, mujoco_hull_mass},
+                                mujoco_budget()),
+                    mujoco_soft(mujoco_hull_settings())),
       },
       {
           {"mujoco", "prebuilt", "the pair's model compiled once and kept (poses set, mj_forward)",

@@ -16,6 +16,9 @@ struct MujocoSettings {
   bool elliptic_cone = true;          // friction: elliptic cone (false: MuJoCo's default pyramid)
   double impratio = 1.0;              // frictional-to-normal impedance ratio (MuJoCo's default)
   int noslip_iterations = 0;          // noslip passes after the main solve (0: MuJoCo's default)
+  // Soft-contact duration: an undamped contact lasts this many steps (solref's time constant,
+  // as a multiple of dt; the damping then follows from the scene's restitution).
+  double contact_steps = 25.0;
 };
 
 /// `mujoco-hull`: every body a mesh geom, single-point MPR.

@@ -660,16 +660,43 @@ SolverBudget ode_budget() {
       "dWorldQuickStep iterations (configured: dWorldStep, exact)", {5, 10, 20, 50, 100}, 20, 0};
 }
 
+// The contact softness ODE's manual has its users tune, from `base`'s settings: the world's
+// error reduction (ERP) and constraint force mixing (CFM).
+SoftContact ode_soft(const OdeSettings& base) {
+  return {{{"erp",
+            "error reduction parameter (the share of a penetration corrected per step)",
+            base.erp,
+            0.0,
+            1.0,
+            {0.05, 0.1, 0.2, 0.4, 0.8}},
+           {"cfm",
+            "constraint force mixing (contact compliance)",
+            base.cfm,
+            0.0,
+            1.0,
+            {1e-10, 1e-7, 1e-5, 1e-3}}},
+          [base](const Scene& scene, const DynamicsOptions& opt, const std::vector<double>& v) {
+            OdeSettings s = base;
+            s.erp = v.at(0);
+            s.cfm = v.at(1);
+            return ode_dynamics_with(scene, opt, s);
+          }};
+}
+
 const Adapter& ode_adapter() {
   static const Adapter adapter = {
       {
-          with_budget(
-              {"ode", "ODE 0.16.2 dCreateBox (dBoxBox) or dCreateConvex; dWorldStep, bounce = e",
-               ode_contact, ode_dynamics},
-              ode_budget()),
-          with_budget({"ode-hull", "ODE 0.16.2 dCreateConvex (libccd MPR); dWorldStep, bounce = e",
-                       ode_hull_contact, ode_hull_dynamics},
-                      ode_budget()),
+          with_soft(with_budget({"ode",
+                                 "ODE 0.16.2 dCreateBox (dBoxBox) or dCreateConvex; dWorldStep, "
+                                 "bounce = e",
+                                 ode_contact, ode_dynamics},
+                                ode_budget()),
+                    ode_soft(OdeSettings{})),
+          with_soft(with_budget({"ode-hull",
+                                 "ODE 0.16.2 dCreateConvex (libccd MPR); dWorldStep, bounce = e",
+                                 ode_hull_contact, ode_hull_dynamics},
+                                ode_budget()),
+                    ode_soft(ode_hull_settings())),
       },
       {
           {"ode", "prebuilt", "each dBox or dConvex geom built once and kept",

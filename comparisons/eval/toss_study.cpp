@@ -206,18 +206,28 @@ Json updated_params_json(const std::string& path, const std::string& data,
   j["about"] =
       "Restitution e and Coulomb friction mu per dynamics backend, fitted on the training tosses "
       "by `rbx tosses train.csv.gz --fit` (5 x 6 grid over e in [0, 1], mu in [0, 1.5], then "
-      "Nelder-Mead; objective: mean position error in cube widths). Backends not listed run at "
-      "the published e = 0.125, mu = 0.18.";
+      "Nelder-Mead; objective: mean position error in cube widths); then, for a backend with a "
+      "contact softness its experts tune (soft: MuJoCo's contact duration in steps, ODE's and "
+      "DART's erp and cfm), each such parameter over its grid (soft_grid) at the fitted e and mu, "
+      "the best kept. Backends not listed run at the published e = 0.125, mu = 0.18 and their "
+      "own softness.";
   j["model"] = model_json(CubeTossModel{});
   Json& b = j["backends"];
   if (!b.is_object()) b = Json::object();
-  for (const auto& [name, fit] : fits)
+  for (const auto& [name, fit] : fits) {
     b[name] = {{"restitution", fit.params.restitution},
                {"friction", fit.params.friction},
                {"fit_data", fs::path(data).filename().string()},
                {"train_position_error", fit.objective},
                {"evaluations", fit.evaluations},
                {"fit_s", fit.seconds}};
+    for (const auto& [p, v] : fit.params.soft) b[name]["soft"][p] = v;
+    if (const Backend* be = find_backend(name))
+      for (const SoftParameter& p : be->soft.parameters) {
+        b[name]["soft_grid"][p.name] = p.grid;
+        b[name]["soft_own"][p.name] = p.value;
+      }
+  }
   // Registry order, so refitting one backend does not reorder the file.
   Json sorted = Json::object();
   for (const Backend& r : backends())

@@ -282,6 +282,29 @@ void toss_error_fields(Io& io, E& e) {
 
 }  // namespace
 
+Backend toss_backend(const Backend& backend, const ContactParams& params) {
+  if (params.soft.empty() || !backend.soft.dynamics) return backend;
+  std::vector<double> values;
+  for (const SoftParameter& p : backend.soft.parameters) {
+    double v = p.value;
+    for (const auto& [name, x] : params.soft)
+      if (name == p.name) v = x;
+    values.push_back(v);
+  }
+  Backend out = backend;
+  out.dynamics = [run = backend.soft.dynamics, values](const Scene& scene,
+                                                       const DynamicsOptions& opt) {
+    return run(scene, opt, values);
+  };
+  return out;
+}
+
+std::string soft_text(const ContactParams& params) {
+  std::string s;
+  for (const auto& [name, v] : params.soft) s += (s.empty() ? "" : ", ") + name + " " + num(v);
+  return s;
+}
+
 BackendTosses evaluate_backend(const Backend& backend, const std::vector<Toss>& tosses,
                                const ContactParams& params, const CubeTossModel& model) {
   BackendTosses out;
@@ -293,9 +316,10 @@ BackendTosses evaluate_backend(const Backend& backend, const std::vector<Toss>& 
     return out;
   }
   Stopwatch clock;
+  const Backend runs = toss_backend(backend, params);
   // One toss as bytes: its status and message, then its errors when it ran.
   auto one = [&](size_t i) {
-    const TossRun run = simulate_toss(isolated_dynamics_fn(backend), tosses[i], params, model);
+    const TossRun run = simulate_toss(isolated_dynamics_fn(runs), tosses[i], params, model);
     ByteWriter w;
     w.io(run.status, run.message);
     if (run.status == Status::Ok) {
@@ -362,7 +386,7 @@ FitResult fit_backend(const Backend& backend, const std::vector<Toss>& tosses,
   };
   auto f = [&](const Eigen::Vector2d& x) {
     ++fit.evaluations;
-    const double v = fit_objective(backend, tosses, {x[0], x[1]}, model);
+    const double v = fit_objective(backend, tosses, {x[0], x[1], {}}, model);
     if (progress)
       progress(backend.name + ": e = " + fmt_num(x[0], 4) + ", mu = " + fmt_num(x[1], 4) + " -> " +
                fmt_num(v, 5) + " (" + fmt_num(clock.seconds(), 3) + " s)");
@@ -424,11 +448,64 @@ FitResult fit_backend(const Backend& backend, const std::vector<Toss>& tosses,
     }
   }
   const size_t i_best = static_cast<size_t>(std::min_element(fx.begin(), fx.end()) - fx.begin());
-  fit.params = {x[i_best][0], x[i_best][1]};
+  fit.params = {x[i_best][0], x[i_best][1], {}};
   fit.objective = fx[i_best];
+  // The contact softness at the fitted e and mu: each parameter over its grid in turn, the others
+  // at their best so far (the backend's own values first).
+  for (const SoftParameter& sp : backend.soft.parameters) {
+    ContactParams trial = fit.params;
+    trial.soft.emplace_back(sp.name, sp.value);
+    for (const double g : sp.grid) {
+      if (g == sp.value) continue;  // the backend's own value: already the objective's
+      trial.soft.back().second = g;
+      ++fit.evaluations;
+      const double v = fit_objective(backend, tosses, trial, model);
+      if (progress)
+        progress(backend.name + ": " + sp.name + " = " + num(g) + " -> " + fmt_num(v, 5) + " (" +
+                 fmt_num(clock.seconds(), 3) + " s)");
+      if (v < fit.objective) {
+        fit.objective = v;
+        fit.params = trial;
+      }
+    }
+    if (fit.params.soft.size() < trial.soft.size()) fit.params.soft.push_back({sp.name, sp.value});
+  }
   fit.seconds = clock.seconds();
   return fit;
 }
+
+namespace {
+
+// backends.<name>.soft of a params file: each key one of the backend's soft parameters
+// (Backend::soft), each value a number in its range.
+std::vector<std::pair<std::string, double>> read_soft(const std::string& path,
+                                                      const std::string& key,
+                                                      const std::string& name, const Json& soft) {
+  if (!soft.is_object())
+    throw InputError(path + ": " + key + ".soft: must be an object of parameter: value");
+  const Backend* b = find_backend(name);
+  std::string known;
+  if (b)
+    for (const SoftParameter& p : b->soft.parameters) known += (known.empty() ? "" : ", ") + p.name;
+  std::vector<std::pair<std::string, double>> out;
+  for (const auto& [k, v] : soft.items()) {
+    const std::string where = path + ": " + key + ".soft." + k;
+    const SoftParameter* sp = nullptr;
+    if (b)
+      for (const SoftParameter& p : b->soft.parameters)
+        if (p.name == k) sp = &p;
+    if (!sp)
+      throw InputError(where + ": not a soft-contact parameter of " + name + " (" +
+                       (known.empty() ? "it has none" : "it has " + known) + ")");
+    if (!v.is_number() || !(v.get<double>() >= sp->lo && v.get<double>() <= sp->hi))
+      throw InputError(where + ": must be a number in [" + num(sp->lo) + ", " + num(sp->hi) +
+                       "], got " + v.dump());
+    out.emplace_back(k, v.get<double>());
+  }
+  return out;
+}
+
+}  // namespace
 
 std::vector<std::pair<std::string, ContactParams>> read_params_file(const std::string& path) {
   std::vector<std::pair<std::string, ContactParams>> out;
@@ -457,6 +534,7 @@ std::vector<std::pair<std::string, ContactParams>> read_params_file(const std::s
                        num(p.restitution));
     if (!(p.friction >= 0.0 && std::isfinite(p.friction)))
       throw InputError(path + ": " + key + ".friction: must be >= 0, got " + num(p.friction));
+    if (b.contains("soft")) p.soft = read_soft(path, key, name, b["soft"]);
     out.emplace_back(name, p);
   }
   return out;
@@ -482,6 +560,7 @@ Json backend_tosses_json(const BackendTosses& r) {
   j["status"] = to_string(r.status);
   j["message"] = r.message;
   j["params"] = {{"restitution", r.params.restitution}, {"friction", r.params.friction}};
+  for (const auto& [name, v] : r.params.soft) j["params"]["soft"][name] = v;
   j["params_source"] = r.params_source;
   j["tosses"] = r.tosses.size();
   j["position_error"] = spread_json(spread_by(r, &TossErrors::position));

@@ -96,10 +96,21 @@ Json energy_gains_json(const std::vector<EnergyGain>& flagged, size_t scored);
 struct ContactParams {
   double restitution = 0.125;  // e in [0, 1]
   double friction = 0.18;      // Coulomb mu >= 0
+  // The backend's contact softness (Backend::soft), by name; a parameter not named keeps the
+  // backend's own value.
+  std::vector<std::pair<std::string, double>> soft;
 };
 
-/// The parameters fitted to these tosses by the data's authors (ContactNets experiment.json).
-constexpr ContactParams kPublishedParams{0.125, 0.18};
+/// The parameters fitted to these tosses by the data's authors (ContactNets experiment.json);
+/// every backend's softness as rbx configures it.
+inline const ContactParams kPublishedParams{0.125, 0.18, {}};
+
+/// `backend` with the softness of `params` set (itself when `params` names none): the dynamics a
+/// toss runs with.
+Backend toss_backend(const Backend& backend, const ContactParams& params);
+
+/// "erp 0.4, cfm 1e-05" for the named softness values, "" for none.
+std::string soft_text(const ContactParams& params);
 
 /// The scene of one toss: body "cube" at the toss's first sample, static body "floor" whose top
 /// face is z = 0, gravity -z, the given contact parameters, duration = the toss's last time.
@@ -172,13 +183,17 @@ struct FitResult {
 };
 /// Fits restitution in [0, 1] and friction in [0, 1.5]: a 5 x 6 grid, then Nelder-Mead from
 /// the best grid point (simplex of one grid spacing, parameters clamped into the box, at most
-/// 30 evaluations). Deterministic: no random numbers.
+/// 30 evaluations); then, for a backend with contact softness (Backend::soft), each of its
+/// parameters in turn over its grid at the fitted e and mu, the best kept (one pass).
+/// Deterministic: no random numbers.
 FitResult fit_backend(const Backend& backend, const std::vector<Toss>& tosses,
                       const CubeTossModel& model = {},
                       const std::function<void(const std::string&)>& progress = nullptr);
 
-/// Stored per-backend parameters (params.json): backends.<name>.{restitution, friction}.
-/// Returns an empty map when the file does not exist; InputError when it is malformed.
+/// Stored per-backend parameters (params.json): backends.<name>.{restitution, friction, soft}.
+/// Returns an empty map when the file does not exist; InputError naming the file and key when it
+/// is malformed, a value is out of its range, or a soft parameter is not one of a registered
+/// backend's.
 std::vector<std::pair<std::string, ContactParams>> read_params_file(const std::string& path);
 
 /// The JSON of one backend: status, message, params, tosses, position_error,

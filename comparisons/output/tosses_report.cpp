@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace rbx {
 
 Table toss_results_table(const std::vector<BackendTosses>& rs, bool markdown) {
-  Table t({"rank", "backend", "e", "mu", "params", "tosses",
+  Table t({"rank", "backend", "e", "mu", "softness", "params", "tosses",
            "position err (widths) med / mean / p90", "angle err (deg) med / mean / p90",
            "final position err med / mean / p90", "run time (s)", "status"});
   auto triple = [](const Spread& s, int d) {
@@ -39,9 +39,15 @@ Table toss_results_table(const std::vector<BackendTosses>& rs, bool markdown) {
     const Backend* b = find_backend(r.name);
     const std::string mu =
         b && !b->friction ? "none (frictionless)" : fmt_num(r.params.friction, 3);
-    t.add({std::to_string(++rank), r.name, fmt_num(r.params.restitution, 3), mu, r.params_source,
-           std::to_string(r.tosses.size()), triple(spread_of(pos), 3), triple(spread_of(ang), 3),
-           triple(spread_of(fin), 3), fmt_num(r.runtime_s, 3), status});
+    // The contact softness run: the fitted values, else the backend's own (rbx's settings).
+    std::string soft = soft_text(r.params);
+    if (soft.empty() && b)
+      for (const SoftParameter& p : b->soft.parameters)
+        soft += (soft.empty() ? "own: " : ", ") + p.name + " " + fmt_num(p.value, 3);
+    t.add({std::to_string(++rank), r.name, fmt_num(r.params.restitution, 3), mu,
+           soft.empty() ? "-" : soft, r.params_source, std::to_string(r.tosses.size()),
+           triple(spread_of(pos), 3), triple(spread_of(ang), 3), triple(spread_of(fin), 3),
+           fmt_num(r.runtime_s, 3), status});
   }
   return t;
 }
