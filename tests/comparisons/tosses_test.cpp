@@ -271,6 +271,66 @@ TEST(TossesEnergy, NoCommittedTossGainsEnergyBeyondItsTrackingNoise) {
   }
 }
 
+TEST(TossesSoft, OwnValuesReproduceTheBackendAndAnotherValueMovesIt) {
+  // Every backend with a contact softness: its dynamics at its own values are the backend's, bit
+  // for bit, on a real toss; a value off its own (the next one on its grid) moves the result, so
+  // the fit's parameters are live.
+  const std::vector<Toss> tosses =
+      read_tosses(std::string(RBX_SOURCE_DIR) + "/scenes/real/cube_toss/test.csv.gz");
+  const Toss& toss = tosses.front();
+  int tuned = 0;
+  for (const Backend& b : backends()) {
+    if (b.soft.parameters.empty()) continue;
+    ++tuned;
+    const TossRun plain = simulate_toss(b.dynamics, toss, kPublishedParams);
+    ASSERT_EQ(plain.status, Status::Ok) << b.name << ": " << plain.message;
+    for (const SoftParameter& p : b.soft.parameters) {
+      ContactParams own = kPublishedParams;
+      own.soft = {{p.name, p.value}};
+      const TossRun same = simulate_toss(toss_backend(b, own).dynamics, toss, own);
+      ASSERT_EQ(same.status, Status::Ok) << b.name;
+      EXPECT_EQ(same.track.position, plain.track.position) << b.name << " " << p.name;
+      ContactParams other = own;
+      other.soft[0].second = p.grid.front() != p.value ? p.grid.front() : p.grid.back();
+      const TossRun moved = simulate_toss(toss_backend(b, other).dynamics, toss, other);
+      ASSERT_EQ(moved.status, Status::Ok) << b.name;
+      EXPECT_NE(moved.track.position, plain.track.position) << b.name << " " << p.name;
+    }
+  }
+  EXPECT_EQ(tuned, 6);  // mujoco, ode and dart, each with its -hull variant
+}
+
+TEST(TossesSoft, AnUnknownOrOutOfRangeSoftParameterExitsTwoNamingFileAndKey) {
+  const fs::path dir = temp_dir("soft_params");
+  const std::string data = std::string(RBX_SOURCE_DIR) + "/scenes/real/cube_toss/test.csv.gz";
+  const struct {
+    const char* soft;
+    const char* says;
+  } cases[] = {
+      {R"("ode": {"restitution": 0.1, "friction": 0.2, "soft": {"erp": -0.5}})",
+       "backends.ode.soft.erp: must be a number in [0, 1], got -0.5"},
+      {R"("mujoco": {"restitution": 0.1, "friction": 0.2, "soft": {"timeconst": 0.02}})",
+       "backends.mujoco.soft.timeconst: not a soft-contact parameter of mujoco (it has "
+       "contact_steps)"},
+      {R"("bullet": {"restitution": 0.1, "friction": 0.2, "soft": {"erp": 0.2}})",
+       "backends.bullet.soft.erp: not a soft-contact parameter of bullet (it has none)"},
+      {R"("dart": {"restitution": 0.1, "friction": 0.2, "soft": {"cfm": "1e-5"}})",
+       "backends.dart.soft.cfm: must be a number in [1e-09, 1]"},
+  };
+  for (const auto& c : cases) {
+    const fs::path params = dir / "params.json";
+    std::ofstream(params) << "{\"backends\": {" << c.soft << "}}";
+    const fs::path json = dir / "out.json";
+    const CmdResult r = run_rbx("tosses '" + data + "' --backends ode --params '" +
+                                params.string() + "' --json '" + json.string() + "'");
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(params.string() + ": " + c.says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(json));
+  }
+  fs::remove_all(dir);
+}
+
 TEST(TossesSimulation, FlatCubeDroppedFromRestFallsFreelyInEveryBackend) {
   // Closed form z(t) = z0 - g t^2 / 2, sampled at 148 Hz for 0.2 s; from z0 = 0.3 m the cube's
   // bottom face reaches the floor only at t = sqrt(2 (0.3 - 0.0524) / 9.81) = 0.225 s.
@@ -293,7 +353,7 @@ TEST(TossesSimulation, FlatCubeDroppedFromRestFallsFreelyInEveryBackend) {
   int ran = 0;
   for (const Backend& b : backends()) {
     if (!b.dynamics) continue;
-    const TossRun run = simulate_toss(b.dynamics, t, {0.5, 0.5}, model);
+    const TossRun run = simulate_toss(b.dynamics, t, {0.5, 0.5, {}}, model);
     ASSERT_EQ(run.status, Status::Ok) << b.name << ": " << run.message;
     const TossErrors e = toss_errors(t, run.track, 2 * model.half_width);
     for (double d : e.position_by_sample) EXPECT_LE(d, bound * (1 + 1e-6)) << b.name;
@@ -331,7 +391,7 @@ TEST(TossesEvaluate, ALibraryAbortingOnOneTossFailsThatTossAloneAndTheOthersAreK
     if (scene.name == "cube toss 2") std::abort();
     return ode->dynamics(scene, opt);
   };
-  const ContactParams params{0.5, 0.5};
+  const ContactParams params{0.5, 0.5, {}};
   const BackendTosses r = evaluate_backend(aborting, tosses, params, model);
   EXPECT_EQ(r.status, Status::Error);
   EXPECT_NE(r.message.find("1 of 3 tosses failed"), std::string::npos) << r.message;
@@ -366,7 +426,7 @@ TEST(TossesFit, RecoversTheParametersThatGeneratedATossOnTheGrid) {
   seed.samples[0] = {0.0, Vec3(0, 0, 0.15),
                      Quat(Eigen::AngleAxisd(0.4, Vec3(1, 2, 0).normalized())), Vec3(0.8, 0.1, -0.5),
                      Vec3(3, -2, 1)};
-  const TossRun truth = simulate_toss(ode->dynamics, seed, {0.5, 0.3}, model);
+  const TossRun truth = simulate_toss(ode->dynamics, seed, {0.5, 0.3, {}}, model);
   ASSERT_EQ(truth.status, Status::Ok) << truth.message;
   Toss measured = seed;
   for (size_t i = 0; i < measured.samples.size(); ++i) {
@@ -374,7 +434,7 @@ TEST(TossesFit, RecoversTheParametersThatGeneratedATossOnTheGrid) {
     measured.samples[i].orientation = truth.track.orientation[i];
   }
   // Another parameter set gives a visibly different toss (the fit has something to find).
-  EXPECT_GT(fit_objective(*ode, {measured}, {0.125, 0.18}, model), 1e-3);
+  EXPECT_GT(fit_objective(*ode, {measured}, {0.125, 0.18, {}}, model), 1e-3);
   const FitResult fit = fit_backend(*ode, {measured}, model);
   EXPECT_EQ(fit.objective, 0.0);
   EXPECT_EQ(fit.params.restitution, 0.5);
