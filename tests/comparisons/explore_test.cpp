@@ -426,6 +426,25 @@ TEST(ExploreLanding, CustomPassesTheExpectOfSampleScenes) {
   EXPECT_EQ(sticks, 2);
 }
 
+TEST(ExploreLanding, ALandingResolvedAStepLateIsNamedByItsMeasuredOffset) {
+  // Seed 8086, sample 26: a box that the landing stops (sticks), first touch at phase 0.06 of
+  // its step. A library without a time of impact resolves the landing at the next step, so the
+  // base slides on at |v_h| for (1 - phase) dt: it rests exactly that much further along its
+  // launch. custom finds the touch within the step and rests where the closed form says.
+  const LandingSample s = make_landing_sample(8086, 26);
+  ASSERT_FALSE(s.slides);
+  const SampleOutcome o = evaluate_landing_sample(s, {"ode", "dart", "custom"});
+  ASSERT_EQ(o.backends.size(), 3u);
+  const double late = s.slide_speed * (1.0 - s.phase) * s.dt;
+  ASSERT_GT(late, kLandingPositionMark);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(o.backends[k].error, "late_landing") << o.backends[k].backend;
+    // The match's own tolerance (explore_dynamics.cpp): 1e-5 m for a landing that stops.
+    EXPECT_NEAR(o.backends[k].position_err_m, late, 1e-5) << o.backends[k].backend;
+  }
+  EXPECT_EQ(o.backends[2].error, "");
+}
+
 TEST(ExploreLanding, ShrinkKeepsTheSignature) {
   // The one-point hull variant of MuJoCo (MPR, one contact point per step) rests more than
   // 1 mm off on some landings; shrinking rounds the design while the harness still shows it on
