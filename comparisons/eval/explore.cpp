@@ -402,7 +402,7 @@ std::string encode(const SampleOutcome& s) {
   for (const BackendOutcome& b : s.backends)
     j["b"].push_back({b.backend, b.error, b.measured, b.normal_err_deg, b.depth_err_rel,
                       b.point_err_rel, b.message, b.velocity_err_ke, b.momentum_err_ke,
-                      b.position_err_m, b.turn_rad, b.rest_time_err_s});
+                      b.position_err_m, b.turn_rad, b.rest_time_err_s, b.reported_depth_m});
   if (s.phase >= 0) j["ph"] = s.phase;
   return j.dump();
 }
@@ -418,7 +418,7 @@ SampleOutcome decode(const std::string& text) {
   s.depth_rel = j["d"];
   for (const Json& b : j["b"])
     s.backends.push_back(
-        {b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11]});
+        {b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11], b[12]});
   s.phase = j.value("ph", -1.0);
   return s;
 }
@@ -648,7 +648,8 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
                            : -1.0;
     ok = off > kSlideRestTimeMark;
     d << "time to rest off by " << off << " s (the scene's own run, every step)";
-  } else if ((b.error == "position" || b.error == "turn" || b.error == "late_landing") &&
+  } else if ((b.error == "position" || b.error == "turn" || b.error == "late_landing" ||
+              b.error == "deep_contact") &&
              status == "ok") {
     // Landing and slide kinds: the harness's final state of the first body against the scene's
     // [expect] position (distance along the surface, the second body's top) and against its own
@@ -667,10 +668,12 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
         bodies[0].orientation,
         Quat(q[0].get<double>(), q[1].get<double>(), q[2].get<double>(), q[3].get<double>()));
     ok = b.error == "turn" ? !(turn <= kLandingTurnMark) : !(position_err <= kLandingPositionMark);
+    if (b.error == "deep_contact")
+      ok = !(turn <= kLandingTurnMark) || !(position_err <= kLandingPositionMark);
     // late_landing is such a position error, its size matched by explore to a late landing.
     d << "final position off by " << position_err << " m, turned by " << turn << " rad";
   } else if (b.error == "position" || b.error == "turn" || b.error == "rest_time" ||
-             b.error == "tunnel" || b.error == "late_landing") {
+             b.error == "tunnel" || b.error == "late_landing" || b.error == "deep_contact") {
     d << "status " << status;
   }
   if (detail) *detail = d.str();

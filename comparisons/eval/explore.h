@@ -89,6 +89,8 @@ struct BackendOutcome {
   double position_err_m = 0.0;   // horizontal distance of the final centre from the closed form
   double turn_rad = 0.0;         // rotation angle of the final orientation from the initial one
   double rest_time_err_s = 0.0;  // |measured - closed-form time to rest| (the run's samples)
+  // Landing and slide kinds: the deepest contact the library reported in the run (m).
+  double reported_depth_m = 0.0;
 };
 
 /// Everything measured on one sample.

@@ -119,6 +119,10 @@ std::string describe(const BackendOutcome& b) {
            (b.error == "impulse" ? "the impulse is wrong"
                                  : "the impulse is right, the spin after it is not") +
            ")";
+  if (b.error == "deep_contact")
+    return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
+           fmt_num(b.turn_rad, 3) + " rad, after its collider reported a contact " +
+           fmt_num(b.reported_depth_m, 3) + " m deep (no landing or resting box is)";
   if (b.error == "late_landing")
     return "rests " + fmt_num(b.position_err_m, 3) +
            " m further along its launch, the slide of the rest of its step after the touch: the "

@@ -57,6 +57,13 @@ void run_dynamics_subjects(
     const std::vector<Backend>* table, SampleOutcome& out,
     const std::function<void(BackendOutcome&, const DynamicsResult&)>& judge);
 
+/// Landing and slide kinds: records the deepest contact `run` reported and, where `o` already
+/// disagrees and that depth is above a tenth of the box's smallest side `side`, names the
+/// disagreement "deep_contact": no landing or resting box reaches such a depth (a step of
+/// approach, 2 mm here, or a soft contact's sink), so the library's collider answered wrong
+/// (MuJoCo 2.2.2's box-box collider reports metres, MujocoKnownDefect.*).
+void name_deep_contact(BackendOutcome& o, const DynamicsResult& run, double side);
+
 /// The [expect] block of a box that ends at rest at `position`, unturned (landing and slide
 /// kinds), the slide's discretisation bound written with the speed's name and value.
 std::string box_at_rest_expect(const std::string& speed_name, double speed, double dt,

@@ -64,6 +64,12 @@ void run_dynamics_subjects(
   }
 }
 
+void name_deep_contact(BackendOutcome& o, const DynamicsResult& run, double side) {
+  if (run.laws.measured)
+    o.reported_depth_m = run.laws.residuals[static_cast<size_t>(Law::Penetration)].worst;
+  if (!o.error.empty() && o.reported_depth_m > 0.1 * side) o.error = "deep_contact";
+}
+
 std::string box_at_rest_expect(const std::string& speed_name, double speed, double dt,
                                const Vec3& position) {
   std::ostringstream o;
@@ -668,6 +674,7 @@ SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<
                             (off - off.dot(launch) * launch).norm() <= 1e-5
                         ? "late_landing"
                         : "position";
+        name_deep_contact(o, run, s.size.minCoeff());
       });
   return out;
 }

@@ -248,6 +248,7 @@ SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std:
           o.error = "position";
         else if (!(o.rest_time_err_s <= kSlideRestTimeMark))
           o.error = "rest_time";
+        name_deep_contact(o, run, s.size.minCoeff());
       });
   return out;
 }

@@ -93,7 +93,9 @@ std::string markdown_landing(const Json& j) {
        "than 1 mm from the closed form, horizontally (position; late_landing where the offset is "
        "the slide of the rest of the touching step, (|v_h| - |v_h'|) (1 - phase) dt along the "
        "launch, within the slide's own discretisation: the landing resolved at the step after "
-       "the touch, no time of impact). Time to rest: the first step "
+       "the touch, no time of impact); any of these is named deep_contact where the library "
+       "reported a contact deeper than a tenth of the box's smallest side (its collider's "
+       "answer: no landing box goes so deep). Time to rest: the first step "
        "whose horizontal speed is below 1 mm/s, the box moving less than 0.1 mm after it, read "
        "from every step (one step's resolution); reported, not marked. Velocity error: the final "
        "velocities in the energy "
@@ -136,7 +138,9 @@ std::string markdown_slide(const Json& j) {
        "above 1e-3 rad (turn), a resting centre more than 1 mm from the closed form along the "
        "surface (position), or a time to rest more than 3 ms off (rest_time: the first step "
        "whose speed along the surface is below 1 mm/s, the box moving less than 0.1 mm after it, "
-       "read from every step). Velocity error: "
+       "read from every step); any of these is named deep_contact where the library reported a "
+       "contact deeper than a tenth of the box's smallest side (its collider's answer: no "
+       "resting box goes so deep). Velocity error: "
        "the final velocities in the energy norm against the launch's kinetic energy (a 1 m/s "
        "slide's for a box left at rest).\n\n## Backends\n\n";
   Table t({"backend", "samples", "disagreements", "rate", "position err p50/p90/p99 (m)",

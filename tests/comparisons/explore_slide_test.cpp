@@ -151,6 +151,19 @@ TEST(ExploreSlide, TimeToRestReadsThroughJitterNotThroughACreep) {
   EXPECT_EQ(measured_rest_time(run_of(std::vector<double>(300, 0.5), dt), Vec3::UnitZ(), 0.3), 0.3);
 }
 
+TEST(ExploreSlide, AContactReportedMetresDeepNamesTheDisagreement) {
+  // Seed 8086, sample 25: a box sliding on a floor, which MuJoCo's box-box collider reports in
+  // contact metres deep (MujocoKnownDefect.*), so the box is thrown and turned. The run's own
+  // deepest reported contact names it; custom, on the same slide, reports none so deep.
+  const SlideSample s = make_slide_sample(8086, 25);
+  const SampleOutcome o = evaluate_slide_sample(s, {"mujoco", "custom"});
+  ASSERT_EQ(o.backends.size(), 2u);
+  EXPECT_EQ(o.backends[0].error, "deep_contact");
+  EXPECT_GT(o.backends[0].reported_depth_m, 0.1 * s.size.minCoeff());
+  EXPECT_EQ(o.backends[1].error, "");
+  EXPECT_LT(o.backends[1].reported_depth_m, 1e-3);
+}
+
 TEST(ExploreSlide, ARestTimeDisagreementIsReproducedFromTheWrittenScene) {
   // Bullet, left at rest on an incline or launched on one, creeps before it holds on some
   // samples: its time to rest is off by tens of milliseconds. The written scene alone shows it
