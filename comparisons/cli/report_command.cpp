@@ -180,7 +180,8 @@ int report_command(const ReportOptions& opt) {
     parts.end("tosses");
     const std::string summary = report_summary_markdown(scenes, evs, in);
     const std::string details =
-        report_details_markdown(scenes, evs, tmp.string(), figures_ok, views_ok);
+        report_details_markdown(scenes, evs, tmp.string(), figures_ok, views_ok) +
+        explore_details_markdown(in.explore, in.explore_set);
     write_text((tmp / "report.md").string(), summary);
     write_text((tmp / "details.md").string(), details);
     write_report_pages(tmp.string(), scenes, evs, summary, details, views_ok);

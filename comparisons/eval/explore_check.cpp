@@ -30,6 +30,7 @@ void tally(const std::string& scene, const std::vector<std::string>& encoded,
       values[b.backend]["velocity_err_ke"].push_back(b.velocity_err_ke);
       values[b.backend]["position_err_m"].push_back(b.position_err_m);
       values[b.backend]["turn_rad"].push_back(b.turn_rad);
+      values[b.backend]["rest_time_err_s"].push_back(b.rest_time_err_s);
     }
   }
   for (const auto& [backend, n] : samples) {

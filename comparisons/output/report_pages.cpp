@@ -97,38 +97,15 @@ std::string glance_markdown(const std::vector<ScoreRow>& rows) {
   return md.str();
 }
 
-// Explore's fixed samples: per family (contact pairs, impacts, landings) one table, backends by
-// their disagreement rate, with the median and 90th percentile of their errors.
-std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
-                             const ExploreCheckSet& set) {
-  if (metrics.empty()) return "";
-  std::ostringstream md;
-  md << "## Random poses and impacts\n\n"
-        "What no scene of the library shows: `rbx explore`'s fixed samples (seed "
-     << set.seed << "; the ones `rbx check` compares), " << set.contact
-     << " random convex pairs against the `exact` oracle and " << set.impact
-     << " random vertex-on-face impacts at a random phase, " << set.landing
-     << " random landings of a box sliding on a floor with friction (any direction, speed, mu "
-        "and yaw) and "
-     << set.slide
-     << " random slides of a box resting on a floor or an incline (launched along it or left "
-        "at rest) and "
-     << set.tunnel
-     << " random fast projectiles at thin walls (up to 20 times the wall per step), against "
-        "their closed forms. "
-        "*Disagreement*: a sample a backend answers clearly wrong (normal > 1°, depth > 1 % of "
-        "the smaller body, velocity error > 0.1 %, a landing or slide at rest more than 1 mm "
-        "from where Coulomb's law puts it or turned by more than 1e-3 rad, a slide coming to rest "
-        "more than 3 ms off its time, a projectile through or into its wall, a missed or false "
-        "contact, an error). Errors "
-        "are the median and 90th percentile over the samples where both touch. "
-        "`rbx explore` shrinks every disagreement to a scene.\n\n";
-  struct Family {
-    const char* scene;
-    const char* title;
-    std::vector<std::pair<std::string, std::string>> errors;  // metric stem, column
-  };
-  const std::vector<Family> families = {
+// Explore's families in the report: pseudo-scene, title, and the errors shown (metric stem,
+// column).
+struct ExploreFamily {
+  const char* scene;
+  const char* title;
+  std::vector<std::pair<std::string, std::string>> errors;
+};
+const std::vector<ExploreFamily>& explore_families() {
+  static const std::vector<ExploreFamily> families = {
       {"explore/contact",
        "contact pairs",
        {{"normal_err_deg", "normal error (deg) p50 / p90"},
@@ -146,10 +123,90 @@ std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
       {"explore/tunnel",
        "fast projectiles at thin walls",
        {{"velocity_err_ke", "velocity error (KE norm) p50 / p90"}}}};
-  for (const Family& f : families) {
-    std::map<std::string, std::map<std::string, double>> by;  // backend -> metric -> value
-    for (const ExploreCheckMetric& m : metrics)
-      if (m.scene == f.scene) by[m.metric.backend][m.metric.name] = m.metric.value;
+  return families;
+}
+
+// One family's metrics: backend -> metric -> value.
+std::map<std::string, std::map<std::string, double>> family_metrics(
+    const std::vector<ExploreCheckMetric>& metrics, const std::string& scene) {
+  std::map<std::string, std::map<std::string, double>> by;
+  for (const ExploreCheckMetric& m : metrics)
+    if (m.scene == scene) by[m.metric.backend][m.metric.name] = m.metric.value;
+  return by;
+}
+
+// What the samples are and what a disagreement is.
+std::string explore_intro(const ExploreCheckSet& set) {
+  std::ostringstream md;
+  md << "What no scene of the library shows: `rbx explore`'s fixed samples (seed " << set.seed
+     << "; the ones `rbx check` compares), " << set.contact
+     << " random convex pairs against the `exact` oracle, " << set.impact
+     << " random vertex-on-face impacts at a random phase, " << set.landing
+     << " random landings of a box sliding on a floor with friction (any direction, speed, mu "
+        "and yaw), "
+     << set.slide
+     << " random slides of a box resting on a floor or an incline (launched along it or left "
+        "at rest) and "
+     << set.tunnel
+     << " random fast projectiles at thin walls (up to 20 times the wall per step), against "
+        "their closed forms. "
+        "*Disagreement*: a sample a backend answers clearly wrong (normal > 1°, depth > 1 % of "
+        "the smaller body, velocity error > 0.1 %, a landing or slide at rest more than 1 mm "
+        "from where Coulomb's law puts it or turned by more than 1e-3 rad, a slide coming to rest "
+        "more than 3 ms off its time, a projectile through or into its wall, a missed or false "
+        "contact, an error). Errors are the median and 90th percentile over the samples where "
+        "both touch. `rbx explore` shrinks every disagreement to a scene.\n\n";
+  return md.str();
+}
+
+// Explore's fixed samples at a glance: one table, a row per backend and a column per family,
+// each cell its disagreement rate (the errors are in details.md).
+std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
+                             const ExploreCheckSet& set) {
+  if (metrics.empty()) return "";
+  std::ostringstream md;
+  md << "## Random poses and impacts\n\n"
+     << explore_intro(set)
+     << "Each cell: the share of the family's samples the backend disagrees on; the median and "
+        "90th percentile of each error are in details.md.\n\n";
+  std::vector<std::string> header = {"backend"}, order;
+  std::map<std::string, std::map<std::string, double>> rate;  // backend -> family -> rate
+  for (const ExploreFamily& f : explore_families()) {
+    const auto by = family_metrics(metrics, f.scene);
+    if (by.empty()) continue;
+    header.push_back(f.title);
+    for (const auto& [b, v] : by) {
+      if (std::find(order.begin(), order.end(), b) == order.end()) order.push_back(b);
+      rate[b][f.title] = v.at("disagreement_rate_err");
+    }
+  }
+  std::vector<std::string> names;
+  for (const Backend& b : backends())
+    if (rate.count(b.name)) names.push_back(b.name);
+  for (const std::string& b : order)
+    if (std::find(names.begin(), names.end(), b) == names.end()) names.push_back(b);
+  Table t(header);
+  for (const std::string& b : names) {
+    std::vector<std::string> row = {"**" + md_escape(b) + "**"};
+    for (size_t k = 1; k < header.size(); ++k)
+      row.push_back(rate[b].count(header[k]) ? fmt_num(100 * rate[b][header[k]], 3) + " %"
+                                             : std::string("-"));
+    t.add(row);
+  }
+  md << t.markdown() << "\n";
+  return md.str();
+}
+
+}  // namespace
+
+std::string explore_details_markdown(const std::vector<ExploreCheckMetric>& metrics,
+                                     const ExploreCheckSet& set) {
+  if (metrics.empty()) return "";
+  std::ostringstream md;
+  md << "## Random poses and impacts\n\n"
+     << explore_intro(set) << "Per family, backends by their disagreement rate.\n\n";
+  for (const ExploreFamily& f : explore_families()) {
+    auto by = family_metrics(metrics, f.scene);
     if (by.empty()) continue;
     std::vector<std::string> names;
     for (const auto& [b, v] : by) names.push_back(b);
@@ -185,8 +242,6 @@ std::string backends_markdown(const std::vector<std::string>& names) {
          "and its measurement).\n\n" +
          t.markdown() + "\n";
 }
-
-}  // namespace
 
 std::string report_summary_markdown(const std::vector<Scene>& scenes,
                                     const std::vector<SceneEvaluation>& evs,

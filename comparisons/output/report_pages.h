@@ -26,6 +26,11 @@ struct SummaryInputs {
   ExploreCheckSet explore_set;  // the sample set they come from
 };
 
+/// details.md's random poses and impacts: per explore family one table, backends by their
+/// disagreement rate, with the median and 90th percentile of their errors ("" when not run).
+std::string explore_details_markdown(const std::vector<ExploreCheckMetric>& metrics,
+                                     const ExploreCheckSet& set);
+
 /// report.md: at a glance (per family, the most accurate backend and the fastest, each with
 /// its error, scenes within tolerance and run time), the ranked scorecard, the measured causes
 /// of failures (one scene each), error against run time, random poses and impacts (explore's
