@@ -36,13 +36,29 @@ struct Options {
   rbx::EnsembleOptions ensemble;
 };
 
+// A count of at least 1, said in a few words (CLI11's PositiveNumber writes out its range up to
+// the largest double in full).
+const CLI::Validator kAtLeastOne(
+    [](std::string& text) -> std::string {
+      size_t used = 0;
+      long value = 0;
+      try {
+        value = std::stol(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == text.size() && value >= 1) return "";
+      return "must be a whole number >= 1, got '" + text + "'";
+    },
+    "N >= 1");
+
 // run, contacts, compare: the commands on scene files.
 void add_scene_commands(CLI::App& app, Options& o) {
   CLI::App* run = app.add_subcommand("run", "custom engine only: collision events and final state");
   scene_options(run, o.run, false, true);
   run->add_option("--sample-every", o.run.sample_every,
                   "with --json: each backend's trajectory, every N steps")
-      ->check(CLI::PositiveNumber);
+      ->check(kAtLeastOne);
   CLI::App* contacts =
       app.add_subcommand("contacts", "contact query at the t=0 poses, every backend");
   scene_options(contacts, o.contacts, false, true);
@@ -219,7 +235,8 @@ int dispatch(CLI::App& app, const Options& o) {
 }  // namespace
 
 int rbx::command_line(int argc, char** argv) {
-  CLI::App app{"rbx: rigid-body collision detection and response testbed"};
+  // Named, so that usage lines say `rbx`, not the path the binary was started from.
+  CLI::App app{"rbx: rigid-body collision detection and response testbed", "rbx"};
   app.require_subcommand(1);
   Options o;
   add_scene_commands(app, o);

@@ -73,6 +73,27 @@ TEST(Cli, BadSceneExitsTwoWithOneLineAndNoOutputFile) {
   fs::remove_all(dir);
 }
 
+TEST(Cli, ACountBelowOneIsRefusedInOneShortLine) {
+  for (const char* bad : {"0", "-3", "2.5", "x"}) {
+    const CmdResult r =
+        rbx(std::string("run scenes/analytic/headon_e05.toml --sample-every ") + bad);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(
+        r.err.find("--sample-every: must be a whole number >= 1, got '" + std::string(bad) + "'"),
+        std::string::npos)
+        << r.err;
+    EXPECT_LT(r.err.size(), 200u) << r.err;
+  }
+}
+
+TEST(Cli, HelpNamesTheProgramNotItsPath) {
+  const CmdResult r = rbx("--help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("Usage: rbx "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(RBX_BINARY_DIR), std::string::npos) << r.out;
+}
+
 class CliBadInput : public ::testing::TestWithParam<std::string> {};
 
 // `rbx run` on each entry: exit 2, stderr exactly the entry's one expected line, and no output
