@@ -246,6 +246,14 @@ BodyFinal final_state(const std::string& name, const BulletBody& bb) {
   return f;
 }
 
+/// The radius of the largest sphere about the centre of mass inside the body's hull (m).
+double inscribed_radius(const RigidBody& rb) {
+  double inscribed = INFINITY;
+  for (const Plane& p : rb.shape->planes())
+    inscribed = std::min(inscribed, -p.distance(Vec3::Zero()));
+  return inscribed;
+}
+
 /// The single-impulse settings of docs/references.md on the world's solver (`fair_world`).
 void make_solver_fair(btDiscreteDynamicsWorld& world, const BulletSettings& settings) {
   btContactSolverInfo& info = world.getSolverInfo();
@@ -256,6 +264,7 @@ void make_solver_fair(btDiscreteDynamicsWorld& world, const BulletSettings& sett
   // position error is then removed by a separate push that adds no velocity.
   info.m_splitImpulse = 1;
   info.m_splitImpulsePenetrationThreshold = settings.split_impulse_threshold;
+  if (settings.split_turn_erp >= 0) info.m_splitImpulseTurnErp = settings.split_turn_erp;
   // No warm starting: each step's solve starts from zero impulse, not 0.85 of the last
   // step's. Done by the factor, not by clearing SOLVER_USE_WARMSTARTING: without that flag
   // solveGroupCacheFriendlyFinish skips writeBackContacts, so the manifold points would
@@ -318,9 +327,9 @@ BulletBody make_bullet_body(const RigidBody& rb, int i, const Scene& scene,
   if (fair) {
     // Never sleep: a slow body must keep integrating.
     bb.body->setActivationState(DISABLE_DEACTIVATION);
-    // Contacts are solved only once the hulls overlap (default: any point within the
-    // breaking threshold, i.e. before touching), so the impulse acts at contact.
-    bb.body->setContactProcessingThreshold(settings.processing_threshold);
+    // Contacts are solved once the hulls touch (default: any point within the breaking
+    // threshold, i.e. before touching), so the impulse acts at contact (BulletSettings).
+    bb.body->setContactProcessingThreshold(settings.processing_fraction * inscribed_radius(rb));
   }
   // Continuous collision as Bullet's own CCD demo sets it for its cubes (a motion threshold of
   // the half extent, a swept sphere of 0.9 of it), here from the hull's inscribed radius about
@@ -328,9 +337,7 @@ BulletBody make_bullet_body(const RigidBody& rb, int i, const Scene& scene,
   // step is swept from its centre; at a hit it is moved to the hit and keeps its velocity, and
   // the next step's contact responds.
   if (!rb.is_static && settings.ccd_motion_fraction > 0) {
-    double inscribed = INFINITY;
-    for (const Plane& p : rb.shape->planes())
-      inscribed = std::min(inscribed, -p.distance(Vec3::Zero()));
+    const double inscribed = inscribed_radius(rb);
     if (inscribed > 0 && std::isfinite(inscribed)) {
       bb.body->setCcdMotionThreshold(settings.ccd_motion_fraction * inscribed);
       bb.body->setCcdSweptSphereRadius(settings.ccd_sphere_fraction * inscribed);
@@ -487,6 +494,11 @@ BulletSettings bullet_hull_settings() {
   BulletSettings s;
   s.native_boxes = false;
   s.polyhedral_hulls = false;
+  // The one-point hull keeps Bullet's push turn and solves overlapping points only: with one
+  // point per pair there is no other side of a face to lift, and the full turn measured worse
+  // on its incline slide (docs/references.md).
+  s.processing_fraction = 0;
+  s.split_turn_erp = -1;
   return s;
 }
 

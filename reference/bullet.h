@@ -19,8 +19,21 @@ struct BulletSettings {
   double hull_margin = 0.0;  // m, btConvexHullShape's margin (outside the hull: inflates it)
   bool fair_world = true;    // the solver settings below; false: Bullet's defaults throughout
   double split_impulse_threshold = 1e30;  // m; Bullet splits where distance < this (BT_LARGE_FLOAT)
-  double restitution_threshold = 0.0;     // m/s; no bounce below this approach speed
-  double processing_threshold = 0.0;      // m; contacts solved once closer than this
+  // The share of the push's rotation applied with its translation (Bullet's default 0.1): the
+  // split impulse solves each point's push for the whole rigid motion, and applying only a tenth
+  // of its turn leaves the corners of a resting face corrected unequally, which tilts and turns
+  // a sliding box; 1 applies the push as solved (`bullet`). < 0: Bullet's own (`bullet-hull`).
+  double split_turn_erp = 1.0;
+  double restitution_threshold = 0.0;  // m/s; no bounce below this approach speed
+  // A manifold point is solved once its distance is at most this fraction of the body's
+  // inscribed radius (the smaller of the pair's). A hair above zero (`bullet`): the split
+  // impulse's push, solved point by point, lifts one side of a resting face a little past zero
+  // while the other side is still inside, and a point dropped there lets the box hop and creep
+  // down an incline; far below the gap an approaching body leaves between two steps, so an
+  // impact is still solved once the bodies overlap. 0 (`bullet-hull`, the one-point hull's
+  // row): only overlapping points. Bullet's default solves every point within the breaking
+  // threshold, before the bodies touch.
+  double processing_fraction = 2e-7;
   // Continuous collision (Bullet's CCD): a body moving more than this fraction of its inscribed
   // radius in a step is swept, as a sphere of `ccd_sphere_fraction` of that radius, and stopped
   // at the first hit; 0: off (Bullet's default).

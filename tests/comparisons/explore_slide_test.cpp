@@ -13,6 +13,7 @@
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/scene/scene_file.h"
+#include "reference/bullet.h"
 
 namespace rbx {
 namespace {
@@ -165,12 +166,27 @@ TEST(ExploreSlide, AContactReportedMetresDeepNamesTheDisagreement) {
 }
 
 TEST(ExploreSlide, ARestTimeDisagreementIsReproducedFromTheWrittenScene) {
-  // Bullet, left at rest on an incline or launched on one, creeps before it holds on some
-  // samples: its time to rest is off by tens of milliseconds. The written scene alone shows it
-  // (the scene's own run against the closed form recomputed from the scene); custom's does not.
+  // Bullet with its processing threshold at 0 and its own push turn (the settings
+  // BulletSettingsMeasuredOnTheFamily rejects), left at rest on an incline or launched on one,
+  // creeps before it holds on some samples: its time to rest is off by tens of milliseconds.
+  // The written scene alone shows it (the scene's own run against the closed form recomputed
+  // from the scene); custom's does not. Registered as a user backend: the harness finds it by
+  // name, as it finds the scene's.
+  const std::string creeper = "bullet-threshold-0";
+  if (!find_backend(creeper)) {
+    Backend b = *find_backend("bullet");
+    b.name = creeper;
+    b.dynamics = [](const Scene& scene, const DynamicsOptions& opt) {
+      BulletSettings s = bullet_native_settings();
+      s.processing_fraction = 0;
+      s.split_turn_erp = -1;
+      return bullet_at_settings().dynamics(scene, opt, s);
+    };
+    register_backend(b);
+  }
   for (uint64_t i = 0; i < 100; ++i) {
     const SlideSample s = make_slide_sample(5150, i);
-    const SampleOutcome o = evaluate_slide_sample(s, {"bullet"});
+    const SampleOutcome o = evaluate_slide_sample(s, {creeper});
     ASSERT_EQ(o.backends.size(), 1u);
     if (o.backends[0].error != "rest_time") continue;
     std::string detail;
@@ -180,7 +196,80 @@ TEST(ExploreSlide, ARestTimeDisagreementIsReproducedFromTheWrittenScene) {
     EXPECT_FALSE(harness_reproduces(s.text, "slide.toml", custom, &detail)) << detail;
     return;
   }
-  FAIL() << "no sample among the first 100 of seed 5150 where bullet's time to rest is off";
+  FAIL() << "no sample among the first 100 of seed 5150 where " << creeper
+         << "'s time to rest is off";
+}
+
+TEST(ExploreSlide, BulletSettingsMeasuredOnTheFamily) {
+  // Bullet's two resting-contact settings (reference/bullet.h), measured on slides of a seed
+  // not used while choosing them, each alternative beside the chosen pair: the processing
+  // threshold at 0 drops a point the split push lifted past zero, and the box hops and creeps
+  // (time to rest); Bullet's default solves points before they touch; the push's turn at
+  // Bullet's 0.1 tilts and turns sliding boxes. Judged on the errors' 90th percentiles, which
+  // 200 slides fix far better than the few disagreements they hold.
+  const auto bullet_at = [](const std::string& name, void (*change)(BulletSettings&)) {
+    Backend b = *find_backend("bullet");
+    b.name = name;
+    b.library = false;  // in process: the test's speed, the same library calls
+    b.dynamics = [change](const Scene& scene, const DynamicsOptions& opt) {
+      BulletSettings s = bullet_native_settings();
+      change(s);
+      return bullet_at_settings().dynamics(scene, opt, s);
+    };
+    return b;
+  };
+  const std::vector<Backend> table = {
+      bullet_at("chosen", [](BulletSettings&) {}),
+      bullet_at("threshold 0", [](BulletSettings& s) { s.processing_fraction = 0; }),
+      bullet_at("threshold default", [](BulletSettings& s) { s.processing_fraction = 1e30; }),
+      bullet_at("turn erp 0.1", [](BulletSettings& s) { s.split_turn_erp = -1; })};
+  std::vector<std::string> names;
+  for (const Backend& b : table) names.push_back(b.name);
+  std::map<std::string, int> misses;
+  std::map<std::string, std::vector<double>> turn, rest;
+  constexpr int kCount = 200;
+  for (uint64_t i = 0; i < kCount; ++i) {
+    const SampleOutcome o = evaluate_slide_sample(make_slide_sample(31, i), names, &table);
+    for (const BackendOutcome& b : o.backends) {
+      misses[b.backend] += !b.error.empty();
+      turn[b.backend].push_back(b.turn_rad);
+      rest[b.backend].push_back(b.rest_time_err_s);
+    }
+  }
+  const auto p90 = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() * 9 / 10];
+  };
+  const auto p99 = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() * 99 / 100];
+  };
+  for (const std::string& n : names)
+    std::printf(
+        "[measured] bullet, %-18s %2d of %d disagree; turn p90 %.3g p99 %.3g rad, rest "
+        "time p90 %.3g p99 %.3g s\n",
+        n.c_str(), misses[n], kCount, p90(turn[n]), p99(turn[n]), p90(rest[n]), p99(rest[n]));
+  const std::string chosen = "chosen";
+  EXPECT_LE(misses[chosen], kCount / 20);
+  // Each alternative worse by a factor past the percentiles' sampling spread (a few tens of
+  // per cent at 200 samples).
+  EXPECT_GT(p90(turn["threshold 0"]), 5 * p90(turn[chosen]));
+  EXPECT_GT(p99(rest["threshold 0"]), 2 * p99(rest[chosen]));
+  EXPECT_GT(p90(turn["turn erp 0.1"]), 3 * p90(turn[chosen]));
+  EXPECT_GT(p99(rest["turn erp 0.1"]), 2 * p99(rest[chosen]));
+  // Bullet's default threshold slides about as well, but it solves a projectile's contact
+  // before it reaches the wall and sends it back early, at the wrong speed.
+  std::map<std::string, int> tunnel_misses;
+  constexpr int kProjectiles = 40;
+  for (uint64_t i = 0; i < kProjectiles; ++i) {
+    const SampleOutcome o = evaluate_tunnel_sample(make_tunnel_sample(31, i), names, &table);
+    for (const BackendOutcome& b : o.backends) tunnel_misses[b.backend] += !b.error.empty();
+  }
+  for (const std::string& n : names)
+    std::printf("[measured] bullet, %-18s %2d of %d projectiles disagree\n", n.c_str(),
+                tunnel_misses[n], kProjectiles);
+  EXPECT_LE(tunnel_misses[chosen], kProjectiles / 20);
+  EXPECT_GT(tunnel_misses["threshold default"], kProjectiles / 2);
 }
 
 }  // namespace
