@@ -402,7 +402,8 @@ std::string encode(const SampleOutcome& s) {
   for (const BackendOutcome& b : s.backends)
     j["b"].push_back({b.backend, b.error, b.measured, b.normal_err_deg, b.depth_err_rel,
                       b.point_err_rel, b.message, b.velocity_err_ke, b.momentum_err_ke,
-                      b.position_err_m, b.turn_rad, b.rest_time_err_s, b.reported_depth_m});
+                      b.position_err_m, b.turn_rad, b.rest_time_err_s, b.reported_depth_m,
+                      b.rise_m});
   if (s.phase >= 0) j["ph"] = s.phase;
   return j.dump();
 }
@@ -418,7 +419,7 @@ SampleOutcome decode(const std::string& text) {
   s.depth_rel = j["d"];
   for (const Json& b : j["b"])
     s.backends.push_back(
-        {b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11], b[12]});
+        {b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11], b[12], b[13]});
   s.phase = j.value("ph", -1.0);
   return s;
 }
@@ -635,19 +636,26 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
     // form.
     ok = metric("velocity_err_ke") > kMarkVelocityErr;
     d << "velocity_err_ke " << metric("velocity_err_ke");
-  } else if (b.error == "rest_time" && status == "ok") {
-    // Slide kind: the harness checks final states, not when the box came to rest; the written
-    // scene's own run (every step sampled) against its closed form, read from the scene.
+  } else if ((b.error == "rest_time" || b.error == "lift_off") && status == "ok") {
+    // Slide kind: the harness checks final states, not when the box came to rest or how high
+    // it rose on the way; the written scene's own run (every step sampled) against its closed
+    // form, read from the scene.
     const Backend* be = find_backend(b.backend);
     const DynamicsResult run =
         be ? run_dynamics_isolated(*be, scene, DynamicsOptions{0.0, 1}).result : DynamicsResult{};
     const Vec3 n = bodies[1].orientation * Vec3::UnitZ();
-    const double off = run.status == Status::Ok
-                           ? std::abs(measured_rest_time(run.samples, n, scene.sim.duration) -
-                                      slide_rest_time(scene))
-                           : -1.0;
-    ok = off > kSlideRestTimeMark;
-    d << "time to rest off by " << off << " s (the scene's own run, every step)";
+    const bool ran = run.status == Status::Ok;
+    if (b.error == "lift_off") {
+      const double rise = ran ? largest_rise(run.samples, bodies[0].position, n) : -1.0;
+      ok = rise > kLandingPositionMark;
+      d << "rose " << rise << " m off its surface (the scene's own run, every step)";
+    } else {
+      const double off = ran ? std::abs(measured_rest_time(run.samples, n, scene.sim.duration) -
+                                        slide_rest_time(scene))
+                             : -1.0;
+      ok = off > kSlideRestTimeMark;
+      d << "time to rest off by " << off << " s (the scene's own run, every step)";
+    }
   } else if ((b.error == "position" || b.error == "turn" || b.error == "late_landing" ||
               b.error == "deep_contact") &&
              status == "ok") {
@@ -673,7 +681,8 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
     // late_landing is such a position error, its size matched by explore to a late landing.
     d << "final position off by " << position_err << " m, turned by " << turn << " rad";
   } else if (b.error == "position" || b.error == "turn" || b.error == "rest_time" ||
-             b.error == "tunnel" || b.error == "late_landing" || b.error == "deep_contact") {
+             b.error == "tunnel" || b.error == "late_landing" || b.error == "deep_contact" ||
+             b.error == "lift_off") {
     d << "status " << status;
   }
   if (detail) *detail = d.str();

@@ -91,6 +91,8 @@ struct BackendOutcome {
   double rest_time_err_s = 0.0;  // |measured - closed-form time to rest| (the run's samples)
   // Landing and slide kinds: the deepest contact the library reported in the run (m).
   double reported_depth_m = 0.0;
+  // Slide kind: the highest the box's centre rose off the surface, along its normal (m).
+  double rise_m = 0.0;
 };
 
 /// Everything measured on one sample.
@@ -329,9 +331,15 @@ double slide_rest_time(const Scene& scene);
 /// along that plane; `end` when there is none.
 double measured_rest_time(const std::vector<StateSample>& samples, const Vec3& normal, double end);
 
+/// The highest the first body's centre rose above `start` along `normal` in a run's samples (m;
+/// 0 when it never did). A sliding box of the closed form never leaves its surface.
+double largest_rise(const std::vector<StateSample>& samples, const Vec3& start, const Vec3& normal);
+
 /// Runs the sample's scene through each named dynamics backend against its closed form:
 /// status error, then a turn above kLandingTurnMark, then a position along the surface above
-/// kLandingPositionMark, then a time to rest above kSlideRestTimeMark.
+/// kLandingPositionMark, then a time to rest above kSlideRestTimeMark; any of these named
+/// deep_contact (name_deep_contact), else lift_off where the box rose off its surface by more
+/// than kLandingPositionMark on the way.
 SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std::string>& names,
                                     const std::vector<Backend>* table = nullptr);
 

@@ -123,6 +123,11 @@ std::string describe(const BackendOutcome& b) {
     return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
            fmt_num(b.turn_rad, 3) + " rad, after its collider reported a contact " +
            fmt_num(b.reported_depth_m, 3) + " m deep (no landing or resting box is)";
+  if (b.error == "lift_off")
+    return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
+           fmt_num(b.turn_rad, 3) + " rad, its time to rest off by " +
+           fmt_num(b.rest_time_err_s, 3) + " s, after it rose " + fmt_num(b.rise_m, 3) +
+           " m off its surface while sliding (the closed form's box never leaves it)";
   if (b.error == "late_landing")
     return "rests " + fmt_num(b.position_err_m, 3) +
            " m further along its launch, the slide of the rest of its step after the touch: the "

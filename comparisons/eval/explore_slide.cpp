@@ -119,6 +119,14 @@ double measured_rest_time(const std::vector<StateSample>& samples, const Vec3& n
   return t;
 }
 
+double largest_rise(const std::vector<StateSample>& samples, const Vec3& start,
+                    const Vec3& normal) {
+  double rise = 0.0;
+  for (const StateSample& k : samples)
+    rise = std::max(rise, (k.bodies[0].position - start).dot(normal));
+  return rise;
+}
+
 bool realize_slide(SlideSample& s) {
   s.text.clear();
   const double mu = s.friction, g = kGravity, theta = s.incline_deg * M_PI / 180.0;
@@ -249,6 +257,9 @@ SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std:
         else if (!(o.rest_time_err_s <= kSlideRestTimeMark))
           o.error = "rest_time";
         name_deep_contact(o, run, s.size.minCoeff());
+        o.rise_m = largest_rise(run.samples, s.start_position, n);
+        if (!o.error.empty() && o.error != "deep_contact" && o.rise_m > kLandingPositionMark)
+          o.error = "lift_off";
       });
   return out;
 }

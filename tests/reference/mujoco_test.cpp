@@ -293,6 +293,36 @@ TEST(MujocoKnownDefect, BoxBoxReturnsMetresDeepPointsUnderABoxAt45Degrees) {
   EXPECT_LT(straight.finals[0].velocity.norm(), 0.01);
 }
 
+TEST(MujocoKnownDefect, ASlidingBoxLeavesItsSurfaceAtMuTimesItsSlip) {
+  // rbx explore --kind slide --seed 8086, sample 18 shrunk: a 0.4 x 0.8 x 0.3 box resting on a
+  // 30 deg incline, mu = 0.9, launched up the fall line at 1 m/s. Coulomb's law slows it along
+  // the surface; MuJoCo's convex contact model (the cone relaxation Anitescu's model shares)
+  // lets the contact leave at a normal speed of mu times the slip: after its first contact step
+  // the box moves off the surface at 0.485 m/s while it slips at 0.539 m/s, and it flies
+  // centimetres before it lands. Each of the two steps adds g dt = 0.0098 m/s of gravity, the
+  // tolerance here.
+  constexpr double theta = 30 * kPi / 180, mu = 0.9, dt = 1e-3;
+  const Quat tilt(Eigen::AngleAxisd(theta, Vec3::UnitY()));
+  const Vec3 n = tilt * Vec3::UnitZ(), up = -(tilt * Vec3::UnitX());
+  Scene s;
+  s.sim.dt = dt;
+  s.sim.duration = 2 * dt;
+  s.sim.gravity = Vec3(0, 0, -9.81);
+  s.sim.restitution = 0;
+  s.sim.friction = mu;
+  BodySpec incline = box_spec("incline", Vec3(4, 4, 1), -0.5 * n, 1.0, tilt);
+  incline.is_static = true;
+  BodySpec box = box_spec("box", Vec3(0.4, 0.8, 0.3), 0.15 * n, 1.0, tilt);
+  box.velocity = up;
+  s.bodies = {box, incline};
+  const DynamicsResult r = mujoco.dynamics(s, {});
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  const Vec3 v = r.finals[0].velocity;
+  const double normal = v.dot(n), slip = (v - normal * n).norm();
+  EXPECT_GT(normal, 0.4);  // away from the surface
+  EXPECT_NEAR(normal, mu * slip, 9.81 * dt);
+}
+
 // --- Errors: mju_error becomes Status::Error -------------------------------------------------
 
 // An allocator for MuJoCo (mju_user_malloc / mju_user_free) that counts its calls and fails
