@@ -647,7 +647,7 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
     const bool ran = run.status == Status::Ok;
     if (b.error == "lift_off") {
       const double rise = ran ? largest_rise(run.samples, bodies[0].position, n) : -1.0;
-      ok = rise > kLandingPositionMark;
+      ok = rise > kSlideLiftMark;
       d << "rose " << rise << " m off its surface (the scene's own run, every step)";
     } else {
       const double off = ran ? std::abs(measured_rest_time(run.samples, n, scene.sim.duration) -

@@ -258,7 +258,7 @@ SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std:
           o.error = "rest_time";
         name_deep_contact(o, run, s.size.minCoeff());
         o.rise_m = largest_rise(run.samples, s.start_position, n);
-        if (!o.error.empty() && o.error != "deep_contact" && o.rise_m > kLandingPositionMark)
+        if (!o.error.empty() && o.error != "deep_contact" && o.rise_m > kSlideLiftMark)
           o.error = "lift_off";
       });
   return out;

@@ -140,8 +140,8 @@ std::string markdown_slide(const Json& j) {
        "whose speed along the surface is below 1 mm/s, the box moving less than 0.1 mm after it, "
        "read from every step); any of these is named deep_contact where the library reported a "
        "contact deeper than a tenth of the box's smallest side (its collider's answer: no "
-       "resting box goes so deep), else lift_off where the box's centre rose more than 1 mm off "
-       "its surface on the way (the closed form's box never leaves it; docs/references.md says "
+       "resting box goes so deep), else lift_off where the box's centre rose more than 0.1 mm "
+       "off its surface on the way (the closed form's box never leaves it; docs/references.md says "
        "whose model does this). Velocity error: "
        "the final velocities in the energy norm against the launch's kinetic energy (a 1 m/s "
        "slide's for a box left at rest).\n\n## Backends\n\n";

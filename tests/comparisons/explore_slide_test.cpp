@@ -188,7 +188,7 @@ TEST(ExploreSlide, ABoxThatRoseOffItsSurfaceNamesTheDisagreement) {
   const SampleOutcome o = evaluate_slide_sample(s, {"mujoco", "custom"});
   ASSERT_EQ(o.backends.size(), 2u);
   EXPECT_EQ(o.backends[0].error, "lift_off");
-  EXPECT_GT(o.backends[0].rise_m, kLandingPositionMark);
+  EXPECT_GT(o.backends[0].rise_m, kSlideLiftMark);
   std::string detail;
   EXPECT_TRUE(harness_reproduces(s.text, "slide.toml", o.backends[0], &detail)) << detail;
   EXPECT_EQ(o.backends[1].error, "");
