@@ -90,6 +90,21 @@ Vec3 angular_momentum(const std::vector<RigidBody>& inputs, const std::vector<Bo
   return h;
 }
 
+std::pair<double, double> drift_scales(const std::vector<RigidBody>& inputs,
+                                       const std::vector<BodyFinal>& s, double p_scale,
+                                       double h_scale) {
+  if (p_scale > 0 || h_scale > 0) return {p_scale, h_scale};
+  double p = 0.0, h = 0.0;
+  for (size_t i = 0; i < inputs.size() && i < s.size(); ++i) {
+    if (inputs[i].is_static) continue;
+    const std::vector<BodyFinal> one = {s[i]};
+    const std::vector<RigidBody> body = {inputs[i]};
+    p += linear_momentum(body, one).norm();
+    h += angular_momentum(body, one).norm();
+  }
+  return {p > 0 ? p : 1.0, h > 0 ? h : 1.0};
+}
+
 std::vector<BodyFinal> initial_states(const std::vector<RigidBody>& inputs) {
   std::vector<BodyFinal> s;
   for (const RigidBody& b : inputs)
@@ -225,7 +240,9 @@ StabilityTrace trace_stability(const std::vector<RigidBody>& inputs, const Dynam
   // Penetration at rest: the least, over the last fifth of the run, of each sample's deepest
   // overlap. An impact overlaps for a step or two and is gone; sinking persists in every sample.
   double pen_rest = std::numeric_limits<double>::infinity();
-  const double e_scale = std::max({std::abs(inv.e0), initial_kinetic_energy(inputs), 1e-300});
+  // Against the starting energy; where the bodies start still with no potential energy, against
+  // the most kinetic energy the run reaches (a growth of 1: all of it made by the run).
+  double e_scale = std::max(std::abs(inv.e0), initial_kinetic_energy(inputs)), ke_max = 0.0;
   std::vector<bool> passed(g.watch.size(), false);
   const size_t rest_from = samples.size() * 4 / 5;
   size_t sample_index = 0;
@@ -235,14 +252,16 @@ StabilityTrace trace_stability(const std::vector<RigidBody>& inputs, const Dynam
       if (!finite_state(b)) tr.nonfinite = true;
     if (tr.nonfinite) break;
     const double e = total_energy(inputs, smp.bodies, gravity);
+    ke_max = std::max(ke_max, kinetic_energy(inputs, smp.bodies));
     e_max = std::max(e_max, e);
     e_min = std::min(e_min, e);
     e_end = e;
     if (inv.closed) {
+      const auto [p_scale, h_scale] = drift_scales(inputs, smp.bodies, inv.p_scale, inv.h_scale);
       tr.drift =
-          std::max(tr.drift, (linear_momentum(inputs, smp.bodies) - inv.p0).norm() / inv.p_scale);
+          std::max(tr.drift, (linear_momentum(inputs, smp.bodies) - inv.p0).norm() / p_scale);
       tr.hdrift =
-          std::max(tr.hdrift, (angular_momentum(inputs, smp.bodies) - inv.h0).norm() / inv.h_scale);
+          std::max(tr.hdrift, (angular_momentum(inputs, smp.bodies) - inv.h0).norm() / h_scale);
     }
     const double pen_sample = overlaps[sample_index - 1];
     tr.pen_max = std::max(tr.pen_max, pen_sample);
@@ -260,6 +279,7 @@ StabilityTrace trace_stability(const std::vector<RigidBody>& inputs, const Dynam
     }
   }
   for (bool p : passed) tr.tunnelled += p ? 1 : 0;
+  if (!(e_scale > 0)) e_scale = ke_max > 0 ? ke_max : 1.0;
   tr.growth = (e_max - inv.e0) / e_scale;
   tr.pen_rest = std::isfinite(pen_rest) ? pen_rest : 0.0;  // 0: no sample at rest
   // Signed drift: the largest |E - E0| / scale over the run, with its sign (gain +, loss -);

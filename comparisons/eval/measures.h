@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "comparisons/eval/contact_eval.h"
@@ -44,6 +45,13 @@ double initial_kinetic_energy(const std::vector<RigidBody>& inputs);
 Vec3 linear_momentum(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& s);
 /// Angular momentum about the origin of the moving bodies in states `s` (kg m^2/s).
 Vec3 angular_momentum(const std::vector<RigidBody>& inputs, const std::vector<BodyFinal>& s);
+/// The scales (linear, angular) a momentum drift in states `s` is measured against: the run's
+/// own from its start (`p_scale`, `h_scale`), or, where every body started still (both 0), the
+/// sums of the bodies' momentum magnitudes in `s`, so that equal and opposite momenta count as
+/// conserved to their own round-off; 1 where nothing moves at all.
+std::pair<double, double> drift_scales(const std::vector<RigidBody>& inputs,
+                                       const std::vector<BodyFinal>& s, double p_scale,
+                                       double h_scale);
 /// The bodies' states at t = 0.
 std::vector<BodyFinal> initial_states(const std::vector<RigidBody>& inputs);
 /// Size of a body: its bounding-box diagonal (m).

@@ -86,6 +86,47 @@ TEST(Harness, AThrowingDynamicsBackendDoesNotStopTheOthers) {
   EXPECT_FALSE(b.contains("exact"));
 }
 
+TEST(Harness, BodiesThatStartStillAreJudgedAgainstTheMotionTheRunMade) {
+  // Two free unit cubes (0.3 and 0.7 kg) placed at the same spot, at rest, no gravity, and a
+  // backend that throws them apart with equal and opposite momenta (12 kg m/s, 1 kg m^2/s, each
+  // to its round-off) and energy made from nothing. With no motion at the start to scale
+  // against, the drifts are measured against the momenta the run made (round-off, not 1e135
+  // against a floor of 1e-300) and the energy growth against the most kinetic energy it reached
+  // (1: all of it made).
+  const Scene scene = parse_scene(
+      "checks = [\"impulse\", \"stability\"]\n[sim]\ndt = 0.01\nduration = 0.02\n"
+      "gravity = [0, 0, 0]\n[[body]]\nname = \"A\"\nmass = 0.3\n[[body]]\nname = \"B\"\n"
+      "mass = 0.7\n",
+      "same_spot.toml");
+  const auto state = [](const char* name, double mass, double sign, double t) {
+    const double v = sign * 12 / mass, w = sign * 6 / mass;  // I = m / 6 for a unit cube
+    return BodyFinal{name, Vec3(v * t, 0, 0), Quat::Identity(), Vec3(v, 0, 0), Vec3(0, 0, w)};
+  };
+  Backend apart{"apart", "test: throws two bodies apart", nullptr,
+                [&](const Scene&, const DynamicsOptions&) {
+                  DynamicsResult r;
+                  for (double t : {0.01, 0.02})
+                    r.samples.push_back({t, {state("A", 0.3, 1, t), state("B", 0.7, -1, t)}});
+                  r.finals = r.samples.back().bodies;
+                  return r;
+                }};
+  apart.library = false;
+  const std::vector<Backend> table = {apart};
+  HarnessOptions opt;
+  opt.registry = &table;
+  opt.sweep = false;
+  const SceneEvaluation ev = evaluate_scene(scene, opt);
+  const auto value = [&](const std::string& name) {
+    for (const Metric& m : ev.metrics)
+      if (m.backend == "apart" && m.name == name) return m.value;
+    ADD_FAILURE() << "no metric " << name;
+    return -1.0;
+  };
+  EXPECT_LT(value("momentum_drift_err"), 1e-15);
+  EXPECT_LT(value("angular_momentum_drift_err"), 1e-15);
+  EXPECT_DOUBLE_EQ(value("energy_growth_err"), 1.0);
+}
+
 TEST(Harness, WithoutATableTheRegistryIsUsed) {
   // The seam changes nothing by default: --backends names come from the registry.
   const Scene scene = parse_scene("checks = [\"contact\"]\n[[body]]\nname = \"A\"\n", "one.toml");
