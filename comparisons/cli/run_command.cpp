@@ -33,7 +33,12 @@ void print_dynamics(std::ostream& out, const std::string& name, const Scene& sce
   Table f({"body", "position (COM)", "velocity", "angular velocity"});
   for (const BodyFinal& b : r.finals)
     f.add({b.name, fmt_vec(b.position), fmt_vec(b.velocity), fmt_vec(b.angular_velocity)});
-  out << "final state at t = " << fmt_num(scene.sim.steps() * scene.sim.dt) << " s:\n";
+  // A run that stopped early (its message says where) did not reach the scene's end.
+  if (r.status == Status::Ok)
+    out << "final state at t = " << fmt_num(scene.sim.steps() * scene.sim.dt) << " s:\n";
+  else
+    out << "state where the run stopped (before t = " << fmt_num(scene.sim.steps() * scene.sim.dt)
+        << " s, the scene's end):\n";
   f.print(out);
 }
 

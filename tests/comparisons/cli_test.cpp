@@ -94,6 +94,24 @@ TEST(Cli, HelpNamesTheProgramNotItsPath) {
   EXPECT_EQ(r.out.find(RBX_BINARY_DIR), std::string::npos) << r.out;
 }
 
+TEST(Cli, ARunThatStoppedEarlyDoesNotClaimTheScenesEnd) {
+  // A cube spinning at 1e300 rad/s: the engine stops at its first step (non-finite state), so
+  // the state printed is where it stopped, not the state at the scene's 0.1 s.
+  const fs::path dir = temp_dir("stopped");
+  std::ofstream(dir / "spin.toml") << "[sim]\ndt = 0.001\nduration = 0.1\ngravity = [0, 0, 0]\n"
+                                      "[[body]]\nname = \"a\"\nangular_velocity = [1e300, 0, 0]\n";
+  const CmdResult r = rbx_in(dir.string(), "run spin.toml");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.out.find("at step 1"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("final state at t = 0.1 s"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("state where the run stopped (before t = 0.1 s"), std::string::npos)
+      << r.out;
+  const CmdResult ok = rbx("run scenes/analytic/headon_e05.toml");
+  EXPECT_EQ(ok.code, 0);
+  EXPECT_NE(ok.out.find("final state at t = "), std::string::npos) << ok.out;
+  fs::remove_all(dir);
+}
+
 class CliBadInput : public ::testing::TestWithParam<std::string> {};
 
 // `rbx run` on each entry: exit 2, stderr exactly the entry's one expected line, and no output
