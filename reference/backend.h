@@ -251,10 +251,11 @@ inline Backend with_budget(Backend b, SolverBudget budget) {
 /// Every backend, in report order; those added by register_backend last.
 const std::vector<Backend>& backends();
 /// Adds a backend to the registry for the rest of the process (a researcher's own, from Python):
-/// it is marked `user` (its results are never cached: its code is not hashed). Throws
-/// std::invalid_argument on an empty or taken name, a name with a comma or a space, or a
-/// backend with neither a contact query nor dynamics. Call it before any run starts: pointers
-/// to registry rows (find_backend) may move.
+/// it is marked `user` (its results are never cached: its code is not hashed). A name
+/// registered before is replaced in its place (a notebook's edit and rerun). Throws
+/// std::invalid_argument on an empty name, a built-in backend's name, a name with a comma or a
+/// space, or a backend with neither a contact query nor dynamics. Call it before any run
+/// starts: pointers to registry rows (find_backend) may move.
 void register_backend(Backend b);
 /// The backend called `name`, or nullptr.
 const Backend* find_backend(const std::string& name);

@@ -57,10 +57,17 @@ void register_backend(Backend b) {
   if (b.name.empty() || b.name.find_first_of(", \t\n") != std::string::npos)
     throw std::invalid_argument("backend name '" + b.name +
                                 "': one word without commas or spaces, please");
-  if (find_backend(b.name)) throw std::invalid_argument("backend name '" + b.name + "' is taken");
   if (!b.contact && !b.dynamics)
     throw std::invalid_argument("backend '" + b.name + "' has neither contact nor dynamics");
   b.user = true;
+  for (Backend& have : registry_table()) {
+    if (have.name != b.name) continue;
+    if (!have.user)
+      throw std::invalid_argument("backend name '" + b.name + "' is a built-in backend's");
+    // Registered again (a notebook's edit and rerun): the new one replaces it, in its place.
+    have = std::move(b);
+    return;
+  }
   registry_table().push_back(std::move(b));
 }
 

@@ -376,7 +376,8 @@ def register_contact_backend(name, fn, description=None):
     triangles), "position" (centre of mass, world), "orientation" ([w, x, y, z]), "name",
     "static"; it returns a list of {"point", "normal", "depth"} (normal a unit vector from B
     toward A, depth > 0 overlapping), empty when apart. The backend then runs in compare, check,
-    explore and report like any other, isolated like a library (its own process, a deadline)."""
+    explore and report like any other, isolated like a library (its own process, a deadline).
+    Registering a name again replaces its function (edit and rerun); a built-in name is refused."""
     _check_registration(name, fn)
     _rbx.register_contact_backend(name, description or f"Python contact function {name}", fn)
 

@@ -166,6 +166,20 @@ def test_a_contact_function_agrees_with_the_oracle_and_is_listed():
     assert row["user"] and row["kind"] == ["contact"]
 
 
+def test_registering_a_name_again_replaces_the_function_a_built_in_name_is_refused():
+    a = {"size": [1, 1, 1], "position": [0, 0, 0.4]}
+    b = {"size": [4, 4, 1], "position": [0, 0, -0.5]}
+    first = [{"point": [0, 0, 0], "normal": [0, 0, 1], "depth": 0.1}]
+    rbx.register_contact_backend("py-edited", lambda x, y: first)
+    assert rbx.contact(a, b, backend="py-edited")[0]["depth"] == 0.1
+    # The notebook's cell edited and run again: the new function answers, listed once.
+    rbx.register_contact_backend("py-edited", lambda x, y: [dict(first[0], depth=0.2)])
+    assert rbx.contact(a, b, backend="py-edited")[0]["depth"] == 0.2
+    assert [r["name"] for r in rbx.backends()].count("py-edited") == 1
+    with pytest.raises(ValueError, match="built-in"):
+        rbx.register_contact_backend("custom", lambda x, y: first)
+
+
 def test_the_arguments_a_contact_function_gets():
     shapes = {}
 
@@ -339,7 +353,7 @@ def test_bad_arguments_raise_with_one_line():
                     backends=["no-such-backend"])
     with pytest.raises(TypeError, match="fn: a function"):
         rbx.register_contact_backend("py-not-callable", 3)
-    with pytest.raises(ValueError, match="taken"):
+    with pytest.raises(ValueError, match="built-in"):
         rbx.register_contact_backend("exact", sat_contact)
     with pytest.raises(ValueError, match="vertices must be N x 3"):
         rbx.contact({"vertices": [[0, 0, 0]]}, {"size": [1, 1, 1]})
