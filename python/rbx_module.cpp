@@ -171,6 +171,11 @@ ContactResult contacts_of(const py::handle& out) {
       throw std::runtime_error(at + " depth is not a number");
     }
     if (!std::isfinite(c.depth)) throw std::runtime_error(at + " depth is not finite");
+    // A depth is an overlap: a separated pair has no contact to return (the registered
+    // function's contract, docstring of register_contact_backend).
+    if (c.depth < 0)
+      throw std::runtime_error(at + " depth " + std::to_string(c.depth) +
+                               " is negative (the overlap, >= 0; return no contact when apart)");
     c.feature = d.contains("feature") ? py::str(d["feature"]).cast<std::string>() : "";
     r.contacts.push_back(c);
   }

@@ -319,14 +319,19 @@ def test_an_exception_or_a_wrong_return_type_is_that_backends_error():
     rbx.register_contact_backend("py-returns-int", lambda a, b: 7)
     rbx.register_contact_backend("py-no-depth", lambda a, b: [{"point": [0, 0, 0],
                                                               "normal": [0, 0, 1]}])
+    rbx.register_contact_backend("py-negative-depth", lambda a, b: [
+        {"point": [0, 0, 0], "normal": [0, 0, 1], "depth": -0.1}])
     path = os.path.join(ROOT, "scenes", "contact", "axis_z.toml")
-    doc = rbx.contacts(path, backends=["py-raises", "py-returns-int", "py-no-depth", "exact"])
+    doc = rbx.contacts(path, backends=["py-raises", "py-returns-int", "py-no-depth",
+                                       "py-negative-depth", "exact"])
     bs = doc["backends"]
     assert bs["py-raises"]["status"] == "error"
     assert "ZeroDivisionError: division by zero" in bs["py-raises"]["message"]
     assert bs["py-returns-int"]["status"] == "error"
     assert "returned int" in bs["py-returns-int"]["message"]
     assert 'no "depth"' in bs["py-no-depth"]["message"]
+    assert bs["py-negative-depth"]["status"] == "error"
+    assert "depth -0.100000 is negative" in bs["py-negative-depth"]["message"]
     assert bs["exact"]["status"] == "ok"  # the run went on
     # The same for response functions, in a dynamics run.
     rbx.register_response_backend("py-response-raises", lambda a, b, c, e: 1 / 0)
