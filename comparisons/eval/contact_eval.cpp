@@ -13,36 +13,52 @@
 
 namespace rbx {
 
-ContactRun run_contact(const Backend& b, const RigidBody& a, const RigidBody& bb, int repeats) {
+ContactRun run_contact(const Backend& b, const RigidBody& a, const RigidBody& bb) {
   ContactRun run;
   if (!b.contact) {
     run.result = {Status::Unsupported, b.name + " has no contact query (dynamics only)", {}};
     return run;
   }
-  // The repeats, timed one by one, with the median kept.
-  auto timed = [&] {
+  auto answer = [&] {
     TimedContact t;
-    std::vector<double> times;
-    for (int k = 0; k < std::max(repeats, 1); ++k) {
-      Stopwatch clock;
-      try {
-        t.result = b.contact(a, bb);
-      } catch (const std::exception& e) {
-        t.result = {Status::Error, e.what(), {}};
-      }
-      times.push_back(clock.seconds());
-      if (t.result.status != Status::Ok) break;
+    Stopwatch clock;
+    try {
+      t.result = b.contact(a, bb);
+    } catch (const std::exception& e) {
+      t.result = {Status::Error, e.what(), {}};
     }
-    std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
-    t.runtime_s = times[times.size() / 2];
+    t.runtime_s = clock.seconds();
     return t;
   };
   // A library's query runs isolated, under its deadline (reference/isolate.h); ours in process.
   const TimedContact t =
-      b.library ? isolated_contact(b.name, CallDeadlines{}.contact_s, timed) : timed();
+      b.library ? isolated_contact(b.name, CallDeadlines{}.contact_s, answer) : answer();
   run.result = t.result;
-  run.runtime_s = t.runtime_s;
+  run.timing.cold_s = t.runtime_s;
   return run;
+}
+
+bool timeable(const ContactRun& run) {
+  return run.result.status == Status::Ok || run.result.status == Status::Touching;
+}
+
+void time_contacts(const std::vector<const Backend*>& backends, std::vector<ContactRun*> runs,
+                   const RigidBody& a, const RigidBody& b, const TimingPlan& plan) {
+  std::vector<TimedSubject> subjects;
+  std::vector<ContactRun*> timed;
+  for (size_t i = 0; i < backends.size() && i < runs.size(); ++i) {
+    const Backend& be = *backends[i];
+    if (runs[i]->cached || !timeable(*runs[i]) || !be.contact) continue;
+    subjects.push_back(
+        {be.name, be.library, [&be, &a, &b] { be.contact(a, b); }, CallDeadlines{}.contact_s});
+    timed.push_back(runs[i]);
+  }
+  const std::vector<Timing> t = time_interleaved(subjects, plan);
+  for (size_t i = 0; i < timed.size(); ++i) {
+    const double cold = timed[i]->timing.cold_s;
+    timed[i]->timing = t[i];
+    timed[i]->timing.cold_s = cold;
+  }
 }
 
 TimedDynamics run_dynamics_isolated(const Backend& b, const Scene& scene,

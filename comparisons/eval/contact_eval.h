@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "comparisons/eval/timing.h"
 #include "reference/backend.h"
 #include "reference/isolate.h"
 
@@ -11,13 +12,22 @@ namespace rbx {
 /// A contact query's result and its run time.
 struct ContactRun {
   ContactResult result;
-  double runtime_s = 0.0;  // median over the repeats
-  bool cached = false;     // read from the reference-result cache (runtime_s is the stored one)
+  Timing timing;        // cold_s: the answering call; the rest once timed (time_contacts)
+  bool cached = false;  // read from the reference-result cache (the timing is the stored one)
 };
 
-/// Runs backend `b` on (A, B) `repeats` times (median time); a thrown exception becomes status
-/// Error with its message; a backend without contact queries gives Unsupported.
-ContactRun run_contact(const Backend& b, const RigidBody& a, const RigidBody& bb, int repeats = 1);
+/// Backend `b`'s answer on (A, B): one call, timed alone as the cold call (timing.cold_s); a
+/// thrown exception becomes status Error with its message; a backend without contact queries
+/// gives Unsupported. A library's call is isolated (reference/isolate.h).
+ContactRun run_contact(const Backend& b, const RigidBody& a, const RigidBody& bb);
+
+/// Whether a query's answer is worth timing: it answered (a contact, none, or touching).
+bool timeable(const ContactRun& run);
+
+/// Times, interleaved (timing.h), the queries on (A, B) of the backends whose runs are timeable
+/// and not cached; each such run's timing is filled in, its cold call kept.
+void time_contacts(const std::vector<const Backend*>& backends, std::vector<ContactRun*> runs,
+                   const RigidBody& a, const RigidBody& b, const TimingPlan& plan);
 
 /// Runs backend `b`'s dynamics on `scene` (a thrown exception becomes status Error); a library's
 /// run is isolated under its deadline (reference/isolate.h), so an abort or an endless loop is

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "comparisons/eval/harness.h"
+#include "comparisons/eval/measures.h"
 #include "engine/bounding.h"
 #include "engine/detect.h"
 #include "engine/format.h"
@@ -69,12 +70,13 @@ ContactsRow compare_row(const std::string& name, const ContactRun& run, const Co
   } else if (!run.result.message.empty() && bj["message"] == "") {
     bj["message"] = run.result.message;  // e.g. a known-defect note
   }
-  bj["runtime_s"] = bj["runtime_s"].get<double>() + run.runtime_s;
+  bj["runtime_s"] = bj["runtime_s"].get<double>() + run.timing.median_s;
   for (const ContactPoint& p : run.result.contacts)
     bj["contacts"].push_back(contact_json(a.name, b.name, 0.0, p));
   Json pair = {{"bodies", {a.name, b.name}},
                {"status", to_string(run.result.status)},
                {"touching", c != nullptr}};
+  put_timing(run.timing, pair);
   if (c && t) {
     pair["normal_err_deg"] = angle_deg(c->normal, t->normal);
     pair["depth_err"] = c->depth - t->depth;
@@ -130,7 +132,7 @@ Json contacts_json(const Scene& scene, const ContactsComparison& c, const Json& 
 }  // namespace
 
 ContactsComparison compare_contacts(const Scene& scene, const std::vector<std::string>& names,
-                                    bool at_first) {
+                                    bool at_first, double budget_s) {
   ContactsComparison c;
   c.at_first = at_first;
   const std::vector<RigidBody> bodies =
@@ -147,19 +149,21 @@ ContactsComparison compare_contacts(const Scene& scene, const std::vector<std::s
       const RigidBody &a = bodies[i], &b = bodies[j];
       if (a.is_static && b.is_static) continue;
       if (!bounding_check(a, b)) continue;
-      // The oracle always runs: it is what the differences are measured against.
-      ContactsPair p{a.name, b.name, run_contact(*find_backend("exact"), a, b), {}};
+      // The oracle always runs, first: it is what the differences are measured against.
+      std::vector<const Backend*> subjects = {find_backend("exact")};
+      for (const std::string& name : names)
+        if (name != "exact") subjects.push_back(find_backend(name));
+      const PairRuns runs = contact_runs(subjects, a, b, ResultCache(), budget_s);
+      ContactsPair p{a.name, b.name, runs.runs[0], {}};
       const ContactPoint* truth = deepest(p.truth_run.result);
-      std::vector<std::pair<std::string, ContactRun>> runs;
       bool any = truth != nullptr;
-      for (const std::string& name : names) {
-        runs.emplace_back(name,
-                          name == "exact" ? p.truth_run : run_contact(*find_backend(name), a, b));
-        any = any || !runs.back().second.result.contacts.empty();
-      }
+      for (const ContactRun& r : runs.runs) any = any || !r.result.contacts.empty();
       if (!any) continue;
-      for (const auto& [name, run] : runs)
-        p.rows.push_back(compare_row(name, run, truth, a, b, tol, backends_json[name], c.marks));
+      for (size_t k = 0, other = 1; k < names.size(); ++k) {
+        const ContactRun& run = names[k] == "exact" ? runs.runs[0] : runs.runs[other++];
+        p.rows.push_back(
+            compare_row(names[k], run, truth, a, b, tol, backends_json[names[k]], c.marks));
+      }
       c.pairs.push_back(std::move(p));
     }
   }

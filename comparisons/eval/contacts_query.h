@@ -40,8 +40,10 @@ struct ContactsComparison {
 /// Queries every pair of bodies (not both static) whose bounds meet, with every backend in
 /// `names` and the oracle; `at_first` moves the bodies first with the custom engine to the first
 /// step whose start has a touching pair (by the oracle's test). Marks as `rbx compare` marks:
-/// clearly different from the oracle (disagrees) or beyond its round-off (deviates).
+/// clearly different from the oracle (disagrees) or beyond its round-off (deviates). Every
+/// query is timed as the report times it (contact_runs: at least `budget_s` each, interleaved;
+/// 0: untimed), its cold first call apart.
 ContactsComparison compare_contacts(const Scene& scene, const std::vector<std::string>& names,
-                                    bool at_first);
+                                    bool at_first, double budget_s = 0.01);
 
 }  // namespace rbx

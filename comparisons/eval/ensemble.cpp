@@ -8,6 +8,7 @@
 
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/explore.h"
+#include "comparisons/eval/metrics.h"
 #include "comparisons/eval/select_backends.h"
 #include "reference/result_codec.h"
 
@@ -32,19 +33,10 @@ Quat rotation_by(const Vec3& w) {
   return Quat(Eigen::AngleAxisd(angle, w / angle));
 }
 
-// Linear-interpolation percentile of sorted values (p in [0, 1]).
-double percentile(const std::vector<double>& sorted, double p) {
-  if (sorted.empty()) return 0.0;
-  const double at = p * static_cast<double>(sorted.size() - 1);
-  const size_t lo = static_cast<size_t>(std::floor(at));
-  const size_t hi = std::min(sorted.size() - 1, lo + 1);
-  return sorted[lo] + (at - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
-}
-
 // The width of the 5-95 % range of values.
 double range_5_95(std::vector<double> values) {
   std::sort(values.begin(), values.end());
-  return percentile(values, 0.95) - percentile(values, 0.05);
+  return sorted_quantile(values, 0.95) - sorted_quantile(values, 0.05);
 }
 
 // Root mean square distance of vectors from their mean, and the widest 5-95 % coordinate range.
@@ -240,7 +232,7 @@ int cluster_count(const Scene& scene, const CopyStates& copies) {
       if (a != b) nearest[a] = std::min(nearest[a], distance(a, b));
   std::vector<double> sorted = nearest;
   std::sort(sorted.begin(), sorted.end());
-  const double link = 5.0 * percentile(sorted, 0.5);
+  const double link = 5.0 * sorted_quantile(sorted, 0.5);
   // Single linkage by union-find over the pairs within the link distance.
   std::vector<size_t> root(n);
   std::iota(root.begin(), root.end(), 0);

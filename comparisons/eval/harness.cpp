@@ -89,8 +89,9 @@ class Evaluator {
     j["causes"] = causes;
     Json sweep = Json::array();
     for (const SweepPoint& s : out_.sweep) {
-      Json point = {{"backend", s.backend},     {"kind", s.kind},   {"dt", s.dt},
-                    {"runtime_s", s.runtime_s}, {"error", s.error}, {"against", s.against}};
+      Json point = {{"backend", s.backend}, {"kind", s.kind}, {"dt", s.dt}, {"error", s.error}};
+      point["against"] = s.against;
+      put_timing(s.timing, point);
       if (s.kind == "budget") point["budget"] = s.budget;
       sweep.push_back(std::move(point));
     }
@@ -234,13 +235,16 @@ class Evaluator {
                                        " m from the true contact region");
     }
 
-    for (const std::string& name : names) {
-      const Backend& be = backend(name);
-      const ContactRun run =
-          timed_contact(name == "exact" ? exact : be, a, b, cache_, opt_.timing_budget_s);
+    std::vector<const Backend*> subjects;
+    for (const std::string& name : names)
+      subjects.push_back(name == "exact" ? &exact : &backend(name));
+    const PairRuns runs = contact_runs(subjects, a, b, cache_, opt_.timing_budget_s);
+    for (size_t i = 0; i < names.size(); ++i) {
+      const std::string& name = names[i];
+      const ContactRun& run = runs.runs[i];
       set_status(name, run.result.status, run.result.message);
       Json& bj = backend_json(name);
-      bj["runtime_s"] = bj["runtime_s"].get<double>() + run.runtime_s;
+      bj["runtime_s"] = bj["runtime_s"].get<double>() + run.timing.median_s;
       if (run.cached) bj["cached"] = true;
       for (const ContactPoint& p : run.result.contacts)
         bj["contacts"].push_back(contact_json(a.name, b.name, 0.0, p));
@@ -278,20 +282,16 @@ class Evaluator {
       if (sat.touching && !sat.manifold.empty())
         metric("contact", name, pair, "point_err_rel",
                contact_point_error(c->point, a, b, sat.manifold) / size, "exact");
-      out_.sweep.push_back({name, "contact", 0.0, run.runtime_s, angle, normal_src});
+      out_.sweep.push_back({name, "contact", 0.0, run.timing, angle, normal_src});
       // The same query with the library's shapes built once (its "prebuilt" variant): the
       // figures time both, so that the cost of building a shape shows apart from the query.
-      if (const QueryVariant* v = find_query_variant(name, "prebuilt")) {
-        Backend pre = be;
-        pre.name = name + "+prebuilt";
-        pre.contact = v->contact;
-        const ContactRun pr = timed_contact(pre, a, b, cache_, opt_.timing_budget_s);
-        const ContactPoint* pc = deepest(pr.result);
-        if (pr.result.status != Status::Ok || !pc || !same_answer(*c, *pc))
+      if (const std::optional<ContactRun>& pr = runs.prebuilt[i]) {
+        const ContactPoint* pc = deepest(pr->result);
+        if (pr->result.status != Status::Ok || !pc || !same_answer(*c, *pc))
           out_.disagreements.push_back(name + " on " + pair +
                                        ": the prebuilt variant answers differently");
         else
-          out_.sweep.push_back({name, "contact-prebuilt", 0.0, pr.runtime_s, angle, normal_src});
+          out_.sweep.push_back({name, "contact-prebuilt", 0.0, pr->timing, angle, normal_src});
       }
       // Disagreement marks: beyond round-off-level tolerance of the truth (1e-6 rad ~ 6e-5 deg;
       // depth within the scene's tolerance or 1e-6 of the body size).
@@ -463,8 +463,8 @@ class Evaluator {
       for (const DynRun& r : sw.runs) {
         if (r.result.status != Status::Ok) continue;
         if (!fr.have_expect && &r == &sw.runs.back()) continue;  // zero by construction
-        out_.sweep.push_back(
-            {name, "dynamics", r.dt, r.runtime_s, error_of(r.result.finals), against});
+        out_.sweep.push_back({name, "dynamics", r.dt, Timing::once(r.runtime_s),
+                              error_of(r.result.finals), against});
       }
       const std::vector<SweepPoint> budgets = budget_points(
           backend(name), scene_, main, cache_, inputs_, error_of, against, &out_.skipped);

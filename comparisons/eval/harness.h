@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "comparisons/eval/json_io.h"
+#include "comparisons/eval/timing.h"
 #include "comparisons/scene/scene_collection.h"  // scene_family, for the harness's users
 #include "engine/scene.h"
 #include "reference/backend.h"
@@ -18,7 +19,8 @@ namespace rbx {
 struct HarnessOptions {
   std::string backends;           // --backends LIST ("" : the scene's, or all that serve a check)
   bool sweep = true;              // run the time-step sweep for error against run time
-  double timing_budget_s = 0.01;  // per contact query and backend: repeat until this much time
+  double timing_budget_s = 0.01;  // per contact query and backend: timed at least this long
+                                  // (timing.h); 0: the answers only, untimed
   /// Backends to choose from; nullptr: the registry (reference/registry.cpp). Tests pass their
   /// own table to add a failing backend without touching the registry.
   const std::vector<Backend>* registry = nullptr;
@@ -55,10 +57,10 @@ struct Metric {
 /// One point of error against run time.
 struct SweepPoint {
   std::string backend;
-  std::string kind;  // "dynamics" (a time step), "budget" (a solver budget at the scene's
-                     // step), "contact" or "contact-prebuilt" (a query)
-  double dt = 0.0;   // s (dynamics, budget)
-  double runtime_s = 0.0;
+  std::string kind;    // "dynamics" (a time step), "budget" (a solver budget at the scene's
+                       // step), "contact" or "contact-prebuilt" (a query)
+  double dt = 0.0;     // s (dynamics, budget)
+  Timing timing;       // a query's (timing.h); a dynamics run's is its one run: one round, one call
   double error = 0.0;  // velocity error in the kinetic-energy norm, or normal angle (deg)
   std::string against;
   int budget = 0;  // the solver budget (kind "budget"; Backend::budget), else 0: as configured

@@ -170,6 +170,28 @@ void write_text(const std::string& path, const std::string& text) {
 
 void write_json(const std::string& path, const Json& j) { write_text(path, j.dump(2) + "\n"); }
 
+void put_timing(const Timing& t, Json& into) {
+  into["runtime_s"] = t.median_s;
+  into["timing"] = {{"q25_s", t.q25_s},
+                    {"q75_s", t.q75_s},
+                    {"calls", t.calls},
+                    {"rounds", t.rounds},
+                    {"cold_s", t.cold_s}};
+}
+
+Timing timing_of(const Json& from) {
+  Timing t;
+  t.median_s = from.value("runtime_s", 0.0);
+  if (!from.contains("timing")) return t;
+  const Json& j = from["timing"];
+  t.q25_s = j.value("q25_s", 0.0);
+  t.q75_s = j.value("q75_s", 0.0);
+  t.calls = j.value("calls", 0L);
+  t.rounds = j.value("rounds", 0);
+  t.cold_s = j.value("cold_s", 0.0);
+  return t;
+}
+
 Stopwatch::Stopwatch()
     : start_ns_(std::chrono::duration_cast<std::chrono::nanoseconds>(
                     std::chrono::steady_clock::now().time_since_epoch())

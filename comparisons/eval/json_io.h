@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "comparisons/eval/timing.h"
 #include "engine/body.h"
 #include "engine/contact.h"
 #include "engine/world.h"
@@ -51,6 +52,11 @@ Json contact_laws_json(const DynamicsResult& r);
 /// What the run's first impulse saw (FirstImpulse), or null when no impulse was applied:
 /// pair, step, contact_points, normal, point, depth, impulse, approach_speed, entry_phase.
 Json first_impulse_json(const FirstImpulse& f);
+
+/// A timing (timing.h) into a JSON object: `runtime_s` (the median per call) and `timing`
+/// {q25_s, q75_s, calls, rounds, cold_s}; read back by timing_of.
+void put_timing(const Timing& t, Json& into);
+Timing timing_of(const Json& from);
 
 /// Writes text to `path` atomically (temporary file in the same folder, then rename), or to
 /// standard output when path is "-". Throws std::runtime_error on failure.

@@ -43,25 +43,57 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
   return run;
 }
 
-ContactRun timed_contact(const Backend& be, const RigidBody& a, const RigidBody& b,
-                         const ResultCache& cache, double budget_s) {
-  const bool cacheable = cache.enabled() && ResultCache::caches(be.name);
-  const std::string key = cacheable ? cache.contact_key(be.name, a, b) : std::string();
-  if (cacheable)
-    if (auto hit = cache.load_contact(key)) {
+ContactRun answer_contact(const Backend& be, const RigidBody& a, const RigidBody& b,
+                          const ResultCache& cache) {
+  if (cache.enabled() && ResultCache::caches(be.name))
+    if (auto hit = cache.load_contact(cache.contact_key(be.name, a, b))) {
       ContactRun run;
       run.result = std::move(hit->result);
-      run.runtime_s = hit->runtime_s;
+      run.timing = hit->timing;
       run.cached = true;
       return run;
     }
-  ContactRun probe = run_contact(be, a, b);
-  int repeats = 1;
-  if (probe.result.status == Status::Ok && probe.runtime_s > 0)
-    repeats = static_cast<int>(std::clamp(budget_s / probe.runtime_s, 1.0, 200.0));
-  ContactRun run = repeats > 1 ? run_contact(be, a, b, repeats) : probe;
-  if (cacheable) cache.store(key, run.result, run.runtime_s);
-  return run;
+  return run_contact(be, a, b);
+}
+
+PairRuns contact_runs(const std::vector<const Backend*>& backends, const RigidBody& a,
+                      const RigidBody& b, const ResultCache& cache, double budget_s) {
+  PairRuns out;
+  std::vector<Backend> variants;
+  variants.reserve(backends.size());  // the subjects below point into it
+  std::vector<const Backend*> subjects;
+  for (const Backend* be : backends) {
+    out.runs.push_back(answer_contact(*be, a, b, cache));
+    out.prebuilt.emplace_back();
+  }
+  for (size_t i = 0; i < backends.size(); ++i) {
+    const QueryVariant* v = find_query_variant(backends[i]->name, "prebuilt");
+    if (!v || !timeable(out.runs[i])) continue;
+    variants.push_back(*backends[i]);
+    variants.back().name = backends[i]->name + "+prebuilt";
+    variants.back().contact = v->contact;
+    out.prebuilt[i] = answer_contact(variants.back(), a, b, cache);
+  }
+  std::vector<ContactRun*> runs;
+  for (size_t i = 0; i < backends.size(); ++i) {
+    subjects.push_back(backends[i]);
+    runs.push_back(&out.runs[i]);
+  }
+  size_t k = 0;
+  for (size_t i = 0; i < backends.size(); ++i)
+    if (out.prebuilt[i]) {
+      subjects.push_back(&variants[k++]);
+      runs.push_back(&*out.prebuilt[i]);
+    }
+  if (budget_s <= 0) return out;  // untimed answers are not stored: a timed run would read them
+  TimingPlan plan;
+  plan.min_time_s = budget_s;
+  time_contacts(subjects, runs, a, b, plan);
+  if (cache.enabled())
+    for (size_t i = 0; i < subjects.size(); ++i)
+      if (!runs[i]->cached && ResultCache::caches(subjects[i]->name))
+        cache.store(cache.contact_key(subjects[i]->name, a, b), runs[i]->result, runs[i]->timing);
+  return out;
 }
 
 // Kinetic energy of the bodies at t = 0 (J).

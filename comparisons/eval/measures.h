@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,10 +35,22 @@ struct DynRun {
 DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every,
                     const ResultCache& cache, const std::vector<RigidBody>& bodies, int budget = 0);
 
-/// A contact query timed for about `budget_s` (median of the repeats, at most 200), or the
-/// cached result of the same query (a reference backend's, see result_cache.h).
-ContactRun timed_contact(const Backend& be, const RigidBody& a, const RigidBody& b,
-                         const ResultCache& cache, double budget_s);
+/// A contact query's answer: the cached run of the same query (a reference backend's, see
+/// result_cache.h, with the timing stored with it), or one fresh call, not yet timed.
+ContactRun answer_contact(const Backend& be, const RigidBody& a, const RigidBody& b,
+                          const ResultCache& cache);
+
+/// Every backend's query on one pair: its run, and the run of its "prebuilt" variant (the
+/// library's shapes built once) where it has one and answered.
+struct PairRuns {
+  std::vector<ContactRun> runs;                     // one per backend, in order
+  std::vector<std::optional<ContactRun>> prebuilt;  // likewise
+};
+
+/// Every backend answers (answer_contact), then the fresh answers are timed together, interleaved
+/// (time_contacts, at least `budget_s` each; 0: untimed) and stored in the cache with their timing.
+PairRuns contact_runs(const std::vector<const Backend*>& backends, const RigidBody& a,
+                      const RigidBody& b, const ResultCache& cache, double budget_s);
 
 /// Kinetic energy of the bodies at t = 0 (J).
 double initial_kinetic_energy(const std::vector<RigidBody>& inputs);

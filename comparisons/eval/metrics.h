@@ -14,6 +14,8 @@ namespace rbx {
 
 /// The median of `v` (the mean of the middle two when even); `v` must not be empty.
 double median_of(std::vector<double> v);
+/// Quantile q in [0, 1] of sorted values, interpolated linearly between neighbours; 0 for none.
+double sorted_quantile(const std::vector<double>& sorted, double q);
 
 /// Reference final velocities of one body; a quantity left empty is not compared.
 struct RefState {

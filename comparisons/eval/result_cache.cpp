@@ -167,13 +167,31 @@ void ResultCache::write(const std::string& key, const std::string& value) const 
   if (ec) fs::remove(tmp, ec);
 }
 
-std::optional<CachedResult<ContactResult>> ResultCache::load_contact(const std::string& key) const {
-  return decode<ContactResult>(read(key));
+// A contact entry: the result as the codec writes it (with the cold call's time), then the rest
+// of its timing.
+std::optional<CachedContact> ResultCache::load_contact(const std::string& key) const {
+  const std::optional<std::string> bytes = read(key);
+  if (!bytes) return std::nullopt;
+  try {
+    ByteReader in(*bytes);
+    std::string result;
+    CachedContact c;
+    in.get(result);
+    in.io(c.timing.median_s, c.timing.q25_s, c.timing.q75_s, c.timing.calls, c.timing.rounds);
+    if (!in.done() || !decode_result(result, c.result, c.timing.cold_s)) return std::nullopt;
+    return c;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
 }
 
-void ResultCache::store(const std::string& key, const ContactResult& c, double runtime_s) const {
+void ResultCache::store(const std::string& key, const ContactResult& c,
+                        const Timing& timing) const {
   if (c.status == Status::Timeout) return;
-  write(key, encode_result(c, runtime_s));
+  ByteWriter w;
+  w.put(encode_result(c, timing.cold_s));
+  w.io(timing.median_s, timing.q25_s, timing.q75_s, timing.calls, timing.rounds);
+  write(key, w.str());
 }
 
 std::optional<CachedResult<DynamicsResult>> ResultCache::load_dynamics(

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "comparisons/eval/timing.h"
 #include "engine/body.h"
 #include "engine/scene.h"
 #include "reference/backend.h"
@@ -27,6 +28,12 @@ template <class Result>
 struct CachedResult {
   Result result;
   double runtime_s = 0.0;
+};
+
+/// A cached contact query, with the timing measured when it was computed (timing.h).
+struct CachedContact {
+  ContactResult result;
+  Timing timing;
 };
 
 /// The reference-result cache in one folder ("" : disabled; nothing is read or written).
@@ -53,7 +60,7 @@ class ResultCache {
   std::string mass_key(const std::string& backend, const RigidBody& body) const;
 
   /// Lookups: nullopt on a miss (no file, another fingerprint, an unreadable file).
-  std::optional<CachedResult<ContactResult>> load_contact(const std::string& key) const;
+  std::optional<CachedContact> load_contact(const std::string& key) const;
   std::optional<CachedResult<DynamicsResult>> load_dynamics(const std::string& key) const;
   std::optional<CachedResult<MassResult>> load_mass(const std::string& key) const;
   /// Numbers the harness derives from a cached run (keyed by the run's key; the harness's own
@@ -66,7 +73,7 @@ class ResultCache {
   /// Stores (atomically: a temporary file renamed into place); failures to write are ignored
   /// (the cache only saves time). A timeout is not stored: it depends on the machine's load at
   /// the time, not on the inputs, so the next run asks the library again.
-  void store(const std::string& key, const ContactResult& r, double runtime_s) const;
+  void store(const std::string& key, const ContactResult& r, const Timing& timing) const;
   void store(const std::string& key, const DynamicsResult& r, double runtime_s) const;
   void store(const std::string& key, const MassResult& r, double runtime_s) const;
 

@@ -17,16 +17,21 @@ void print_contacts(std::ostream& out, const Scene& scene, const ContactsCompari
         << (t ? "depth " + fmt_num(t->depth) + ", normal " + fmt_vec(t->normal) : "no contact")
         << "\n";
     Table table({"backend", "status", "points", "normal", "depth", "point", "angle vs exact",
-                 "depth - exact", "mark", "time (us)"});
+                 "depth - exact", "mark", "time (µs)", "25-75 %", "cold call (µs)"});
     for (const ContactsRow& r : p.rows) {
       const ContactPoint* q = deepest(r.run.result);
-      table.add({r.backend, to_string(r.run.result.status),
-                 std::to_string(r.run.result.contacts.size()), q ? fmt_vec(q->normal) : "-",
-                 q ? fmt_num(q->depth, 5) : "-", q ? fmt_vec(q->point) : "-", r.angle, r.depth_diff,
-                 r.mark == "disagrees"  ? "✗"
-                 : r.mark == "deviates" ? "~"
-                                        : "",
-                 fmt_num(r.run.runtime_s * 1e6, 3)});
+      const bool timed = r.run.timing.rounds > 0;
+      table.add(
+          {r.backend, to_string(r.run.result.status), std::to_string(r.run.result.contacts.size()),
+           q ? fmt_vec(q->normal) : "-", q ? fmt_num(q->depth, 5) : "-",
+           q ? fmt_vec(q->point) : "-", r.angle, r.depth_diff,
+           r.mark == "disagrees"  ? "✗"
+           : r.mark == "deviates" ? "~"
+                                  : "",
+           timed ? fmt_num(r.run.timing.median_s * 1e6, 3) : "-",
+           timed ? fmt_num(r.run.timing.q25_s * 1e6, 3) + "-" + fmt_num(r.run.timing.q75_s * 1e6, 3)
+                 : "-",
+           fmt_num(r.run.timing.cold_s * 1e6, 3)});
     }
     table.print(out);
     for (const ContactsRow& r : p.rows)
@@ -34,7 +39,12 @@ void print_contacts(std::ostream& out, const Scene& scene, const ContactsCompari
         out << "  " << r.backend << ": " << r.run.result.message << "\n";
   }
   for (const std::string& m : c.marks) out << "  " << m << "\n";
-  if (!c.pairs.empty()) return;
+  if (!c.pairs.empty()) {
+    out << "\ntime: per query, the median over rounds of repeated calls (warmed up, backends "
+           "interleaved; docs/bench.md) with its 25-75 % range; the cold call is the first, "
+           "which gave the answer, timed alone\n";
+    return;
+  }
   if (!c.at_first)
     out << "no pair of bodies touches at t = 0 (--at first-contact queries where one first "
            "does)\n";

@@ -628,7 +628,8 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
 
   std::ostringstream metrics, sweep, stab;
   metrics << "scene,family,check,backend,pair,metric,value,against\n";
-  sweep << "scene,family,backend,kind,dt,budget,runtime_s,error,against\n";
+  sweep << "scene,family,backend,kind,dt,budget,runtime_s,error,against,runtime_q25_s,"
+           "runtime_q75_s,calls,rounds,cold_s\n";
   stab << "scene,family,backend,dt,restitution,verdict,energy_growth_rel,energy_drift_rel,"
           "max_penetration_rel,rest_penetration_rel,tunnelled_pairs,jitter_rms_mps\n";
   for (size_t i = 0; i < evs.size(); ++i) {
@@ -638,8 +639,11 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
               << m.name << "," << fmt_num(m.value, 17) << "," << csv_escape(m.against) << "\n";
     for (const SweepPoint& p : evs[i].sweep)
       sweep << sc << "," << fam << "," << p.backend << "," << p.kind << "," << fmt_num(p.dt, 17)
-            << "," << p.budget << "," << fmt_num(p.runtime_s, 6) << "," << fmt_num(p.error, 17)
-            << "," << csv_escape(p.against) << "\n";
+            << "," << p.budget << "," << fmt_num(p.timing.median_s, 6) << ","
+            << fmt_num(p.error, 17) << "," << csv_escape(p.against) << ","
+            << fmt_num(p.timing.q25_s, 6) << "," << fmt_num(p.timing.q75_s, 6) << ","
+            << p.timing.calls << "," << p.timing.rounds << "," << fmt_num(p.timing.cold_s, 6)
+            << "\n";
     std::vector<std::pair<std::string, Json>> stab_rows;  // the scene's step, then its sweep
     for (const auto& [name, s] : evs[i].json["stability"].items()) {
       stab_rows.emplace_back(name, s);

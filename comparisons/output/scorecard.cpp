@@ -102,8 +102,8 @@ void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, con
       row.depth_error.push_back(std::max(truth_metric(ev, b, "depth_err"), 0.0));
     }
     for (const SweepPoint& p : ev.sweep) {
-      if (p.backend == b && p.kind == "contact") row.time.push_back(p.runtime_s);
-      if (p.backend == b && p.kind == "contact-prebuilt") row.prebuilt.push_back(p.runtime_s);
+      if (p.backend == b && p.kind == "contact") row.time.push_back(p.timing.median_s);
+      if (p.backend == b && p.kind == "contact-prebuilt") row.prebuilt.push_back(p.timing.median_s);
     }
     return;
   }
@@ -439,40 +439,66 @@ std::string query_time_markdown(const std::vector<SceneEvaluation>& evs,
                                 const std::vector<std::string>& backends) {
   // Pairs (per call, prebuilt) of one query, per backend: the harness writes a query's
   // prebuilt point right after its per-call point (none when the answers differed).
-  std::map<std::string, std::vector<double>> per_call, prebuilt, built;
+  std::map<std::string, std::vector<Timing>> per_call;
+  std::map<std::string, std::vector<double>> prebuilt, built;
   for (const SceneEvaluation& ev : evs)
     for (size_t k = 0; k < ev.sweep.size(); ++k) {
       const SweepPoint& p = ev.sweep[k];
-      if (p.kind == "contact") per_call[p.backend].push_back(p.runtime_s);
-      if (p.kind != "contact-prebuilt" || k == 0) continue;
+      if (p.kind == "contact" && p.timing.rounds > 0) per_call[p.backend].push_back(p.timing);
+      if (p.kind != "contact-prebuilt" || k == 0 || p.timing.rounds == 0) continue;
       const SweepPoint& call = ev.sweep[k - 1];
-      if (call.kind != "contact" || call.backend != p.backend) continue;
-      prebuilt[p.backend].push_back(p.runtime_s);
-      built[p.backend].push_back(call.runtime_s - p.runtime_s);
+      if (call.kind != "contact" || call.backend != p.backend || call.timing.rounds == 0) continue;
+      prebuilt[p.backend].push_back(p.timing.median_s);
+      built[p.backend].push_back(call.timing.median_s - p.timing.median_s);
     }
   if (per_call.empty()) return "";
-  Table t({"backend", "queries", "per call (µs)", "shapes prebuilt (µs)",
-           "building the shapes (µs)", "per call / prebuilt"});
+  Table t({"backend", "queries", "per call (µs)", "25-75 % over rounds", "calls timed",
+           "cold call (µs)", "shapes prebuilt (µs)", "building the shapes (µs)",
+           "per call / prebuilt"});
   for (const std::string& b : backends) {
     if (!per_call.count(b)) continue;
-    const double call = median_of(per_call[b]) * 1e6;
-    if (prebuilt[b].empty()) {
-      t.add({b, std::to_string(per_call[b].size()), fmt_num(call, 3), "—", "—", "—"});
-      continue;
+    std::vector<double> median, spread, cold;
+    long calls = 0;
+    for (const Timing& x : per_call[b]) {
+      median.push_back(x.median_s);
+      spread.push_back(x.spread());
+      cold.push_back(x.cold_s);
+      calls += x.calls;
     }
-    const double pre = median_of(prebuilt[b]) * 1e6;
-    t.add({b, std::to_string(per_call[b].size()), fmt_num(call, 3), fmt_num(pre, 3),
-           fmt_num(median_of(built[b]) * 1e6, 3), fmt_num(call / pre, 3) + "x"});
+    const double call = median_of(median) * 1e6;
+    std::vector<std::string> row = {b,
+                                    std::to_string(median.size()),
+                                    fmt_num(call, 3),
+                                    "±" + fmt_num(50.0 * median_of(spread), 2) + " %",
+                                    std::to_string(calls),
+                                    fmt_num(median_of(cold) * 1e6, 3)};
+    if (prebuilt[b].empty()) {
+      row.insert(row.end(), {"—", "—", "—"});
+    } else {
+      const double pre = median_of(prebuilt[b]) * 1e6;
+      row.insert(row.end(), {fmt_num(pre, 3), fmt_num(median_of(built[b]) * 1e6, 3),
+                             fmt_num(call / pre, 3) + "x"});
+    }
+    t.add(row);
   }
   std::ostringstream md;
-  md << "Contact query time, median over the queries of the run. *Per call* is the backend as it "
-        "runs (the library's shapes built in each query; custom, exact and libccd query our "
-        "hulls directly, nothing to build). *Shapes prebuilt* is the same query with the "
-        "library's shapes built once and kept, as a user holding them across steps would "
-        "(the backend's \"prebuilt\" variant; its answers are checked to be bit-identical, "
-        "else the run reports a disagreement); *building the shapes* is the median of the "
-        "difference per query. In the figures above, hollow markers joined by a dotted line to "
-        "the filled ones are the prebuilt times.\n\n"
+  md << "Contact query time, median over the queries of the run. Each query is timed as "
+        "benchmarks time (docs/bench.md): the backend's first call, which gave its answer, is "
+        "the *cold call*, reported apart; then, after a warm-up call, rounds of repeated calls "
+        "(each round long enough for the clock) until at least "
+     << fmt_num(HarnessOptions{}.timing_budget_s * 1e3) << " ms and " << TimingPlan{}.min_rounds
+     << " rounds, the backends of one pair taking turns round by round so that a passing load of "
+        "the "
+        "machine falls on all alike. *Per call* is the median over the rounds; *25-75 % over "
+        "rounds* is half the range between a query's quartiles relative to its median (the "
+        "median over the queries): how far one query's time moved while it was timed. *Calls "
+        "timed* adds up every query's. *Per call* is the backend as it runs (the library's "
+        "shapes built in each query; custom, exact and libccd query our hulls directly, nothing "
+        "to build). *Shapes prebuilt* is the same query with the library's shapes built once and "
+        "kept, as a user holding them across steps would (the backend's \"prebuilt\" variant; "
+        "its answers are checked to be bit-identical, else the run reports a disagreement); "
+        "*building the shapes* is the median of the difference per query. In the figures above, "
+        "hollow markers joined by a dotted line to the filled ones are the prebuilt times.\n\n"
      << t.markdown() << "\n";
   return md.str();
 }

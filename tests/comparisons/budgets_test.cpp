@@ -31,9 +31,9 @@ SceneEvaluation budget_scene(const std::string& family,
                              const std::vector<std::pair<int, double>>& points) {
   SceneEvaluation ev;
   ev.family = family;
-  ev.sweep.push_back({"bullet", "dynamics", 0.02, 1e-3, 9.0, "analytic"});
+  ev.sweep.push_back({"bullet", "dynamics", 0.02, Timing::once(1e-3), 9.0, "analytic"});
   for (const auto& [budget, error] : points)
-    ev.sweep.push_back({"bullet", "budget", 0.01, 1e-3, error, "analytic", budget});
+    ev.sweep.push_back({"bullet", "budget", 0.01, Timing::once(1e-3), error, "analytic", budget});
   return ev;
 }
 

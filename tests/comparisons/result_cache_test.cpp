@@ -86,10 +86,17 @@ TEST(ResultCache, AnotherReferenceCodeOrOtherInputsMiss) {
   const ResultCache before(dir.string(), "adapters 1111"), after(dir.string(), "adapters 2222");
   ContactResult r{
       Status::Ok, "note", {ContactPoint{Vec3(0.45, 0, 0), Vec3(-1, 0, 0), 0.1, "face"}}};
-  before.store(before.contact_key("fcl", bodies[0], bodies[1]), r, 1.5e-6);
+  const Timing timed{1.5e-6, 1.4e-6, 1.7e-6, 4200, 14, 3.1e-5};
+  before.store(before.contact_key("fcl", bodies[0], bodies[1]), r, timed);
   const auto hit = before.load_contact(before.contact_key("fcl", bodies[0], bodies[1]));
   ASSERT_TRUE(hit);
-  EXPECT_EQ(hit->runtime_s, 1.5e-6);
+  // The whole timing comes back as stored: the report's tables read it for a cached query.
+  EXPECT_EQ(hit->timing.median_s, 1.5e-6);
+  EXPECT_EQ(hit->timing.q25_s, 1.4e-6);
+  EXPECT_EQ(hit->timing.q75_s, 1.7e-6);
+  EXPECT_EQ(hit->timing.calls, 4200);
+  EXPECT_EQ(hit->timing.rounds, 14);
+  EXPECT_EQ(hit->timing.cold_s, 3.1e-5);
   ASSERT_EQ(hit->result.contacts.size(), 1u);
   EXPECT_EQ(hit->result.contacts[0].depth, 0.1);
   EXPECT_EQ(hit->result.message, "note");
@@ -116,8 +123,8 @@ TEST(ResultCache, TimeoutsAreNotKept) {
   const ResultCache cache(dir.string(), "adapters 1111");
   const std::string fcl = cache.contact_key("fcl", bodies[0], bodies[1]);
   const std::string ode = cache.contact_key("ode", bodies[0], bodies[1]);
-  cache.store(fcl, ContactResult{Status::Timeout, "past the deadline", {}}, 30.0);
-  cache.store(ode, ContactResult{Status::Error, "aborted", {}}, 0.1);
+  cache.store(fcl, ContactResult{Status::Timeout, "past the deadline", {}}, Timing::once(30.0));
+  cache.store(ode, ContactResult{Status::Error, "aborted", {}}, Timing::once(0.1));
   EXPECT_FALSE(cache.load_contact(fcl));
   const auto kept = cache.load_contact(ode);
   ASSERT_TRUE(kept);

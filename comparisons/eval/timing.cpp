@@ -1,0 +1,120 @@
+#include "comparisons/eval/timing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+
+#include "comparisons/eval/json_io.h"
+#include "comparisons/eval/metrics.h"
+#include "reference/isolate.h"
+#include "reference/result_codec.h"
+
+namespace rbx {
+namespace {
+
+struct Progress {
+  long per_round = 1;
+  std::vector<double> per_call_s;  // one per round
+  double total_s = 0.0;
+  bool failed = false;
+  bool done = false;
+};
+
+// Runs `n` calls of `s` in a row and returns their time, or a negative number when a call threw
+// or the isolated round failed.
+double timed_round(const TimedSubject& s, long n) {
+  double t = -1.0;
+  auto round = [&] {
+    try {
+      Stopwatch clock;
+      for (long k = 0; k < n; ++k) s.call();
+      t = clock.seconds();
+    } catch (const std::exception&) {
+      t = -1.0;
+    }
+    return std::string();
+  };
+  if (!s.library) {
+    round();
+    return t;
+  }
+  return isolated(s.backend, s.deadline_s, round).status == Status::Ok ? t : -1.0;
+}
+
+bool finished(const Progress& p, const TimingPlan& plan) {
+  const int rounds = static_cast<int>(p.per_call_s.size());
+  return (rounds >= plan.min_rounds && p.total_s >= plan.min_time_s) ||
+         (rounds >= plan.min_rounds_slow && p.total_s >= plan.slow_factor * plan.min_time_s) ||
+         rounds >= plan.max_rounds;
+}
+
+std::vector<Timing> time_here(const std::vector<TimedSubject>& subjects, const TimingPlan& plan) {
+  const size_t n = subjects.size();
+  std::vector<Progress> at(n);
+  // A round long enough that the clock's resolution and overhead vanish, short enough that
+  // every subject gets its minimum count of rounds within its minimum time.
+  const double target_s =
+      std::max(plan.round_floor_s, plan.min_time_s / (2.0 * std::max(plan.min_rounds, 1)));
+  for (size_t i = 0; i < n; ++i) {
+    // The warm-up call, untimed, then one call to size the rounds.
+    const double warm = timed_round(subjects[i], 1);
+    const double one = warm < 0 ? warm : timed_round(subjects[i], 1);
+    if (one < 0) {
+      at[i].failed = true;
+      continue;
+    }
+    at[i].per_round = static_cast<long>(std::clamp(std::ceil(target_s / std::max(one, 1e-9)), 1.0, 1e7));
+  }
+  for (size_t turn = 0;; ++turn) {
+    bool any = false;
+    for (size_t j = 0; j < n; ++j) {
+      Progress& p = at[(turn + j) % n];
+      if (p.failed || p.done) continue;
+      any = true;
+      const double t = timed_round(subjects[(turn + j) % n], p.per_round);
+      if (t < 0) {
+        p.failed = true;
+        continue;
+      }
+      p.per_call_s.push_back(t / static_cast<double>(p.per_round));
+      p.total_s += t;
+      p.done = finished(p, plan);
+    }
+    if (!any) break;
+  }
+  std::vector<Timing> out(n);
+  for (size_t i = 0; i < n; ++i) {
+    if (at[i].failed) continue;
+    std::vector<double> v = at[i].per_call_s;
+    std::sort(v.begin(), v.end());
+    out[i].median_s = sorted_quantile(v, 0.5);
+    out[i].q25_s = sorted_quantile(v, 0.25);
+    out[i].q75_s = sorted_quantile(v, 0.75);
+    out[i].rounds = static_cast<int>(v.size());
+    out[i].calls = at[i].per_round * out[i].rounds;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<Timing> time_interleaved(const std::vector<TimedSubject>& subjects,
+                                     const TimingPlan& plan) {
+  const bool libraries = std::any_of(subjects.begin(), subjects.end(),
+                                     [](const TimedSubject& s) { return s.library; });
+  if (!libraries || in_isolated_child()) return time_here(subjects, plan);
+  // Every round of a library is an isolated call: inside one supervised child these cost
+  // nothing, where each alone would be a fork.
+  const std::vector<std::string> bytes = run_items_isolated(0, 1, [&](size_t) {
+    ByteWriter w;
+    for (const Timing& t : time_here(subjects, plan))
+      w.io(t.median_s, t.q25_s, t.q75_s, t.calls, t.rounds);
+    return w.str();
+  });
+  std::vector<Timing> out(subjects.size());
+  ByteReader in(bytes.at(0));
+  for (Timing& t : out) in.io(t.median_s, t.q25_s, t.q75_s, t.calls, t.rounds);
+  return out;
+}
+
+}  // namespace rbx

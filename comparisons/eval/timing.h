@@ -1,0 +1,62 @@
+// How rbx times a call, the way benchmark libraries do, so that a run time can be quoted.
+//
+// Design: the answer a backend gives comes from its first call, which is also timed alone and
+// reported apart as the cold call (a fresh process, empty caches, first allocations). Timing is a
+// separate pass over calls that already answered: each subject is warmed up once, its calls per
+// round are chosen so that one round lasts well above the clock's resolution, and then rounds
+// are run in turn, one round of every subject per turn, the starting subject rotating, until
+// each subject has its minimum total time and its minimum count of rounds. Interleaving puts a
+// passing load of the machine on every subject of the same inputs alike, so ratios between them
+// hold better than their absolute times. Each round of a library is one isolated call
+// (reference/isolate.h), made inside one supervised child process, so a library that aborts
+// while being timed loses its timing, not the run. A timing is the median of the rounds' times
+// per call, with its 25-75 % range and the count of calls.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace rbx {
+
+/// A call's run time: the median per call over the timed rounds, its spread and its counts.
+struct Timing {
+  double median_s = 0.0;  // per call, median over the rounds
+  double q25_s = 0.0;     // 25 % quantile of the rounds' per-call times
+  double q75_s = 0.0;     // 75 % quantile
+  long calls = 0;         // calls timed (rounds x calls per round), the warm-up excluded
+  int rounds = 0;         // 0: not timed (the call failed, or failed while being timed)
+  double cold_s = 0.0;    // the first call alone, as it answered: reported apart, never mixed in
+  /// The 25-75 % range relative to the median (0 when untimed).
+  double spread() const { return median_s > 0 ? (q75_s - q25_s) / median_s : 0.0; }
+  /// One call timed alone (a whole dynamics run): the median, the quartiles and the cold call.
+  static Timing once(double s) { return {s, s, s, 1, 1, s}; }
+};
+
+/// How long to time: at least `min_time_s` of timed calls and `min_rounds` rounds per subject;
+/// a subject whose single call is slow stops at `min_rounds_slow` rounds once it has spent
+/// `slow_factor` times the minimum (a 100 ms query is not repeated for seconds).
+struct TimingPlan {
+  double min_time_s = 0.01;
+  int min_rounds = 7;
+  int min_rounds_slow = 3;
+  double slow_factor = 5.0;
+  int max_rounds = 1000;
+  double round_floor_s = 2e-5;  // a round lasts at least this (steady_clock reads in ~20 ns)
+};
+
+/// One subject to time: a call that has already answered, and what isolates it.
+struct TimedSubject {
+  std::string backend;  // names the call in a failure
+  bool library = false;  // a library's call: each round isolated
+  std::function<void()> call;
+  double deadline_s = 30.0;  // per round, as the call's own deadline
+};
+
+/// Times the subjects interleaved (see the design note); one Timing per subject, in order, with
+/// cold_s left 0 for the caller to fill from the answering call. A subject that throws or fails
+/// while being timed gets rounds = 0. Outside a supervised child, the whole pass runs in one.
+std::vector<Timing> time_interleaved(const std::vector<TimedSubject>& subjects,
+                                     const TimingPlan& plan = {});
+
+}  // namespace rbx

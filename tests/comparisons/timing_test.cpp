@@ -1,0 +1,104 @@
+// How rbx times a call (comparisons/eval/timing.h): warmed up, rounds sized above the clock's
+// resolution, subjects interleaved, a failing subject losing its timing and nothing else. No
+// assertion here is a speed goal: the only times asserted are lower bounds a call cannot beat
+// (it spins until its time has passed).
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "comparisons/eval/timing.h"
+
+namespace rbx {
+namespace {
+
+// Spins until `s` seconds have passed: a call that cannot take less.
+void spin(double s) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
+  while (std::chrono::steady_clock::now() < until) {
+  }
+}
+
+TEST(Timing, EveryRoundIsLongerThanTheClocksFloorAndEachSubjectGetsItsMinimum) {
+  TimingPlan plan;
+  plan.min_time_s = 0.004;
+  int fast_calls = 0;
+  const std::vector<Timing> t = time_interleaved(
+      {{"fast", false, [&] { ++fast_calls; }}, {"slow", false, [] { spin(2e-5); }}}, plan);
+  ASSERT_EQ(t.size(), 2u);
+  for (const Timing& x : t) {
+    EXPECT_GE(x.rounds, plan.min_rounds);
+    EXPECT_LE(x.q25_s, x.median_s);
+    EXPECT_LE(x.median_s, x.q75_s);
+    EXPECT_EQ(x.calls % x.rounds, 0) << "every round makes the same number of calls";
+  }
+  // A call that does almost nothing is repeated within a round, so that a round is long enough
+  // to time (round_floor_s); two calls of the warm-up and the sizing come before the rounds.
+  EXPECT_GT(t[0].calls / t[0].rounds, 1);
+  EXPECT_EQ(fast_calls, t[0].calls + 2);
+  EXPECT_GE(t[1].median_s, 2e-5);
+  EXPECT_GE(t[1].q25_s, 2e-5);
+  EXPECT_EQ(t[0].cold_s, 0.0) << "the cold call is the caller's: the one that answered";
+}
+
+TEST(Timing, SubjectsTakeTurnsRoundByRound) {
+  TimingPlan plan;
+  plan.min_time_s = 0.001;  // rounds of one call each (a round aims at 1/14 of this)
+  std::string order;
+  auto call = [&](char who) {
+    return [&order, who] {
+      order += who;
+      spin(1e-4);
+    };
+  };
+  const std::vector<Timing> t =
+      time_interleaved({{"a", false, call('a')}, {"b", false, call('b')}}, plan);
+  ASSERT_EQ(t[0].rounds, t[1].rounds);
+  // After the warm-up and sizing calls (aabb), one round each per turn, the first of a turn
+  // rotating: ab ba ab ..., never three rounds of one subject in a row.
+  ASSERT_EQ(order.substr(0, 4), "aabb");
+  const std::string rounds = order.substr(4);
+  EXPECT_EQ(rounds.size(), static_cast<size_t>(t[0].calls + t[1].calls));
+  EXPECT_EQ(rounds.substr(0, 4), "abba");
+  EXPECT_EQ(rounds.find("aaa"), std::string::npos) << rounds;
+  EXPECT_EQ(rounds.find("bbb"), std::string::npos) << rounds;
+}
+
+TEST(Timing, ASubjectThatThrowsWhileTimedLosesItsTimingOnly) {
+  int calls = 0;
+  const std::vector<Timing> t = time_interleaved(
+      {{"flaky", false,
+        [&] {
+          if (++calls > 3) throw std::runtime_error("gave up");
+        }},
+       {"steady", false, [] { spin(1e-6); }}});
+  EXPECT_EQ(t[0].rounds, 0);
+  EXPECT_EQ(t[0].median_s, 0.0);
+  EXPECT_GE(t[1].rounds, TimingPlan{}.min_rounds);
+  EXPECT_GE(t[1].median_s, 1e-6);
+}
+
+// A library that aborts while being timed (it answered once, then died on a repeat): its rounds
+// run isolated in a supervised child, so it loses its timing and the other library keeps its.
+TEST(Timing, ALibraryThatAbortsWhileTimedLosesItsTimingNotTheRun) {
+  TimingPlan plan;
+  plan.min_time_s = 0.002;
+  int calls = 0;  // counted in the child
+  const std::vector<Timing> t = time_interleaved(
+      {{"steady", true, [] { spin(1e-6); }},
+       {"dies", true,
+        [&] {
+          if (++calls > 5) std::abort();
+        }}},
+      plan);
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_GE(t[0].rounds, plan.min_rounds);
+  EXPECT_GE(t[0].median_s, 1e-6);
+  EXPECT_EQ(t[1].rounds, 0);
+}
+
+}  // namespace
+}  // namespace rbx
