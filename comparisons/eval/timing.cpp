@@ -63,7 +63,8 @@ std::vector<Timing> time_here(const std::vector<TimedSubject>& subjects, const T
       at[i].failed = true;
       continue;
     }
-    at[i].per_round = static_cast<long>(std::clamp(std::ceil(target_s / std::max(one, 1e-9)), 1.0, 1e7));
+    at[i].per_round =
+        static_cast<long>(std::clamp(std::ceil(target_s / std::max(one, 1e-9)), 1.0, 1e7));
   }
   for (size_t turn = 0;; ++turn) {
     bool any = false;

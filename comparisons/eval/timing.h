@@ -47,7 +47,7 @@ struct TimingPlan {
 
 /// One subject to time: a call that has already answered, and what isolates it.
 struct TimedSubject {
-  std::string backend;  // names the call in a failure
+  std::string backend;   // names the call in a failure
   bool library = false;  // a library's call: each round isolated
   std::function<void()> call;
   double deadline_s = 30.0;  // per round, as the call's own deadline

@@ -2,6 +2,8 @@
 // resolution, subjects interleaved, a failing subject losing its timing and nothing else. No
 // assertion here is a speed goal: the only times asserted are lower bounds a call cannot beat
 // (it spins until its time has passed).
+#include "comparisons/eval/timing.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -9,8 +11,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include "comparisons/eval/timing.h"
 
 namespace rbx {
 namespace {
@@ -69,12 +69,12 @@ TEST(Timing, SubjectsTakeTurnsRoundByRound) {
 
 TEST(Timing, ASubjectThatThrowsWhileTimedLosesItsTimingOnly) {
   int calls = 0;
-  const std::vector<Timing> t = time_interleaved(
-      {{"flaky", false,
-        [&] {
-          if (++calls > 3) throw std::runtime_error("gave up");
-        }},
-       {"steady", false, [] { spin(1e-6); }}});
+  const std::vector<Timing> t = time_interleaved({{"flaky", false,
+                                                   [&] {
+                                                     if (++calls > 3)
+                                                       throw std::runtime_error("gave up");
+                                                   }},
+                                                  {"steady", false, [] { spin(1e-6); }}});
   EXPECT_EQ(t[0].rounds, 0);
   EXPECT_EQ(t[0].median_s, 0.0);
   EXPECT_GE(t[1].rounds, TimingPlan{}.min_rounds);
@@ -87,13 +87,12 @@ TEST(Timing, ALibraryThatAbortsWhileTimedLosesItsTimingNotTheRun) {
   TimingPlan plan;
   plan.min_time_s = 0.002;
   int calls = 0;  // counted in the child
-  const std::vector<Timing> t = time_interleaved(
-      {{"steady", true, [] { spin(1e-6); }},
-       {"dies", true,
-        [&] {
-          if (++calls > 5) std::abort();
-        }}},
-      plan);
+  const std::vector<Timing> t = time_interleaved({{"steady", true, [] { spin(1e-6); }},
+                                                  {"dies", true,
+                                                   [&] {
+                                                     if (++calls > 5) std::abort();
+                                                   }}},
+                                                 plan);
   ASSERT_EQ(t.size(), 2u);
   EXPECT_GE(t[0].rounds, plan.min_rounds);
   EXPECT_GE(t[0].median_s, 1e-6);
