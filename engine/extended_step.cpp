@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <tuple>
 #include <utility>
 
@@ -18,6 +19,23 @@
 #include "engine/time_of_impact.h"
 
 namespace rbx {
+
+namespace {
+
+// A time of impact its search could not certify: the world's guard stops the run on it
+// (World::check_state), naming the pair, rather than pass a step that may have let one body
+// through the other. The first such pair of a step is named.
+void report_uncertified(WorldState& world, int i, int j) {
+  if (!world.uncertain.empty()) return;
+  std::ostringstream s;
+  s << "time of impact of bodies " << world.bodies[i].name << " and " << world.bodies[j].name
+    << " not certified at step " << world.step << " (t = " << world.time
+    << " s): they skim past each other too fast for " << world.tunables.toi_max_samples
+    << " samples in one step; lower sim.dt";
+  world.uncertain = s.str();
+}
+
+}  // namespace
 
 // The step as a list of stages: detect, approach velocities, forces, solve, events, time of
 // impact, integrate, project.
@@ -286,9 +304,10 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
       const double s =
           q.squaredNorm() > 0.0 ? std::clamp(-p.dot(q) / q.squaredNorm(), 0.0, 1.0) : 0.0;
       if ((p + s * q).norm() > facts[lo].radius + facts[hi].radius) continue;
-      if (const auto t =
-              time_of_impact(a, b, dt, world.variant, &facts[lo].principal, &facts[hi].principal))
-        hits.emplace_back(*t, lo, hi);
+      const TimeOfImpact t = time_of_impact(a, b, dt, world.variant, world.tunables.toi_max_samples,
+                                            &facts[lo].principal, &facts[hi].principal);
+      if (!t.certified) report_uncertified(world, lo, hi);
+      if (t.time) hits.emplace_back(*t.time, lo, hi);
     }
   }
   // Every other new contact (departure from the seed, whose detection after penetration resolves
@@ -319,9 +338,11 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
                               facts[j].reach))
       continue;
     if (separated(world, a, b, i, j)) continue;
-    if (const auto t = time_of_impact(world.bodies[i], world.bodies[j], dt, world.variant,
-                                      &facts[i].principal, &facts[j].principal))
-      hits.emplace_back(*t, i, j);
+    const TimeOfImpact t =
+        time_of_impact(world.bodies[i], world.bodies[j], dt, world.variant,
+                       world.tunables.toi_max_samples, &facts[i].principal, &facts[j].principal);
+    if (!t.certified) report_uncertified(world, i, j);
+    if (t.time) hits.emplace_back(*t.time, i, j);
   }
   std::sort(hits.begin(), hits.end());
   for (const auto& [t, i, j] : hits) {

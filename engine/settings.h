@@ -61,6 +61,9 @@ struct WorldSettings {
   /// Relative to the thinner body's thickness: a pair whose relative sweep is at most this is
   /// left to the next step's detection after penetration (nothing can pass through).
   double toi_pair_sweep = 0.25;
+  /// Samples one time-of-impact search may take in a step (time_of_impact); a search that
+  /// needs more stops the run, saying so, rather than pass a step it cannot certify.
+  long toi_max_samples = 1000000;
 
   // Broad phase (engine/broadphase.cpp); the pairs are the same whatever these say.
 

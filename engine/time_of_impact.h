@@ -33,16 +33,28 @@ double sweep_length(const RigidBody& body, double t);
 /// caller. Zero for a static body.
 double travel_bound(const RigidBody& body, double turn_rate, double radius, double t);
 
+/// The answer of a time-of-impact search.
+struct TimeOfImpact {
+  std::optional<double> time;  // s into the step: the first touch; none when none within dt
+  bool certified = true;       // false: the search stopped at its sample limit before dt
+};
+
 /// First time in (0, dt] at which A and B, moving torque-free from their current poses with
 /// their current velocities, touch by the detector; nothing when they do not within dt.
-/// Conservative advancement in fixed samples: the relative motion between two samples is at most
-/// a quarter of the thinner body's thickness, so no sample pair can straddle a whole crossing;
-/// then bisection on the detector between the last separated and the first touching sample, to
-/// 1e-12 of dt. Meant for pairs separated at the step's start. `frame_a`, `frame_b` as for
-/// advanced.
-std::optional<double> time_of_impact(const RigidBody& a, const RigidBody& b, double dt,
-                                     DetectorVariant variant,
-                                     const PrincipalFrame* frame_a = nullptr,
-                                     const PrincipalFrame* frame_b = nullptr);
+/// Samples in time, each checked by the detector, never farther apart than either of:
+/// - a quarter of the thinner body's thickness of relative travel (travel_bound), so no pair of
+///   samples can straddle a whole crossing;
+/// - the gap along a separating axis found at the earlier sample, divided by the pair's travel
+///   rate, so nothing can touch between them (conservative advancement).
+/// A fixed grid of the first kind when it takes at most `max_samples` samples (the cost known in
+/// advance; WorldSettings::toi_max_samples); past that, steps of the larger of the two. Then
+/// bisection on the detector between the last separated and the first touching sample, to 1e-12 of
+/// dt. A search that reaches `max_samples` before dt (bodies skimming past each other at a speed of
+/// millions of their thicknesses per step) is not certified: its answer says so. Meant for pairs
+/// separated at the step's start. `frame_a`, `frame_b` as for advanced.
+TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt,
+                            DetectorVariant variant, long max_samples,
+                            const PrincipalFrame* frame_a = nullptr,
+                            const PrincipalFrame* frame_b = nullptr);
 
 }  // namespace rbx

@@ -50,6 +50,10 @@ std::string shortest(double v) {
 }  // namespace
 
 bool World::check_state() {
+  if (!state_.uncertain.empty()) {
+    failure_ = state_.uncertain;
+    return false;
+  }
   auto fail = [&](const RigidBody& b, const char* what) {
     std::ostringstream s;
     s << "non-finite " << what << " of body " << b.name << " at step " << state_.step

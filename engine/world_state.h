@@ -65,6 +65,9 @@ struct WorldState {
   double time = 0.0;                         // s, at the start of the step being taken
   long step = 0;                             // steps taken
   std::vector<SolvedContact> step_contacts;  // every contact point the last step solved
+  /// Why the last step cannot vouch for its result ("" when it can): a time of impact whose
+  /// search stopped uncertified. The world's guard stops the run on it.
+  std::string uncertain;
 
   /// Records a collision of bodies i and j resolved at `time` with normal impulse `impulse`
   /// (N s): the one place both contact models build an event.

@@ -13,6 +13,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The fastest a body or a point of it may move (m/s): the speed of light. Rigid bodies and
+// Newton's impacts are the model up to there; the custom engine's time of impact is certified
+// up to there or stops the run saying it is not (engine/time_of_impact.h).
+constexpr double kMaxSpeed = 299792458.0;
+
 // Name first: every other message names the body by it.
 std::string read_body_name(const Reader& r, const toml::table& t) {
   const toml::node* name_node = t.get("name");
@@ -226,8 +231,14 @@ Quat read_quaternion(const Reader& r, const toml::node& n, const std::string& p,
 // Pose and velocities: rotation (degrees, R = Rz Ry Rx) or a unit quaternion, not both.
 void read_pose(const Reader& r, const toml::table& t, const std::string& p, BodySpec& b,
                std::vector<std::string>& notes) {
-  if (const toml::node* n = t.get("position"))
+  if (const toml::node* n = t.get("position")) {
     b.position = r.vec3(*n, p + "position", "body.position");
+    // Beyond kMaxLength, squared lengths overflow, as for a shape's coordinates.
+    if (!(b.position.cwiseAbs().maxCoeff() <= kMaxLength))
+      r.fail(line_of(n), p + "position",
+             "coordinates must be within 1e12 m of the origin, got " + vec_text(b.position),
+             "give it in metres");
+  }
   const toml::node* rotation = t.get("rotation");
   const toml::node* orientation = t.get("orientation");
   if (rotation && orientation) {
@@ -241,10 +252,31 @@ void read_pose(const Reader& r, const toml::table& t, const std::string& p, Body
     b.orientation = Quat(rotation_from_euler_deg(deg)).normalized();
   }
   if (orientation) b.orientation = read_quaternion(r, *orientation, p, notes);
-  if (const toml::node* n = t.get("velocity"))
+  if (const toml::node* n = t.get("velocity")) {
     b.velocity = r.vec3(*n, p + "velocity", "body.velocity");
-  if (const toml::node* n = t.get("angular_velocity"))
+    if (!(b.velocity.norm() <= kMaxSpeed))
+      r.fail(line_of(n), p + "velocity",
+             "speed " + num(b.velocity.norm()) + " m/s is above the speed of light (" +
+                 num(kMaxSpeed) + " m/s), where rigid-body mechanics does not hold",
+             "give it in m/s, at most 2.99792458e8");
+  }
+  if (const toml::node* n = t.get("angular_velocity")) {
     b.angular_velocity = r.vec3(*n, p + "angular_velocity", "body.angular_velocity");
+    // The speed of the vertex farthest from the body's origin, by the same limit.
+    double radius = 0.0;
+    for (const Vec3& v : b.shape->vertices()) radius = std::max(radius, v.norm());
+    if (!(b.angular_velocity.norm() * radius <= kMaxSpeed)) {
+      // The largest rate, rounded down to 4 digits so that the suggestion is accepted.
+      const double most = kMaxSpeed / radius;
+      const double unit = std::pow(10.0, std::floor(std::log10(most)) - 3);
+      r.fail(line_of(n), p + "angular_velocity",
+             "spins its farthest vertex (" + fmt_num(radius) + " m out) at " +
+                 fmt_num(b.angular_velocity.norm() * radius) + " m/s, above the speed of light (" +
+                 num(kMaxSpeed) + " m/s)",
+             "give it in rad/s, at most " + fmt_num(std::floor(most / unit) * unit) +
+                 " for this body");
+    }
+  }
 }
 
 }  // namespace

@@ -519,6 +519,31 @@ TEST(SceneOverrides, UnforcedSweepStepBlamesTheSweepEntry) {
             "limit of 1e8; shorten duration, raise dt, or pass --force to run it anyway");
 }
 
+TEST(SceneFile, PositionsAndSpeedsStayInTheirRanges) {
+  // Positions within 1e12 m as a shape's coordinates; no body or vertex faster than light (a
+  // cube falling at 5e9 m/s passed through a slab with "ok"). The edges themselves are accepted.
+  const std::string body = "[[body]]\nname = \"A\"\n";
+  EXPECT_EQ(input_error([&] { parse_scene(body + "position = [0, -2e12, 0]\n", "t.toml"); }),
+            "t.toml:3: body.A.position: coordinates must be within 1e12 m of the origin, got "
+            "[0, -2e+12, 0]; give it in metres");
+  EXPECT_NO_THROW(parse_scene(body + "position = [1e12, -1e12, 1e12]\n", "t.toml"));
+  EXPECT_EQ(input_error([&] { parse_scene(body + "velocity = [3e8, 0, 0]\n", "t.toml"); }),
+            "t.toml:3: body.A.velocity: speed 3e+08 m/s is above the speed of light (299792458 "
+            "m/s), where rigid-body mechanics does not hold; give it in m/s, at most "
+            "2.99792458e8");
+  EXPECT_NO_THROW(parse_scene(body + "velocity = [0, 0, -299792458]\n", "t.toml"));
+  // The speed is the vector's: 2e8 along each of two axes is 2.83e8, under; along three, over.
+  EXPECT_NO_THROW(parse_scene(body + "velocity = [2e8, 2e8, 0]\n", "t.toml"));
+  EXPECT_THROW(parse_scene(body + "velocity = [2e8, 2e8, 2e8]\n", "t.toml"), InputError);
+  // A unit cube's farthest vertex is sqrt(3)/2 m out: 3.5e8 rad/s spins it at 3.03e8 m/s.
+  EXPECT_EQ(
+      input_error([&] { parse_scene(body + "angular_velocity = [0, 0, 3.5e8]\n", "t.toml"); }),
+      "t.toml:3: body.A.angular_velocity: spins its farthest vertex (0.866025 m out) at "
+      "3.03109e+08 m/s, above the speed of light (299792458 m/s); give it in rad/s, at "
+      "most 3.461e+08 for this body");
+  EXPECT_NO_THROW(parse_scene(body + "angular_velocity = [0, 0, 3.461e8]\n", "t.toml"));
+}
+
 TEST(SceneFile, ShapeLengthsStayWhereSquaresAndVolumesAreFinite) {
   // Before, [1e200, 1, 1] overflowed the volume and was called "zero area"; a 1e13 m vertex and
   // a 1e-13 m extent are just past the [1e-12, 1e12] m range.

@@ -15,6 +15,9 @@ namespace {
 
 using test::box_body;
 
+// The extended world's sample limit (WorldSettings::toi_max_samples).
+const long kSamples = WorldSettings().toi_max_samples;
+
 RigidBody plate(double dt_unused = 0) {
   (void)dt_unused;
   return box_body("A", Vec3(0.01, 1, 1), 1.0, Vec3(-0.3, 0, 0), Quat::Identity(), Vec3(100, 0, 0));
@@ -27,12 +30,84 @@ RigidBody wall() {
 TEST(TimeOfImpact, ThinPlateMeetsThinWallAtTheClosedFormTime) {
   // stress/tunnel_thin_wall: front face -0.295 + 100 t meets 0.995 at t = 0.0129 s; the step
   // 0.02 s starts separated and ends past the wall.
-  const auto t = time_of_impact(plate(), wall(), 0.02, DetectorVariant::Faithful);
-  ASSERT_TRUE(t);
+  const TimeOfImpact hit =
+      time_of_impact(plate(), wall(), 0.02, DetectorVariant::Faithful, kSamples);
+  ASSERT_TRUE(hit.certified);
+  ASSERT_TRUE(hit.time);
+  const double t = *hit.time;
   // Bisection to 1e-12 of dt plus the detector's touching tolerance (1e-9 of the size, 2e-11 s
   // at 100 m/s).
-  EXPECT_NEAR(*t, 0.0129, 1e-10);
-  EXPECT_FALSE(time_of_impact(plate(), wall(), 0.012, DetectorVariant::Faithful));
+  EXPECT_NEAR(t, 0.0129, 1e-10);
+  const TimeOfImpact miss =
+      time_of_impact(plate(), wall(), 0.012, DetectorVariant::Faithful, kSamples);
+  EXPECT_TRUE(miss.certified);
+  EXPECT_FALSE(miss.time);
+}
+
+// A unit cube falling at 2.99e8 m/s (just under the loader's speed limit, the speed of light)
+// onto a 1 cm slab 100 km below, in a step of 1 ms: a grid of quarter-thickness samples would
+// take 1.2e11 samples, so the search steps by the gap along a separating axis instead and meets
+// the closed-form time.
+TEST(TimeOfImpact, AFallAtTheSpeedLimitIsCaughtAtItsClosedFormTime) {
+  const double v = 2.99e8, drop = 1e5;
+  const RigidBody cube =
+      box_body("cube", Vec3::Ones(), 1.0, Vec3(0, 0, 0.5 + drop), Quat::Identity(), Vec3(0, 0, -v));
+  const RigidBody slab = box_body("slab", Vec3(4, 4, 0.01), 1.0, Vec3(0, 0, -0.005),
+                                  Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true);
+  for (const double dt : {1e-3, 1.0}) {
+    const TimeOfImpact hit = time_of_impact(cube, slab, dt, DetectorVariant::Accelerated, 100);
+    ASSERT_TRUE(hit.certified) << "dt " << dt;
+    ASSERT_TRUE(hit.time) << "dt " << dt;
+    // Bisection to 1e-12 of dt, the detector's touching tolerance (1e-9 of the size: 3e-18 s
+    // at this speed) and the round-off of a position 1e5 m from the origin (1.5e-11 m, 5e-20 s).
+    EXPECT_NEAR(*hit.time, drop / v, 1e-12 * dt + 1e-17) << "dt " << dt;
+  }
+  // The extended world bounces it (e = 1): one collision, the velocity reversed to round-off.
+  SimSettings sim;
+  sim.dt = 1e-3;
+  sim.duration = 0.002;
+  World world(sim, {cube, slab});
+  world.set_contact_model(ContactModel::Extended);
+  const RunResult r = world.run();
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.events.size(), 1u);
+  EXPECT_NEAR(r.bodies[0].velocity.z(), v, 1e-12 * v);
+}
+
+// A thin plate skimming 0.1 mm over a floor 1 km wide (the detector's touching tolerance there
+// is 1.4 micrometres) at 1e8 m/s: the gap proves nothing, so the
+// search is left with quarter-thickness steps, more than it may take; it says it is not
+// certified, and the world's run stops on it, naming the pair, instead of passing the step.
+TEST(TimeOfImpact, ASearchPastItsSampleLimitIsNotCertified) {
+  const RigidBody plate_over = box_body("plate", Vec3(1, 1, 0.01), 1.0, Vec3(0, 0, 0.005 + 1e-4),
+                                        Quat::Identity(), Vec3(1e8, 0, 0));
+  const RigidBody floor = box_body("floor", Vec3(1e3, 1e3, 1), 1.0, Vec3(0, 0, -0.5),
+                                   Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true);
+  const TimeOfImpact hit =
+      time_of_impact(plate_over, floor, 1e-3, DetectorVariant::Accelerated, 100);
+  EXPECT_FALSE(hit.certified);
+  EXPECT_FALSE(hit.time);
+  // Over a step of 1 ns (0.1 m, 40 quarter thicknesses of the plate) the search is within its
+  // limit: certified, no touch.
+  const TimeOfImpact short_step =
+      time_of_impact(plate_over, floor, 1e-9, DetectorVariant::Accelerated, 100);
+  EXPECT_TRUE(short_step.certified);
+  EXPECT_FALSE(short_step.time);
+
+  SimSettings sim;
+  sim.dt = 1e-3;
+  sim.duration = 0.01;
+  WorldSettings tunables;
+  tunables.toi_max_samples = 100;
+  World world(sim, {plate_over, floor}, DetectorVariant::Accelerated, BroadPhaseMethod::Tree,
+              tunables);
+  world.set_contact_model(ContactModel::Extended);
+  const RunResult r = world.run();
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.steps_taken, 1);
+  EXPECT_NE(r.message.find("time of impact of bodies plate and floor not certified at step 0"),
+            std::string::npos)
+      << r.message;
 }
 
 TEST(TimeOfImpact, ThicknessIsTheThinnestWidth) {
