@@ -24,12 +24,13 @@ namespace {
 
 // A time of impact its search could not certify: the world's guard stops the run on it
 // (World::check_state), naming the pair, rather than pass a step that may have let one body
-// through the other. The first such pair of a step is named.
+// through the other. The first such pair of a step is named; the step is counted as the guard
+// counts it, by the state it would end at.
 void report_uncertified(WorldState& world, int i, int j) {
   if (!world.uncertain.empty()) return;
   std::ostringstream s;
   s << "time of impact of bodies " << world.bodies[i].name << " and " << world.bodies[j].name
-    << " not certified at step " << world.step << " (t = " << world.time
+    << " not certified at step " << world.step + 1 << " (t = " << (world.step + 1) * world.sim.dt
     << " s): they skim past each other too fast for " << world.tunables.toi_max_samples
     << " samples in one step; lower sim.dt";
   world.uncertain = s.str();

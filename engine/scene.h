@@ -114,7 +114,10 @@ struct Expect {
   /// What the block holds: "analytic" (a closed form) or "exact" (the exact oracle's answer,
   /// as `rbx explore` writes into the scenes it shrinks); metrics name it as their truth.
   std::string truth = "analytic";
-  std::string known_failure;  // non-empty: the custom engine is known to miss this, and why
+  /// The engines under test it binds ("custom", "custom-seed"): their misses fail the scene.
+  std::vector<std::string> engines = {"custom"};
+  /// Non-empty: "ENGINE: why", an engine of `engines` known to miss this, and why.
+  std::string known_failure;
   std::vector<ExpectBody> bodies;
   std::optional<ExpectContact> contact;
 };

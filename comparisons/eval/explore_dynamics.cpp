@@ -73,7 +73,8 @@ void name_deep_contact(BackendOutcome& o, const DynamicsResult& run, double side
 std::string box_at_rest_expect(const std::string& speed_name, double speed, double dt,
                                const Vec3& position) {
   std::ostringstream o;
-  o << "[expect]\nknown_failure = \"custom-seed: the seed omits friction and resting contact "
+  o << "[expect]\nengines = [\"custom\", \"custom-seed\"]\nknown_failure = \"custom-seed: the seed "
+       "omits friction and resting contact "
        "(seed correction 12 (what the seed admits it lacks)): the box slides on, or sinks\"\n"
        "# 1 mm (position; the explore mark), 1e-3 m/s and rad/s (at rest): a time-stepped slide\n"
        "# falls short of the integral by at most "

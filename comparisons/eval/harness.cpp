@@ -99,23 +99,21 @@ class Evaluator {
     j["stability"] = stability_json_.is_null() ? Json::object() : stability_json_;
     if (!stability_sweep_json_.is_null()) j["stability_sweep"] = stability_sweep_json_;
     j["skipped"] = out_.skipped;
-    // A documented limitation excuses the engine it names only ("custom: ..." or
-    // "custom-seed: ...", the text before the colon): any other subject's failure (the oracle's:
-    // a wrong derivation; the other custom engine's) still fails the scene.
-    const std::string known_subject = scene_.expect ? scene_.expect->known_failure.substr(
-                                                          0, scene_.expect->known_failure.find(':'))
-                                                    : "";
+    // A documented limitation excuses the engine it names only ("ENGINE: why"): any other
+    // engine's or the oracle's failure (a wrong derivation) still fails the scene.
+    const std::string known = scene_.expect ? scene_.expect->known_failure : "";
+    const std::string subject = known.substr(0, known.find(':'));
     out_.expect_known =
-        scene_.expect && !scene_.expect->known_failure.empty() && !out_.expect_failures.empty() &&
-        (known_subject == "custom" || known_subject == "custom-seed") &&
+        !known.empty() && !out_.expect_failures.empty() && binds(subject) &&
         std::all_of(out_.expect_failures.begin(), out_.expect_failures.end(),
-                    [&](const std::string& f) { return f.rfind(known_subject + ":", 0) == 0; });
+                    [&](const std::string& f) { return f.rfind(subject + ":", 0) == 0; });
     expect_binding();
     j["expect"] = {{"checked", out_.expect_checked},
                    {"passed", out_.expect_checked && out_.expect_failures.empty()},
                    {"unchecked", out_.expect_unchecked},
                    {"failures", out_.expect_failures},
-                   {"known_failure", scene_.expect ? scene_.expect->known_failure : ""},
+                   {"engines", scene_.expect ? scene_.expect->engines : std::vector<std::string>()},
+                   {"known_failure", known},
                    {"excused", out_.expect_known}};
     j["disagreements"] = out_.disagreements;
     j["deviations"] = out_.deviations;
@@ -124,8 +122,8 @@ class Evaluator {
 
  private:
   // Which parts of [expect] were bound: [expect.contact] by the oracle's query of the first pair
-  // (it runs whenever the contact check does), [expect.body] by the custom engine's completed
-  // run. A reference outside the closed form is marked (disagrees), it does not bind it.
+  // (whenever the contact check runs), [expect.body] by a bound engine's completed run (binds).
+  // A reference outside the closed form is marked (disagrees), it does not bind it.
   void expect_binding() {
     if (!scene_.expect) return;
     const Expect& e = *scene_.expect;
@@ -137,13 +135,18 @@ class Evaluator {
                             scene_.has_check(CheckKind::Stability);
       out_.expect_unchecked.push_back(
           !dynamics ? "[expect.body]: the scene runs no dynamics check"
-                    : "[expect.body]: binds the custom engine, which was not run (backends: " +
-                          join_names() + ")");
+                    : "[expect.body]: binds " + Json(e.engines).dump() +
+                          ", none of which ran (backends: " + join_names() + ")");
     }
     out_.expect_checked =
         (e.contact && expect_contact_bound_) || (!e.bodies.empty() && expect_bodies_bound_);
     if (!e.contact && e.bodies.empty())
       out_.expect_unchecked.push_back("[expect] gives nothing to check");
+  }
+
+  bool binds(const std::string& name) const {  // an engine under test [expect] binds
+    const std::vector<std::string>* e = scene_.expect ? &scene_.expect->engines : nullptr;
+    return e && std::find(e->begin(), e->end(), name) != e->end();
   }
 
   std::string join_names() const {
@@ -307,9 +310,8 @@ class Evaluator {
       }
       // [expect.contact] binds the engine under test too, like [expect.body]: a violation
       // fails the scene unless the scene documents it as a known failure.
-      if (name == "custom" && ex)
-        expect_contact_failures("custom", *ex, touch, c->normal, c->depth, tol,
-                                out_.expect_failures);
+      if (binds(name) && ex)
+        expect_contact_failures(name, *ex, touch, c->normal, c->depth, tol, out_.expect_failures);
     }
   }
 
@@ -478,10 +480,9 @@ class Evaluator {
              std::abs(main.result.events.front().time - sw.fine->result.events.front().time),
              fmt_dt(fr.finest));
     conservation(name, main.result.finals, fr);
-    // [expect.body] binds the custom engine, both the extended one and the seed's algorithm;
-    // every backend, custom included, is marked by the same rule where it misses the closed
-    // form.
-    if ((name == "custom" || name == "custom-seed") && scene_.expect) {
+    // [expect.body] binds the engines the scene names (the custom engine by default); every
+    // backend, those included, is marked by the same rule where it misses the closed form.
+    if (binds(name)) {
       check_expect_bodies(name, main.result.finals);
       expect_bodies_bound_ = true;
     }
@@ -501,8 +502,7 @@ class Evaluator {
   // under test (no final state to compare is not a pass).
   void stopped_run(const std::string& name, const DynRun& main, const DynamicsFrame& fr) {
     if (scene_.has_check(CheckKind::Stability)) stability(name, main, fr);
-    if ((name == "custom" || name == "custom-seed") && scene_.expect &&
-        !scene_.expect->bodies.empty()) {
+    if (binds(name) && !scene_.expect->bodies.empty()) {
       out_.expect_failures.push_back(
           name + ": the run stopped before t = duration: " + main.result.message);
       expect_bodies_bound_ = true;

@@ -77,8 +77,8 @@ std::string change_text(double old, double cur, const std::string& unit) {
          fmt_num(d, 3) + unit + ")";
 }
 
-// The engine a scene's known failure names ("custom: ..." or "custom-seed: ..."; no prefix:
-// custom), when that engine ran, bound the [expect] and has no violation left: it passes now.
+// The engine a scene's known failure names ("custom: ..." or "custom-seed: ...", as the loader
+// stores it), when that engine ran, bound the [expect] and has no violation left: it passes now.
 bool known_failure_passes(const Scene& s, const SceneEvaluation& ev, std::string& subject) {
   subject = "custom";
   if (!s.expect || s.expect->known_failure.empty()) return false;

@@ -258,15 +258,41 @@ Expect read_expect(const Reader& r, const toml::table& t, const std::vector<Body
              "must be \"analytic\" or \"exact\", got \"" + e.truth + "\"",
              "write truth = \"analytic\" for a closed form, \"exact\" for the oracle's answer");
   }
-  // A closed form the custom engine is known to miss (a documented limitation): kept as the
-  // truth, reported as known, and pinned by the tests so a fix is noticed.
+  // The engines under test that [expect] binds: their misses fail the scene. The custom engine
+  // by default; the seed's own algorithm only where the scene says so (it lacks friction and
+  // resting contact, so a new scene with either would fail on it until excused).
+  if (const toml::node* n = t.get("engines")) {
+    e.engines = names_from(r, *n, "expect.engines", {"custom", "custom-seed"}, "engine");
+    if (e.engines.empty())
+      r.fail(line_of(n), "expect.engines", "lists no engine",
+             "write engines = [\"custom\"] (the default) or [\"custom\", \"custom-seed\"]");
+  }
+  // A closed form an engine under test is known to miss (a documented limitation): kept as the
+  // truth, reported as known, and pinned by the tests so a fix is noticed. "custom-seed: why"
+  // excuses the seed's algorithm, "custom: why" or plain "why" the custom engine; stored with
+  // its engine named.
   if (const toml::node* n = t.get("known_failure")) {
     e.known_failure = r.string(*n, "expect.known_failure", "expect.known_failure");
-    // It excuses the engine it names: without the name it would excuse nothing, silently.
+    if (e.known_failure.empty())
+      r.fail(line_of(n), "expect.known_failure", "is empty",
+             "say why the engine misses the closed form, e.g. known_failure = \"no friction\"");
     if (!starts_with(e.known_failure, "custom: ") && !starts_with(e.known_failure, "custom-seed: "))
+      e.known_failure = "custom: " + e.known_failure;
+    const std::string engine = e.known_failure.substr(0, e.known_failure.find(':'));
+    // It excuses an engine [expect] binds: any other would excuse nothing, silently.
+    if (std::find(e.engines.begin(), e.engines.end(), engine) == e.engines.end()) {
+      const auto join_quoted_list = [](const std::vector<std::string>& words) {
+        std::string out;
+        for (const std::string& w : words) out += (out.empty() ? "" : "\", \"") + w;
+        return out;
+      };
+      std::vector<std::string> with = e.engines;
+      with.push_back(engine);
       r.fail(line_of(n), "expect.known_failure",
-             "must start with the engine it excuses, \"custom: \" or \"custom-seed: \"",
-             "write e.g. known_failure = \"custom: why it fails here\"");
+             "excuses " + engine + ", which [expect] does not bind (engines = [\"" +
+                 join_quoted_list(e.engines) + "\"])",
+             "write engines = [\"" + join_quoted_list(with) + "\"] in [expect]");
+    }
   }
   std::vector<std::string> names;
   for (const BodySpec& b : bodies) names.push_back(b.name);

@@ -95,12 +95,14 @@ TEST(Cli, HelpNamesTheProgramNotItsPath) {
 }
 
 TEST(Cli, ARunThatStoppedEarlyDoesNotClaimTheScenesEnd) {
-  // A cube spinning at 1e300 rad/s: the engine stops at its first step (non-finite state), so
-  // the state printed is where it stopped, not the state at the scene's 0.1 s.
+  // A cube falling under the seed's explicit Euler, which gains m g^2 dt^2 / 2 a step, with the
+  // energy guard at 1 + 1e-6: the engine stops at its first step, so the state printed is where
+  // it stopped, not the state at the scene's 0.1 s.
   const fs::path dir = temp_dir("stopped");
-  std::ofstream(dir / "spin.toml") << "[sim]\ndt = 0.001\nduration = 0.1\ngravity = [0, 0, 0]\n"
-                                      "[[body]]\nname = \"a\"\nangular_velocity = [1e300, 0, 0]\n";
-  const CmdResult r = rbx_in(dir.string(), "run spin.toml");
+  std::ofstream(dir / "fall.toml") << "[sim]\ndt = 0.001\nduration = 0.1\ngravity = [0, 0, -9.81]\n"
+                                      "integrator = \"euler\"\nmax_energy_ratio = 1.000001\n"
+                                      "[[body]]\nname = \"a\"\nposition = [0, 0, 10]\n";
+  const CmdResult r = rbx_in(dir.string(), "run fall.toml");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.out.find("at step 1"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("final state at t = 0.1 s"), std::string::npos) << r.out;
@@ -325,6 +327,50 @@ TEST(Cli, CompareExitsOneOnAWrongExpectation) {
       rbx("compare '" + (dir / "wrong.toml").string() + "' --backends exact,custom");
   EXPECT_EQ(wrong.code, 1);
   EXPECT_NE(wrong.out.find("[expect] FAILED"), std::string::npos) << wrong.out;
+  fs::remove_all(dir);
+}
+
+// docs/workflow.md's walkthrough, run as written: its scene and [expect] blocks, and the lines
+// it quotes from compare's output, with and without the seed's algorithm bound.
+TEST(WorkflowDoc, TheWalkthroughPrintsWhatItSays) {
+  std::ifstream in(std::string(RBX_SOURCE_DIR) + "/docs/workflow.md");
+  std::vector<std::string> blocks;  // the fenced blocks, in order, indentation removed
+  std::string line;
+  bool inside = false;
+  while (std::getline(in, line)) {
+    const size_t indent = line.find_first_not_of(' ');
+    const std::string text = indent == std::string::npos ? "" : line.substr(indent);
+    if (text.rfind("```", 0) == 0) {
+      if (!inside) blocks.emplace_back();
+      inside = !inside;
+      continue;
+    }
+    if (inside) blocks.back() += line.substr(std::min(line.size(), size_t{3})) + "\n";
+  }
+  ASSERT_GE(blocks.size(), 4u);
+  const std::string& scene = blocks[0];
+  const std::string& expect = blocks[1];
+  const fs::path dir = temp_dir("walkthrough");
+  const auto lines_in = [](const std::string& block, const std::string& out) {
+    std::istringstream lines(block);
+    std::string l;
+    while (std::getline(lines, l))
+      if (!l.empty()) {
+        EXPECT_NE(out.find(l), std::string::npos) << l << "\nnot in:\n" << out;
+      }
+  };
+  std::ofstream(dir / "my_drop.toml") << scene << expect;
+  const CmdResult passed = rbx_in(dir.string(), "compare my_drop.toml");
+  EXPECT_EQ(passed.code, 0) << passed.out << passed.err;
+  lines_in(blocks[2], passed.out);
+  std::string both = expect;
+  both.insert(both.find("[expect]\n") + 9, "engines = [\"custom\", \"custom-seed\"]\n");
+  std::ofstream(dir / "my_drop.toml") << scene << both;
+  const CmdResult failed = rbx_in(dir.string(), "compare my_drop.toml");
+  EXPECT_EQ(failed.code, 1) << failed.out << failed.err;
+  lines_in(blocks[3], failed.out);
+  const CmdResult bullet = rbx_in(dir.string(), "compare my_drop.toml --backends bullet");
+  EXPECT_NE(bullet.out.find("[expect] not checked"), std::string::npos) << bullet.out;
   fs::remove_all(dir);
 }
 

@@ -174,6 +174,77 @@ TEST(HarnessExpect, AnEngineRunThatStopsFailsItsExpectationAndReferencesDoNotBin
   EXPECT_FALSE(ev.json["expect"]["passed"].get<bool>());
 }
 
+TEST(HarnessExpect, ItBindsTheEnginesItNamesTheCustomEngineByDefault) {
+  // Head-on equal masses, e = 1: A ends at -1 m/s. The real custom engine meets it; a stand-in
+  // for the seed's algorithm leaves A still (as the seed leaves a box sliding where friction
+  // would stop it): marked as any backend is, but failing the scene only where [expect] binds it.
+  const std::string text =
+      "checks = [\"impulse\"]\n[[body]]\nname = \"A\"\nposition = [-1, 0, 0]\nvelocity = [1, 0, "
+      "0]\n[[body]]\nname = \"B\"\nposition = [1, 0, 0]\nvelocity = [-1, 0, 0]\n[expect]\n";
+  const std::string body = "[expect.body.A]\nvelocity = [-1, 0, 0]\n";
+  std::vector<Backend> table = {*find_backend("custom"), *find_backend("custom-seed")};
+  table[1].dynamics = [](const Scene& s, const DynamicsOptions&) {
+    DynamicsResult r;
+    for (const BodySpec& b : s.bodies)
+      r.finals.push_back({b.name, b.position, b.orientation, Vec3::Zero(), Vec3::Zero()});
+    return r;
+  };
+  HarnessOptions opt;
+  opt.sweep = false;
+  opt.registry = &table;
+  const auto run = [&](const std::string& expect) {
+    return evaluate_scene(parse_scene(text + expect + body, "headon.toml"), opt);
+  };
+  SceneEvaluation ev = run("");
+  EXPECT_TRUE(ev.json["expect"]["passed"].get<bool>()) << ev.json["expect"];
+  EXPECT_EQ(ev.json["expect"]["engines"], Json({"custom"}));
+  const std::string marks = ev.json["disagreements"].dump();
+  EXPECT_NE(marks.find("custom-seed"), std::string::npos) << marks;
+  ev = run("engines = [\"custom\", \"custom-seed\"]\n");
+  ASSERT_EQ(ev.expect_failures.size(), 1u);
+  EXPECT_EQ(ev.expect_failures[0].rfind("custom-seed: ", 0), 0u) << ev.expect_failures[0];
+  EXPECT_FALSE(ev.expect_known);
+  ev = run(
+      "engines = [\"custom\", \"custom-seed\"]\nknown_failure = \"custom-seed: stands still\"\n");
+  EXPECT_TRUE(ev.expect_known);
+  // Binding only the seed's algorithm: the custom engine is marked, not bound.
+  ev = run("engines = [\"custom-seed\"]\n");
+  ASSERT_EQ(ev.expect_failures.size(), 1u);
+  EXPECT_EQ(ev.expect_failures[0].rfind("custom-seed: ", 0), 0u);
+}
+
+TEST(HarnessExpect, AKnownFailureExcusesAnEngineItBinds) {
+  const std::string text = "[[body]]\nname = \"A\"\n[expect]\n";
+  // Plain text, as the format's example shows it, excuses the custom engine.
+  EXPECT_EQ(parse_scene(text + "known_failure = \"no friction\"\n", "t.toml").expect->known_failure,
+            "custom: no friction");
+  EXPECT_EQ(parse_scene(text + "known_failure = \"custom: no friction\"\n", "t.toml")
+                .expect->known_failure,
+            "custom: no friction");
+  const auto message = [&](const std::string& expect) {
+    try {
+      parse_scene(text + expect, "t.toml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message("known_failure = \"custom-seed: no friction\"\n"),
+            "t.toml:4: expect.known_failure: excuses custom-seed, which [expect] does not bind "
+            "(engines = [\"custom\"]); write engines = [\"custom\", \"custom-seed\"] in [expect]");
+  EXPECT_EQ(message("engines = [\"custom-seed\"]\nknown_failure = \"why\"\n"),
+            "t.toml:5: expect.known_failure: excuses custom, which [expect] does not bind (engines "
+            "= [\"custom-seed\"]); write engines = [\"custom-seed\", \"custom\"] in [expect]");
+  EXPECT_EQ(message("known_failure = \"\"\n"),
+            "t.toml:4: expect.known_failure: is empty; say why the engine misses the closed form, "
+            "e.g. known_failure = \"no friction\"");
+  EXPECT_EQ(message("engines = []\n"),
+            "t.toml:4: expect.engines: lists no engine; write engines = [\"custom\"] (the default) "
+            "or [\"custom\", \"custom-seed\"]");
+  EXPECT_NE(message("engines = [\"bullet\"]\n").find("t.toml:4: expect.engines: "),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace rbx
 

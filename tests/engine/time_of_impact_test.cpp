@@ -105,7 +105,7 @@ TEST(TimeOfImpact, ASearchPastItsSampleLimitIsNotCertified) {
   const RunResult r = world.run();
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.steps_taken, 1);
-  EXPECT_NE(r.message.find("time of impact of bodies plate and floor not certified at step 0"),
+  EXPECT_NE(r.message.find("time of impact of bodies plate and floor not certified at step 1"),
             std::string::npos)
       << r.message;
 }
