@@ -276,4 +276,6 @@ PYBIND11_MODULE(_rbx, m) {
         py::arg("fn"), "Adds a Python contact function as a backend.");
   m.def("register_response_backend", &rbx::register_response, py::arg("name"),
         py::arg("description"), py::arg("fn"), "Adds a Python collision response as a backend.");
+  m.def("unregister_backend", &rbx::unregister_backend, py::arg("name"),
+        "Removes a backend registered from Python.");
 }

@@ -257,6 +257,9 @@ const std::vector<Backend>& backends();
 /// space, or a backend with neither a contact query nor dynamics. Call it before any run
 /// starts: pointers to registry rows (find_backend) may move.
 void register_backend(Backend b);
+/// Removes a backend register_backend added. Throws std::invalid_argument on a built-in
+/// backend's name or a name no backend has. Pointers to registry rows may move, as there.
+void unregister_backend(const std::string& name);
 /// The backend called `name`, or nullptr.
 const Backend* find_backend(const std::string& name);
 /// The backend called `name` in `table` (null: the registry), or nullptr.

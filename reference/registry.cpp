@@ -1,4 +1,5 @@
 // The backend registry: every adapter's rows (reference/<library>.cpp), in report order.
+#include <algorithm>
 #include <stdexcept>
 
 #include "reference/backend.h"
@@ -69,6 +70,17 @@ void register_backend(Backend b) {
     return;
   }
   registry_table().push_back(std::move(b));
+}
+
+void unregister_backend(const std::string& name) {
+  std::vector<Backend>& table = registry_table();
+  const auto it =
+      std::find_if(table.begin(), table.end(), [&](const Backend& b) { return b.name == name; });
+  if (it == table.end())
+    throw std::invalid_argument("no backend named '" + name + "' to unregister");
+  if (!it->user)
+    throw std::invalid_argument("backend '" + name + "' is built in; only registered ones go");
+  table.erase(it);
 }
 
 const Backend* find_backend(const std::string& name) { return find_backend(name, nullptr); }

@@ -186,6 +186,13 @@ class Evaluator {
     }
   }
 
+  // A call that failed or ran out of time gave no answer to agree with: it disagrees, saying so
+  // (a backend that cannot take the scene, Unsupported, does not).
+  void failed_call(const std::string& who, Status s, const std::string& message) {
+    if (s == Status::Error || s == Status::Timeout)
+      out_.disagreements.push_back(who + ": " + to_string(s) + ": " + message);
+  }
+
   // -- contact ---------------------------------------------------------------------------------
   void contact_check() {
     const std::vector<std::string> names =
@@ -257,7 +264,10 @@ class Evaluator {
                         ex && ex->touching ? stated : "exact", depth_src);
         continue;
       }
-      if (run.result.status != Status::Ok) continue;
+      if (run.result.status != Status::Ok) {
+        failed_call(name + " on " + pair, run.result.status, run.result.message);
+        continue;
+      }
 
       const ContactPoint* c = deepest(run.result);
       const bool touch = c != nullptr;
@@ -450,6 +460,7 @@ class Evaluator {
         inputs_.begin(), inputs_.end(), [](const RigidBody& b) { return !b.is_static; }));
     bj["trajectory"] = trajectory_json(main.result.samples, inputs_, frame_budget(moving));
     if (main.result.status != Status::Ok) {
+      failed_call(name, main.result.status, main.result.message);
       stopped_run(name, main, fr);
       return;
     }
@@ -675,36 +686,16 @@ class Evaluator {
     return "stability";
   }
 
-  // Compares final states with [expect.body]: violations of the custom engine fail the scene.
-  std::vector<std::string> expect_violations(const std::string& name,
-                                             const std::vector<BodyFinal>& finals) {
-    std::vector<std::string> v;
-    const double tol = scene_.expect->tolerance;
-    for (const ExpectBody& eb : scene_.expect->bodies) {
-      auto it = std::find_if(finals.begin(), finals.end(),
-                             [&](const BodyFinal& f) { return f.name == eb.name; });
-      if (it == finals.end()) continue;
-      auto check = [&](const char* what, const std::optional<Vec3>& want, const Vec3& got) {
-        if (want && (got - *want).cwiseAbs().maxCoeff() > tol)
-          v.push_back(name + ": body " + eb.name + " " + what + " " + fmt_vec(got, 8) +
-                      ", expected " + fmt_vec(*want, 8) + " (tolerance " + fmt_num(tol, 3) + ")");
-      };
-      check("velocity", eb.velocity, it->velocity);
-      check("angular_velocity", eb.angular_velocity, it->angular_velocity);
-      check("position", eb.position, it->position);
-    }
-    return v;
-  }
-
   void check_expect_bodies(const std::string& name, const std::vector<BodyFinal>& finals) {
-    for (std::string& s : expect_violations(name, finals)) out_.expect_failures.push_back(s);
+    for (std::string& s : expect_violations(name, *scene_.expect, finals))
+      out_.expect_failures.push_back(s);
   }
 
   // A reference outside the [expect] tolerance: a disagreement when its velocity error is above
   // kMarkVelocityErr (or only positions are expected), else a deviation.
   void mark_expect_disagreement(const std::string& name, const std::vector<BodyFinal>& finals,
                                 double velocity_err) {
-    const auto v = expect_violations(name, finals);
+    const auto v = expect_violations(name, *scene_.expect, finals);
     if (v.empty()) return;
     const std::string text = v.front() + (v.size() > 1 ? " (and more)" : "");
     const bool velocities = velocity_err > 0.0;

@@ -336,4 +336,26 @@ double rest_jitter(const std::vector<RigidBody>& inputs, const std::vector<State
   return count ? std::sqrt(sum / count) : 0.0;
 }
 
+// The final states that miss [expect.body] beyond its tolerance, one line each ("BACKEND: body
+// NAME velocity (...), expected (...) (tolerance ...)").
+std::vector<std::string> expect_violations(const std::string& backend, const Expect& expect,
+                                           const std::vector<BodyFinal>& finals) {
+  std::vector<std::string> v;
+  const double tol = expect.tolerance;
+  for (const ExpectBody& eb : expect.bodies) {
+    auto it = std::find_if(finals.begin(), finals.end(),
+                           [&](const BodyFinal& f) { return f.name == eb.name; });
+    if (it == finals.end()) continue;
+    auto check = [&](const char* what, const std::optional<Vec3>& want, const Vec3& got) {
+      if (want && (got - *want).cwiseAbs().maxCoeff() > tol)
+        v.push_back(backend + ": body " + eb.name + " " + what + " " + fmt_vec(got, 8) +
+                    ", expected " + fmt_vec(*want, 8) + " (tolerance " + fmt_num(tol, 3) + ")");
+    };
+    check("velocity", eb.velocity, it->velocity);
+    check("angular_velocity", eb.angular_velocity, it->angular_velocity);
+    check("position", eb.position, it->position);
+  }
+  return v;
+}
+
 }  // namespace rbx

@@ -151,4 +151,9 @@ StabilityTrace trace_stability(const std::vector<RigidBody>& inputs, const Dynam
 double rest_jitter(const std::vector<RigidBody>& inputs, const std::vector<StateSample>& samples,
                    const Vec3& gravity);
 
+/// The final states that miss [expect.body] beyond its tolerance, one line each, named by
+/// `backend` ("custom: body A velocity (...), expected (...) (tolerance 1e-06)").
+std::vector<std::string> expect_violations(const std::string& backend, const Expect& expect,
+                                           const std::vector<BodyFinal>& finals);
+
 }  // namespace rbx

@@ -24,7 +24,8 @@ import _rbx
 
 __all__ = ["backends", "compare", "run", "trajectory", "contacts", "contact", "explore", "ensemble",
            "tosses", "check",
-           "report", "register_contact_backend", "register_response_backend", "scene_toml"]
+           "report", "register_contact_backend", "register_response_backend", "unregister",
+           "scene_toml"]
 
 
 # -- arguments -------------------------------------------------------------------------------
@@ -390,3 +391,12 @@ def register_response_backend(name, fn, description=None):
     "angular_velocity"; contact is {"point", "normal" (from B toward A), "depth", "feature"}."""
     _check_registration(name, fn)
     _rbx.register_response_backend(name, description or f"Python response function {name}", fn)
+
+
+def unregister(name):
+    """Removes backend `name`, registered with register_contact_backend or
+    register_response_backend, for the rest of the process. A built-in backend's name, or a name
+    no backend has, raises ValueError."""
+    if not isinstance(name, str):
+        raise TypeError("name: a string")
+    _rbx.unregister_backend(name)

@@ -182,6 +182,40 @@ def test_registering_a_name_again_replaces_the_function_a_built_in_name_is_refus
         rbx.register_contact_backend("custom", lambda x, y: first)
 
 
+def test_unregister_removes_a_registered_backend_only():
+    rbx.register_contact_backend("py-gone", lambda x, y: [])
+    assert "py-gone" in [r["name"] for r in rbx.backends()]
+    rbx.unregister("py-gone")
+    assert "py-gone" not in [r["name"] for r in rbx.backends()]
+    with pytest.raises(ValueError, match="no backend named 'py-gone'"):
+        rbx.unregister("py-gone")
+    with pytest.raises(ValueError, match="built in"):
+        rbx.unregister("bullet")
+
+
+def test_compare_says_whether_it_passed_and_a_failed_call_disagrees():
+    # Two unit cubes overlapping by 0.1 along x: [expect.contact] holds for the custom engine; a
+    # registered function that raises gives no answer, so it disagrees, naming its error.
+    scene = {"checks": ["contact"], "sim": {"duration": 0},
+             "body": [{"name": "A"}, {"name": "B", "position": [0.9, 0, 0]}],
+             "expect": {"tolerance": 1e-9, "contact": {"normal": [-1, 0, 0], "depth": 0.1}}}
+
+    def broken(a, b):
+        raise RuntimeError("not written yet")
+
+    rbx.register_contact_backend("py-broken", broken)
+    try:
+        doc = rbx.compare(scene, backends=["custom", "exact", "py-broken"])
+    finally:
+        rbx.unregister("py-broken")
+    assert doc["passed"] and doc["scenes"][0]["passed"]
+    failed = [d for d in doc["scenes"][0]["disagreements"] if d.startswith("py-broken")]
+    assert len(failed) == 1 and "error" in failed[0] and "not written yet" in failed[0], failed
+    wrong = dict(scene, expect={"tolerance": 1e-9, "contact": {"normal": [-1, 0, 0], "depth": 0.2}})
+    doc = rbx.compare(wrong, backends=["custom", "exact"])
+    assert not doc["passed"] and not doc["scenes"][0]["passed"]
+
+
 def test_the_arguments_a_contact_function_gets():
     shapes = {}
 
