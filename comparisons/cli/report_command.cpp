@@ -106,6 +106,8 @@ int report_command(const ReportOptions& opt) {
 
   HarnessOptions hopt;
   hopt.backends = opt.backends;
+  hopt.cache_dir = ResultCache::default_dir();  // filled for rbx check, never read: own timings
+  hopt.cache_reads = false;
   // Scenes spread over MPI ranks (under mpirun) and threads, results back in scene order on
   // rank 0 (eval/parallel.h): the report is the same for any number of ranks and threads.
   ParallelRun par(opt.threads);
@@ -137,7 +139,8 @@ int report_command(const ReportOptions& opt) {
       if (b.contact) contact.push_back(b.name);
       if (b.dynamics) impact.push_back(b.name);
     }
-    in.explore = explore_check_metrics(contact, impact, in.explore_set, nullptr, &par);
+    const ResultCache fill(hopt.cache_dir, ResultCache::code_fingerprint(), false);
+    in.explore = explore_check_metrics(contact, impact, in.explore_set, nullptr, &par, &fill);
     parts.end("explore");
   }
   if (!par.root()) return 0;  // rank 0 writes everything

@@ -308,9 +308,29 @@ namespace {
 // depth carries about 1e-15 relative error), so a touching mismatch inside it is not counted.
 constexpr double kTouchBand = 1e-9;
 
+// A library's answer on a sample, from the cache when it holds one and kept there when not
+// (never an engine's: ResultCache::caches). Keyed apart from the harness's timed answers: these
+// carry only the one call's time.
+ContactRun sample_answer(const Backend& be, const RigidBody& a, const RigidBody& b,
+                         const ResultCache* cache) {
+  if (!cache || !cache->enabled() || !ResultCache::caches(be.name)) return run_contact(be, a, b);
+  const std::string key = "explore " + cache->contact_key(be.name, a, b);
+  if (auto hit = cache->load_contact(key)) {
+    ContactRun run;
+    run.result = std::move(hit->result);
+    run.timing = hit->timing;
+    run.cached = true;
+    return run;
+  }
+  ContactRun run = run_contact(be, a, b);
+  cache->store(key, run.result, run.timing);
+  return run;
+}
+
 SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
                               const std::vector<std::string>& names, const std::string& shapes,
-                              const std::vector<Backend>* table = nullptr) {
+                              const std::vector<Backend>* table = nullptr,
+                              const ResultCache* cache = nullptr) {
   SampleOutcome out;
   out.shapes = shapes;
   const SatResult sat = sat_query(*a.shape, a.pose(), *b.shape, b.pose());
@@ -322,7 +342,7 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
   for (const std::string& name : names) {
     const Backend* be = find_backend(name, table);
     if (!be || !be->contact) continue;
-    const ContactRun run = run_contact(*be, a, b);
+    const ContactRun run = sample_answer(*be, a, b, cache);
     if (run.result.status == Status::Unsupported) continue;
     BackendOutcome o;
     o.backend = name;
@@ -375,9 +395,10 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
 }  // namespace
 
 SampleOutcome evaluate_contact_sample(const ContactSample& s, const std::vector<std::string>& names,
-                                      const std::vector<Backend>* table) {
+                                      const std::vector<Backend>* table, const ResultCache* cache) {
   const RigidBody a = build_body(s.a, "A"), b = build_body(s.b, "B");
-  SampleOutcome out = evaluate_bodies(a, b, names, s.a.shape_class + "-" + s.b.shape_class, table);
+  SampleOutcome out =
+      evaluate_bodies(a, b, names, s.a.shape_class + "-" + s.b.shape_class, table, cache);
   out.index = s.index;
   out.pose_class = s.pose_class;
   return out;

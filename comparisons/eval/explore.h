@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "comparisons/eval/json_io.h"
+#include "comparisons/eval/result_cache.h"
 #include "engine/math.h"
 #include "reference/backend.h"
 
@@ -111,7 +112,8 @@ struct SampleOutcome {
 /// Thresholds: the harness's marks of a clear disagreement (kMarkAngleDeg, kMarkDepthRel).
 /// Backends are looked up in `table` (default: the registry).
 SampleOutcome evaluate_contact_sample(const ContactSample& s, const std::vector<std::string>& names,
-                                      const std::vector<Backend>* table = nullptr);
+                                      const std::vector<Backend>* table = nullptr,
+                                      const ResultCache* cache = nullptr);
 
 /// The same on a scene's text (as `rbx compare` would read it); `shapes` names the classes of
 /// A and B ("box-hull"), which the text does not record.
@@ -190,7 +192,8 @@ bool realize_impact(ImpactSample& s);
 /// Runs the sample's scene through each named dynamics backend against its closed form (backends
 /// looked up in `table`, default: the registry).
 SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<std::string>& names,
-                                     const std::vector<Backend>* table = nullptr);
+                                     const std::vector<Backend>* table = nullptr,
+                                     const ResultCache* cache = nullptr);
 
 /// Impact groups shrunk like the contact ones: fewer hull points, rotations toward whole
 /// degrees, rounder speeds, masses and e, as long as `backend` keeps signature `sig`.
@@ -257,7 +260,8 @@ bool realize_landing(LandingSample& s);
 /// status error, then a turn above kLandingTurnMark, then a position above
 /// kLandingPositionMark.
 SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<std::string>& names,
-                                      const std::vector<Backend>* table = nullptr);
+                                      const std::vector<Backend>* table = nullptr,
+                                      const ResultCache* cache = nullptr);
 
 /// Landing groups shrunk toward round designs (unit mass, no yaw, a slide along x, rounder mu,
 /// sizes, speeds and phase) while `backend` keeps signature `sig`.
@@ -348,7 +352,8 @@ double largest_rise(const std::vector<StateSample>& samples, const Vec3& start, 
 /// deep_contact (name_deep_contact), else lift_off where the box rose off its surface by more
 /// than kSlideLiftMark on the way.
 SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std::string>& names,
-                                    const std::vector<Backend>* table = nullptr);
+                                    const std::vector<Backend>* table = nullptr,
+                                    const ResultCache* cache = nullptr);
 
 /// Slide groups shrunk toward round designs (unit mass, no yaw, axis directions, rounder mu,
 /// sizes, speed and angle) while `backend` keeps signature `sig`.
@@ -404,7 +409,8 @@ bool realize_tunnel(TunnelSample& s);
 /// error, then a centre past the wall's near face at the end (tunnel), then a velocity error
 /// above kMarkVelocityErr in the energy norm (velocity).
 SampleOutcome evaluate_tunnel_sample(const TunnelSample& s, const std::vector<std::string>& names,
-                                     const std::vector<Backend>* table = nullptr);
+                                     const std::vector<Backend>* table = nullptr,
+                                     const ResultCache* cache = nullptr);
 
 /// Tunnel groups shrunk toward round designs while `backend` keeps signature `sig`.
 struct TunnelShrinkResult {

@@ -54,7 +54,7 @@ void tally(const std::string& scene, const std::vector<std::string>& encoded,
 std::vector<ExploreCheckMetric> explore_check_metrics(
     const std::vector<std::string>& contact_backends,
     const std::vector<std::string>& impact_backends, const ExploreCheckSet& set,
-    const std::vector<Backend>* table, const ParallelRun* given) {
+    const std::vector<Backend>* table, const ParallelRun* given, const ResultCache* cache) {
   std::vector<ExploreCheckMetric> out;
   std::optional<ParallelRun> own;
   if (!given) own.emplace();
@@ -64,7 +64,7 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
           run.map(static_cast<size_t>(set.contact),
                   [&](size_t i) {
                     return encode(evaluate_contact_sample(make_contact_sample(set.seed, i),
-                                                          contact_backends, table));
+                                                          contact_backends, table, cache));
                   }),
           {"normal_err_deg", "depth_err_rel"}, "exact", out);
   if (!impact_backends.empty() && set.impact > 0)
@@ -72,7 +72,7 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
           run.map(static_cast<size_t>(set.impact),
                   [&](size_t i) {
                     return encode(evaluate_impact_sample(make_impact_sample(set.seed, i),
-                                                         impact_backends, table));
+                                                         impact_backends, table, cache));
                   }),
           {"velocity_err_ke"}, "analytic", out);
   if (!impact_backends.empty() && set.landing > 0)
@@ -80,7 +80,7 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
           run.map(static_cast<size_t>(set.landing),
                   [&](size_t i) {
                     return encode(evaluate_landing_sample(make_landing_sample(set.seed, i),
-                                                          impact_backends, table));
+                                                          impact_backends, table, cache));
                   }),
           {"position_err_m", "turn_rad"}, "analytic", out);
   if (!impact_backends.empty() && set.slide > 0)
@@ -88,7 +88,7 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
           run.map(static_cast<size_t>(set.slide),
                   [&](size_t i) {
                     return encode(evaluate_slide_sample(make_slide_sample(set.seed, i),
-                                                        impact_backends, table));
+                                                        impact_backends, table, cache));
                   }),
           {"position_err_m", "turn_rad", "rest_time_err_s"}, "analytic", out);
   if (!impact_backends.empty() && set.tunnel > 0)
@@ -96,7 +96,7 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
           run.map(static_cast<size_t>(set.tunnel),
                   [&](size_t i) {
                     return encode(evaluate_tunnel_sample(make_tunnel_sample(set.seed, i),
-                                                         impact_backends, table));
+                                                         impact_backends, table, cache));
                   }),
           {"velocity_err_ke"}, "analytic", out);
   return out;

@@ -8,6 +8,7 @@
 
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/parallel.h"
+#include "comparisons/eval/result_cache.h"
 #include "reference/backend.h"
 
 namespace rbx {
@@ -37,10 +38,12 @@ struct ExploreCheckMetric {
 /// `rbx explore` classifies them. Impacts, landings, slides and tunnels run the
 /// dynamics backends. Backends are looked up in `table` (null: the registry). The samples
 /// run on `run`'s ranks and threads (null: a run of its own); every rank must call it, the
-/// metrics come back on rank 0.
+/// metrics come back on rank 0. `cache`, when given, serves and keeps the libraries' answers
+/// (result_cache.h): an engine edit reruns only the engines' samples.
 std::vector<ExploreCheckMetric> explore_check_metrics(
     const std::vector<std::string>& contact_backends,
     const std::vector<std::string>& impact_backends, const ExploreCheckSet& set,
-    const std::vector<Backend>* table = nullptr, const ParallelRun* run = nullptr);
+    const std::vector<Backend>* table = nullptr, const ParallelRun* run = nullptr,
+    const ResultCache* cache = nullptr);
 
 }  // namespace rbx

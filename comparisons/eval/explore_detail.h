@@ -51,10 +51,11 @@ std::string dynamic_body_text(const ExploreBody& e, const std::string& name, dou
 /// Runs each named dynamics backend on `scene` (those without dynamics, or unsupported, left
 /// out) and appends one outcome each to `out`: a status error, or a run returning the wrong
 /// number of final states, as `error`; a finished run measured and classified by `judge`.
-/// Backends are looked up in `table` (null: the registry).
+/// Backends are looked up in `table` (null: the registry); `cache`, when given, serves and keeps
+/// the libraries' runs (result_cache.h; never the engines').
 void run_dynamics_subjects(
     const Scene& scene, const std::vector<std::string>& names, const DynamicsOptions& options,
-    const std::vector<Backend>* table, SampleOutcome& out,
+    const std::vector<Backend>* table, const ResultCache* cache, SampleOutcome& out,
     const std::function<void(BackendOutcome&, const DynamicsResult&)>& judge);
 
 /// Landing and slide kinds: records the deepest contact `run` reported and, where `o` already

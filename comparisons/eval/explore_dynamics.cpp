@@ -11,6 +11,7 @@
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/explore_detail.h"
 #include "comparisons/eval/harness.h"
+#include "comparisons/eval/measures.h"
 #include "comparisons/eval/metrics.h"
 #include "comparisons/scene/mesh_io.h"
 #include "comparisons/scene/scene_file.h"
@@ -40,12 +41,17 @@ std::string dynamic_body_text(const ExploreBody& e, const std::string& name, dou
 
 void run_dynamics_subjects(
     const Scene& scene, const std::vector<std::string>& names, const DynamicsOptions& options,
-    const std::vector<Backend>* table, SampleOutcome& out,
+    const std::vector<Backend>* table, const ResultCache* cache, SampleOutcome& out,
     const std::function<void(BackendOutcome&, const DynamicsResult&)>& judge) {
+  const std::vector<RigidBody> bodies = cache ? make_bodies(scene) : std::vector<RigidBody>();
   for (const std::string& name : names) {
     const Backend* be = find_backend(name, table);
     if (!be || !be->dynamics) continue;
-    DynamicsResult run = run_dynamics_isolated(*be, scene, options).result;
+    DynamicsResult run = cache
+                             ? run_dynamics(*be, scene, options.dt > 0 ? options.dt : scene.sim.dt,
+                                            options.sample_every, *cache, bodies)
+                                   .result
+                             : run_dynamics_isolated(*be, scene, options).result;
     if (run.status == Status::Unsupported) continue;
     BackendOutcome o;
     o.backend = name;
@@ -392,7 +398,7 @@ ImpactSample make_impact_sample(uint64_t seed, uint64_t index) {
 }
 
 SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<std::string>& names,
-                                     const std::vector<Backend>* table) {
+                                     const std::vector<Backend>* table, const ResultCache* cache) {
   SampleOutcome out;
   out.index = s.index;
   out.pose_class = s.b_static ? "static" : "free";
@@ -415,7 +421,7 @@ SampleOutcome evaluate_impact_sample(const ImpactSample& s, const std::vector<st
   }
   if (e_ref < 1e-12 * e0) e_ref = e0;
   run_dynamics_subjects(
-      scene, names, DynamicsOptions{0.0, 0}, table, out,
+      scene, names, DynamicsOptions{0.0, 0}, table, cache, out,
       [&](BackendOutcome& o, const DynamicsResult& run) {
         o.velocity_err_ke = ke_norm_error(inputs, run.finals, ref, e0);
         // The same norm on momenta: p and L about the COM are what the impulse sets and the flight
@@ -633,7 +639,7 @@ LandingSample make_landing_sample(uint64_t seed, uint64_t index) {
 }
 
 SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<std::string>& names,
-                                      const std::vector<Backend>* table) {
+                                      const std::vector<Backend>* table, const ResultCache* cache) {
   SampleOutcome out;
   out.index = s.index;
   out.pose_class = "landing";
@@ -658,7 +664,7 @@ SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<
   const double slack = 0.5 * s.speed_after * s.dt + 1e-5;
   // Every step sampled: the time to rest is read from the samples.
   run_dynamics_subjects(
-      scene, names, DynamicsOptions{0.0, 1}, table, out,
+      scene, names, DynamicsOptions{0.0, 1}, table, cache, out,
       [&](BackendOutcome& o, const DynamicsResult& run) {
         const BodyFinal& f = run.finals[0];
         const Vec3 off(f.position.x() - s.expect_position.x(),

@@ -225,7 +225,7 @@ SlideSample make_slide_sample(uint64_t seed, uint64_t index) {
 }
 
 SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std::string>& names,
-                                    const std::vector<Backend>* table) {
+                                    const std::vector<Backend>* table, const ResultCache* cache) {
   SampleOutcome out;
   out.index = s.index;
   out.pose_class = "slide";
@@ -242,7 +242,7 @@ SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std:
                                                     std::nullopt};
   const Vec3 n = s.normal;
   run_dynamics_subjects(
-      scene, names, DynamicsOptions{0.0, 1}, table, out,
+      scene, names, DynamicsOptions{0.0, 1}, table, cache, out,
       [&](BackendOutcome& o, const DynamicsResult& run) {
         const BodyFinal& f = run.finals[0];
         const Vec3 off = f.position - s.expect_position;

@@ -119,7 +119,7 @@ TunnelSample make_tunnel_sample(uint64_t seed, uint64_t index) {
 }
 
 SampleOutcome evaluate_tunnel_sample(const TunnelSample& s, const std::vector<std::string>& names,
-                                     const std::vector<Backend>* table) {
+                                     const std::vector<Backend>* table, const ResultCache* cache) {
   SampleOutcome out;
   out.index = s.index;
   out.pose_class = "tunnel";
@@ -134,7 +134,7 @@ SampleOutcome evaluate_tunnel_sample(const TunnelSample& s, const std::vector<st
   const std::vector<std::optional<RefState>> ref = {RefState{s.velocity_after, Vec3::Zero()},
                                                     std::nullopt};
   const Vec3 n = inputs[1].orientation * Vec3::UnitZ();
-  run_dynamics_subjects(scene, names, DynamicsOptions{}, table, out,
+  run_dynamics_subjects(scene, names, DynamicsOptions{}, table, cache, out,
                         [&](BackendOutcome& o, const DynamicsResult& run) {
                           const BodyFinal& f = run.finals[0];
                           o.velocity_err_ke = ke_norm_error(inputs, run.finals, ref, e0);

@@ -51,7 +51,7 @@ class Evaluator {
         opt_(opt),
         table_(opt.registry ? *opt.registry : backends()),
         inputs_(make_bodies(scene)),
-        cache_(opt.cache_dir) {
+        cache_(opt.cache_dir, ResultCache::code_fingerprint(), opt.cache_reads) {
     out_.family = scene_family(scene.file);
   }
 

@@ -28,6 +28,8 @@ struct HarnessOptions {
   /// byte-identical either way; a cached backend's JSON says "cached": true (its timings are
   /// those of the run that filled the cache).
   std::string cache_dir;
+  /// false: the cache is filled, never read (rbx report: its timings are its own).
+  bool cache_reads = true;
   /// Run every impact scene with a closed form also with first contact 1/3 and 2/3 of a step
   /// later (the bodies moved back along their velocities; metrics velocity_err_ke_phase_*).
   bool phases = true;

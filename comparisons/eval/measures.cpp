@@ -85,10 +85,13 @@ PairRuns contact_runs(const std::vector<const Backend*>& backends, const RigidBo
       subjects.push_back(&variants[k++]);
       runs.push_back(&*out.prebuilt[i]);
     }
-  if (budget_s <= 0) return out;  // untimed answers are not stored: a timed run would read them
-  TimingPlan plan;
-  plan.min_time_s = budget_s;
-  time_contacts(subjects, runs, a, b, plan);
+  // Untimed answers (rbx check's) are stored with their one call's time: only rbx check reads
+  // the cache, and it reports no query times.
+  if (budget_s > 0) {
+    TimingPlan plan;
+    plan.min_time_s = budget_s;
+    time_contacts(subjects, runs, a, b, plan);
+  }
   if (cache.enabled())
     for (size_t i = 0; i < subjects.size(); ++i)
       if (!runs[i]->cached && ResultCache::caches(subjects[i]->name))

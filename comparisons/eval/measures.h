@@ -48,7 +48,8 @@ struct PairRuns {
 };
 
 /// Every backend answers (answer_contact), then the fresh answers are timed together, interleaved
-/// (time_contacts, at least `budget_s` each; 0: untimed) and stored in the cache with their timing.
+/// (time_contacts, at least `budget_s` each; 0: untimed, each with its one call's time) and stored
+/// in the cache with their timing.
 PairRuns contact_runs(const std::vector<const Backend*>& backends, const RigidBody& a,
                       const RigidBody& b, const ResultCache& cache, double budget_s);
 

@@ -128,7 +128,7 @@ std::string ResultCache::mass_key(const std::string& backend, const RigidBody& b
 }
 
 std::optional<std::string> ResultCache::read(const std::string& key) const {
-  if (dir_.empty()) return std::nullopt;
+  if (dir_.empty() || !reads_) return std::nullopt;
   std::ifstream in(std::filesystem::path(dir_) / file_name(key), std::ios::binary);
   if (!in) return std::nullopt;
   std::stringstream s;

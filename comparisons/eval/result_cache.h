@@ -39,9 +39,12 @@ struct CachedContact {
 /// The reference-result cache in one folder ("" : disabled; nothing is read or written).
 class ResultCache {
  public:
-  /// `code`: what identifies the reference code (tests pass another to see a miss).
-  explicit ResultCache(std::string dir = "", std::string code = code_fingerprint())
-      : dir_(std::move(dir)), code_(std::move(code)) {}
+  /// `code`: what identifies the reference code (tests pass another to see a miss). `reads`
+  /// false: results are stored and never read (rbx report fills the cache with runs it timed
+  /// itself; rbx check reads them).
+  explicit ResultCache(std::string dir = "", std::string code = code_fingerprint(),
+                       bool reads = true)
+      : dir_(std::move(dir)), code_(std::move(code)), reads_(reads) {}
 
   /// True when results of `backend` may be cached: every backend except ours (custom*, exact) and
   /// those registered at run time (Backend::user).
@@ -82,6 +85,7 @@ class ResultCache {
   void write(const std::string& key, const std::string& value) const;
   std::string dir_;
   std::string code_;
+  bool reads_ = true;
 };
 
 }  // namespace rbx

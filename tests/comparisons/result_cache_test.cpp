@@ -5,11 +5,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 
+#include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/scene/scene_file.h"
 
@@ -111,6 +114,63 @@ TEST(ResultCache, AnotherReferenceCodeOrOtherInputsMiss) {
   for (const auto& e : fs::directory_iterator(dir))
     fs::resize_file(e.path(), fs::file_size(e.path()) - 3);
   EXPECT_FALSE(before.load_contact(before.contact_key("fcl", bodies[0], bodies[1])));
+  fs::remove_all(dir);
+}
+
+// rbx report fills the cache without reading it (its timings are its own); rbx check, reading
+// the same folder, finds what it stored.
+TEST(ResultCache, AFillOnlyCacheStoresWhatItNeverReads) {
+  const fs::path dir = temp_dir("cache_fill");
+  const Scene scene = parse_scene(
+      "[[body]]\nname = \"A\"\n[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n", "pair.toml");
+  const std::vector<RigidBody> bodies = make_bodies(scene);
+  const ResultCache fill(dir.string(), "adapters 1111", false),
+      check(dir.string(), "adapters 1111");
+  const std::string key = fill.contact_key("fcl", bodies[0], bodies[1]);
+  EXPECT_EQ(key, check.contact_key("fcl", bodies[0], bodies[1]));
+  fill.store(key, ContactResult{Status::Ok, "", {}}, Timing::once(1e-6));
+  EXPECT_FALSE(fill.load_contact(key));
+  EXPECT_TRUE(check.load_contact(key));
+  fill.store_derived(key, "toss errors", {1.0, 2.0});
+  EXPECT_FALSE(fill.load_derived(key, "toss errors"));
+  EXPECT_EQ(*check.load_derived(key, "toss errors"), std::vector<double>({1.0, 2.0}));
+  fs::remove_all(dir);
+}
+
+// Explore's fixed samples read a library's answers from the cache the second time: the same
+// metrics, and not one call to the library.
+TEST(ResultCache, ExploreSamplesReadALibrarysAnswersBack) {
+  const fs::path dir = temp_dir("cache_explore");
+  const ResultCache cache(dir.string());
+  std::vector<Backend> table = {*find_backend("exact"), *find_backend("fcl"),
+                                *find_backend("bullet")};
+  // Library calls run in a child process (isolate.h): each one leaves a byte in a file.
+  const std::string log = (dir / "calls").string();
+  const auto calls = [log] { return fs::exists(log) ? static_cast<int>(fs::file_size(log)) : 0; };
+  const auto fcl = table[1].contact;
+  table[1].contact = [fcl, log](const RigidBody& a, const RigidBody& b) {
+    std::ofstream(log, std::ios::app) << 'x';
+    return fcl(a, b);
+  };
+  const auto bullet = table[2].dynamics;
+  table[2].dynamics = [bullet, log](const Scene& s, const DynamicsOptions& o) {
+    std::ofstream(log, std::ios::app) << 'x';
+    return bullet(s, o);
+  };
+  ExploreCheckSet set;
+  set.contact = 12;
+  set.impact = 3;
+  set.landing = set.slide = set.tunnel = 0;
+  const ParallelRun one(1);
+  const auto first = explore_check_metrics({"fcl"}, {"bullet"}, set, &table, &one, &cache);
+  EXPECT_EQ(calls(), 15);
+  const auto second = explore_check_metrics({"fcl"}, {"bullet"}, set, &table, &one, &cache);
+  EXPECT_EQ(calls(), 15);
+  ASSERT_EQ(first.size(), second.size());
+  for (size_t i = 0; i < first.size(); ++i) {
+    EXPECT_EQ(first[i].metric.name, second[i].metric.name);
+    EXPECT_EQ(first[i].metric.value, second[i].metric.value) << first[i].metric.name;
+  }
   fs::remove_all(dir);
 }
 
