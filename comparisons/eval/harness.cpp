@@ -262,6 +262,9 @@ class Evaluator {
       if (run.result.status == Status::Touching) {
         touching_answer(name, pair, run.result, truth, std::max(tol, 1e-6 * size),
                         ex && ex->touching ? stated : "exact", depth_src);
+        // Timed like any answer; no normal to score: its error is the depth it is scored at.
+        out_.sweep.push_back(
+            {name, "contact-touching", 0.0, run.timing, true_touch ? true_depth : 0.0, depth_src});
         continue;
       }
       if (run.result.status != Status::Ok) {

@@ -9,6 +9,7 @@
 
 #include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/harness.h"
+#include "comparisons/output/scorecard.h"
 #include "engine/scene.h"
 
 namespace rbx {
@@ -31,8 +32,12 @@ struct SummaryInputs {
 std::string explore_details_markdown(const std::vector<ExploreCheckMetric>& metrics,
                                      const ExploreCheckSet& set);
 
-/// report.md: at a glance (per family, the most accurate backend and the fastest, each with
-/// its error, scenes within tolerance and run time), the ranked scorecard, the measured causes
+/// report.md's At a glance, from the scorecard's ranked rows: per family the custom engine, the
+/// most accurate library and the fastest library (among those that ran every timed scene of
+/// the family), each with its error, scenes within tolerance and run time.
+std::string glance_markdown(const std::vector<ScoreRow>& rows);
+
+/// report.md: at a glance (glance_markdown), the ranked scorecard, the measured causes
 /// of failures (one scene each), error against run time, random poses and impacts (explore's
 /// fixed samples, when run), the real tosses, and links to the full tables.
 std::string report_summary_markdown(const std::vector<Scene>& scenes,

@@ -93,7 +93,8 @@ Measure measure_of(const Scene& scene) {
   return Measure::Dynamics;
 }
 
-// Adds one scene's errors and run time to a row (the backend answered, status ok).
+// Adds one scene's errors and run time to a row (the backend answered: status ok, or touching
+// with no normal, which adds its time and no error).
 void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, const Json& bj) {
   const std::string& b = row.backend;
   if (row.measure == Measure::Contact) {
@@ -102,7 +103,8 @@ void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, con
       row.depth_error.push_back(std::max(truth_metric(ev, b, "depth_err"), 0.0));
     }
     for (const SweepPoint& p : ev.sweep) {
-      if (p.backend == b && p.kind == "contact") row.time.push_back(p.timing.median_s);
+      if (p.backend == b && (p.kind == "contact" || p.kind == "contact-touching"))
+        row.time.push_back(p.timing.median_s);
       if (p.backend == b && p.kind == "contact-prebuilt") row.prebuilt.push_back(p.timing.median_s);
     }
     return;
@@ -275,7 +277,8 @@ std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
           ++row.within;
         }
         if (bj["status"] == "touching") ++row.touching;
-        if (bj["status"] == "ok") add_scene(row, scenes[i], ev, bj);
+        // A touching answer has no normal to score, but its query time counts like any.
+        if (bj["status"] == "ok" || bj["status"] == "touching") add_scene(row, scenes[i], ev, bj);
       }
       if (row.run > 0) group.push_back(std::move(row));
     }
@@ -444,7 +447,8 @@ std::string query_time_markdown(const std::vector<SceneEvaluation>& evs,
   for (const SceneEvaluation& ev : evs)
     for (size_t k = 0; k < ev.sweep.size(); ++k) {
       const SweepPoint& p = ev.sweep[k];
-      if (p.kind == "contact" && p.timing.rounds > 0) per_call[p.backend].push_back(p.timing);
+      if ((p.kind == "contact" || p.kind == "contact-touching") && p.timing.rounds > 0)
+        per_call[p.backend].push_back(p.timing);
       if (p.kind != "contact-prebuilt" || k == 0 || p.timing.rounds == 0) continue;
       const SweepPoint& call = ev.sweep[k - 1];
       if (call.kind != "contact" || call.backend != p.backend || call.timing.rounds == 0) continue;

@@ -127,6 +127,27 @@ TEST(Harness, BodiesThatStartStillAreJudgedAgainstTheMotionTheRunMade) {
   EXPECT_DOUBLE_EQ(value("energy_growth_err"), 1.0);
 }
 
+TEST(Harness, ATouchingAnswerIsTimedLikeAnyOther) {
+  // Two cubes face to face at zero depth: libccd's MPR answers "touching, no normal". The answer
+  // is timed like any (a query the fastest library could be), its error the depth it is scored
+  // at (0 here: right).
+  const Scene scene =
+      load_scene(std::string(RBX_SOURCE_DIR) + "/scenes/contact/touching_zero_depth.toml");
+  HarnessOptions opt;
+  opt.backends = "libccd-mpr";
+  opt.sweep = false;
+  const SceneEvaluation ev = evaluate_scene(scene, opt);
+  ASSERT_EQ(ev.json["backends"]["libccd-mpr"]["status"], "touching");
+  int points = 0;
+  for (const SweepPoint& p : ev.sweep) {
+    if (p.backend != "libccd-mpr" || p.kind != "contact-touching") continue;
+    ++points;
+    EXPECT_GT(p.timing.rounds, 0);
+    EXPECT_EQ(p.error, 0.0);
+  }
+  EXPECT_EQ(points, 1);
+}
+
 TEST(Harness, WithoutATableTheRegistryIsUsed) {
   // The seam changes nothing by default: --backends names come from the registry.
   const Scene scene = parse_scene("checks = [\"contact\"]\n[[body]]\nname = \"A\"\n", "one.toml");

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "comparisons/output/report_pages.h"
+
 namespace rbx {
 namespace {
 
@@ -61,6 +63,36 @@ TEST(ScorecardMatrix, OneRowPerBackendInRegistryOrderAndEachCellInItsColumnsUnit
   const std::string odd =
       scorecard_matrix_markdown({row("my_*x*", "seed", Measure::Dynamics, {0.1}, 1, 1)});
   EXPECT_NE(odd.find("| **my\\_\\*x\\*** | #1 0.1, 1/1 |"), std::string::npos) << odd;
+}
+
+TEST(AtAGlance, TheEngineThenTheMostAccurateAndTheFastestLibrary) {
+  // Ranked as score_rows ranks them. fcl is the most accurate library, ode the fastest of those
+  // that ran every timed scene (libccd-mpr is faster but timed on one scene of two: a median of
+  // fewer, smaller scenes); the engines and the oracle are never the libraries named.
+  const auto timed = [](ScoreRow r, std::vector<double> t) {
+    r.time = std::move(t);
+    return r;
+  };
+  const std::vector<ScoreRow> rows = {
+      timed(row("custom", "contact", Measure::Contact, {0.0, 0.0}, 2, 2), {2e-6, 2e-6}),
+      timed(row("exact", "contact", Measure::Contact, {0.0, 0.0}, 2, 2), {1e-7, 1e-7}),
+      timed(row("fcl", "contact", Measure::Contact, {1.0, 1.0}, 2, 2), {3e-6, 3e-6}),
+      timed(row("ode", "contact", Measure::Contact, {2.0, 2.0}, 2, 1), {1e-6, 1e-6}),
+      timed(row("libccd-mpr", "contact", Measure::Contact, {3.0}, 2, 1), {2e-7}),
+      timed(row("custom-seed", "seed", Measure::Dynamics, {0.0}, 1, 1), {1e-7}),
+      timed(row("bullet", "seed", Measure::Dynamics, {0.5}, 1, 0), {4e-6}),
+  };
+  const std::string md = glance_markdown(rows);
+  EXPECT_EQ(
+      line_of(md, "| contact (contacts) |"),
+      "| contact (contacts) | 0° / 0.001 (2), 2 of 2, 2 µs/query | **fcl** | 1° / 0.001 (2), 2 "
+      "of 2, 3 µs/query | **ode** | 1 µs/query, 2° / 0.001 (2), 1 of 2 |")
+      << md;
+  // No custom row in a family: a dash; the seed's own algorithm is an engine, not a library.
+  EXPECT_EQ(line_of(md, "| seed (dynamics) |"),
+            "| seed (dynamics) | - | **bullet** | 0.5 (1), 0 of 1, 4 µs/step | **bullet** | 4 "
+            "µs/step, 0.5 (1), 0 of 1 |")
+      << md;
 }
 
 }  // namespace
