@@ -5,6 +5,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -101,6 +103,16 @@ std::pair<long, long> screenshot_pixels(const fs::path& a, const fs::path& b, in
   return {col, diff};
 }
 
+// The shortest text that reads back as `v` (a page address's #t=).
+std::string fmt_shortest(double v) {
+  char buf[32];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    if (std::stod(buf) == v) break;
+  }
+  return buf;
+}
+
 // Everything wrong with a page, judged against `expected` (the view data it should show).
 std::vector<std::string> check_page(const fs::path& page, const nlohmann::json& expected) {
   std::vector<std::string> bad;
@@ -135,9 +147,14 @@ std::vector<std::string> check_page(const fs::path& page, const nlohmann::json& 
                   std::to_string(bodies) + " (one per body and backend, at least one)");
   if (expected["duration"].get<double>() > 0 && !(st.value("time", 0.0) > 0))
     bad.push_back("playing did not advance the time");
+  // #t=SECONDS opens at that time of the run, as a media fragment does (a quarter of it here).
+  const std::string quarter = fmt_shortest(expected["duration"].get<double>() / 4);
+  const double opened = page_state(page, "#t=" + quarter, 1000).value("time", -1.0);
+  if (!(std::abs(opened - std::stod(quarter)) <= 1e-12))
+    bad.push_back("#t=" + quarter + " opened at t = " + std::to_string(opened));
   // Screenshots at the start and at the end of the run: bodies drawn, and moved.
   const fs::path s0 = page.string() + ".0.png", s1 = page.string() + ".1.png";
-  for (const auto& [shot, hash] : {std::pair{s0, "#t=0"}, std::pair{s1, "#t=1"}})
+  for (const auto& [shot, hash] : {std::pair{s0, "#t=0"}, std::pair{s1, "#t=end"}})
     shell(chromium("--screenshot='" + shot.string() + "' 'file://" + page.string() + hash + "'",
                    2000) +
           " > /dev/null 2>&1");

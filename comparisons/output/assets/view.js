@@ -300,9 +300,11 @@
   window.addEventListener("resize", function () { layout(); render(); });
 
   layout();
-  // #t=FRACTION opens at that fraction of the run; #play starts playing.
-  var hash = window.location.hash, m = /t=([0-9.]+)/.exec(hash);
-  setTime(m ? duration * parseFloat(m[1]) : 0);
+  // #t=SECONDS opens at that time of the run, as a media fragment does (clamped to the run;
+  // #t=end at its end); #play starts playing.
+  var hash = window.location.hash, m = /t=(end|[0-9.eE+]+)/.exec(hash);
+  var at = m ? (m[1] === "end" ? duration : parseFloat(m[1])) : 0;
+  setTime(isFinite(at) ? at : 0);
   state.loaded = true;
   publish();
   if (/play/.test(hash)) setPlaying(true);
