@@ -132,6 +132,9 @@ void add_study_commands(CLI::App& app, Options& o) {
   explore->add_option("--seed", o.explore.seed, "seed (default 1)");
   explore->add_option("--kind", o.explore.kind, "contact | impact | landing | slide | tunnel");
   explore->add_option("--backends", o.explore.backends, "comma-separated backend names");
+  explore->add_option("--shapes", o.explore.shapes,
+                      "contact kind: only these shape-class pairs, e.g. box-box,box-hull (classes "
+                      "box, hull, sliver; other samples are left out, not redrawn)");
   explore->add_option("--out", o.explore.out, "output folder (default reports/explore)");
   explore->add_option("--baseline", o.explore.baseline,
                       "stored explore.json: exit 1 when a backend got worse");

@@ -112,6 +112,7 @@ struct ExploreOptions {
   int shrink_budget = 400;       // predicate evaluations per group
   bool bench = false;            // --bench: throughput of the sampling only, hulls under 100 points
   bool no_figure = false;        // --no-figure: skip matplotlib (tests)
+  std::string shapes;            // --shapes PAIRS: contact kind, shape-class pairs kept ("" : all)
 };
 
 /// Options of `rbx ensemble`.

@@ -62,14 +62,24 @@ int explore_command(const ExploreOptions& opt) {
   set.count = opt.count;
   set.backends = opt.backends;
   set.shrink_budget = opt.shrink_budget;
+  for (size_t at = 0; at < opt.shapes.size();) {
+    const size_t comma = std::min(opt.shapes.find(',', at), opt.shapes.size());
+    set.shapes.push_back(opt.shapes.substr(at, comma - at));
+    at = comma + 1;
+  }
+  check_shape_pairs(set.shapes, set.kind);
   if (opt.bench) return explore_bench(set, par);
 
   const ExploreCampaign c = run_explore(set, par);
   if (!par.root()) return std::atoi(par.broadcast("").c_str());
   const fs::path out = opt.out.empty() ? fs::path("reports/explore") : fs::path(opt.out);
   write_explore(out, c, !opt.no_figure);
-  std::cout << "rbx explore: " << opt.count << " samples, " << c.groups << " disagreement groups, "
-            << c.scenes.size() << " scenes (" << c.reproduced << " reproduced by the harness) in "
+  std::cout << "rbx explore: " << opt.count << " samples"
+            << (set.shapes.empty() ? std::string()
+                                   : " (" + std::to_string(c.result.value("samples_kept", 0L)) +
+                                         " of the shapes " + opt.shapes + ", the rest left out)")
+            << ", " << c.groups << " disagreement groups, " << c.scenes.size() << " scenes ("
+            << c.reproduced << " reproduced by the harness) in "
             << fmt_num(c.sampling_s + c.shrinking_s, 3) << " s on " << par.ranks() << " rank(s) x "
             << par.threads() << " thread(s) -> " << out.string() << "/explore.{json,md}\n";
   // Samples that could not be made are said, never silently left out; none made at all is a

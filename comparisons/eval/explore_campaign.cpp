@@ -292,6 +292,13 @@ std::string shrink_tunnel_group(const Json& g, uint64_t seed, long count, int bu
       });
 }
 
+// Whether the pair of shape classes (a, b) is one of `pairs`, in either order.
+bool keeps_shapes(const std::vector<std::string>& pairs, const std::string& a,
+                  const std::string& b) {
+  return std::find(pairs.begin(), pairs.end(), a + "-" + b) != pairs.end() ||
+         std::find(pairs.begin(), pairs.end(), b + "-" + a) != pairs.end();
+}
+
 // Every sample, spread over ranks and threads; encoded outcomes in index order on rank 0.
 // `bench`: contact samples with a hull of 100+ points are left out (encoded as "").
 std::vector<std::string> sample_all(const ExploreSettings& set,
@@ -311,6 +318,8 @@ std::vector<std::string> sample_all(const ExploreSettings& set,
         return encode(evaluate_tunnel_sample(make_tunnel_sample(set.seed, i), names));
       const ContactSample s = make_contact_sample(set.seed, i);
       if (bench && (s.a.points.size() >= 100 || s.b.points.size() >= 100)) return "";
+      if (!set.shapes.empty() && !keeps_shapes(set.shapes, s.a.shape_class, s.b.shape_class))
+        return "";
       o = evaluate_contact_sample(s, names);
     } catch (const std::exception& e) {
       o.pose_class = "invalid";
@@ -346,6 +355,7 @@ Tallies tally_samples(const std::vector<std::string>& raw, const std::vector<std
   Tallies t;
   for (const std::string& n : names) t.backend[n];
   for (const std::string& text : raw) {
+    if (text.empty()) continue;  // left out: not of the shape classes asked for
     const SampleOutcome s = decode(text);
     if (s.pose_class == "invalid") {
       if (t.invalid++ == 0) t.first_invalid = s.feature;
@@ -550,6 +560,11 @@ ExploreCampaign run_explore(const ExploreSettings& set, const ParallelRun& par) 
   j["kind"] = set.kind;
   j["seed"] = set.seed;
   j["count"] = set.count;
+  if (!set.shapes.empty()) {
+    j["shapes"] = set.shapes;
+    j["samples_kept"] = static_cast<long>(
+        std::count_if(raw.begin(), raw.end(), [](const std::string& r) { return !r.empty(); }));
+  }
   j["backends_run"] = names;
   j["invalid_samples"] = t.invalid;
   j["pose_classes"] = t.pose_classes;
@@ -564,6 +579,24 @@ ExploreCampaign run_explore(const ExploreSettings& set, const ParallelRun& par) 
                  {"ranks", par.ranks()},
                  {"threads_per_rank", par.threads()}};
   return c;
+}
+
+void check_shape_pairs(const std::vector<std::string>& pairs, const std::string& kind) {
+  if (pairs.empty()) return;
+  if (kind != "contact")
+    throw InputError("rbx explore: --shapes: only for --kind contact (the " + kind +
+                     " kind draws its own boxes)");
+  const std::vector<std::string> classes = {"box", "hull", "sliver"};
+  for (const std::string& p : pairs) {
+    const size_t dash = p.find('-');
+    const auto known = [&](const std::string& c) {
+      return std::find(classes.begin(), classes.end(), c) != classes.end();
+    };
+    if (dash == std::string::npos || !known(p.substr(0, dash)) || !known(p.substr(dash + 1)))
+      throw InputError("rbx explore: --shapes: \"" + p +
+                       "\" is not a pair of shape classes; write e.g. box-box,box-hull (classes: "
+                       "box, hull, sliver)");
+  }
 }
 
 std::vector<std::string> explore_regressions(const Json& now, const std::string& path, int& worse) {
@@ -581,6 +614,10 @@ std::vector<std::string> explore_regressions(const Json& now, const std::string&
       throw InputError(path + ": " + key + ": the baseline was run with " +
                        (old.contains(key) ? old[key].dump() : "nothing") + ", this run with " +
                        now[key].dump() + " (use the same --seed, --count and --kind)");
+  if (old.value("shapes", Json::array()) != now.value("shapes", Json::array()))
+    throw InputError(path + ": shapes: the baseline was run with " +
+                     old.value("shapes", Json::array()).dump() + ", this run with " +
+                     now.value("shapes", Json::array()).dump() + " (use the same --shapes)");
   worse = 0;
   // Same seed set, same code: identical numbers; anything above round-off of the summary
   // (1e-12 relative) is a change.

@@ -21,7 +21,14 @@ struct ExploreSettings {
   long count = 20000;            // samples
   std::string backends;          // --backends LIST ("" or "all": every subject backend)
   int shrink_budget = 400;       // predicate evaluations per group (impact <= 120, landing <= 60)
+  /// Contact kind: the shape classes kept, as pairs in either order ("box-box", "box-hull";
+  /// classes box, hull, sliver); empty: every pair. A drawn sample of another pair is left out
+  /// (counted, not redrawn), so that sample k of seed s stays the same sample.
+  std::vector<std::string> shapes;
 };
+
+/// The pair names --shapes takes, and InputError naming the first it does not.
+void check_shape_pairs(const std::vector<std::string>& pairs, const std::string& kind);
 
 /// A campaign's outcome, on rank 0 (other ranks get timings only).
 struct ExploreCampaign {

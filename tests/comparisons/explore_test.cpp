@@ -15,6 +15,7 @@
 #include <string>
 
 #include "comparisons/cli/commands.h"
+#include "comparisons/eval/explore_campaign.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/parallel.h"
 #include "comparisons/scene/scene_file.h"
@@ -499,6 +500,31 @@ TEST(ExploreCommand, LandingSameJsonWithOneAndThreeThreads) {
   EXPECT_EQ(j["backends"]["custom"]["by_phase_quarter"].size(), 4u);
   EXPECT_TRUE(j["backends"]["custom"]["errors"].contains("position_err_m"));
   fs::remove_all(base);
+}
+
+// --shapes keeps the samples of the pairs named, in either order, each the same sample it is
+// without the option (sample k of seed s); the rest are left out and counted, not redrawn.
+TEST(ExploreShapes, OnlyThePairsNamedAreRun) {
+  ExploreSettings set;
+  set.count = 60;
+  set.backends = "fcl";
+  set.shapes = {"box-hull"};
+  const ParallelRun one(1);
+  const ExploreCampaign c = run_explore(set, one);
+  long expected = 0;
+  for (uint64_t i = 0; i < 60; ++i) {
+    const ContactSample s = make_contact_sample(set.seed, i);
+    const std::string pair = s.a.shape_class + "-" + s.b.shape_class;
+    expected += pair == "box-hull" || pair == "hull-box" ? 1 : 0;
+  }
+  ASSERT_GT(expected, 0);
+  EXPECT_LT(expected, 60);
+  EXPECT_EQ(c.result["samples_kept"].get<long>(), expected);
+  EXPECT_EQ(c.result["backends"]["fcl"]["samples"].get<long>(), expected);
+  EXPECT_THROW(check_shape_pairs({"box-cone"}, "contact"), InputError);
+  EXPECT_THROW(check_shape_pairs({"box"}, "contact"), InputError);
+  EXPECT_THROW(check_shape_pairs({"box-box"}, "landing"), InputError);
+  EXPECT_NO_THROW(check_shape_pairs({"sliver-hull", "box-box"}, "contact"));
 }
 
 }  // namespace
