@@ -25,6 +25,12 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 # One (colour, marker) per backend, the same in every figure (backend_style.py).
 from backend_style import order, save, style  # noqa: E402,F401
+
+
+def layer(backend):
+    """Drawing order: the engines under test above the libraries, so that where they agree at
+    round-off (most scenes) the engine's marker is the one seen."""
+    return {"custom": 6, "custom-seed": 5}.get(backend, 3)
 from ensemble_plots import scatter as ensemble_scatter  # noqa: E402
 from law_plots import contact_laws  # noqa: E402
 
@@ -138,17 +144,26 @@ def error_vs_runtime(report, out):
                     continue
                 panel.errorbar(xs, ys, yerr=[lo, hi], color=colour, marker=marker, ms=5, lw=1.4,
                                capsize=2, ls="-" if panel is ax else "--",
-                               label=f"{backend} ({n} scenes)")
+                               label=f"{backend} ({n} scenes)", zorder=layer(backend))
                 if panel is ax:
                     # The coarsest step: a large open marker; its points join the Pareto front.
                     ax.scatter([xs[0]], [ys[0]], s=150, facecolors="none", edgecolors=colour,
                                lw=1.5)
                     allpts += [(x, y) for x, y in zip(xs, ys)]
                 else:
-                    # Each point names its budget.
+                    # Each point names its budget; budgets whose points sit on one another
+                    # (converged) share one label, "10-100", not labels printed over each other.
+                    runs = []
                     for x, y, k in zip(xs, ys, keys):
-                        axb.annotate(str(k), (x, y), textcoords="offset points", xytext=(4, 3),
-                                     fontsize=6, color=colour)
+                        if runs and abs(math.log(x / runs[-1][0])) < 0.06 and \
+                                abs(math.log(y / runs[-1][1])) < 0.5:
+                            runs[-1][3] = k
+                        else:
+                            runs.append([x, y, k, k])
+                    for x, y, first, last in runs:
+                        text = str(first) if first == last else f"{first}-{last}"
+                        axb.annotate(text, (x, y), textcoords="offset points", xytext=(4, 3),
+                                     fontsize=6, color=colour, zorder=layer(backend))
             panel.set_xscale("log")
             panel.set_yscale("log")
             panel.set_xlabel("run time of one scene run (s), median over the scenes")
@@ -192,7 +207,7 @@ def error_vs_runtime(report, out):
                 ax.errorbar([t2], [floored(q2)], xerr=[[t2 - t1], [t3 - t2]],
                             yerr=[[floored(q2) - floored(q1)], [floored(q3) - floored(q2)]],
                             color=colour, marker=marker, ms=7, capsize=2,
-                            label=f"{backend} (worst {worst:.2g})")
+                            label=f"{backend} (worst {worst:.2g})", zorder=layer(backend))
                 # The worst scene as a small hollow marker above: a known failure shows.
                 ax.scatter([t2], [floored(worst)], marker=marker, s=18, facecolors="none",
                            edgecolors=colour)
