@@ -739,6 +739,7 @@ class Evaluator {
     facts.stopped = run.result.status == Status::Error;
     facts.stop_message = run.result.message;
     facts.energy_growth = tr.growth;
+    facts.energy_made_j = tr.made_j;
     facts.closed = fr.closed;
     facts.momentum_drift = tr.drift;
     facts.max_penetration = tr.pen_max;

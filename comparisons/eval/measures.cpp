@@ -314,7 +314,10 @@ StabilityTrace trace_stability(const std::vector<RigidBody>& inputs, const Dynam
     }
   }
   for (bool p : passed) tr.tunnelled += p ? 1 : 0;
-  if (!(e_scale > 0)) e_scale = ke_max > 0 ? ke_max : 1.0;
+  if (!(e_scale > 0)) {
+    e_scale = ke_max > 0 ? ke_max : 1.0;
+    tr.made_j = ke_max;
+  }
   tr.growth = (e_max - inv.e0) / e_scale;
   tr.pen_rest = std::isfinite(pen_rest) ? pen_rest : 0.0;  // 0: no sample at rest
   // Signed drift: the largest |E - E0| / scale over the run, with its sign (gain +, loss -);

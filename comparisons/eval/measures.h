@@ -133,9 +133,11 @@ struct StabilityInvariants {
 /// What the stability check reads off a run's samples.
 struct StabilityTrace {
   bool nonfinite = false;
-  double growth = 0.0;               // the largest energy gain, relative
-  double drift_e = 0.0;              // the largest |E - E0|, relative, signed (+ gained, - lost)
-  double e_change = 0.0;             // at the end (the final state when the run finished)
+  double growth = 0.0;    // the largest energy gain, relative
+  double made_j = 0.0;    // J: the most kinetic energy reached, where the bodies started still
+                          // with no energy (growth is then relative to it); 0 otherwise
+  double drift_e = 0.0;   // the largest |E - E0|, relative, signed (+ gained, - lost)
+  double e_change = 0.0;  // at the end (the final state when the run finished)
   double drift = 0.0, hdrift = 0.0;  // momentum drifts (closed systems)
   double pen_max = 0.0;              // the deepest overlap of any sample
   double pen_rest = 0.0;  // the least over the last fifth of the run of each sample's deepest

@@ -160,7 +160,10 @@ StabilityVerdict stability_verdict(const StabilityFacts& f) {
   // is the integrator's or the contact solver's; so are non-finite states, tunnelling, a run
   // stopped by a guard, momentum drift in a closed system and penetration past half a body.
   if (f.nonfinite) unstable.push_back("non-finite state");
-  if (f.energy_growth > kUnstableEnergyGrowth)
+  if (f.energy_made_j > 0 && f.energy_growth > kUnstableEnergyGrowth)
+    unstable.push_back("energy from nothing: the bodies started still and the run gave them " +
+                       fmt_num(f.energy_made_j, 3) + " J");
+  else if (f.energy_growth > kUnstableEnergyGrowth)
     unstable.push_back("energy grew by " + fmt_num(100 * f.energy_growth, 3) + " %");
   if (f.tunnelled_pairs)
     unstable.push_back(std::to_string(f.tunnelled_pairs) + " pair(s) tunnelled");

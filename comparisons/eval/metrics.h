@@ -79,6 +79,8 @@ struct StabilityFacts {
   bool stopped = false;           // the backend stopped with an error
   std::string stop_message;       // its message
   double energy_growth = 0.0;     // (max E - E0) / scale over the run
+  double energy_made_j = 0.0;     // J, > 0: the bodies started still with no energy, and the
+                                  // run gave them this much (growth is then relative to it)
   double energy_final = 0.0;      // (E_end - E0) / scale: the signed change at the end
   double restitution = 1.0;       // the scene's e
   double friction = 0.0;          // the scene's Coulomb mu
