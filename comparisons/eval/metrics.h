@@ -104,8 +104,9 @@ constexpr double kDissipativeEnergyLoss = 0.01;
 constexpr double kSinkPenetrationRel = 0.01;
 
 /// The stability verdict, worst word first:
-/// - "unstable": non-finite state, energy gain > 1 %, tunnelling, a stopped run, momentum drift
-///   > 1e-6 in a closed system, or penetration > 50 % of the smaller body at any time;
+/// - "unstable": non-finite state, energy gain > 1 % (of the starting energy; where the bodies
+///   start still with none, any gain is "energy from nothing"), tunnelling, a stopped run, momentum
+///   drift > 1e-6 in a closed system, or penetration > 50 % of the smaller body at any time;
 /// - "sinks": penetrating by more than 1 % of the smaller body in every sample of the last fifth
 ///   of the run (bodies come to rest inside each other);
 /// - "dissipative": e = 1 and no friction, yet the run ends with more than 1 % of the energy
