@@ -278,10 +278,11 @@ def contact(a, b, backend="exact"):
 
 
 def explore(count=20000, seed=1, kind="contact", backends=None, out=None, threads=0,
-            shrink_budget=None, baseline=None, figure=True):
+            shrink_budget=None, baseline=None, figure=True, shapes=None):
     """`rbx explore`: random samples against the exact oracle, disagreements grouped and each
     group shrunk to a scene under OUT/scenes/. Returns explore.json (as a dict) with "out" set to
-    the folder (default reports/explore, as the command's)."""
+    the folder (default reports/explore, as the command's). `shapes`: the contact kind's
+    shape-class pairs kept (["box-box", "box-hull"]; classes box, hull, sliver), as --shapes."""
     if kind not in ("contact", "impact", "landing", "slide", "tunnel"):
         raise ValueError("kind: contact, impact, landing, slide or tunnel")
     args = ["explore", "--count", int(count), "--seed", int(seed), "--kind", kind,
@@ -294,6 +295,8 @@ def explore(count=20000, seed=1, kind="contact", backends=None, out=None, thread
         args += ["--baseline", os.fspath(baseline)]
     if not figure:
         args.append("--no-figure")
+    if shapes is not None:
+        args += ["--shapes", ",".join([shapes] if isinstance(shapes, str) else shapes)]
     code, _ = _command(args, show_progress=True)
     folder = os.fspath(out) if out is not None else os.path.join(_source_dir(), "reports",
                                                                     "explore")

@@ -216,6 +216,15 @@ def test_compare_says_whether_it_passed_and_a_failed_call_disagrees():
     assert not doc["passed"] and not doc["scenes"][0]["passed"]
 
 
+def test_explore_keeps_only_the_shape_pairs_asked_for(tmp_path):
+    ex = rbx.explore(count=40, backends=["fcl"], out=tmp_path, figure=False,
+                     shapes=["box-box", "hull-box"])
+    assert ex["shapes"] == ["box-box", "hull-box"]
+    assert 0 < ex["samples_kept"] < 40 and ex["backends"]["fcl"]["samples"] == ex["samples_kept"]
+    with pytest.raises(ValueError, match="--shapes"):
+        rbx.explore(count=5, out=tmp_path, figure=False, shapes="box-cone")
+
+
 def test_the_arguments_a_contact_function_gets():
     shapes = {}
 
