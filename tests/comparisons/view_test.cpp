@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +18,7 @@
 #include "comparisons/output/scorecard.h"
 #include "comparisons/output/view_page.h"
 #include "comparisons/scene/scene_file.h"
+#include "engine/format.h"
 
 namespace fs = std::filesystem;
 
@@ -105,12 +105,9 @@ std::pair<long, long> screenshot_pixels(const fs::path& a, const fs::path& b, in
 
 // The shortest text that reads back as `v` (a page address's #t=).
 std::string fmt_shortest(double v) {
-  char buf[32];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-    if (std::stod(buf) == v) break;
-  }
-  return buf;
+  NumberFormat f;
+  f.digits = 0;
+  return format_number(v, f);
 }
 
 // Everything wrong with a page, judged against `expected` (the view data it should show).
