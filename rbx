@@ -17,7 +17,7 @@ caller="$(pwd)"
 cd "$here"
 
 packages=(cmake g++ pkg-config libeigen3-dev libbullet-dev libfcl-dev libccd-dev libgtest-dev
-          libbenchmark-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libmujoco-dev
+          libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libmujoco-dev
           libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib zlib1g-dev
           libjs-three chromium python3-pil libopenmpi-dev openmpi-bin python3-dev pybind11-dev
           python3-numpy python3-pytest libdart-dev)

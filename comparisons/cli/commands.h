@@ -92,8 +92,9 @@ struct BenchOptions {
   bool quick = false;  // --quick: fewer sizes and shorter runs (under a minute)
 };
 
-/// `rbx bench`: narrow phase of every contact backend, broad phase and whole step, timed with
-/// Google Benchmark; writes perf.md, perf.json, perf.csv and log-log figures to the folder.
+/// `rbx bench`: narrow phase of every contact backend, broad phase and whole step, each group of
+/// compared cases timed in turns (docs/bench.md); writes perf.md, perf.json, perf.csv and log-log
+/// figures to the folder.
 int bench_command(const BenchOptions& opt);
 
 }  // namespace rbx

@@ -1,34 +1,42 @@
-// `rbx bench`: the performance comparison of issue 6, on Google Benchmark.
+// `rbx bench`: the performance comparison of the contact query, the broad phase and the whole step.
 //
-// Three families of cases (the table kFamilies below), each case registered with
-// benchmark::RegisterBenchmark and collected by a reporter that keeps the time per iteration (no
-// console table):
+// Four families of cases (the table kFamilies below), each built as groups of cases that are
+// timed together (comparisons/eval/timing.h: rounds in turns, the first case rotating, until each
+// has its minimum time and count of rounds):
 //   - narrowphase: every contact backend through the registry's ContactFn, on the same convex
 //     pairs (a unit box, and hulls of N random points on a sphere of diameter 1) at the same
-//     poses (touching, deep, separated). One iteration is one query at each of the pose kind's
-//     poses; ns_per_query is the time per iteration over the number of poses.
+//     poses (touching, deep, separated); a group is one shape size and pose kind. One call is
+//     one query at each of the next poses of the cycle; ns_per_query is the time per call over
+//     the number of poses.
 //   - broadphase: the engine's broad-phase methods finding the pairs of a crowd of cubes (a
 //     fixed density, so the pairs per body stay constant), after a small motion of every body
-//     per step (the motion is not timed).
-//   - step: whole dynamics runs of scenes/many/ with the custom engine and Bullet. Each is run
-//     for two durations; the difference in time over the difference in steps removes the set-up
-//     (building worlds and shapes), leaving microseconds per body per step.
-// Every case runs one untimed pass first (warm-up: caches, lazily built hierarchies, page
-// faults), then Google Benchmark times iterations until the case's minimum time.
+//     per step (the motion is not timed); a group is one crowd size.
+//   - step: whole dynamics runs of scenes/many/ with the custom engine and Bullet, each for two
+//     durations; a group is one scene. Each round's difference in time over the difference in
+//     steps removes the set-up (building worlds and shapes), leaving microseconds per body per
+//     step.
+//   - explore: `rbx explore`'s contact samples per minute on one thread.
+// Every case's warm-up runs first and alone, timed (its cold pass, reported apart: caches,
+// lazily built hierarchies, page faults). Google Benchmark, which the bench used before, times
+// one case after another and keeps the fastest repetition; it cannot take turns between cases,
+// and a ratio of two cases timed minutes apart carried the machine's load between them.
 // The pages (perf.md, perf.json, perf.csv, figures) are written by comparisons/output/.
 #include "comparisons/eval/bench_cases.h"
 
-#include <benchmark/benchmark.h>
-
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
+#include <thread>
 #include <utility>
 
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/explore_campaign.h"
+#include "comparisons/eval/json_io.h"
+#include "comparisons/eval/metrics.h"
 #include "comparisons/eval/parallel.h"
 #include "comparisons/scene/mesh_io.h"
 #include "comparisons/scene/scene_file.h"
@@ -51,6 +59,9 @@ BenchPlan bench_plan(bool quick) {
     p.steps_100 = {10, 60};
     p.steps_1000 = {2, 32};
     p.step_min_time = 0.1;
+    p.step_rounds = 5;
+    p.explore_samples = 500;
+    p.explore_min_time = 0.5;
   } else {
     p.hull_sizes = {32, 128, 512, 2048, 8192};
     p.poses = kBenchPoseCycle;
@@ -58,9 +69,13 @@ BenchPlan bench_plan(bool quick) {
     p.min_time = 0.2;
     p.crowd_sizes = {1000, 2000, 5000, 10000, 20000};
     p.crowd_min_time = 0.3;
-    p.steps_100 = {20, 120};
-    p.steps_1000 = {10, 60};
+    // The long runs are long enough that a round's difference (tens of milliseconds) stands
+    // well above the noise of building the world.
+    p.steps_100 = {20, 420};
+    p.steps_1000 = {10, 110};
     p.step_min_time = 0.2;
+    // The whole step's ratios carry goals: more rounds narrow their median.
+    p.step_rounds = 15;
   }
   return p;
 }
@@ -198,53 +213,29 @@ double fit_exponent(const std::vector<std::pair<double, double>>& points) {
 namespace {
 
 // ---------------------------------------------------------------------------------------------
-// Collecting Google Benchmark's results.
+// What the groups' timings gave, per case name.
 
-class Collector : public benchmark::BenchmarkReporter {
- public:
-  explicit Collector(std::size_t total) : total_(total) {}
-  bool ReportContext(const Context& context) override {
-    cpus = context.cpu_info.num_cpus;
-    mhz = context.cpu_info.cycles_per_second / 1e6;
-    return true;
-  }
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& r : runs) {
-      if (r.run_type != Run::RT_Iteration) continue;
-      const std::string name = r.run_name.function_name;
-      ++done_;
-      if (r.error_occurred) {
-        errors[name] = r.error_message;
-      } else {
-        // Repeated cases keep their fastest repetition: the one least disturbed by other load
-        // on a shared machine.
-        const double t = r.real_accumulated_time / static_cast<double>(r.iterations);
-        if (!seconds.count(name) || t < seconds[name]) {
-          seconds[name] = t;
-          iterations[name] = static_cast<long>(r.iterations);
-        }
-      }
-      std::cerr << "bench [" << done_ << "/" << total_ << "] " << name << ": "
-                << (r.error_occurred ? "error: " + r.error_message
-                                     : std::to_string(seconds[name] * 1e6) + " us/iteration")
-                << "\n";
-    }
-  }
-  int cpus = 0;
-  double mhz = 0.0;
-  std::map<std::string, double> seconds;  // per iteration
-  std::map<std::string, long> iterations;
+struct CaseTimes {
+  std::map<std::string, Rounds> rounds;  // per call, seconds
+  std::map<std::string, double> cold_s;  // the warm-up pass, timed alone
   std::map<std::string, std::string> errors;
-
- private:
-  std::size_t total_;
-  std::size_t done_ = 0;
+  // A case's time in a row's unit (`scale` per second of a call), or an error.
+  BenchTime time(const std::string& name, double scale) const {
+    const auto it = rounds.find(name);
+    if (it == rounds.end() || it->second.per_call_s.empty()) return {};
+    std::vector<double> v;
+    for (double t : it->second.per_call_s) v.push_back(t * scale);
+    BenchTime out = bench_time(v);
+    out.calls = it->second.per_round * out.rounds;
+    if (cold_s.count(name)) out.cold = cold_s.at(name) * scale;
+    return out;
+  }
 };
 
-// A family's cases, and how it turns their timings into its rows once they have run.
+// A family's groups, and how it turns their timings into its rows once they have run.
 struct CaseSet {
-  std::vector<BenchCase> cases;
-  std::function<void(Collector&, BenchResults&)> collect;
+  std::vector<BenchGroup> groups;
+  std::function<void(const CaseTimes&, BenchResults&)> collect;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -276,12 +267,18 @@ CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
       std::mt19937_64 pose_rng(1000003ull * static_cast<unsigned>(n) +
                                static_cast<unsigned>(&kind - kPoseKinds) + 1);
       auto pair = std::make_shared<PosedPair>(make_poses(shape, box, kind, plan.poses, pose_rng));
+      BenchGroup group;
+      group.name = "narrowphase/" + std::to_string(n) + "/" + kind.name;
+      group.plan.min_time_s = plan.min_time;
       for (const NarrowBackend& b : nb) {
         if (b.boxes_only && !box) continue;
         if (n > (plan.quick ? b.max_vertices_quick : b.max_vertices_full)) continue;
         auto c = std::make_shared<State>();
-        c->row = {b.backend, b.variant, kind.name, "", n, static_cast<int>(shape.vertices().size()),
-                  NAN,       0};
+        c->row.backend = b.backend;
+        c->row.variant = b.variant;
+        c->row.pose = kind.name;
+        c->row.vertices = n;
+        c->row.hull_vertices = static_cast<int>(shape.vertices().size());
         c->name = "narrowphase/" + b.backend + "/" + b.variant + "/" + std::to_string(n) + "/" +
                   kind.name;
         c->pair = pair;
@@ -299,12 +296,12 @@ CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
         };
         BenchCase bc;
         bc.name = c->name;
-        // Warm-up: one untimed iteration's poses (caches, lazily built hierarchies).
+        // Warm-up: one call's poses (caches, lazily built hierarchies), the cold pass.
         const std::size_t per_iteration = static_cast<std::size_t>(plan.poses_per_iteration);
         bc.warm_up = [c, query, per_iteration] {
           for (std::size_t k = 0; k < per_iteration; ++k) query(k);
         };
-        // Each iteration the next poses of the cycle: a sequence as long as the cycle is not one
+        // Each call the next poses of the cycle: a sequence as long as the cycle is not one
         // a branch predictor learns, as it learns a few poses repeated (docs/bench.md). Every
         // status that is not ok is kept.
         bc.body = [c, query, per_iteration] {
@@ -312,29 +309,21 @@ CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
             const ContactResult r = query(c->next++);
             if (r.status != Status::Ok)
               c->status = std::string(to_string(r.status)) + ": " + r.message;
-            benchmark::DoNotOptimize(r);
           }
         };
-        bc.min_time_s = plan.min_time;
-        // The cases behind the goals, and every cheap one, are repeated (fastest kept).
-        const bool goal = (b.backend == "custom" && b.variant == "accelerated") ||
-                          b.backend == "fcl-box" || (b.backend == "fcl" && n == 2048);
-        bc.repetitions = goal || n <= 128 ? kBenchRepetitions : 1;
-        set.cases.push_back(bc);
+        group.cases.push_back(bc);
       }
+      set.groups.push_back(std::move(group));
     }
   }
-  set.collect = [states, poses = plan.poses_per_iteration](Collector& collector,
+  set.collect = [states, poses = plan.poses_per_iteration](const CaseTimes& times,
                                                            BenchResults& out) {
     for (const auto& c : states) {
       NarrowRow r = c->row;
       r.status = c->status;
-      if (collector.seconds.count(c->name)) {
-        r.ns_per_query = collector.seconds[c->name] * 1e9 / static_cast<double>(poses);
-        r.iterations = collector.iterations[c->name];
-      } else if (collector.errors.count(c->name)) {
-        r.status = "error: " + collector.errors[c->name];
-      }
+      // A call queries `poses` poses: the row's unit is ns per query.
+      r.ns_per_query = times.time(c->name, 1e9 / static_cast<double>(poses));
+      if (times.errors.count(c->name)) r.status = "error: " + times.errors.at(c->name);
       out.narrow.push_back(r);
     }
   };
@@ -370,6 +359,9 @@ CaseSet broadphase_cases(const BenchPlan& plan, std::mt19937_64& rng) {
   for (int n : plan.crowd_sizes) {
     auto crowd = std::make_shared<std::vector<std::vector<RigidBody>>>();
     for (int k = 0; k < kBenchCrowds; ++k) crowd->push_back(cube_crowd(n, rng));
+    BenchGroup group;
+    group.name = "broadphase/" + std::to_string(n);
+    group.plan.min_time_s = plan.crowd_min_time;
     for (BroadPhaseMethod m : kBenchBroadPhaseMethods) {
       auto c = std::make_shared<State>();
       c->row.method = to_string(m);
@@ -400,15 +392,14 @@ CaseSet broadphase_cases(const BenchPlan& plan, std::mt19937_64& rng) {
         c->pairs += found;
         ++c->steps;
       };
-      bc.min_time_s = plan.crowd_min_time;
-      bc.repetitions = kBenchRepetitions;
-      set.cases.push_back(bc);
+      group.cases.push_back(bc);
     }
+    set.groups.push_back(std::move(group));
   }
-  set.collect = [states](Collector& collector, BenchResults& out) {
+  set.collect = [states](const CaseTimes& times, BenchResults& out) {
     for (const auto& c : states) {
       BroadRow r = c->row;
-      if (collector.seconds.count(c->name)) r.ns_per_step = collector.seconds[c->name] * 1e9;
+      r.ns_per_step = times.time(c->name, 1e9);
       if (c->steps > 0) r.pairs_per_step = static_cast<double>(c->pairs) / c->steps;
       out.broad.push_back(r);
     }
@@ -472,19 +463,25 @@ CaseSet step_cases(const BenchPlan& plan, std::mt19937_64&) {
     const Scene base = load_scene(file);
     int moving = 0;
     for (const BodySpec& b : base.bodies) moving += b.is_static ? 0 : 1;
+    BenchGroup group;
+    group.name = "step/" + stem;
+    group.plan.min_time_s = plan.step_min_time;
+    // Every engine gets all its rounds, however long a run takes: the goals' ratios are taken
+    // round by round.
+    group.plan.min_rounds = plan.step_rounds;
+    group.plan.min_rounds_slow = plan.step_rounds;
     for (const StepRunner& runner : kStepRunners) {
       for (long k : steps) {
         auto c = std::make_shared<State>();
         c->scene = base;
         c->scene.sim.duration = static_cast<double>(k) * base.sim.dt;
         c->steps = c->scene.sim.steps();
-        c->row = {runner.backend,
-                  runner.variant,
-                  stem,
-                  moving,
-                  static_cast<int>(base.bodies.size()),
-                  NAN,
-                  "ok"};
+        c->row.backend = runner.backend;
+        c->row.variant = runner.variant;
+        c->row.scene = stem;
+        c->row.bodies = moving;
+        c->row.total_bodies = static_cast<int>(base.bodies.size());
+        c->row.status = "ok";
         c->name = "step/" + std::string(runner.backend) + "/" + runner.variant + "/" + stem + "/" +
                   std::to_string(k);
         c->run = runner.run;
@@ -496,27 +493,36 @@ CaseSet step_cases(const BenchPlan& plan, std::mt19937_64&) {
           const std::string err = c->run(c->scene);
           if (!err.empty()) c->status = "error: " + err;
         };
-        bc.min_time_s = plan.step_min_time;
-        // The whole-step rows carry a goal: on a full run, the fastest of several runs, as for
-        // the goal's narrow-phase cases (one run alone takes whatever load the machine has then).
-        bc.repetitions = plan.quick ? 1 : kBenchRepetitions;
-        set.cases.push_back(bc);
+        group.cases.push_back(bc);
       }
     }
+    set.groups.push_back(std::move(group));
   }
-  set.collect = [states](Collector& collector, BenchResults& out) {
+  set.collect = [states](const CaseTimes& times, BenchResults& out) {
     for (std::size_t i = 0; i + 1 < states.size(); i += 2) {
-      // Consecutive cases: the short and the long run of one backend and scene.
+      // Consecutive cases: the short and the long run of one backend and scene, timed in the
+      // same turns, so each round gives its own difference.
       const State& a = *states[i];
       const State& b = *states[i + 1];
       StepRow r = a.row;
       r.status = a.status != "ok" ? a.status : b.status;
-      if (collector.seconds.count(a.name) && collector.seconds.count(b.name) && b.steps > a.steps)
-        r.us_per_body_step = (collector.seconds[b.name] - collector.seconds[a.name]) * 1e6 /
-                             static_cast<double>((b.steps - a.steps) * r.bodies);
+      const auto ra = times.rounds.find(a.name), rb = times.rounds.find(b.name);
+      if (ra != times.rounds.end() && rb != times.rounds.end() && b.steps > a.steps) {
+        const double per = 1e6 / static_cast<double>((b.steps - a.steps) * r.bodies);
+        std::vector<double> v;
+        const std::vector<double>&ta = ra->second.per_call_s, &tb = rb->second.per_call_s;
+        for (std::size_t k = 0; k < std::min(ta.size(), tb.size()); ++k)
+          v.push_back((tb[k] - ta[k]) * per);
+        r.us_per_body_step = bench_time(v);
+        r.us_per_body_step.calls = ra->second.per_round * static_cast<long>(ta.size()) +
+                                   rb->second.per_round * static_cast<long>(tb.size());
+        if (times.cold_s.count(a.name)) r.us_per_body_step.cold = times.cold_s.at(a.name) * 1e6;
+      }
+      if (times.errors.count(a.name)) r.status = "error: " + times.errors.at(a.name);
+      if (times.errors.count(b.name)) r.status = "error: " + times.errors.at(b.name);
       // The extra steps cost less than the noise of the set-up: no measurement.
-      if (!(r.us_per_body_step > 0.0) && r.status == "ok") {
-        r.us_per_body_step = NAN;
+      if (!(r.us_per_body_step.median > 0.0) && r.status == "ok") {
+        r.us_per_body_step = {};
         r.status = "extra steps within the timing noise of the set-up";
       }
       out.step.push_back(r);
@@ -534,7 +540,7 @@ CaseSet step_cases(const BenchPlan& plan, std::mt19937_64&) {
 
 CaseSet explore_cases(const BenchPlan& plan, std::mt19937_64&) {
   auto settings = std::make_shared<ExploreSettings>();
-  settings->count = plan.quick ? 500 : 2000;
+  settings->count = plan.explore_samples;
   settings->backends = "custom,fcl";
   auto par = std::make_shared<ParallelRun>(1);
   auto done = std::make_shared<long>(0);
@@ -543,15 +549,24 @@ CaseSet explore_cases(const BenchPlan& plan, std::mt19937_64&) {
   BenchCase bc;
   bc.name = name;
   bc.warm_up = [] {};
-  // One iteration is the whole block of samples.
+  // One call is the whole block of samples.
   bc.body = [settings, par, done] { *done = explore_throughput(*settings, *par).done; };
-  bc.min_time_s = plan.quick ? 0.5 : 3.0;
-  bc.repetitions = kBenchRepetitions;
-  set.cases.push_back(bc);
-  set.collect = [name, done](Collector& collector, BenchResults& out) {
-    ExploreRow r{"exact, custom, fcl", static_cast<int>(*done), NAN};
-    if (collector.seconds.count(name) && *done > 0)
-      r.samples_per_minute = 60.0 * static_cast<double>(*done) / collector.seconds[name];
+  BenchGroup group{name, {}, {bc}};
+  group.plan.min_time_s = plan.explore_min_time;
+  group.plan.min_rounds = 3;
+  set.groups.push_back(group);
+  set.collect = [name, done](const CaseTimes& times, BenchResults& out) {
+    ExploreRow r;
+    r.backends = "exact, custom, fcl";
+    r.samples = static_cast<int>(*done);
+    // Samples per minute per round: a rate, so its median is the rate of the median round.
+    const auto it = times.rounds.find(name);
+    if (it != times.rounds.end() && *done > 0) {
+      std::vector<double> v;
+      for (double t : it->second.per_call_s) v.push_back(60.0 * static_cast<double>(*done) / t);
+      r.samples_per_minute = bench_time(v);
+      r.samples_per_minute.calls = it->second.per_round * r.samples_per_minute.rounds;
+    }
     out.explore.push_back(r);
   };
   return set;
@@ -571,43 +586,85 @@ const Family kFamilies[] = {
 
 }  // namespace
 
+BenchTime bench_time(std::vector<double> per_round) {
+  BenchTime t;
+  t.per_round = per_round;
+  std::sort(per_round.begin(), per_round.end());
+  if (per_round.empty()) return t;
+  t.median = sorted_quantile(per_round, 0.5);
+  t.q25 = sorted_quantile(per_round, 0.25);
+  t.q75 = sorted_quantile(per_round, 0.75);
+  t.rounds = static_cast<int>(per_round.size());
+  return t;
+}
+
+RatioSpread bench_ratio(const BenchTime& a, const BenchTime& b) {
+  return paired_ratio(a.per_round, b.per_round);
+}
+
+namespace {
+
+// The machine's clock as the kernel reports it (MHz of the first CPU listed), 0 if unknown.
+double cpu_mhz() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("cpu MHz", 0) == 0) return std::atof(line.substr(line.find(':') + 1).c_str());
+  return 0.0;
+}
+
+}  // namespace
+
 BenchResults run_bench(const BenchPlan& plan) {
   std::mt19937_64 rng(20240606);
   std::vector<CaseSet> sets;
   for (const Family& f : kFamilies) sets.push_back(f.build(plan, rng));
-
-  // Register every case: warm-up, then timed iterations with the set-up paused out.
-  std::size_t total = 0, runs = 0;
+  std::size_t total = 0, groups = 0;
   for (const CaseSet& set : sets)
-    for (const BenchCase& bc : set.cases) {
-      ++total;
-      runs += static_cast<std::size_t>(bc.repetitions);
-      benchmark::RegisterBenchmark(bc.name.c_str(),
-                                   [bc](benchmark::State& state) {
-                                     bc.warm_up();
-                                     for (auto _ : state) {
-                                       if (bc.set_up) {
-                                         state.PauseTiming();
-                                         bc.set_up();
-                                         state.ResumeTiming();
-                                       }
-                                       bc.body();
-                                     }
-                                   })
-          ->MinTime(bc.min_time_s)
-          ->Repetitions(bc.repetitions);
+    for (const BenchGroup& g : set.groups) {
+      ++groups;
+      total += g.cases.size();
     }
-  std::cerr << "bench: " << total << " cases, " << runs << " runs ("
+  std::cerr << "bench: " << total << " cases in " << groups << " groups timed together ("
             << (plan.quick ? "quick" : "full") << ")\n";
-  Collector collector(runs);
-  benchmark::RunSpecifiedBenchmarks(&collector);
-  benchmark::ClearRegisteredBenchmarks();
+
+  // Per group: every case's warm-up, timed alone (its cold pass), then the rounds in turns.
+  CaseTimes times;
+  std::size_t done = 0;
+  for (const CaseSet& set : sets)
+    for (const BenchGroup& g : set.groups) {
+      std::vector<TimedSubject> subjects;
+      std::vector<const BenchCase*> timed;
+      for (const BenchCase& bc : g.cases) {
+        try {
+          Stopwatch clock;
+          bc.warm_up();
+          times.cold_s[bc.name] = clock.seconds();
+        } catch (const std::exception& e) {
+          times.errors[bc.name] = e.what();
+          continue;
+        }
+        subjects.push_back({bc.name, false, bc.body, 0.0, bc.set_up});
+        timed.push_back(&bc);
+      }
+      const std::vector<Rounds> rounds = time_rounds(subjects, g.plan);
+      for (std::size_t i = 0; i < timed.size(); ++i) {
+        if (rounds[i].per_call_s.empty())
+          times.errors[timed[i]->name] = "failed while being timed";
+        else
+          times.rounds[timed[i]->name] = rounds[i];
+      }
+      ++done;
+      std::cerr << "bench [" << done << "/" << groups << "] " << g.name << ": " << timed.size()
+                << " cases, " << (rounds.empty() ? 0 : timing_of(rounds.front()).rounds)
+                << " rounds\n";
+    }
 
   BenchResults out;
-  out.cpus = collector.cpus;
-  out.mhz = collector.mhz;
+  out.cpus = static_cast<int>(std::thread::hardware_concurrency());
+  out.mhz = cpu_mhz();
   out.cases = total;
-  for (const CaseSet& set : sets) set.collect(collector, out);
+  for (const CaseSet& set : sets) set.collect(times, out);
   return out;
 }
 

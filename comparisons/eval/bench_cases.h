@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "comparisons/eval/timing.h"
 #include "engine/body.h"
 #include "engine/broadphase.h"
 #include "engine/polyhedron.h"
@@ -32,8 +33,6 @@ inline constexpr PoseKind kPoseKinds[] = {
 /// is not one a branch predictor learns, as it learns a handful of poses repeated.
 constexpr int kBenchPoseCycle = 256;
 
-/// Repetitions of the cheap cases and of those behind the goals (the fastest is kept).
-constexpr int kBenchRepetitions = 3;
 /// Size (m) of every benchmark shape: the unit box and hulls of points on a sphere of radius 0.5.
 constexpr double kBenchShapeSize = 1.0;
 
@@ -47,11 +46,14 @@ struct BenchPlan {
   std::vector<int> hull_sizes;              // vertices of the hulls (the box is always included)
   int poses = 3;                            // distinct poses per kind, queried in turn
   int poses_per_iteration = 3;              // consecutive poses of the cycle in one iteration
-  double min_time = 0.2;                    // s, minimum timed time per case
+  double min_time = 0.2;                    // s, minimum timed time per case (rounds: 7)
   std::vector<int> crowd_sizes;             // bodies in the broad-phase crowds
   double crowd_min_time = 0.2;              // s
   std::vector<long> steps_100, steps_1000;  // step counts of the two runs per scene
   double step_min_time = 0.1;               // s
+  int step_rounds = 7;                      // rounds of every whole-step run, at least
+  int explore_samples = 2000;               // samples drawn per call of the explore case
+  double explore_min_time = 3.0;            // s
 };
 
 /// The full plan, or the quick one (--quick).
@@ -95,41 +97,64 @@ std::vector<RigidBody> cube_crowd(int n, std::mt19937_64& rng);
 
 // ---- Cases and results ---------------------------------------------------------------------
 
-/// One timed case. Google Benchmark calls it several times (to size the iteration count, and
-/// per repetition); each call runs warm_up once, then timed iterations of body, with set_up
-/// before each (not timed).
+/// One timed case: a name, an untimed warm-up and set-up, and a timed body. The warm-up runs
+/// once, timed alone: the case's cold pass, reported apart. Then rounds of body calls are timed
+/// (comparisons/eval/timing.h), with set_up before every call, outside the clock.
 struct BenchCase {
   std::string name;               // family/backend/variant/size/kind
-  std::function<void()> warm_up;  // untimed, once per call: caches, hierarchies, page faults
-  std::function<void()> set_up;   // untimed, before every iteration; empty: none
-  std::function<void()> body;     // the timed work of one iteration
-  double min_time_s = 0.1;        // minimum timed time
-  int repetitions = 1;            // the fastest repetition is kept
+  std::function<void()> warm_up;  // once, first: caches, hierarchies, page faults
+  std::function<void()> set_up;   // untimed, before every call; empty: none
+  std::function<void()> body;     // the timed work of one call
 };
+
+/// Cases timed together, round by round in turns (the backends on one shape size and pose kind,
+/// the broad-phase methods on one crowd, the engines on one scene): a passing load of the machine
+/// falls on all of them alike, and the ratio between two is taken round by round.
+struct BenchGroup {
+  std::string name;
+  TimingPlan plan;
+  std::vector<BenchCase> cases;
+};
+
+/// A timed quantity in its row's unit (ns per query, ns per step, µs per body-step): the median
+/// over rounds, their 25-75 % range, the counts, the cold pass, and every round's value in the
+/// order run, so that two rows of one group give a ratio round by round.
+struct BenchTime {
+  double median = NAN, q25 = NAN, q75 = NAN;
+  int rounds = 0;
+  long calls = 0;
+  double cold = NAN;  // the warm-up pass, timed alone (for the whole step: the short run's)
+  std::vector<double> per_round;
+};
+
+/// The per-round values' median and quartiles as a BenchTime (counts and cold left to fill).
+BenchTime bench_time(std::vector<double> per_round);
+
+/// The ratio a / b of two rows timed in one group, round by round.
+RatioSpread bench_ratio(const BenchTime& a, const BenchTime& b);
 
 /// A narrow-phase result row.
 struct NarrowRow {
   std::string backend, variant, pose, status;
   int vertices = 0;       // nominal: 8 for the box, else the hull's point count
   int hull_vertices = 0;  // as built
-  double ns_per_query = NAN;
-  long iterations = 0;
+  BenchTime ns_per_query;
 };
 
 /// A broad-phase result row.
 struct BroadRow {
   std::string method;
   int bodies = 0;
-  double ns_per_step = NAN;
+  BenchTime ns_per_step;
   double pairs_per_step = 0.0;
 };
 
 /// A whole-step result row.
 struct StepRow {
   std::string backend, variant, scene;
-  int bodies = 0;        // moving bodies
-  int total_bodies = 0;  // including static walls
-  double us_per_body_step = NAN;
+  int bodies = 0;              // moving bodies
+  int total_bodies = 0;        // including static walls
+  BenchTime us_per_body_step;  // per round: (long run - short run) / (extra steps x bodies)
   std::string status;
 };
 
@@ -137,12 +162,12 @@ struct StepRow {
 struct ExploreRow {
   std::string backends;  // what each sample runs through
   int samples = 0;       // samples timed (a block, each under 100 points)
-  double samples_per_minute = NAN;
+  BenchTime samples_per_minute;
 };
 
 /// Everything a run measured.
 struct BenchResults {
-  int cpus = 0;  // as Google Benchmark saw the machine
+  int cpus = 0;  // as the process sees the machine
   double mhz = 0.0;
   std::size_t cases = 0;
   std::vector<NarrowRow> narrow;
@@ -151,7 +176,7 @@ struct BenchResults {
   std::vector<ExploreRow> explore;
 };
 
-/// Builds every family's cases, times them with Google Benchmark and returns the rows.
+/// Builds every family's groups of cases, times each group interleaved and returns the rows.
 BenchResults run_bench(const BenchPlan& plan);
 
 /// Least-squares slope of log(time) against log(size): the exponent of time against size.

@@ -13,8 +13,7 @@ namespace rbx {
 namespace {
 
 struct Progress {
-  long per_round = 1;
-  std::vector<double> per_call_s;  // one per round
+  Rounds rounds;
   double total_s = 0.0;
   bool failed = false;
   bool done = false;
@@ -26,9 +25,19 @@ double timed_round(const TimedSubject& s, long n) {
   double t = -1.0;
   auto round = [&] {
     try {
-      Stopwatch clock;
-      for (long k = 0; k < n; ++k) s.call();
-      t = clock.seconds();
+      if (s.set_up) {
+        t = 0.0;
+        for (long k = 0; k < n; ++k) {
+          s.set_up();
+          Stopwatch clock;
+          s.call();
+          t += clock.seconds();
+        }
+      } else {
+        Stopwatch clock;
+        for (long k = 0; k < n; ++k) s.call();
+        t = clock.seconds();
+      }
     } catch (const std::exception&) {
       t = -1.0;
     }
@@ -42,13 +51,15 @@ double timed_round(const TimedSubject& s, long n) {
 }
 
 bool finished(const Progress& p, const TimingPlan& plan) {
-  const int rounds = static_cast<int>(p.per_call_s.size());
+  const int rounds = static_cast<int>(p.rounds.per_call_s.size());
   return (rounds >= plan.min_rounds && p.total_s >= plan.min_time_s) ||
          (rounds >= plan.min_rounds_slow && p.total_s >= plan.slow_factor * plan.min_time_s) ||
          rounds >= plan.max_rounds;
 }
 
-std::vector<Timing> time_here(const std::vector<TimedSubject>& subjects, const TimingPlan& plan) {
+}  // namespace
+
+std::vector<Rounds> time_rounds(const std::vector<TimedSubject>& subjects, const TimingPlan& plan) {
   const size_t n = subjects.size();
   std::vector<Progress> at(n);
   // A round long enough that the clock's resolution and overhead vanish, short enough that
@@ -63,7 +74,7 @@ std::vector<Timing> time_here(const std::vector<TimedSubject>& subjects, const T
       at[i].failed = true;
       continue;
     }
-    at[i].per_round =
+    at[i].rounds.per_round =
         static_cast<long>(std::clamp(std::ceil(target_s / std::max(one, 1e-9)), 1.0, 1e7));
   }
   for (size_t turn = 0;; ++turn) {
@@ -72,44 +83,65 @@ std::vector<Timing> time_here(const std::vector<TimedSubject>& subjects, const T
       Progress& p = at[(turn + j) % n];
       if (p.failed || p.done) continue;
       any = true;
-      const double t = timed_round(subjects[(turn + j) % n], p.per_round);
+      const double t = timed_round(subjects[(turn + j) % n], p.rounds.per_round);
       if (t < 0) {
         p.failed = true;
         continue;
       }
-      p.per_call_s.push_back(t / static_cast<double>(p.per_round));
+      p.rounds.per_call_s.push_back(t / static_cast<double>(p.rounds.per_round));
       p.total_s += t;
       p.done = finished(p, plan);
     }
     if (!any) break;
   }
-  std::vector<Timing> out(n);
-  for (size_t i = 0; i < n; ++i) {
-    if (at[i].failed) continue;
-    std::vector<double> v = at[i].per_call_s;
-    std::sort(v.begin(), v.end());
-    out[i].median_s = sorted_quantile(v, 0.5);
-    out[i].q25_s = sorted_quantile(v, 0.25);
-    out[i].q75_s = sorted_quantile(v, 0.75);
-    out[i].rounds = static_cast<int>(v.size());
-    out[i].calls = at[i].per_round * out[i].rounds;
-  }
+  std::vector<Rounds> out(n);
+  for (size_t i = 0; i < n; ++i)
+    if (!at[i].failed) out[i] = at[i].rounds;
   return out;
 }
 
-}  // namespace
+Timing timing_of(const Rounds& r) {
+  Timing t;
+  if (r.per_call_s.empty()) return t;
+  std::vector<double> v = r.per_call_s;
+  std::sort(v.begin(), v.end());
+  t.median_s = sorted_quantile(v, 0.5);
+  t.q25_s = sorted_quantile(v, 0.25);
+  t.q75_s = sorted_quantile(v, 0.75);
+  t.rounds = static_cast<int>(v.size());
+  t.calls = r.per_round * t.rounds;
+  return t;
+}
+
+RatioSpread paired_ratio(const std::vector<double>& a, const std::vector<double>& b) {
+  std::vector<double> q;
+  for (size_t k = 0; k < std::min(a.size(), b.size()); ++k)
+    if (b[k] != 0.0 && std::isfinite(a[k] / b[k])) q.push_back(a[k] / b[k]);
+  RatioSpread r;
+  if (q.empty()) return r;
+  std::sort(q.begin(), q.end());
+  r.median = sorted_quantile(q, 0.5);
+  r.q25 = sorted_quantile(q, 0.25);
+  r.q75 = sorted_quantile(q, 0.75);
+  r.rounds = static_cast<int>(q.size());
+  return r;
+}
 
 std::vector<Timing> time_interleaved(const std::vector<TimedSubject>& subjects,
                                      const TimingPlan& plan) {
   const bool libraries = std::any_of(subjects.begin(), subjects.end(),
                                      [](const TimedSubject& s) { return s.library; });
-  if (!libraries || in_isolated_child()) return time_here(subjects, plan);
+  auto here = [&] {
+    std::vector<Timing> t;
+    for (const Rounds& r : time_rounds(subjects, plan)) t.push_back(timing_of(r));
+    return t;
+  };
+  if (!libraries || in_isolated_child()) return here();
   // Every round of a library is an isolated call: inside one supervised child these cost
   // nothing, where each alone would be a fork.
   const std::vector<std::string> bytes = run_items_isolated(0, 1, [&](size_t) {
     ByteWriter w;
-    for (const Timing& t : time_here(subjects, plan))
-      w.io(t.median_s, t.q25_s, t.q75_s, t.calls, t.rounds);
+    for (const Timing& t : here()) w.io(t.median_s, t.q25_s, t.q75_s, t.calls, t.rounds);
     return w.str();
   });
   std::vector<Timing> out(subjects.size());

@@ -13,6 +13,7 @@
 // per call, with its 25-75 % range and the count of calls.
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -51,7 +52,33 @@ struct TimedSubject {
   bool library = false;  // a library's call: each round isolated
   std::function<void()> call;
   double deadline_s = 30.0;  // per round, as the call's own deadline
+  /// Untimed work before every call (moving a crowd between broad-phase steps); empty: none.
+  /// With it each call is timed alone and the round's time is the sum.
+  std::function<void()> set_up = {};
 };
+
+/// One subject's rounds as timed: the time per call of each round, in the order run. Round k of
+/// every subject ran in the same turn, so rounds of the same index are paired in time.
+struct Rounds {
+  std::vector<double> per_call_s;  // empty: the subject failed (or threw) while being timed
+  long per_round = 0;              // calls in each round
+};
+
+/// The timing of a subject's rounds: median, quartiles and counts (cold_s left 0).
+Timing timing_of(const Rounds& r);
+
+/// A ratio between two subjects timed together, round by round: the median and 25-75 % range
+/// of a[k] / b[k] over the rounds both have. NaN (and rounds 0) when they share none.
+struct RatioSpread {
+  double median = NAN, q25 = NAN, q75 = NAN;
+  int rounds = 0;
+};
+RatioSpread paired_ratio(const std::vector<double>& a, const std::vector<double>& b);
+
+/// The rounds themselves, timed in this process (for subjects that are not libraries, or
+/// inside a supervised child): what time_interleaved summarises.
+std::vector<Rounds> time_rounds(const std::vector<TimedSubject>& subjects,
+                                const TimingPlan& plan = {});
 
 /// Times the subjects interleaved (see the design note); one Timing per subject, in order, with
 /// cold_s left 0 for the caller to fill from the answering call. A subject that throws or fails

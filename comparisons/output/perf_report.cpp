@@ -37,158 +37,26 @@ std::string cpu_model() {
   return "unknown CPU";
 }
 
-// The exponent fit of one series (hull sizes only, the box excluded).
-double series_exponent(const std::vector<NarrowRow>& rows, const std::string& backend,
-                       const std::string& variant, const std::string& pose) {
-  std::vector<std::pair<double, double>> pts;
-  for (const NarrowRow& r : rows)
-    if (r.backend == backend && r.variant == variant && r.pose == pose && r.vertices > 8 &&
-        std::isfinite(r.ns_per_query))
-      pts.push_back({static_cast<double>(r.vertices), r.ns_per_query});
-  return fit_exponent(pts);
+// A timed row's figures for perf.json: the median (the row's key), its quartiles, counts and
+// the cold pass.
+void put_time(Json& row, const std::string& key, const BenchTime& t) {
+  auto finite = [](double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); };
+  row[key] = finite(t.median);
+  row["q25"] = finite(t.q25);
+  row["q75"] = finite(t.q75);
+  row["rounds"] = t.rounds;
+  row["calls"] = t.calls;
+  row["cold"] = finite(t.cold);
 }
 
-double find_time(const std::vector<NarrowRow>& rows, const std::string& backend,
-                 const std::string& variant, const std::string& pose, int vertices) {
-  for (const NarrowRow& r : rows)
-    if (r.backend == backend && r.variant == variant && r.pose == pose && r.vertices == vertices)
-      return r.ns_per_query;
-  return NAN;
+// A table cell: the median and half its 25-75 % range, relative ("4.1 µs ±1.2%").
+std::string time_cell(const BenchTime& t, bool ns) {
+  if (!std::isfinite(t.median)) return "—";
+  std::string cell = ns ? fmt_duration_ns(t.median) : bench_num(t.median, 3);
+  if (t.rounds > 1 && t.median > 0)
+    cell += " ±" + bench_num(50.0 * (t.q75 - t.q25) / t.median, 2) + "%";
+  return cell;
 }
-
-}  // namespace
-
-// The profiles behind the contact-query goals (perf and cachegrind, 2026-11-28, after the inner
-// polytope, the region's centre and the scan on AVX; hulls of random points on a sphere), each a
-// measured cause.
-constexpr const char* kDetectorProfile =
-    "touching, the tests no longer run for shapes the inner polytope proves to overlap: at N = 32 "
-    "the shapes' vertex climbs (GJK's and EPA's supports, the candidates' overlaps) are about a "
-    "quarter of the query, the narrowed search an eighth, EPA's own bookkeeping a tenth and the "
-    "region's centre about a fifth.";
-constexpr const char* kDeepProfile =
-    "deep, small hulls: at N = 128 the shapes' supports (a scan of every vertex, four at a time) "
-    "are about 3/10 of the query's instructions (about 15 EPA iterations, two supports each, "
-    "before the polytope's nearest triangle lies on a face of the Minkowski difference), EPA's "
-    "own bookkeeping (nearest triangle, seen triangles, new faces) about a quarter, the narrowed "
-    "search about a fifth and the region's centre about a twentieth. FCL's convex pairs run "
-    "libccd's MPR, which estimates the depth without certifying the least overlap.";
-
-// The profile behind the whole-step goal (perf, 2026-11-28, many_1000 over the bench's first 60
-// steps, with the broad phase's pairs kept from step to step), a measured cause.
-constexpr const char* kStepProfile =
-    "the whole step, many_1000: the separation proofs of the pairs passing the bounding check are "
-    "about a third of the step (the seed's bounding spheres of neighbouring cubes overlap, so "
-    "about 2,700 pairs pass it each step), the look-ahead's moves of every body about a sixth, "
-    "the broad phase (its pairs kept from step to step) and the state check about a tenth each. "
-    "On many_100 Bullet's own time varies by a quarter from run to run (0.26 to 0.33 µs per "
-    "body-step).";
-
-std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& results) {
-  std::vector<PerfGoal> goals;
-  const double fast_exp = series_exponent(results.narrow, "custom", "accelerated", "touching");
-  goals.push_back({"custom (accelerated), touching: time grows no faster than N^1.2",
-                   "exponent " + bench_num(fast_exp) +
-                       " (N = " + std::to_string(plan.hull_sizes.front()) + " to " +
-                       std::to_string(plan.hull_sizes.back()) + ")",
-                   std::isfinite(fast_exp) && fast_exp <= 1.2, ""});
-  const double fast_2048 = find_time(results.narrow, "custom", "accelerated", "touching", 2048);
-  // Against FCL with its shapes built once (custom keeps its hierarchies per shape too): the
-  // per-call `fcl` row also pays for building fcl::Convex, which would flatter custom.
-  const double fcl_2048 = find_time(results.narrow, "fcl", "prebuilt", "touching", 2048);
-  goals.push_back(
-      {"custom (accelerated) no slower than fcl (shapes prebuilt) at N = 2048, touching",
-       fmt_duration_ns(fast_2048) + " vs " + fmt_duration_ns(fcl_2048) + ": ratio " +
-           bench_num(fast_2048 / fcl_2048),
-       fast_2048 <= fcl_2048, kDetectorProfile});
-  const double fast_box = find_time(results.narrow, "custom", "accelerated", "touching", 8);
-  const double fclbox = find_time(results.narrow, "fcl-box", "default", "touching", 8);
-  goals.push_back({"custom (accelerated) within 1.5x of fcl-box on two boxes, touching",
-                   fmt_duration_ns(fast_box) + " vs " + fmt_duration_ns(fclbox) + ": ratio " +
-                       bench_num(fast_box / fclbox),
-                   fast_box <= 1.5 * fclbox, ""});
-  for (BroadPhaseMethod m : kBenchBroadPhaseMethods) {
-    std::vector<std::pair<double, double>> pts;
-    for (const BroadRow& r : results.broad)
-      if (r.method == to_string(m) && std::isfinite(r.ns_per_step))
-        pts.push_back({static_cast<double>(r.bodies), r.ns_per_step});
-    if (m == BroadPhaseMethod::Tree) {
-      const double e = fit_exponent(pts);
-      goals.push_back(
-          {"broad phase (tree, the world's default): pair finding grows no faster than "
-           "N^1.2",
-           "exponent " + bench_num(e) + " (" + std::to_string(plan.crowd_sizes.front()) + " to " +
-               std::to_string(plan.crowd_sizes.back()) + " bodies)",
-           std::isfinite(e) && e <= 1.2, ""});
-    }
-  }
-
-  // Issues 11 and 24: the custom contact query (detector and contact plane) no slower than FCL
-  // with prebuilt shapes at every hull size timed, touching (issue 11) and deep (issue 24).
-  for (const char* pose : {"touching", "deep"}) {
-    std::string measured;
-    bool met = true;
-    int compared = 0;
-    for (int n : plan.hull_sizes) {
-      const double c = find_time(results.narrow, "custom", "accelerated", pose, n);
-      const double f = find_time(results.narrow, "fcl", "prebuilt", pose, n);
-      if (!std::isfinite(c) || !std::isfinite(f)) continue;
-      ++compared;
-      met = met && c <= f;
-      measured += (measured.empty() ? "" : ", ") + ("N = " + std::to_string(n) + ": ") +
-                  bench_num(c / f, 2) + "x";
-    }
-    const bool touching = std::string(pose) == "touching";
-    goals.push_back(
-        {std::string("custom (accelerated) no slower than fcl (shapes prebuilt) at every hull "
-                     "size timed, ") +
-             pose + (touching ? " (issue 11)" : " (issue 24)"),
-         measured.empty() ? "not measured" : measured, met && compared > 0,
-         touching ? kDetectorProfile : kDeepProfile});
-  }
-  for (const char* scene : {"many_100", "many_1000"}) {
-    double custom = NAN, bullet = NAN;
-    for (const StepRow& r : results.step)
-      if (r.scene == scene && r.variant != "faithful") {
-        if (r.backend == "custom") custom = r.us_per_body_step;
-        if (r.backend == "bullet") bullet = r.us_per_body_step;
-      }
-    const std::string measured = bench_num(custom, 3) + " µs vs " + bench_num(bullet, 3) +
-                                 " µs: ratio " + bench_num(custom / bullet, 3);
-    goals.push_back({std::string("whole custom step within 2x of Bullet per body-step on ") +
-                         scene + " (issue 11)",
-                     measured, custom <= 2.0 * bullet, ""});
-    // Issue 24: with the time of impact of every new contact and the chosen plane.
-    goals.push_back({std::string("whole custom step no slower than Bullet per body-step on ") +
-                         scene + " (issue 24)",
-                     measured, custom <= bullet, kStepProfile});
-  }
-  // Issue 15: the extended engine (friction, manifolds, time of impact) within 2x of the
-  // seed's algorithm (the custom-seed backend) per body-step on many_1000.
-  {
-    double custom = NAN, seed = NAN;
-    for (const StepRow& r : results.step)
-      if (r.scene == "many_1000") {
-        if (r.backend == "custom" && r.variant != "faithful") custom = r.us_per_body_step;
-        if (r.backend == "custom-seed") seed = r.us_per_body_step;
-      }
-    goals.push_back({"custom step within 2x of custom-seed per body-step on many_1000 (issue 15)",
-                     bench_num(custom, 3) + " µs vs " + bench_num(seed, 3) + " µs: ratio " +
-                         bench_num(custom / seed, 3),
-                     custom <= 2.0 * seed, ""});
-  }
-  // Issue 17: explore's contact samples per minute per core.
-  for (const ExploreRow& r : results.explore)
-    goals.push_back({"rbx explore: at least 50,000 contact samples per minute per core through " +
-                         r.backends + " on hulls under 100 points (issue 17)",
-                     bench_num(r.samples_per_minute, 3) + " per minute (one thread, " +
-                         std::to_string(r.samples) +
-                         " samples of seed 1, as `rbx explore --bench --threads 1`)",
-                     r.samples_per_minute >= 50000.0, ""});
-  return goals;
-}
-
-namespace {
 
 // perf.json: the machine, the settings, every row, the goals and the fitted exponents.
 Json perf_json(const BenchPlan& plan, const BenchResults& results,
@@ -212,38 +80,49 @@ Json perf_json(const BenchPlan& plan, const BenchResults& results,
                    {"deep_offset", kPoseKinds[1].offset},
                    {"separated_offset", kPoseKinds[2].offset}};
   j["rows"] = Json::array();
-  for (const NarrowRow& r : results.narrow)
-    j["rows"].push_back(
-        {{"kind", "narrowphase"},
-         {"backend", r.backend},
-         {"variant", r.variant},
-         {"vertices", r.vertices},
-         {"hull_vertices", r.hull_vertices},
-         {"pose", r.pose},
-         {"ns_per_query", std::isfinite(r.ns_per_query) ? Json(r.ns_per_query) : Json(nullptr)},
-         {"iterations", r.iterations},
-         {"status", r.status}});
-  for (const BroadRow& r : results.broad)
-    j["rows"].push_back(
-        {{"kind", "broadphase"},
-         {"method", r.method},
-         {"bodies", r.bodies},
-         {"ns_per_step", std::isfinite(r.ns_per_step) ? Json(r.ns_per_step) : Json(nullptr)},
-         {"pairs_per_step", r.pairs_per_step}});
-  for (const StepRow& r : results.step)
-    j["rows"].push_back(
-        {{"kind", "step"},
-         {"backend", r.backend},
-         {"variant", r.variant},
-         {"scene", r.scene},
-         {"bodies", r.bodies},
-         {"total_bodies", r.total_bodies},
-         {"us_per_body_step",
-          std::isfinite(r.us_per_body_step) ? Json(r.us_per_body_step) : Json(nullptr)},
-         {"status", r.status}});
+  for (const NarrowRow& r : results.narrow) {
+    Json row = {{"kind", "narrowphase"},
+                {"backend", r.backend},
+                {"variant", r.variant},
+                {"vertices", r.vertices},
+                {"hull_vertices", r.hull_vertices},
+                {"pose", r.pose},
+                {"status", r.status}};
+    put_time(row, "ns_per_query", r.ns_per_query);
+    j["rows"].push_back(row);
+  }
+  for (const BroadRow& r : results.broad) {
+    Json row = {{"kind", "broadphase"},
+                {"method", r.method},
+                {"bodies", r.bodies},
+                {"pairs_per_step", r.pairs_per_step}};
+    put_time(row, "ns_per_step", r.ns_per_step);
+    j["rows"].push_back(row);
+  }
+  for (const StepRow& r : results.step) {
+    Json row = {{"kind", "step"},    {"backend", r.backend}, {"variant", r.variant},
+                {"scene", r.scene},  {"bodies", r.bodies},   {"total_bodies", r.total_bodies},
+                {"status", r.status}};
+    put_time(row, "us_per_body_step", r.us_per_body_step);
+    j["rows"].push_back(row);
+  }
+  for (const ExploreRow& r : results.explore) {
+    Json row = {{"kind", "explore"}, {"backends", r.backends}, {"samples", r.samples}};
+    put_time(row, "samples_per_minute", r.samples_per_minute);
+    j["rows"].push_back(row);
+  }
   j["goals"] = Json::array();
-  for (const PerfGoal& g : goals)
-    j["goals"].push_back({{"goal", g.goal}, {"measured", g.measured}, {"met", g.met}});
+  for (const PerfGoal& g : goals) {
+    Json ratios = Json::array();
+    for (const GoalRatio& q : g.ratios)
+      ratios.push_back({{"between", q.label},
+                        {"median", std::isfinite(q.ratio.median) ? Json(q.ratio.median) : Json()},
+                        {"q25", std::isfinite(q.ratio.q25) ? Json(q.ratio.q25) : Json()},
+                        {"q75", std::isfinite(q.ratio.q75) ? Json(q.ratio.q75) : Json()},
+                        {"rounds", q.ratio.rounds}});
+    j["goals"].push_back(
+        {{"goal", g.goal}, {"measured", g.measured}, {"met", g.met}, {"ratios", ratios}});
+  }
   j["exponents"] = Json::object();
   for (const NarrowBackend& b : nb)
     for (const PoseKind& k : kPoseKinds) {
@@ -257,16 +136,21 @@ Json perf_json(const BenchPlan& plan, const BenchResults& results,
 // perf.csv: one line per row.
 std::string perf_csv(const BenchResults& results) {
   std::ostringstream csv;
-  csv << "kind,backend,variant,method,scene,vertices,pose,bodies,value,unit\n";
+  auto figures = [](const BenchTime& t) {
+    return bench_num(t.median, 6) + "," + bench_num(t.q25, 6) + "," + bench_num(t.q75, 6) + "," +
+           std::to_string(t.rounds) + "," + std::to_string(t.calls) + "," + bench_num(t.cold, 6);
+  };
+  csv << "kind,backend,variant,method,scene,vertices,pose,bodies,value,q25,q75,rounds,calls,cold,"
+         "unit\n";
   for (const NarrowRow& r : results.narrow)
     csv << "narrowphase," << r.backend << "," << r.variant << ",,," << r.vertices << "," << r.pose
-        << ",," << bench_num(r.ns_per_query, 6) << ",ns_per_query\n";
+        << ",," << figures(r.ns_per_query) << ",ns_per_query\n";
   for (const BroadRow& r : results.broad)
-    csv << "broadphase,,," << r.method << ",,,," << r.bodies << "," << bench_num(r.ns_per_step, 6)
+    csv << "broadphase,,," << r.method << ",,,," << r.bodies << "," << figures(r.ns_per_step)
         << ",ns_per_step\n";
   for (const StepRow& r : results.step)
     csv << "step," << r.backend << "," << r.variant << ",," << r.scene << ",,," << r.bodies << ","
-        << bench_num(r.us_per_body_step, 6) << ",us_per_body_step\n";
+        << figures(r.us_per_body_step) << ",us_per_body_step\n";
 
   return csv.str();
 }
@@ -278,13 +162,17 @@ std::string goals_markdown(const BenchPlan& plan, const BenchResults& results,
   md << "# Performance: `rbx bench" << (plan.quick ? " --quick" : "") << "`\n\n";
   md << "Machine: " << cpu_model() << ", " << results.cpus << " CPUs (shared); Release build; "
      << (plan.quick ? "quick run (fewer sizes and poses, short times). " : "full run. ")
-     << "Google Benchmark: every case runs one untimed warm-up pass, then is timed for at least "
+     << "Every case runs its warm-up first, timed alone (its cold pass, in perf.json and "
+        "perf.csv). The cases compared with each other (the backends on one shape size and pose "
+        "kind, the broad-phase methods on one crowd, the engines on one scene) are timed "
+        "together, in rounds taken in turns with the first case rotating, until each has at "
+        "least "
      << plan.min_time << " s (narrow phase), " << plan.crowd_min_time << " s (broad phase), "
-     << plan.step_min_time << " s (whole step); the broad phase, "
-     << (plan.quick ? "" : "the whole steps, ")
-     << "the narrow-phase cases of up to 128 vertices and those behind the goals run "
-     << kBenchRepetitions
-     << " times and keep the fastest (the machine is shared). Wall time of the timing: "
+     << plan.step_min_time << " s and " << plan.step_rounds
+     << " rounds (whole step) and 7 rounds, so a passing load of the shared machine falls on "
+        "them alike (docs/bench.md). A time is the median over rounds, ± half its 25-75 % "
+        "range; a ratio is taken round by round, its median with the 25-75 % range of the "
+        "rounds' ratios. Wall time of the timing: "
      << bench_num(timing_s, 3) << " s.\n\n";
   md << "## Goals\n\n| goal | measured | met |\n|---|---|---|\n";
   for (const PerfGoal& g : goals)
@@ -315,7 +203,8 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
      << "% gap (*separated*); " << plan.poses << " distinct poses per kind, taken in turn, "
      << plan.poses_per_iteration
      << " per timed iteration, so that no backend is timed on a few poses its processor's branch "
-        "predictor has learned by heart (docs/bench.md); the time is the mean per query. Times "
+        "predictor has learned by heart (docs/bench.md); the time is the median over rounds of the "
+        "mean per query in a round, ± half the 25-75 % range of the rounds. Times "
         "include what each adapter "
         "does per call (the references build their library's shape from the hull on every "
         "query, as the adapters are written; `custom` caches its hierarchies per shape "
@@ -348,7 +237,7 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
     for (const NarrowBackend& b : nb) {
       md << "| " << b.backend << " | " << b.variant << " |";
       for (int n : sizes) {
-        double t = NAN;
+        BenchTime t;
         std::string note;
         for (const NarrowRow& r : results.narrow)
           if (r.backend == b.backend && r.variant == b.variant && r.pose == k.name &&
@@ -356,7 +245,7 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
             t = r.ns_per_query;
             if (r.status != "ok") note = " (" + r.status.substr(0, r.status.find(':')) + ")";
           }
-        md << " " << fmt_duration_ns(t) << note << " |";
+        md << " " << time_cell(t, true) << note << " |";
       }
       md << " " << bench_num(series_exponent(results.narrow, b.backend, b.variant, k.name), 2)
          << " |\n";
@@ -388,8 +277,9 @@ std::string broad_markdown(const BenchPlan& plan, const BenchResults& results) {
     for (int n : plan.crowd_sizes)
       for (const BroadRow& r : results.broad)
         if (r.method == to_string(m) && r.bodies == n) {
-          md << " " << fmt_duration_ns(r.ns_per_step) << " |";
-          if (std::isfinite(r.ns_per_step)) pts.push_back({static_cast<double>(n), r.ns_per_step});
+          md << " " << time_cell(r.ns_per_step, true) << " |";
+          if (std::isfinite(r.ns_per_step.median))
+            pts.push_back({static_cast<double>(n), r.ns_per_step.median});
           pairs = r.pairs_per_step;
         }
     md << " " << bench_num(fit_exponent(pts), 2) << " | " << bench_num(pairs, 4) << " (at "
@@ -411,11 +301,16 @@ std::string step_markdown(const BenchResults& results) {
         "loops) with the all-pairs check; "
         "`custom-seed` is the seed's algorithm as the custom-seed backend runs it (first hit, "
         "single-point frictionless impulse).\n\n"
-        "| scene | moving bodies | backend | variant | µs per body per step | status |\n"
-        "|---|---:|---|---|---:|---|\n";
+        "Each round runs the short and the long run of every engine in turn; its difference "
+        "gives that round's figure.\n\n"
+        "| scene | moving bodies | backend | variant | µs per body per step | 25-75 % | rounds "
+        "| status |\n"
+        "|---|---:|---|---|---:|---|---:|---|\n";
   for (const StepRow& r : results.step)
     md << "| " << r.scene << " | " << r.bodies << " (" << r.total_bodies << " in all) | "
-       << r.backend << " | " << r.variant << " | " << bench_num(r.us_per_body_step, 3) << " | "
+       << r.backend << " | " << r.variant << " | " << bench_num(r.us_per_body_step.median, 3)
+       << " | " << bench_num(r.us_per_body_step.q25, 3) << "-"
+       << bench_num(r.us_per_body_step.q75, 3) << " | " << r.us_per_body_step.rounds << " | "
        << r.status << " |\n";
   md << "\n";
 

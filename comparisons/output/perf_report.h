@@ -1,23 +1,13 @@
-// `rbx bench`'s pages: the goals of issue 6 judged on the measured rows, and perf.md, perf.json,
+// `rbx bench`'s pages: the goals (comparisons/eval/bench_goals.h) and perf.md, perf.json,
 // perf.csv and figures/perf_*.{png,svg} (comparisons/output/bench_plots.py, matplotlib).
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "comparisons/eval/bench_cases.h"
+#include "comparisons/eval/bench_goals.h"
 
 namespace rbx {
-
-/// One performance goal and what was measured against it.
-struct PerfGoal {
-  std::string goal, measured;
-  bool met = false;
-  std::string behind;  // the profile last measured behind the goal, printed when it is not met
-};
-
-/// The goals of issue 6, judged on the rows of a run.
-std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& results);
 
 /// Writes perf.md, perf.json, perf.csv and the figures into `out`, each file built in a
 /// temporary folder and moved in (other files there, such as `rbx report`'s, are kept). With

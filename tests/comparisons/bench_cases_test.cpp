@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <random>
+#include <string>
 
 namespace rbx {
 namespace {
@@ -75,6 +76,65 @@ TEST(BenchCases, EveryNarrowBackendHasAQueryAndTheQuickPlanIsPartOfTheFullOne) {
   EXPECT_LE(quick.poses_per_iteration, full.poses_per_iteration);
   // Both runs query a cycle of distinct poses many iterations long (docs/bench.md).
   for (const BenchPlan& p : {quick, full}) EXPECT_GE(p.poses, 20 * p.poses_per_iteration);
+}
+
+TEST(BenchCases, EveryRowOfARunIsTimedInRoundsWithItsColdPassApart) {
+  // A run as small as the families allow: the box and one hull, one crowd, a few steps, a few
+  // explore samples, and times so short that every case stops at its minimum count of rounds
+  // (a slow call at the smaller count TimingPlan allows it).
+  BenchPlan plan = bench_plan(true);
+  plan.hull_sizes = {32};
+  plan.min_time = 1e-4;
+  plan.crowd_sizes = {200};
+  plan.crowd_min_time = 1e-4;
+  plan.steps_100 = {2, 4};
+  plan.steps_1000 = {1, 2};
+  plan.step_min_time = 1e-4;
+  plan.step_rounds = 3;
+  plan.explore_samples = 20;
+  plan.explore_min_time = 1e-4;
+  const BenchResults r = run_bench(plan);
+  auto well_formed = [](const BenchTime& t, int min_rounds, const std::string& what) {
+    EXPECT_GE(t.rounds, min_rounds) << what;
+    EXPECT_EQ(t.per_round.size(), static_cast<std::size_t>(t.rounds)) << what;
+    EXPECT_LE(t.q25, t.median) << what;
+    EXPECT_LE(t.median, t.q75) << what;
+  };
+  ASSERT_FALSE(r.narrow.empty());
+  for (const NarrowRow& row : r.narrow) {
+    const std::string what =
+        row.backend + "/" + row.variant + "/" + std::to_string(row.vertices) + "/" + row.pose;
+    EXPECT_EQ(row.status, "ok") << what;
+    well_formed(row.ns_per_query, TimingPlan{}.min_rounds_slow, what);
+    EXPECT_GT(row.ns_per_query.median, 0.0) << what;
+    EXPECT_GT(row.ns_per_query.cold, 0.0) << what;
+    EXPECT_GE(row.ns_per_query.calls, row.ns_per_query.rounds) << what;
+  }
+  // Every backend of one size and kind was timed in the same turns: any two share rounds.
+  for (const NarrowRow& a : r.narrow)
+    for (const NarrowRow& b : r.narrow) {
+      if (a.vertices == b.vertices && a.pose == b.pose) {
+        EXPECT_GT(bench_ratio(a.ns_per_query, b.ns_per_query).rounds, 0);
+      }
+    }
+  ASSERT_EQ(r.broad.size(), 3u);
+  for (const BroadRow& row : r.broad)
+    well_formed(row.ns_per_step, TimingPlan{}.min_rounds_slow, row.method);
+  // Two scenes, four engines.
+  ASSERT_EQ(r.step.size(), 8u);
+  for (const StepRow& row : r.step) {
+    const std::string what = row.scene + "/" + row.backend + "/" + row.variant;
+    // A round's figure is a difference of two runs of a few steps: it may be lost in the noise
+    // of building the world, and the row then says so instead of giving a number.
+    if (row.status == "ok") {
+      well_formed(row.us_per_body_step, TimingPlan{}.min_rounds_slow, what);
+    } else {
+      EXPECT_EQ(row.status, "extra steps within the timing noise of the set-up") << what;
+    }
+  }
+  ASSERT_EQ(r.explore.size(), 1u);
+  well_formed(r.explore[0].samples_per_minute, 3, "explore");
+  EXPECT_GT(r.explore[0].samples, 0);
 }
 
 }  // namespace

@@ -44,6 +44,32 @@ TEST(Timing, EveryRoundIsLongerThanTheClocksFloorAndEachSubjectGetsItsMinimum) {
   EXPECT_EQ(t[0].cold_s, 0.0) << "the cold call is the caller's: the one that answered";
 }
 
+TEST(Timing, SetUpRunsBeforeEveryCallOutsideTheClock) {
+  // The set-up spins 1 ms and the call 20 µs: a round timed with its set-ups would give at
+  // least 1 ms per call; timed without them, a call's median stays far below (the spin ends at
+  // 20 µs; 500 µs leaves the scheduler a wide margin).
+  TimingPlan plan;
+  plan.min_time_s = 1e-6;
+  plan.min_rounds = 5;
+  plan.min_rounds_slow = 5;  // the rounds all count, however the time adds up
+  int set_ups = 0, calls = 0;
+  TimedSubject s{"moved", false, [&] {
+                   ++calls;
+                   spin(2e-5);
+                 }};
+  s.set_up = [&] {
+    ++set_ups;
+    spin(1e-3);
+  };
+  const std::vector<Rounds> r = time_rounds({s}, plan);
+  ASSERT_EQ(r.size(), 1u);
+  ASSERT_EQ(static_cast<int>(r[0].per_call_s.size()), plan.min_rounds);
+  EXPECT_EQ(set_ups, calls) << "one set-up before every call";
+  const Timing t = timing_of(r[0]);
+  EXPECT_GE(t.median_s, 2e-5);
+  EXPECT_LT(t.median_s, 5e-4);
+}
+
 TEST(Timing, SubjectsTakeTurnsRoundByRound) {
   TimingPlan plan;
   plan.min_time_s = 1e-6;  // every subject stops at min_rounds, whatever the load: one call a round
