@@ -14,8 +14,9 @@ Mat3 RigidBody::inertia_world() const {
 
 double RigidBody::kinetic_energy() const {
   if (is_static) return 0.0;
-  return 0.5 * mass * velocity.squaredNorm() +
-         0.5 * angular_velocity.dot(inertia_world() * angular_velocity);
+  // w . (R I R^T w) = (R^T w) . I (R^T w): one rotation of a vector, no world-frame matrix.
+  const Vec3 w_body = orientation.conjugate() * angular_velocity;
+  return 0.5 * mass * velocity.squaredNorm() + 0.5 * w_body.dot(inertia_body * w_body);
 }
 
 Vec3 RigidBody::linear_momentum() const { return is_static ? Vec3::Zero() : Vec3(mass * velocity); }

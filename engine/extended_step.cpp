@@ -232,7 +232,7 @@ void ExtendedStep::place_boxes(const std::vector<RigidBody>& bodies,
 }
 
 bool ExtendedStep::separated(const WorldState& world, const RigidBody& a, const RigidBody& b, int i,
-                             int j) {
+                             int j, double travel) {
   const std::vector<BodyFacts>& facts = world.facts;
   // The pair's tolerance, 1e-9 x the larger size, is the larger of the two bodies' own.
   const double margin = separation_margin(std::max(facts[i].own_tol, facts[j].own_tol),
@@ -242,6 +242,11 @@ bool ExtendedStep::separated(const WorldState& world, const RigidBody& a, const 
   if (gap_ab.maxCoeff() > margin || gap_ba.maxCoeff() > margin) return true;
   const long long key = static_cast<long long>(i) * static_cast<long long>(world.bodies.size()) + j;
   const auto kept = witnesses_.find(key);
+  // Proved at the step's start with room for both bodies' travel along the step (no point moves
+  // farther): still apart at its end.
+  if (travel >= 0.0 && kept != witnesses_.end() && kept->second.step == steps_ &&
+      kept->second.gap - travel > margin)
+    return true;
   if (kept != witnesses_.end()) {
     // The bounding boxes' bound first (exact for boxes), the vertices only when it falls short.
     const Vec3 u = b.orientation * kept->second.axis;
@@ -276,7 +281,7 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
   std::vector<double> sweep(n);
   double thinnest = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < n; ++i) {
-    sweep[i] = sweep_length(world.bodies[i], dt);
+    sweep[i] = sweep_length(world.bodies[i], facts[i].radius, dt);
     thinnest = std::min(thinnest, facts[i].thickness);
   }
   std::set<std::pair<int, int>> touching;
@@ -330,15 +335,9 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
     const auto [i, j] = pair;
     const RigidBody &a = ahead_[i], &b = ahead_[j];
     if ((a.is_static && b.is_static) || touching.count(pair) || asked.count(pair)) continue;
-    // Still apart at the step's end: proved at its start with room for both bodies' travel
-    // along the step (no point moves farther), else by the pair's kept axis or a new one.
-    const auto kept = witnesses_.find(static_cast<long long>(i) * static_cast<long long>(n) + j);
-    if (kept != witnesses_.end() && kept->second.step == steps_ &&
-        kept->second.gap - travel[i] - travel[j] >
-            separation_margin(std::max(facts[i].own_tol, facts[j].own_tol), facts[i].reach,
-                              facts[j].reach))
-      continue;
-    if (separated(world, a, b, i, j)) continue;
+    // Still apart at the step's end: by the gap proved at its start less both bodies' travel,
+    // else by the pair's kept axis or a new one.
+    if (separated(world, a, b, i, j, travel[i] + travel[j])) continue;
     const TimeOfImpact t =
         time_of_impact(world.bodies[i], world.bodies[j], dt, world.variant,
                        world.tunables.toi_max_samples, &facts[i].principal, &facts[j].principal);

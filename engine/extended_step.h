@@ -46,9 +46,11 @@ class ExtendedStep {
   static void integrate_bodies(WorldState& world, const std::vector<bool>& moved,
                                const std::vector<RigidBody>& ahead);
   // True when bodies i and j, as `a` and `b` (at the step's start, or moved to its end), are
-  // proved apart (the detector would find nothing): by the pair's kept axis, else by a new one,
-  // which is then kept.
-  bool separated(const WorldState& world, const RigidBody& a, const RigidBody& b, int i, int j);
+  // proved apart (the detector would find nothing): by their world boxes; with `travel` (m, the
+  // two bodies' travel over the step, for poses at its end), by the gap kept this step at its
+  // start less that travel; by the pair's kept axis; else by a new one, which is then kept.
+  bool separated(const WorldState& world, const RigidBody& a, const RigidBody& b, int i, int j,
+                 double travel = -1.0);
 
   // The growth of the bounding spheres (m) for one broad phase serving both the step's start and
   // its end (the look-ahead): twice the farthest any body's sphere centre reaches at its start

@@ -17,6 +17,10 @@ struct PrincipalFrame {
   Mat3 axes = Mat3::Identity();
 };
 
+/// Two principal moments closer than this many epsilons of the largest are one moment: the
+/// round-off of a mesh's integrals and of the 3x3 eigensolver (rotate_free_body's splitting).
+inline constexpr double kEqualMoments = 64.0;
+
 /// The principal frame of a symmetric positive definite inertia (Eigen's direct 3x3 solver).
 PrincipalFrame principal_frame(const Mat3& inertia_body);
 
@@ -44,6 +48,14 @@ double free_turn_rate(const PrincipalFrame& frame);
 /// rotate_free_body with the principal frame of `inertia_body` (kg m^2, body frame).
 Quat rotate_free_body(const Quat& orientation, const Mat3& inertia_body, const Vec3& momentum,
                       double dt);
+
+/// The world angular momentum R I R^T w of a body (kg m^2/s), about its centre of mass.
+Vec3 world_momentum(const RigidBody& body);
+
+/// The body's orientation after dt of torque-free rotation with world angular momentum
+/// `momentum` (rotate_free_body; unchanged when it is zero): the turn integrate_symplectic makes.
+Quat free_rotation(const RigidBody& body, const Vec3& momentum, double dt,
+                   const PrincipalFrame* frame = nullptr);
 
 /// Dispatches on the scene's integrator. Static bodies never move. `frame` as for
 /// integrate_symplectic.

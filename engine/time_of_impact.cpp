@@ -25,10 +25,15 @@ RigidBody advanced(const RigidBody& body, double t, const PrincipalFrame* frame)
   return moved;
 }
 
-double sweep_length(const RigidBody& body, double t) {
+Pose advanced_pose(const RigidBody& body, double t, const PrincipalFrame* frame) {
+  if (body.is_static) return body.pose();
+  // What advanced() computes of the pose, without copying the body: no gravity, so the centre
+  // moves by v t, and the free rotation under the body's world angular momentum.
+  return {body.position + body.velocity * t, free_rotation(body, world_momentum(body), t, frame)};
+}
+
+double sweep_length(const RigidBody& body, double radius, double t) {
   if (body.is_static) return 0.0;
-  double radius = 0.0;
-  for (const Vec3& v : body.shape->vertices()) radius = std::max(radius, v.norm());
   return (body.velocity.norm() + body.angular_velocity.norm() * radius) * t;
 }
 
@@ -46,7 +51,7 @@ TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt,
   // One detection cache for every sample (its scratch lists allocated once).
   DetectionCache cache;
   const auto pose_at = [&](const RigidBody& body, double t, const PrincipalFrame* frame) {
-    return advanced(body, t, frame).pose();
+    return advanced_pose(body, t, frame);
   };
   auto touching = [&](double t) {
     return detect(*a.shape, pose_at(a, t, frame_a), *b.shape, pose_at(b, t, frame_b), variant,

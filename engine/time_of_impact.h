@@ -22,9 +22,13 @@ double shape_thickness(const ConvexPolyhedron& shape);
 /// `frame`, when given, is the body's principal frame kept by the caller (the same numbers).
 RigidBody advanced(const RigidBody& body, double t, const PrincipalFrame* frame = nullptr);
 
+/// advanced(body, t, frame).pose(), without copying the body.
+Pose advanced_pose(const RigidBody& body, double t, const PrincipalFrame* frame = nullptr);
+
 /// Largest distance (m) a point of the body can travel over time t with its current velocity:
-/// |v| t + |w| r t, r its bounding radius about the centre of mass (a bound, not exact).
-double sweep_length(const RigidBody& body, double t);
+/// |v| t + |w| r t, r = `radius`, its bounding radius about the centre of mass (BodyFacts), a
+/// bound, not exact.
+double sweep_length(const RigidBody& body, double radius, double t);
 
 /// Largest distance (m) any point of the body can move as advanced(body, t) moves it: |v| t,
 /// plus the free rotation's turn (at most free_turn_rate(frame) |L| t, L the world angular

@@ -106,15 +106,18 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
   };
   const double fast_exp = series_exponent(nr, "custom", "accelerated", "touching");
   goals.push_back({"custom (accelerated), touching: time grows no faster than N^1.2",
-                   "exponent " + num(fast_exp) + " (N = " + std::to_string(plan.hull_sizes.front()) +
-                       " to " + std::to_string(plan.hull_sizes.back()) + ")",
-                   std::isfinite(fast_exp) && fast_exp <= 1.2, "", {}});
+                   "exponent " + num(fast_exp) +
+                       " (N = " + std::to_string(plan.hull_sizes.front()) + " to " +
+                       std::to_string(plan.hull_sizes.back()) + ")",
+                   std::isfinite(fast_exp) && fast_exp <= 1.2,
+                   "",
+                   {}});
   // Against FCL with its shapes built once (custom keeps its hierarchies per shape too): the
   // per-call `fcl` row also pays for building fcl::Convex, which would flatter custom.
-  goals.push_back(ratio_goal(
-      "custom (accelerated) no slower than fcl (shapes prebuilt) at N = 2048, touching", "N = 2048",
-      query("custom", "accelerated", "touching", 2048), query("fcl", "prebuilt", "touching", 2048),
-      1.0, "ns", kDetectorProfile));
+  goals.push_back(
+      ratio_goal("custom (accelerated) no slower than fcl (shapes prebuilt) at N = 2048, touching",
+                 "N = 2048", query("custom", "accelerated", "touching", 2048),
+                 query("fcl", "prebuilt", "touching", 2048), 1.0, "ns", kDetectorProfile));
   goals.push_back(ratio_goal("custom (accelerated) within 1.5x of fcl-box on two boxes, touching",
                              "box", query("custom", "accelerated", "touching", 8),
                              query("fcl-box", "default", "touching", 8), 1.5, "ns"));
@@ -124,18 +127,22 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
       if (r.method == to_string(BroadPhaseMethod::Tree) && std::isfinite(r.ns_per_step.median))
         pts.push_back({static_cast<double>(r.bodies), r.ns_per_step.median});
     const double e = fit_exponent(pts);
-    goals.push_back({"broad phase (tree, the world's default): pair finding grows no faster than "
-                     "N^1.2",
-                     "exponent " + num(e) + " (" + std::to_string(plan.crowd_sizes.front()) +
-                         " to " + std::to_string(plan.crowd_sizes.back()) + " bodies)",
-                     std::isfinite(e) && e <= 1.2, "", {}});
+    goals.push_back(
+        {"broad phase (tree, the world's default): pair finding grows no faster than "
+         "N^1.2",
+         "exponent " + num(e) + " (" + std::to_string(plan.crowd_sizes.front()) + " to " +
+             std::to_string(plan.crowd_sizes.back()) + " bodies)",
+         std::isfinite(e) && e <= 1.2,
+         "",
+         {}});
   }
   // The custom contact query (detector and contact plane) no slower than FCL with prebuilt shapes
   // at every hull size timed, touching and deep.
   for (const char* pose : {"touching", "deep"}) {
     PerfGoal g;
-    g.goal = std::string("custom (accelerated) no slower than fcl (shapes prebuilt) at every hull "
-                         "size timed, ") +
+    g.goal = std::string(
+                 "custom (accelerated) no slower than fcl (shapes prebuilt) at every hull "
+                 "size timed, ") +
              pose;
     g.behind = std::string(pose) == "touching" ? kDetectorProfile : kDeepProfile;
     g.met = true;
@@ -155,21 +162,20 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
     }
     goals.push_back(g);
   }
-  auto step = [&](const char* scene, const char* backend,
-                  const char* variant) -> const BenchTime* {
+  auto step = [&](const char* scene, const char* backend, const char* variant) -> const BenchTime* {
     const StepRow* r = find_step(results.step, scene, backend, variant);
     return r && r->us_per_body_step.rounds > 0 ? &r->us_per_body_step : nullptr;
   };
   for (const char* scene : {"many_100", "many_1000"}) {
     const BenchTime *custom = step(scene, "custom", "accelerated"),
                     *bullet = step(scene, "bullet", "default");
-    goals.push_back(ratio_goal(
-        std::string("whole custom step within 2x of Bullet per body-step on ") + scene, scene,
-        custom, bullet, 2.0, "µs"));
+    goals.push_back(
+        ratio_goal(std::string("whole custom step within 2x of Bullet per body-step on ") + scene,
+                   scene, custom, bullet, 2.0, "µs"));
     // With the time of impact of every new contact and the chosen plane.
-    goals.push_back(ratio_goal(
-        std::string("whole custom step no slower than Bullet per body-step on ") + scene, scene,
-        custom, bullet, 1.0, "µs", kStepProfile));
+    goals.push_back(
+        ratio_goal(std::string("whole custom step no slower than Bullet per body-step on ") + scene,
+                   scene, custom, bullet, 1.0, "µs", kStepProfile));
   }
   // The extended engine (friction, manifolds, time of impact) within 2x of the seed's algorithm
   // (the custom-seed backend) per body-step on many_1000.
@@ -181,12 +187,13 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
     goals.push_back({"rbx explore: at least 50,000 contact samples per minute per core through " +
                          r.backends + " on hulls under 100 points",
                      num(r.samples_per_minute.median, 3) + " per minute (" +
-                         num(r.samples_per_minute.q25, 3) + "-" +
-                         num(r.samples_per_minute.q75, 3) + " over " +
-                         std::to_string(r.samples_per_minute.rounds) + " rounds; one thread, " +
-                         std::to_string(r.samples) +
+                         num(r.samples_per_minute.q25, 3) + "-" + num(r.samples_per_minute.q75, 3) +
+                         " over " + std::to_string(r.samples_per_minute.rounds) +
+                         " rounds; one thread, " + std::to_string(r.samples) +
                          " samples of seed 1, as `rbx explore --bench --threads 1`)",
-                     r.samples_per_minute.median >= 50000.0, "", {}});
+                     r.samples_per_minute.median >= 50000.0,
+                     "",
+                     {}});
   return goals;
 }
 

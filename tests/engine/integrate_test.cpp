@@ -25,6 +25,23 @@ TEST(Integrate, SymplecticFreeFlightUnderGravityMatchesItsClosedForm) {
   EXPECT_LT((b.position - x).norm(), 1e-11);  // 100 additions of O(10) values
 }
 
+TEST(Integrate, AMeshCubesNearlyEqualMomentsAreOneMoment) {
+  // A cube's inertia from its mesh, through the eigensolver, has moments a few ulps apart: the
+  // free rotation treats them as one (kEqualMoments), so the body turns about L alone, at the
+  // rate 1 / I, with no remainder turns adding their round-off (free_turn_rate sums them).
+  const RigidBody b = box_body("cube", Vec3::Constant(0.2), 1, Vec3::Zero(), Quat::Identity());
+  const PrincipalFrame f = principal_frame(b.inertia_body);
+  // The case is only a case when the moments are not already equal bit for bit.
+  ASSERT_FALSE(f.moments(0) == f.moments(1) && f.moments(1) == f.moments(2))
+      << "moments " << f.moments.transpose();
+  const double rate = free_turn_rate(f);
+  EXPECT_TRUE(rate == 1.0 / f.moments(0) || rate == 1.0 / f.moments(2)) << rate;
+  // Three distinct moments (a 1 x 2 x 3 box) keep their remainder: the rate is larger.
+  const RigidBody brick = box_body("brick", Vec3(1, 2, 3), 1, Vec3::Zero(), Quat::Identity());
+  const PrincipalFrame g = principal_frame(brick.inertia_body);
+  EXPECT_GT(free_turn_rate(g), 1.0 / g.moments(0) * (1.0 + 1e-3));
+}
+
 TEST(Integrate, EulerMovesWithTheOldVelocity) {
   // The seed's explicit Euler: x_n = x0 + n v0 dt + g dt^2 n (n - 1) / 2.
   RigidBody b = box_body("A", Vec3::Ones(), 1, Vec3::Zero(), Quat::Identity(), Vec3(1, 0, 0));

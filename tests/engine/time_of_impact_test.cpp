@@ -208,5 +208,22 @@ TEST(ExtendedWorld, DropNeverGainsEnergy) {
   EXPECT_LT(world.bodies()[1].velocity.norm(), 1e-3);  // at rest in the end
 }
 
+TEST(TimeOfImpact, AnAdvancedPoseIsTheAdvancedBodysPoseBitForBit) {
+  // The search moves poses without copying bodies: the same numbers as advanced().
+  for (const Vec3& size : {Vec3(0.2, 0.2, 0.2), Vec3(1, 2, 3)}) {
+    RigidBody b = box_body("b", size, 2, Vec3(0.1, -0.2, 0.3),
+                           Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())),
+                           Vec3(1, -2, 0.5), Vec3(3, 0.4, -7));
+    const PrincipalFrame f = principal_frame(b.inertia_body);
+    for (double t : {0.0, 1e-3, 0.37}) {
+      for (const PrincipalFrame* frame : {static_cast<const PrincipalFrame*>(nullptr), &f}) {
+        const Pose p = advanced_pose(b, t, frame), q = advanced(b, t, frame).pose();
+        EXPECT_EQ(p.position, q.position);
+        EXPECT_EQ(p.orientation.coeffs(), q.orientation.coeffs());
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rbx
