@@ -67,8 +67,8 @@ std::vector<Rounds> time_rounds(const std::vector<TimedSubject>& subjects, const
   const double target_s =
       std::max(plan.round_floor_s, plan.min_time_s / (2.0 * std::max(plan.min_rounds, 1)));
   for (size_t i = 0; i < n; ++i) {
-    // The warm-up call, untimed, then one call to size the rounds.
-    const double warm = timed_round(subjects[i], 1);
+    // The warm-up call, untimed (unless the caller made it), then one call to size the rounds.
+    const double warm = plan.warmed_up ? 0.0 : timed_round(subjects[i], 1);
     const double one = warm < 0 ? warm : timed_round(subjects[i], 1);
     if (one < 0) {
       at[i].failed = true;
@@ -76,6 +76,13 @@ std::vector<Rounds> time_rounds(const std::vector<TimedSubject>& subjects, const
     }
     at[i].rounds.per_round =
         static_cast<long>(std::clamp(std::ceil(target_s / std::max(one, 1e-9)), 1.0, 1e7));
+    // A call that alone lasts the minimum time is a round of its own: after the caller's
+    // warm-up, it is not made twice more before its rounds.
+    if (plan.warmed_up && one >= plan.min_time_s) {
+      at[i].rounds.per_call_s.push_back(one);
+      at[i].total_s += one;
+      at[i].done = finished(at[i], plan);
+    }
   }
   for (size_t turn = 0;; ++turn) {
     bool any = false;

@@ -44,6 +44,11 @@ struct TimingPlan {
   double slow_factor = 5.0;
   int max_rounds = 1000;
   double round_floor_s = 2e-5;  // a round lasts at least this (steady_clock reads in ~20 ns)
+  /// The caller has already run every subject once (its warm-up): no warm-up call here, and the
+  /// call that sizes the rounds counts as the first round when it alone lasts min_time_s (a
+  /// query of seconds is not run twice more before its rounds; that round then precedes the
+  /// first turn).
+  bool warmed_up = false;
 };
 
 /// One subject to time: a call that has already answered, and what isolates it.

@@ -224,9 +224,9 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
     }
     for (std::size_t i = 0; i < caps.size(); ++i) md << (i ? ", " : "") << caps[i];
     md << " (the seed loops cost about 16 N^2 primitive tests per query; bullet-sat rebuilds its "
-          "polyhedral features on every call; DART collides the hulls as triangle meshes; "
-          "`fcl-box` "
-          "takes boxes only).\n\n";
+          "polyhedral features on every call; DART collides the hulls as triangle meshes; Bullet "
+          "and ODE build their shapes from the points on every call, about 2 s a query at "
+          "N = 8192; `fcl-box` takes boxes only).\n\n";
   }
   for (const PoseKind& k : kPoseKinds) {
     md << "### " << k.name << "\n\n| backend | variant |";

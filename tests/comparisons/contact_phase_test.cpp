@@ -1,4 +1,4 @@
-// Contact phase and the measured why-list (issue 12): an impact scene is also run with first
+// Contact phase and the measured why-list: an impact scene is also run with first
 // contact 1/3 and 2/3 of a step later, its closed form unchanged; and the cause written for a
 // backend's miss follows what its first impulse recorded, not a fixed text.
 #include <gtest/gtest.h>

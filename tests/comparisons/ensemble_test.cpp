@@ -129,7 +129,7 @@ TEST(Ensemble, HeadOnImpactsKeepTheInputSpreadWhereTheClosedFormIsMetAndTheStepT
     EXPECT_GT(b.velocity_amplification, 0.5);
     EXPECT_LT(b.velocity_amplification, 2.0);
     // One face contact in every copy; the seed's first hit names the feature its tests find
-    // first at the depth the step first sees, which varies with the copy (issue 24's finding).
+    // first at the depth the step first sees, which varies with the copy.
     if (b.backend != "custom-seed") {
       EXPECT_EQ(b.sequences.size(), 1u);
     }

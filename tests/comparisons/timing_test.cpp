@@ -70,6 +70,30 @@ TEST(Timing, SetUpRunsBeforeEveryCallOutsideTheClock) {
   EXPECT_LT(t.median_s, 5e-4);
 }
 
+TEST(Timing, AWarmedUpCallThatLastsTheMinimumTimeIsARoundItself) {
+  // A call of 3 ms against a minimum time of 2 ms: after the caller's warm-up, the call that
+  // sizes the rounds is the first round, so every call made is a call timed.
+  for (bool warmed_up : {false, true}) {
+    TimingPlan plan;
+    plan.min_time_s = 2e-3;
+    plan.min_rounds = 3;
+    plan.warmed_up = warmed_up;
+    int calls = 0;
+    const std::vector<Rounds> r = time_rounds({{"slow", false,
+                                                [&] {
+                                                  ++calls;
+                                                  spin(3e-3);
+                                                }}},
+                                              plan);
+    ASSERT_EQ(r.size(), 1u);
+    const int rounds = static_cast<int>(r[0].per_call_s.size());
+    EXPECT_GE(rounds, plan.min_rounds);
+    EXPECT_EQ(r[0].per_round, 1);
+    EXPECT_EQ(calls, warmed_up ? rounds : rounds + 2) << "warmed up: " << warmed_up;
+    for (double t : r[0].per_call_s) EXPECT_GE(t, 3e-3);
+  }
+}
+
 TEST(Timing, SubjectsTakeTurnsRoundByRound) {
   TimingPlan plan;
   plan.min_time_s = 1e-6;  // every subject stops at min_rounds, whatever the load: one call a round
