@@ -27,20 +27,24 @@ def narrowphase(rows, out):
     for r in rows:
         if r["kind"] == "narrowphase" and r["ns_per_query"] is not None:
             by_pose[r["pose"]][(r["backend"], r["variant"])].append(
-                (r["vertices"], r["ns_per_query"]))
+                (r["vertices"], r["ns_per_query"], r.get("q25") or r["ns_per_query"],
+                 r.get("q75") or r["ns_per_query"]))
     for pose, series in by_pose.items():
         fig, ax = plt.subplots(figsize=(8, 5.5))
         for (backend, variant), pts in sorted(series.items()):
             pts.sort()
-            hull = [(n, t * 1e-3) for n, t in pts if n > 8]
-            box = [(n, t * 1e-3) for n, t in pts if n == 8]
+            hull = [(n, t * 1e-3, lo * 1e-3, hi * 1e-3) for n, t, lo, hi in pts if n > 8]
+            box = [(n, t * 1e-3) for n, t, _, _ in pts if n == 8]
             colour, marker = backend_style.style(backend)
             dashed = variant == "faithful"
             label = backend if variant == "default" else f"{backend} ({variant})"
             if hull:
-                ax.plot([p[0] for p in hull], [p[1] for p in hull], marker=marker, color=colour,
-                        linestyle="--" if dashed else "-", label=label,
-                        linewidth=2.5 if (backend == "custom" and not dashed) else 1.2)
+                # The 25-75 % range of the rounds as the error bar.
+                ax.errorbar([p[0] for p in hull], [p[1] for p in hull],
+                            yerr=[[p[1] - p[2] for p in hull], [p[3] - p[1] for p in hull]],
+                            marker=marker, color=colour, linestyle="--" if dashed else "-",
+                            label=label, capsize=2,
+                            linewidth=2.5 if (backend == "custom" and not dashed) else 1.2)
             if box:
                 ax.plot([p[0] for p in box], [p[1] for p in box], marker=marker, color=colour,
                         linestyle="none", markerfacecolor="none", markersize=9,
@@ -59,18 +63,22 @@ def broadphase(rows, out):
     series = defaultdict(list)
     for r in rows:
         if r["kind"] == "broadphase" and r["ns_per_step"] is not None:
-            series[r["method"]].append((r["bodies"], r["ns_per_step"] * 1e-6))
+            series[r["method"]].append((r["bodies"], r["ns_per_step"] * 1e-6,
+                                        (r.get("q25") or r["ns_per_step"]) * 1e-6,
+                                        (r.get("q75") or r["ns_per_step"]) * 1e-6))
     if not series:
         return
     fig, ax = plt.subplots(figsize=(7, 5))
     for method, pts in sorted(series.items()):
         pts.sort()
         colour, marker = METHOD_STYLE.get(method, ("black", "o"))
-        ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=marker, color=colour,
-                label=method)
+        # The 25-75 % range of the rounds as the error bar.
+        ax.errorbar([p[0] for p in pts], [p[1] for p in pts],
+                    yerr=[[p[1] - p[2] for p in pts], [p[3] - p[1] for p in pts]],
+                    marker=marker, color=colour, label=method, capsize=3)
     # A slope-1 guide through the first point of the tree.
     if "tree" in series:
-        n0, t0 = sorted(series["tree"])[0]
+        n0, t0 = sorted(series["tree"])[0][:2]
         xs = [n0, sorted(series["tree"])[-1][0]]
         ax.plot(xs, [t0 * x / n0 for x in xs], color="grey", linestyle=":", label="slope 1")
     ax.set_xscale("log")
@@ -94,7 +102,12 @@ def step(rows, out):
                                                  else f'\n({r["variant"]})') for r in bars]
     colours = [backend_style.colour(r["backend"], [r["backend"] for r in bars]) for r in bars]
     # A linear axis from zero: the bars' heights are then in the ratio of the times.
-    ax.bar(range(len(bars)), [r["us_per_body_step"] for r in bars], color=colours)
+    heights = [r["us_per_body_step"] for r in bars]
+    # The 25-75 % range of the rounds as the error bar (absent for a row without rounds).
+    low = [h - (r.get("q25") if r.get("q25") is not None else h) for h, r in zip(heights, bars)]
+    high = [(r.get("q75") if r.get("q75") is not None else h) - h for h, r in zip(heights, bars)]
+    ax.bar(range(len(bars)), heights, color=colours, yerr=[low, high], capsize=3,
+           error_kw={"elinewidth": 1})
     ax.set_xticks(range(len(bars)))
     ax.set_xticklabels(labels, fontsize=7)
     ax.set_ylim(bottom=0)
