@@ -72,7 +72,7 @@ BenchPlan bench_plan(bool quick) {
     // The long runs are long enough that a round's difference (tens of milliseconds) stands
     // well above the noise of building the world.
     p.steps_100 = {20, 420};
-    p.steps_1000 = {10, 110};
+    p.steps_1000 = {10, 310};
     p.step_min_time = 0.2;
     // The whole step's ratios carry goals: more rounds narrow their median.
     p.step_rounds = 15;
