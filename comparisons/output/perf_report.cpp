@@ -37,10 +37,12 @@ std::string cpu_model() {
   return "unknown CPU";
 }
 
+// A number for perf.json: null when not finite.
+Json finite(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+
 // A timed row's figures for perf.json: the median (the row's key), its quartiles, counts and
 // the cold pass.
 void put_time(Json& row, const std::string& key, const BenchTime& t) {
-  auto finite = [](double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); };
   row[key] = finite(t.median);
   row["q25"] = finite(t.q25);
   row["q75"] = finite(t.q75);
@@ -116,9 +118,9 @@ Json perf_json(const BenchPlan& plan, const BenchResults& results,
     Json ratios = Json::array();
     for (const GoalRatio& q : g.ratios)
       ratios.push_back({{"between", q.label},
-                        {"median", std::isfinite(q.ratio.median) ? Json(q.ratio.median) : Json()},
-                        {"q25", std::isfinite(q.ratio.q25) ? Json(q.ratio.q25) : Json()},
-                        {"q75", std::isfinite(q.ratio.q75) ? Json(q.ratio.q75) : Json()},
+                        {"median", finite(q.ratio.median)},
+                        {"q25", finite(q.ratio.q25)},
+                        {"q75", finite(q.ratio.q75)},
                         {"rounds", q.ratio.rounds}});
     j["goals"].push_back(
         {{"goal", g.goal}, {"measured", g.measured}, {"met", g.met}, {"ratios", ratios}});
