@@ -1,6 +1,7 @@
 #include "comparisons/output/scorecard.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -228,9 +229,19 @@ std::string scene_slug(const std::string& family, const std::string& file) {
 }
 
 std::string md_escape(const std::string& s) {
+  // A list marker opens a list only at the start of a line: escaping it there (a digit run's
+  // '.' or ')', a leading '-' or '+') keeps the text a paragraph wherever it is placed.
+  size_t digits = 0;
+  while (digits < s.size() && std::isdigit(static_cast<unsigned char>(s[digits]))) ++digits;
+  const size_t marker = digits;
+  const bool list = marker < s.size() && (digits > 0 ? s[marker] == '.' || s[marker] == ')'
+                                                     : s[marker] == '-' || s[marker] == '+');
   std::string out;
-  for (char c : s) {
-    if (std::string("\\`*_[]<>|#").find(c) != std::string::npos) out += '\\';
+  for (size_t i = 0; i < s.size(); ++i) {
+    char c = s[i];
+    // '&' would start an entity (md4c decodes "&lt;"), '~' a strikethrough in GitHub's Markdown.
+    if (std::string("\\`*_[]<>|#&~").find(c) != std::string::npos || (list && i == marker))
+      out += '\\';
     if (c == '\n' || c == '\r') c = ' ';
     out += c;
   }

@@ -15,7 +15,9 @@ namespace rbx {
 /// The file-name slug of a scene in a report: FAMILY_STEM (figures, replay pages).
 std::string scene_slug(const std::string& family, const std::string& file);
 
-/// Text safe in Markdown (table cells and link text): \ ` * _ [ ] < > | # escaped.
+/// Text safe in Markdown (table cells, link text, a paragraph): \ ` * _ [ ] < > | # & ~ escaped,
+/// and a list marker that would open the text ("- ", "+ ", "1. ") escaped too; line breaks are
+/// spaces.
 std::string md_escape(const std::string& s);
 
 /// What a scorecard row's error measures: a contact query's normal angle and depth, a dynamic

@@ -16,6 +16,8 @@
 
 #include "comparisons/output/backend_style.h"
 #include "comparisons/output/markdown_html.h"
+#include "comparisons/output/scorecard.h"  // md_escape
+#include "comparisons/output/table.h"      // html_escape
 
 namespace fs = std::filesystem;
 
@@ -168,7 +170,7 @@ TEST(ReportPages, LinksResolveUnitsFollowTheMetricAndSceneTextStaysText) {
   fs::remove_all(dir);
 }
 
-TEST(MarkdownHtml, RendersTheReportsSubsetAndEscapesText) {
+TEST(MarkdownHtml, RendersTheReportsMarkdownWithHeadingAnchorsAndTables) {
   const std::string html = markdown_to_html(
       "# A \\<title\\>\n\nText with **bold**, _it_, `a<b`, a [link](x.html#y) and "
       "![fig](f.png).\n\n| a | b\\|c |\n|---|---|\n| 1 | <i> |\n\n- one\n  - nested\n- two\n");
@@ -179,11 +181,48 @@ TEST(MarkdownHtml, RendersTheReportsSubsetAndEscapesText) {
   EXPECT_NE(html.find("<a href=\"x.html#y\">link</a>"), std::string::npos) << html;
   EXPECT_NE(html.find("<img src=\"f.png\" alt=\"fig\">"), std::string::npos) << html;
   EXPECT_NE(html.find("<th>b|c</th>"), std::string::npos) << html;
+  // Raw HTML in the Markdown is text, not markup.
   EXPECT_NE(html.find("<td>&lt;i&gt;</td>"), std::string::npos) << html;
-  EXPECT_NE(html.find("<li>one</li>\n<ul>\n<li>nested</li>"), std::string::npos) << html;
+  EXPECT_EQ(html.find("<i>"), std::string::npos) << html;
+  // The nested item is a list inside the first item (valid HTML: a <ul> sits in an <li>).
+  const size_t one = html.find("<li>one"), nested = html.find("<ul>", one),
+               close = html.find("</li>", one);
+  ASSERT_NE(one, std::string::npos) << html;
+  EXPECT_LT(nested, close) << html;
+  EXPECT_NE(html.find("<li>nested</li>"), std::string::npos) << html;
   // An escaped underscore in a name is text, not emphasis.
   EXPECT_EQ(markdown_to_html("a\\_b\\_c"), "<p>a_b_c</p>\n");
   EXPECT_EQ(heading_anchor("analytic/corner\\_drop\\_e05"), "analytic-corner_drop_e05");
+  // Every heading level gets its anchor, from the heading's text (markup dropped).
+  EXPECT_EQ(markdown_to_html("### Error against `run` time\n"),
+            "<h3 id=\"error-against-run-time\">Error against <code>run</code> time</h3>\n");
+}
+
+TEST(MarkdownHtml, AnyTextThroughMdEscapeStaysOneParagraphOfText) {
+  // Scene names and descriptions are a user's text: whatever Markdown or HTML they hold, once
+  // md_escape'd they render as the same characters, escaped, in one paragraph.
+  const std::string hostile[] = {
+      "<b>bold</b> & <script>alert(1)</script>",
+      "[click](javascript:alert(1)) ![x](y.png) <http://example.com>",
+      "**strong** _em_ `code` ~~gone~~ a|b # not a heading",
+      "- not a list",
+      "+ not a list",
+      "12. not a list",
+      "3) not a list",
+      "&lt;b&gt; &amp; &#60;",
+      "> not a quote",
+      "line one\nline two",
+  };
+  for (const std::string& text : hostile) {
+    const std::string html = markdown_to_html(md_escape(text) + "\n");
+    std::string flat = text;
+    for (char& c : flat)
+      if (c == '\n') c = ' ';
+    EXPECT_EQ(html, "<p>" + html_escape(flat) + "</p>\n") << text;
+    // The same text as a table cell.
+    const std::string cell = markdown_to_html("| h |\n|---|\n| " + md_escape(text) + " |\n");
+    EXPECT_NE(cell.find("<td>" + html_escape(flat) + "</td>"), std::string::npos) << cell;
+  }
 }
 
 }  // namespace
