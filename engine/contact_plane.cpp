@@ -24,7 +24,8 @@ bool lex_less(const Vec3& p, const Vec3& q) {
 
 ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
                                   const ConvexPolyhedron& b, const Pose& pb, PlaneMethod method) {
-  return choose_contact_plane(a, pa, b, pb, Vec3::UnitZ(), plane_detail::kInf, method);
+  ContactScratch scratch;
+  return choose_contact_plane(a, pa, b, pb, Vec3::UnitZ(), plane_detail::kInf, method, scratch);
 }
 
 namespace {
@@ -34,8 +35,8 @@ namespace {
 std::optional<ContactPlane> choose(const ConvexPolyhedron& a, const Pose& pa,
                                    const ConvexPolyhedron& b, const Pose& pb,
                                    const Vec3& known_normal, double known_overlap,
-                                   PlaneMethod method, bool proof_only) {
-  thread_local plane_detail::Candidates found;
+                                   PlaneMethod method, bool proof_only, ContactScratch& scratch) {
+  plane_detail::Candidates& found = scratch.lists().found;
   found.kept.clear();
   found.upper = plane_detail::kInf;
   // A NaN is no bound.
@@ -50,11 +51,12 @@ std::optional<ContactPlane> choose(const ConvexPolyhedron& a, const Pose& pa,
   // boxes (docs/contact_plane.md); the scan stays as its independent check.
   if (method == PlaneMethod::Automatic) method = PlaneMethod::Search;
   // The scan answers only for shapes it proves to overlap; the search for every pair.
-  if (method == PlaneMethod::Scan && plane_detail::scan_candidates(a, pa, b, pb, found)) {
+  if (method == PlaneMethod::Scan &&
+      plane_detail::scan_candidates(a, pa, b, pb, found, scratch.lists())) {
     found.proved = true;
   } else {
     found.kept.clear();
-    plane_detail::search_candidates(a, pa, b, pb, found);
+    plane_detail::search_candidates(a, pa, b, pb, found, scratch.lists());
   }
   if (proof_only && !found.proved) return std::nullopt;
 
@@ -111,13 +113,23 @@ std::optional<ContactPlane> choose(const ConvexPolyhedron& a, const Pose& pa,
 ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
                                   const ConvexPolyhedron& b, const Pose& pb,
                                   const Vec3& known_normal, double known_overlap,
+                                  PlaneMethod method, ContactScratch& scratch) {
+  return *choose(a, pa, b, pb, known_normal, known_overlap, method, false, scratch);
+}
+
+ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
+                                  const ConvexPolyhedron& b, const Pose& pb,
+                                  const Vec3& known_normal, double known_overlap,
                                   PlaneMethod method) {
-  return *choose(a, pa, b, pb, known_normal, known_overlap, method, false);
+  ContactScratch scratch;
+  return choose_contact_plane(a, pa, b, pb, known_normal, known_overlap, method, scratch);
 }
 
 std::optional<ContactPlane> choose_overlap_plane(const ConvexPolyhedron& a, const Pose& pa,
-                                                 const ConvexPolyhedron& b, const Pose& pb) {
-  return choose(a, pa, b, pb, Vec3::UnitZ(), plane_detail::kInf, PlaneMethod::Automatic, true);
+                                                 const ConvexPolyhedron& b, const Pose& pb,
+                                                 ContactScratch& scratch) {
+  return choose(a, pa, b, pb, Vec3::UnitZ(), plane_detail::kInf, PlaneMethod::Automatic, true,
+                scratch);
 }
 
 }  // namespace rbx

@@ -18,6 +18,7 @@
 
 #include <optional>
 
+#include "engine/contact_scratch.h"
 #include "engine/math.h"
 #include "engine/polyhedron.h"
 
@@ -66,6 +67,12 @@ ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
 ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
                                   const ConvexPolyhedron& b, const Pose& pb,
                                   const Vec3& known_normal, double known_overlap,
+                                  PlaneMethod method, ContactScratch& scratch);
+
+/// The same, on a scratch of its own (allocated for the one query: tests and tools).
+ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
+                                  const ConvexPolyhedron& b, const Pose& pb,
+                                  const Vec3& known_normal, double known_overlap,
                                   PlaneMethod method = PlaneMethod::Automatic);
 
 /// The same plane, only for shapes proved to overlap by more than round-off: by the scan's point
@@ -73,6 +80,7 @@ ContactPlane choose_contact_plane(const ConvexPolyhedron& a, const Pose& pa,
 /// search's narrowing). Nothing for shapes touching, apart, or too close to touching to tell
 /// (the whole search is then not run): a detector decides those.
 std::optional<ContactPlane> choose_overlap_plane(const ConvexPolyhedron& a, const Pose& pa,
-                                                 const ConvexPolyhedron& b, const Pose& pb);
+                                                 const ConvexPolyhedron& b, const Pose& pb,
+                                                 ContactScratch& scratch);
 
 }  // namespace rbx

@@ -10,9 +10,11 @@
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "engine/contact_plane.h"
+#include "engine/contact_scratch.h"
 #include "engine/gauss_map.h"
 #include "engine/polyhedron.h"
 
@@ -53,6 +55,30 @@ struct Candidates {
   /// Left by the method: whether it proved that the shapes overlap by more than round-off (the
   /// scan's point inside both, the polytope's tetrahedron around the origin).
   bool proved = false;
+};
+
+/// Each query file's own lists (defined in that file: the search's, the scan's, the inner
+/// polytope's, the contact region's), made on first use and kept by a Scratch.
+struct SearchLists;
+struct ScanLists;
+struct PolytopeLists;
+struct RegionLists;
+/// Frees a file's lists where their type is complete (one overload defined in each file).
+struct ListsDeleter {
+  void operator()(SearchLists* p) const;
+  void operator()(ScanLists* p) const;
+  void operator()(PolytopeLists* p) const;
+  void operator()(RegionLists* p) const;
+};
+
+/// What a ContactScratch holds (engine/contact_scratch.h): the candidates of choose_contact_plane
+/// and each query file's lists.
+struct Scratch {
+  Candidates found;
+  std::unique_ptr<SearchLists, ListsDeleter> search;
+  std::unique_ptr<ScanLists, ListsDeleter> scan;
+  std::unique_ptr<PolytopeLists, ListsDeleter> polytope;
+  std::unique_ptr<RegionLists, ListsDeleter> region;
 };
 
 /// Shapes with at most this many vertices take their support by a scan, larger ones by a climb:
@@ -122,7 +148,7 @@ inline bool arcs_cross(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec
 /// overlap; it returns false, keeping nothing, when it cannot prove that they do (then the search
 /// answers).
 bool scan_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                     const Pose& pb, Candidates& out);
+                     const Pose& pb, Candidates& out, Scratch& scratch);
 
 /// Whether two cones of directions (axes unit, world) hold no direction in common: the angle
 /// between their axes exceeds the sum of their angles.
@@ -142,11 +168,12 @@ inline bool cones_apart(const Vec3& axis0, const DirectionCone& c0, const Vec3& 
 /// margin), the only directions that can hold a candidate within the tie margin of the least.
 /// Returns false, leaving `out` alone, when it cannot bound (shapes apart, touching, or a
 /// degenerate polytope): then the search covers every direction.
-bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& out);
+bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& out,
+                          Scratch& scratch);
 
 /// The search: branch and bound over both shapes' Gauss maps
 /// (engine/contact_plane_search.cpp).
 void search_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                       const Pose& pb, Candidates& out);
+                       const Pose& pb, Candidates& out, Scratch& scratch);
 
 }  // namespace rbx::plane_detail

@@ -219,10 +219,19 @@ struct Polytope {
 
 }  // namespace
 
-bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& out) {
+// The polytope's lists, kept by the caller's scratch between queries.
+struct PolytopeLists {
+  Polytope poly;
+};
+
+void ListsDeleter::operator()(PolytopeLists* p) const { delete p; }
+
+bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& out,
+                          Scratch& scratch) {
   std::array<Point, 4> s;
   if (!enclose(a, b, s)) return false;
-  thread_local Polytope poly;
+  if (!scratch.polytope) scratch.polytope.reset(new PolytopeLists);
+  Polytope& poly = scratch.polytope->poly;
   poly.points.assign(s.begin(), s.end());
   poly.faces.clear();
   // The tetrahedron, each face wound away from the vertex opposite it.

@@ -304,10 +304,17 @@ void edge_axes(Query& q) {
 
 }  // namespace
 
+// The scan's lists: one query's state, kept by the caller's scratch between queries.
+struct ScanLists {
+  Query q;
+};
+
+void ListsDeleter::operator()(ScanLists* p) const { delete p; }
+
 bool scan_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                     const Pose& pb, Candidates& out) {
-  // Scratch reused across queries on this thread (allocated once, as the detector's).
-  thread_local Query q;
+                     const Pose& pb, Candidates& out, Scratch& scratch) {
+  if (!scratch.scan) scratch.scan.reset(new ScanLists);
+  Query& q = scratch.scan->q;
   place(a, pa, q.a);
   place(b, pb, q.b);
   sample(q.a, q.b.centre - q.a.centre);

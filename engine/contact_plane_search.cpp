@@ -347,10 +347,17 @@ void Query::edge_pair(const KeptArc& ka, const KeptArc& kb) {
 
 }  // namespace
 
+// The search's lists: one query's state, kept by the caller's scratch between queries.
+struct SearchLists {
+  Query q;
+};
+
+void ListsDeleter::operator()(SearchLists* p) const { delete p; }
+
 void search_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                       const Pose& pb, Candidates& out) {
-  // Scratch reused across queries on this thread (allocated once, as the detector's).
-  thread_local Query q;
+                       const Pose& pb, Candidates& out, Scratch& scratch) {
+  if (!scratch.search) scratch.search.reset(new SearchLists);
+  Query& q = scratch.search->q;
   q.a.set(a, pa);
   q.b.set(b, pb);
   q.upper = kInf;
@@ -364,7 +371,7 @@ void search_candidates(const ConvexPolyhedron& a, const Pose& pa, const ConvexPo
   q.tie = 1e-12 * scale;
   // The inner polytope narrows the directions and may lower the known overlap.
   q.within = DirectionCone{};
-  if (out.polytope && inner_polytope_bound(q.a, q.b, q.tie, out)) {
+  if (out.polytope && inner_polytope_bound(q.a, q.b, q.tie, out, scratch)) {
     q.within = out.within;
     out.proved = true;
   } else if (out.proof_only) {

@@ -38,10 +38,9 @@ void extreme_indices(const plane_detail::Side& s, const Vec3& d, double eps,
     }
 }
 
-// The same vertices, placed in the world.
+// The same vertices, placed in the world (`found`: the indices' list, reused).
 void extreme_feature(const plane_detail::Side& s, const Vec3& d, double eps, std::vector<Vec3>& out,
-                     int start = -1) {
-  thread_local std::vector<int> found;
+                     std::vector<int>& found, int start = -1) {
   extreme_indices(s, d, eps, found, start);
   out.clear();
   for (const int i : found) out.push_back(s.world(i));
@@ -55,12 +54,11 @@ bool lex_less(const Vec2& p, const Vec2& q) {
 
 // The convex hull of points on the plane, in place, counter-clockwise (Andrew's monotone chain):
 // one point, two (a segment) or a polygon without collinear corners. The lists of this file are
-// reused buffers (one query allocates nothing once they have grown).
-void hull2(std::vector<Vec2>& p) {
+// the caller's scratch (one query allocates nothing once they have grown); `h` is the chain's.
+void hull2(std::vector<Vec2>& p, std::vector<Vec2>& h) {
   std::sort(p.begin(), p.end(), lex_less);
   p.erase(std::unique(p.begin(), p.end()), p.end());
   if (p.size() < 3) return;
-  thread_local std::vector<Vec2> h;
   h.resize(2 * p.size());
   std::size_t k = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -89,9 +87,9 @@ void clip_half(const std::vector<Vec2>& poly, const Vec2& w, double c, double to
 }
 
 // `poly` cut, in place, to its part inside every edge of the counter-clockwise convex polygon
-// `clip`.
-void clip_by(std::vector<Vec2>& poly, const std::vector<Vec2>& clip, double tol) {
-  thread_local std::vector<Vec2> cut;
+// `clip`; `cut` holds each half-plane's result.
+void clip_by(std::vector<Vec2>& poly, const std::vector<Vec2>& clip, double tol,
+             std::vector<Vec2>& cut) {
   for (std::size_t i = 0; i < clip.size() && !poly.empty(); ++i) {
     const Vec2 e = clip[(i + 1) % clip.size()] - clip[i];
     // The edge's outward normal (the polygon lies to the left of each edge).
@@ -162,11 +160,11 @@ struct Projected {
   int vertices = 0;
 };
 
+// `h` (the heights) and `chain` (hull2's) are the caller's lists.
 void project(const std::vector<Vec3>& feature, const Vec3& t1, const Vec3& t2, const Vec3& axis,
-             Projected& out) {
+             Projected& out, std::vector<double>& h, std::vector<Vec2>& chain) {
   out.hull.clear();
   out.height = 0.0;
-  thread_local std::vector<double> h;
   h.clear();
   for (const Vec3& x : feature) {
     out.hull.emplace_back(x.dot(t1), x.dot(t2));
@@ -178,7 +176,7 @@ void project(const std::vector<Vec3>& feature, const Vec3& t1, const Vec3& t2, c
   for (const double z : h) out.height += z;
   out.height /= static_cast<double>(h.size());
   out.vertices = static_cast<int>(feature.size());
-  hull2(out.hull);
+  hull2(out.hull, chain);
 }
 
 // A geometric order of the two features (never the argument slot): the one with more hull
@@ -191,7 +189,22 @@ bool before(const Projected& x, const Projected& y) {
 
 }  // namespace
 
+// The contact region's lists, kept by the caller's scratch between queries: each helper's own
+// (no two live at once share one).
+struct plane_detail::RegionLists {
+  std::vector<int> found, deepest, shared, face;  // vertex indices
+  std::vector<Vec3> ref_pts, inc_pts;             // the two features' vertices, world
+  Projected ref, inc;                             // the two features on the plane
+  std::vector<Vec2> region, kept;                 // their overlap, its corners kept
+  std::vector<Vec2> chain, cut;                   // hull2's chain, clip_by's half-plane cut
+  std::vector<double> heights;                    // project's
+};
+
+void plane_detail::ListsDeleter::operator()(RegionLists* p) const { delete p; }
+
 namespace {
+
+using plane_detail::RegionLists;
 
 // A frame of the plane with unit normal `axis`: two unit vectors across it, a function of the
 // axis alone.
@@ -206,28 +219,27 @@ void plane_frame(const Vec3& axis, Vec3& t1, Vec3& t2) {
 // An edge-pair axis: each shape's feature along the normal (an edge, to round-off), projected,
 // and the midpoint of their closest points, midway between them along the normal.
 Vec3 edge_pair_centre(const plane_detail::Side& sa, const plane_detail::Side& sb,
-                      const ContactPlane& plane, double eps) {
+                      const ContactPlane& plane, double eps, RegionLists& w) {
   const Vec3& n = plane.normal;
-  thread_local std::vector<Vec3> fa, fb;
-  extreme_feature(sa, -n, eps, fa, plane.vertex_a);
-  extreme_feature(sb, n, eps, fb, plane.vertex_b);
+  std::vector<Vec3>&fa = w.ref_pts, &fb = w.inc_pts;
+  extreme_feature(sa, -n, eps, fa, w.found, plane.vertex_a);
+  extreme_feature(sb, n, eps, fb, w.found, plane.vertex_b);
   // The frame of the sign-free axis, and the two features in an order of the geometry: the
   // same numbers in either body order.
   const Vec3 axis = plane_detail::canonical(n);
   Vec3 t1, t2;
   plane_frame(axis, t1, t2);
-  thread_local Projected pa, pb;
-  project(fa, t1, t2, axis, pa);
-  project(fb, t1, t2, axis, pb);
+  Projected &pa = w.ref, &pb = w.inc;
+  project(fa, t1, t2, axis, pa, w.heights, w.chain);
+  project(fb, t1, t2, axis, pb, w.heights, w.chain);
   const Projected& ref = before(pa, pb) ? pa : pb;
   const Projected& inc = &ref == &pa ? pb : pa;
   Vec2 centre;
   if (ref.hull.size() >= 3) {
     // Parallel faces within round-off of the axis: their overlap.
-    thread_local std::vector<Vec2> region;
-    region = inc.hull;
-    clip_by(region, ref.hull, eps);
-    centre = centroid2(region.empty() ? inc.hull : region, eps);
+    w.region = inc.hull;
+    clip_by(w.region, ref.hull, eps, w.cut);
+    centre = centroid2(w.region.empty() ? inc.hull : w.region, eps);
   } else {
     centre = segments_meet(ref.hull, inc.hull);
   }
@@ -245,11 +257,11 @@ struct Incident {
   int deep = -1;               // the deepest vertex (the first by index of several)
 };
 Incident incident_feature(const plane_detail::Side& is, const Vec3& m, double eps, int hint,
-                          std::vector<Vec3>& pts) {
+                          std::vector<Vec3>& pts, RegionLists& w) {
   const GaussMap& gi = *is.map;
   // The deepest vertex: of several within the tolerance, the first by index (not the climb's,
   // which depends on where it started).
-  thread_local std::vector<int> deepest;
+  std::vector<int>& deepest = w.deepest;
   extreme_indices(is, -m, eps, deepest, hint);
   const int deep = *std::min_element(deepest.begin(), deepest.end());
   const Vec3 m_local = is.rt * m;
@@ -257,7 +269,7 @@ Incident incident_feature(const plane_detail::Side& is, const Vec3& m, double ep
   double most = plane_detail::kInf;
   for (int k = gi.vertex_triangle_start[deep]; k < gi.vertex_triangle_start[deep + 1]; ++k)
     most = std::min(most, planes[gi.vertex_triangles[k]].normal.dot(m_local));
-  thread_local std::vector<int> shared, face;
+  std::vector<int>&shared = w.shared, &face = w.face;
   shared.clear();
   Incident out;
   out.single = deepest.size() == 1;
@@ -287,7 +299,11 @@ Incident incident_feature(const plane_detail::Side& is, const Vec3& m, double ep
 }  // namespace
 
 Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                           const Pose& pb, const ContactPlane& plane, std::string& feature) {
+                           const Pose& pb, const ContactPlane& plane, std::string& feature,
+                           ContactScratch& scratch) {
+  plane_detail::Scratch& lists = scratch.lists();
+  if (!lists.region) lists.region.reset(new RegionLists);
+  RegionLists& w = *lists.region;
   plane_detail::Side sa, sb;
   sa.set(a, pa);
   sb.set(b, pb);
@@ -297,7 +313,7 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   const double eps = point_in_mesh_tolerance(a, b);
   if (plane.axis == PlaneAxis::EdgeEdge) {
     feature = "edge";
-    return edge_pair_centre(sa, sb, plane, eps);
+    return edge_pair_centre(sa, sb, plane, eps, w);
   }
 
   // A face axis: the reference face (the face whose normal is the axis, outward m) and the
@@ -306,10 +322,10 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   const plane_detail::Side& rs = ref_b ? sb : sa;
   const plane_detail::Side& is = ref_b ? sa : sb;
   const Vec3 m = ref_b ? n : Vec3(-n);
-  thread_local std::vector<Vec3> ref_pts, inc_pts;
-  extreme_feature(rs, m, eps, ref_pts, ref_b ? plane.vertex_b : plane.vertex_a);
+  std::vector<Vec3>&ref_pts = w.ref_pts, &inc_pts = w.inc_pts;
+  extreme_feature(rs, m, eps, ref_pts, w.found, ref_b ? plane.vertex_b : plane.vertex_a);
   const Incident inc_face =
-      incident_feature(is, m, eps, ref_b ? plane.vertex_a : plane.vertex_b, inc_pts);
+      incident_feature(is, m, eps, ref_b ? plane.vertex_a : plane.vertex_b, inc_pts, w);
   const Vec3& inc_n = inc_face.normal;
   const double inc_offset = inc_face.offset;
   // A single deepest vertex is a vertex contact.
@@ -321,19 +337,18 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   const double up = axis == m ? 1.0 : -1.0;
   Vec3 t1, t2;
   plane_frame(axis, t1, t2);
-  thread_local Projected ref, inc;
-  project(ref_pts, t1, t2, axis, ref);
-  project(inc_pts, t1, t2, axis, inc);
+  Projected &ref = w.ref, &inc = w.inc;
+  project(ref_pts, t1, t2, axis, ref, w.heights, w.chain);
+  project(inc_pts, t1, t2, axis, inc, w.heights, w.chain);
   // Parallel faces (the incident one within round-off of against m): the plane's keys may have
   // taken either as the reference, so the two are ordered by the geometry instead.
   if (1.0 + inc_n.dot(m) <= 1e-12) {
     const bool ref_first = !before(inc, ref);
     const Projected& x = ref_first ? ref : inc;
     const Projected& y = ref_first ? inc : ref;
-    thread_local std::vector<Vec2> region;
-    region = y.hull;
-    clip_by(region, x.hull, eps);
-    const Vec2 c = centroid2(region.empty() ? y.hull : region, eps);
+    w.region = y.hull;
+    clip_by(w.region, x.hull, eps, w.cut);
+    const Vec2 c = centroid2(w.region.empty() ? y.hull : w.region, eps);
     return c.x() * t1 + c.y() * t2 + (0.5 * (x.height + y.height)) * axis;
   }
   // Heights along m from here on.
@@ -347,9 +362,9 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   // below the reference plane (the manifold's points, as Box2D keeps them); none left: the
   // deepest vertex. The centre is their centroid, midway between the incident surface and the
   // reference plane.
-  thread_local std::vector<Vec2> region, kept;
+  std::vector<Vec2>&region = w.region, &kept = w.kept;
   region = inc.hull;
-  clip_by(region, ref.hull, eps);
+  clip_by(region, ref.hull, eps, w.cut);
   kept.clear();
   for (const Vec2& p : region)
     if (inc_height(p) - ref.height <= eps) kept.push_back(p);
@@ -357,24 +372,26 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
     const Vec3 x = is.world(inc_face.deep);
     kept.emplace_back(x.dot(t1), x.dot(t2));
   }
-  hull2(kept);
+  hull2(kept, w.chain);
   const Vec2 c = centroid2(kept, eps);
   return c.x() * t1 + c.y() * t2 + (0.5 * (inc_height(c) + ref.height)) * m;
 }
 
 std::optional<ContactPoint> find_contact(const ConvexPolyhedron& a, const Pose& pa,
                                          const ConvexPolyhedron& b, const Pose& pb,
-                                         DetectorVariant variant, DetectionCache& cache) {
-  if (const auto plane = choose_overlap_plane(a, pa, b, pb)) {
+                                         DetectorVariant variant, DetectionCache& cache,
+                                         ContactScratch& scratch) {
+  if (const auto plane = choose_overlap_plane(a, pa, b, pb, scratch)) {
     ContactPoint c;
     c.normal = plane->normal;
     c.depth = plane->depth;
-    c.point = contact_region_centre(a, pa, b, pb, *plane, c.feature);
+    c.point = contact_region_centre(a, pa, b, pb, *plane, c.feature, scratch);
     return c;
   }
   auto c = detect(a, pa, b, pb, variant, cache);
   if (!c) return c;
-  const ContactPlane plane = choose_contact_plane(a, pa, b, pb, c->normal, c->depth);
+  const ContactPlane plane =
+      choose_contact_plane(a, pa, b, pb, c->normal, c->depth, PlaneMethod::Automatic, scratch);
   c->normal = plane.normal;
   c->depth = plane.depth;
   return c;

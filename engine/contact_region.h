@@ -26,7 +26,8 @@ namespace rbx {
 /// from either body order (to the last bit). `feature` names the pair of features: "vertex"
 /// when either is a single vertex, "edge" for two edges, "face" otherwise.
 Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                           const Pose& pb, const ContactPlane& plane, std::string& feature);
+                           const Pose& pb, const ContactPlane& plane, std::string& feature,
+                           ContactScratch& scratch);
 
 /// The extended engine's contact of a pair (the `custom` backend's query). Shapes proved to
 /// overlap (choose_overlap_plane) take the chosen plane and the centre of the contact region,
@@ -35,6 +36,7 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
 /// (the overlap along the tests' normal bounding it) and keeps the detector's point.
 std::optional<ContactPoint> find_contact(const ConvexPolyhedron& a, const Pose& pa,
                                          const ConvexPolyhedron& b, const Pose& pb,
-                                         DetectorVariant variant, DetectionCache& cache);
+                                         DetectorVariant variant, DetectionCache& cache,
+                                         ContactScratch& scratch);
 
 }  // namespace rbx

@@ -320,9 +320,8 @@ void table_candidates(const AcceleratedView& x, Primitive kind, int n, std::vect
 
 // Puts a list of indices below n in increasing order without repeats, through a bitmap: linear
 // in the list plus n / 64 words, where a comparison sort of the thousands of primitives a deep
-// cap holds took a large share of the query. The bitmap is left cleared.
-void sort_unique(std::vector<int>& list, std::size_t n) {
-  thread_local std::vector<std::uint64_t> bits;
+// cap holds took a large share of the query. The bitmap (the workspace's) is left cleared.
+void sort_unique(std::vector<int>& list, std::size_t n, std::vector<std::uint64_t>& bits) {
   if (bits.size() < (n + 63) / 64) bits.assign((n + 63) / 64, 0);
   if (list.empty()) return;
   std::size_t lo = bits.size(), hi = 0;
@@ -357,6 +356,7 @@ bool find_cap(AcceleratedView& x, const Limits& lim, AcceleratedWorkspace& ws, i
   std::vector<int>& cap = ws.cap[slot];
   cap.clear();
   x.cap = &cap;
+  x.bits = &ws.bits;
   if (x.linear) {
     // Few vertices: every one below the limit, by a scan.
     const int nv = static_cast<int>(verts.size());
@@ -399,7 +399,7 @@ bool find_cap(AcceleratedView& x, const Limits& lim, AcceleratedWorkspace& ws, i
       if (plane.local_distance(verts[w]) <= limit) cap.push_back(w);
     }
   }
-  sort_unique(cap, verts.size());
+  sort_unique(cap, verts.size(), ws.bits);
   return true;
 }
 
@@ -428,7 +428,7 @@ void cap_candidates(const AcceleratedView& x, Primitive kind, std::vector<int>& 
   const std::vector<int>& start = triangles ? h.triangle_start : h.edge_start;
   const std::vector<int>& list = triangles ? h.vertex_triangles : h.vertex_edges;
   for (int v : cap) out.insert(out.end(), list.begin() + start[v], list.begin() + start[v + 1]);
-  sort_unique(out, triangles ? x.shape->triangles().size() : x.shape->edges().size());
+  sort_unique(out, triangles ? x.shape->triangles().size() : x.shape->edges().size(), *x.bits);
   std::size_t kept = 0;
   for (int i : out) {
     bool culled_out;

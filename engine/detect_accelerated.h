@@ -41,6 +41,7 @@
 // and vertices (with the same margin rule) instead of searching the trees.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -110,6 +111,8 @@ struct AcceleratedView {
   // plane or beyond it (its "cap", increasing; prepare). Every hit lies on a primitive with a
   // vertex in the cap. Null: no cap (no facing face), the trees cull instead.
   const std::vector<int>* cap = nullptr;
+  // With a cap: the workspace's bitmap that puts index lists in order (sort_unique), left cleared.
+  std::vector<std::uint64_t>* bits = nullptr;
 
   int num_triangles() const { return static_cast<int>(shape->triangles().size()); }
   __attribute__((always_inline)) Vec3 vertex(int i) const {
@@ -142,7 +145,8 @@ struct AcceleratedWorkspace {
   std::vector<double> tables[2];
   CullPlane cull[2][kMaxCullPlanes];
   std::vector<int> cap[2];
-  std::vector<unsigned> seen[2];  // cap search marks: seen[v] == stamp
+  std::vector<unsigned> seen[2];    // cap search marks: seen[v] == stamp
+  std::vector<std::uint64_t> bits;  // sort_unique's bitmap, cleared between uses
   unsigned stamp[2] = {0, 0};
 };
 

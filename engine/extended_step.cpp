@@ -114,7 +114,7 @@ std::vector<PairManifold> ExtendedStep::detect_manifolds(WorldState& world) {
     if (grow_ > 0.0 && !spheres_touch(spheres_[pair.first], spheres_[pair.second])) continue;
     if (separated(world, a, b, pair.first, pair.second)) continue;  // the detector finds nothing
     auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant,
-                            world.tunables.position_slop);
+                            world.tunables.position_slop, detection_, contact_scratch_);
     if (m) manifolds.push_back({pair.first, pair.second, std::move(*m), a.pose(), b.pose()});
   }
   return manifolds;
@@ -352,7 +352,7 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
     a = advanced(a, t, &facts[i].principal);
     b = advanced(b, t, &facts[j].principal);
     if (auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant,
-                                world.tunables.position_slop)) {
+                                world.tunables.position_slop, detection_, contact_scratch_)) {
       const std::vector<PairManifold> one = {{i, j, std::move(*m), a.pose(), b.pose()}};
       const auto approach = normal_velocities(world.bodies, one);
       // Every impact here is a collision: its event whatever its approach speed.

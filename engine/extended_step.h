@@ -9,7 +9,9 @@
 #include <vector>
 
 #include "engine/broadphase.h"
+#include "engine/contact_scratch.h"
 #include "engine/contact_solver.h"
+#include "engine/detect.h"
 #include "engine/world_state.h"
 
 namespace rbx {
@@ -87,6 +89,9 @@ class ExtendedStep {
   std::vector<BodyPair> ahead_pairs_;  // scratch: look_ahead_pairs' output
   std::vector<BoundingSphere> spheres_;      // scratch: one pose's bounding spheres
   std::vector<Vec3> static_lo_, static_hi_;  // m, world: the static bodies' boxes, once
+  // The manifolds' detector cache and contact-plane scratch, reused pair after pair.
+  DetectionCache detection_;
+  ContactScratch contact_scratch_;
 };
 
 }  // namespace rbx

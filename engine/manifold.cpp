@@ -144,13 +144,23 @@ std::vector<ManifoldPoint> support_corners(const std::vector<ManifoldPoint>& pts
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
                                               const ConvexPolyhedron& b, const Pose& pb,
                                               DetectorVariant variant, double support_slack) {
-  const auto hit = detect(a, pa, b, pb, variant);
+  DetectionCache cache;
+  ContactScratch scratch;
+  return build_manifold(a, pa, b, pb, variant, support_slack, cache, scratch);
+}
+
+std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
+                                              const ConvexPolyhedron& b, const Pose& pb,
+                                              DetectorVariant variant, double support_slack,
+                                              DetectionCache& cache, ContactScratch& scratch) {
+  const auto hit = detect(a, pa, b, pb, variant, cache);
   if (!hit) return std::nullopt;
   ContactManifold m;
   m.detector_contact = *hit;
   // The tests decide that the shapes touch; the plane is chosen (engine/contact_plane.h), the
   // overlap along the tests' normal bounding it from the start.
-  const ContactPlane plane = choose_contact_plane(a, pa, b, pb, hit->normal, hit->depth);
+  const ContactPlane plane =
+      choose_contact_plane(a, pa, b, pb, hit->normal, hit->depth, PlaneMethod::Automatic, scratch);
   m.normal = plane.normal;
   m.depth = plane.depth;
   const Vec3& n = m.normal;

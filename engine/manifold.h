@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "engine/contact.h"
+#include "engine/contact_scratch.h"
 #include "engine/detect.h"
 #include "engine/polyhedron.h"
 #include "engine/settings.h"
@@ -47,6 +48,14 @@ struct ContactManifold {
 /// the corners cannot give; engine/manifold.cpp, support_corners), except the deepest point when
 /// it is deeper than every corner by more than the slack. When no point qualifies (a face
 /// centroid inside, no vertex), the detector's point is the manifold.
+/// The detector runs on `cache` and the plane on `scratch`, the caller's (a world's step keeps
+/// one of each); the answer does not depend on them.
+std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
+                                              const ConvexPolyhedron& b, const Pose& pb,
+                                              DetectorVariant variant, double support_slack,
+                                              DetectionCache& cache, ContactScratch& scratch);
+
+/// The same on a cache and scratch of its own (allocated for the one query: tests and tools).
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
                                               const ConvexPolyhedron& b, const Pose& pb,
                                               DetectorVariant variant,

@@ -13,12 +13,13 @@ namespace {
 // The contact of the `custom` backend on either detector: the plane of least overlap
 // (engine/contact_plane.h) and the centre of the contact region (engine/contact_region.h) for
 // shapes proved to overlap; the detector for the rest, from either body order alike. One
-// detection cache per thread, reused by every query as the World reuses one per pair: its
-// scratch lists are allocated once. Answers do not depend on it.
+// detection cache and one contact scratch per thread, reused by every query as a world's step
+// reuses its own: their lists are allocated once. Answers do not depend on them.
 ContactResult engine_contact(const RigidBody& a, const RigidBody& b, DetectorVariant variant) {
   thread_local DetectionCache cache;
+  thread_local ContactScratch scratch;
   ContactResult r;
-  if (auto c = find_contact(*a.shape, a.pose(), *b.shape, b.pose(), variant, cache))
+  if (auto c = find_contact(*a.shape, a.pose(), *b.shape, b.pose(), variant, cache, scratch))
     r.contacts.push_back(*c);
   return r;
 }

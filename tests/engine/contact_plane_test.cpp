@@ -287,6 +287,7 @@ TEST(ContactPlane, TheInnerPolytopeNarrowsTheSearchWithoutChangingThePlane) {
 }
 
 TEST(ContactPlane, TheInnerPolytopeBoundsOverlappingShapesOnly) {
+  ContactScratch scratch;  // reused by every query below: answers do not depend on it
   // Overlapping shapes: the polytope bounds the least overlap from above (to round-off, at most
   // the whole search's answer plus its tie margin) and leaves a narrow cone around the answer's
   // direction (D's direction is minus the normal). Apart or touching: it declines.
@@ -311,7 +312,7 @@ TEST(ContactPlane, TheInnerPolytopeBoundsOverlappingShapesOnly) {
       sb.set(b, pb);
       plane_detail::Candidates out;
       const double tie = 1e-12 * 4.0;
-      const bool bounded = plane_detail::inner_polytope_bound(sa, sb, tie, out);
+      const bool bounded = plane_detail::inner_polytope_bound(sa, sb, tie, out, scratch.lists());
       if (gap > 0) {
         EXPECT_FALSE(bounded) << "apart by " << gap;
         continue;
@@ -330,6 +331,7 @@ TEST(ContactPlane, TheInnerPolytopeBoundsOverlappingShapesOnly) {
 }
 
 TEST(ContactPlane, TheInnerPolytopeProvesOverlapOnPosesOfRoundCoordinates) {
+  ContactScratch scratch;  // reused by every query below: answers do not depend on it
   // Stacked axis-aligned boxes at offsets of round decimals, as scenes place them: GJK's
   // tetrahedron then often has the origin exactly on a face plane, which the polytope must grow
   // past rather than give up. Closed form: the overlap along z is the depth, the normal is +-z.
@@ -348,10 +350,11 @@ TEST(ContactPlane, TheInnerPolytopeProvesOverlapOnPosesOfRoundCoordinates) {
             sa.set(a, pa);
             sb.set(b, pb);
             plane_detail::Candidates out;
-            if (plane_detail::inner_polytope_bound(sa, sb, 1e-12 * 4.0, out)) ++proved;
+            if (plane_detail::inner_polytope_bound(sa, sb, 1e-12 * 4.0, out, scratch.lists()))
+              ++proved;
             for (const bool swap : {false, true}) {
-              const auto p =
-                  swap ? choose_overlap_plane(b, pb, a, pa) : choose_overlap_plane(a, pa, b, pb);
+              const auto p = swap ? choose_overlap_plane(b, pb, a, pa, scratch)
+                                  : choose_overlap_plane(a, pa, b, pb, scratch);
               ASSERT_TRUE(p) << "offset " << i << " " << j << " depth " << depth;
               // Round-off of coordinates of order 1 m.
               EXPECT_NEAR(p->depth, depth, 1e-12);
@@ -363,6 +366,7 @@ TEST(ContactPlane, TheInnerPolytopeProvesOverlapOnPosesOfRoundCoordinates) {
 }
 
 TEST(ContactPlane, LevelAndStackedPosesAreProvedAndReversedInEitherOrder) {
+  ContactScratch scratch;  // reused by every query below: answers do not depend on it
   // Poses as scenes write them: shapes turned about z by multiples of 15 degrees, placed at
   // decimal offsets, many level with each other (equal overlap along +z and -z) or centred on
   // each other. Every pair that overlaps by more than round-off must be proved to overlap in
@@ -388,8 +392,8 @@ TEST(ContactPlane, LevelAndStackedPosesAreProvedAndReversedInEitherOrder) {
               if (!(whole.depth > 1e-9)) continue;
               ++overlapping;
               if (at.z() == 0) ++level;
-              const auto ab = choose_overlap_plane(a, pa, b, pb);
-              const auto ba = choose_overlap_plane(b, pb, a, pa);
+              const auto ab = choose_overlap_plane(a, pa, b, pb, scratch);
+              const auto ba = choose_overlap_plane(b, pb, a, pa, scratch);
               ASSERT_TRUE(ab && ba) << "turn " << turn << " at " << at.transpose();
               // Round-off: the two orders climb from different vertices (as in
               // EitherBodyOrderGivesTheSameContactReversed).
