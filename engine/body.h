@@ -6,7 +6,7 @@
 
 #include "engine/mass_properties.h"
 #include "engine/polyhedron.h"
-#include "engine/scene.h"
+#include "engine/world_definition.h"
 
 namespace rbx {
 

@@ -1,4 +1,5 @@
-// Contact vocabulary shared by the engine, the references and the harness.
+// Contact vocabulary shared by the engine and every user of its contacts (the reference
+// libraries' adapters, the comparisons).
 //
 // Convention (everywhere): for a contact between A and B, in that order, `normal` is a unit
 // vector in the world frame pointing from B toward A (the direction that pushes A out of B);
@@ -38,8 +39,8 @@ struct ContactPoint {
   Vec3 normal = Vec3::UnitZ();  // unit, world, from B toward A
   double depth = 0.0;           // m, >= 0
   // What found the point, as written into results: to_string(Feature) for the custom detector,
-  // a library's own label ("mpr", "gjk-epa", ...) for a reference backend. A label, not a type:
-  // the backends' labels are open-ended, and the custom engine dispatches on Feature.
+  // a library's own label ("mpr", "gjk-epa", ...) for a reference library. A label, not a type:
+  // the libraries' labels are open-ended, and the custom engine dispatches on Feature.
   std::string feature;
 };
 

@@ -29,11 +29,11 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
                            const Pose& pb, const ContactPlane& plane, std::string& feature,
                            ContactScratch& scratch);
 
-/// The extended engine's contact of a pair (the `custom` backend's query). Shapes proved to
-/// overlap (choose_overlap_plane) take the chosen plane and the centre of the contact region,
-/// with no detector. The others (touching within the tolerance, apart, or too close to tell)
-/// are left to the detector `variant` (both give the same answer); a hit takes the chosen plane
-/// (the overlap along the tests' normal bounding it) and keeps the detector's point.
+/// The extended engine's contact of a pair (what `custom` answers a contact query with). Shapes
+/// proved to overlap (choose_overlap_plane) take the chosen plane and the centre of the contact
+/// region, with no detector. The others (touching within the tolerance, apart, or too close to
+/// tell) are left to the detector `variant` (both give the same answer); a hit takes the chosen
+/// plane (the overlap along the tests' normal bounding it) and keeps the detector's point.
 std::optional<ContactPoint> find_contact(const ConvexPolyhedron& a, const Pose& pa,
                                          const ConvexPolyhedron& b, const Pose& pb,
                                          DetectorVariant variant, DetectionCache& cache,

@@ -23,9 +23,8 @@ namespace rbx {
 
 /// Which response a world runs (the contact model; the detector is the other axis,
 /// DetectorVariant). `Seed`: the seed's algorithm with its corrections (first hit, single-point
-/// impulse, frictionless): the `custom-seed` backend. `Extended`: manifolds, simultaneous
-/// impulses with Coulomb friction, resting contact, position projection and time of impact: the
-/// `custom` backend.
+/// impulse, frictionless), `custom-seed`. `Extended`: manifolds, simultaneous impulses with
+/// Coulomb friction, resting contact, position projection and time of impact, `custom`.
 enum class ContactModel { Seed, Extended };
 
 /// The manifold of bodies a and b (indices into the world's bodies).

@@ -2,7 +2,7 @@
 #pragma once
 
 #include "engine/body.h"
-#include "engine/scene.h"
+#include "engine/world_definition.h"
 
 namespace rbx {
 

@@ -1,6 +1,6 @@
 // The seed's step: for every pair passing the bounding check, in (i, j) order, the face, vertex
 // and edge tests, each hit resolved at once by a single-point frictionless impulse; then Euler
-// integration of every body (the `custom-seed` backend).
+// integration of every body (`custom-seed`).
 #pragma once
 
 #include "engine/detect.h"

@@ -12,9 +12,9 @@
 #include "engine/detect.h"
 #include "engine/extended_step.h"
 #include "engine/response.h"
-#include "engine/scene.h"
 #include "engine/seed_step.h"
 #include "engine/settings.h"
+#include "engine/world_definition.h"
 #include "engine/world_state.h"
 
 namespace rbx {
@@ -29,15 +29,17 @@ struct RunResult {
 };
 
 /// A set of bodies stepped by one of two contact models (ContactModel): the seed's algorithm
-/// (the default) or the extended engine's.
+/// (`custom-seed`) or the extended engine's (`custom`), named by whoever builds the world.
 class World {
  public:
+  /// `model` is the contact model every step uses: Seed, the seed's single-point impulse;
+  /// Extended, manifolds, friction, resting contact and time of impact (engine/extended_step.h).
   /// `broad_phase` chooses how the pairs passing the bounding check are found; every method
   /// finds the same pairs and the world resolves them in the seed's (i, j) order, so results
   /// do not depend on it (AllPairs is the seed's double loop). `tunables`: the broad phase's
   /// settings and the extended step's solver, projection and time-of-impact ones
   /// (engine/settings.h).
-  World(SimSettings sim, std::vector<RigidBody> bodies,
+  World(SimSettings sim, std::vector<RigidBody> bodies, ContactModel model,
         DetectorVariant variant = DetectorVariant::Accelerated,
         BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree,
         const WorldSettings& tunables = WorldSettings());
@@ -53,9 +55,6 @@ class World {
   const std::string& failure() const { return failure_; }
   /// Steps taken so far.
   long steps_taken() const { return state_.step; }
-  /// Chooses the contact model (default Seed: the seed's single-point impulse). Extended:
-  /// manifolds, friction, resting contact, time of impact (engine/extended_step.h).
-  void set_contact_model(ContactModel model) { contact_model_ = model; }
   /// Seed model only: each hit is resolved by `response` instead of the seed's single-point
   /// impulse (a researcher's own response, engine/response.h); an empty function restores it.
   /// An event is recorded for every non-zero impulse, with its normal component as `impulse`;
@@ -78,7 +77,7 @@ class World {
   bool check_state();
 
   WorldState state_;
-  ContactModel contact_model_ = ContactModel::Seed;
+  ContactModel contact_model_;
   SeedStep seed_;
   ExtendedStep extended_;
   std::string failure_;
@@ -86,8 +85,9 @@ class World {
   double energy_scale_ = 0.0;  // J, the energy budget the guard compares growth with
 };
 
-/// Builds every body of the scene and runs it with the custom engine (the seed's contact model).
-RunResult run_scene(const Scene& scene, DetectorVariant variant = DetectorVariant::Accelerated,
+/// Builds every body of the definition and runs it with the given contact model.
+RunResult run_world(const WorldDefinition& definition, ContactModel model,
+                    DetectorVariant variant = DetectorVariant::Accelerated,
                     BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree);
 
 }  // namespace rbx

@@ -10,8 +10,8 @@
 #include "engine/contact.h"
 #include "engine/detect.h"
 #include "engine/integrate.h"
-#include "engine/scene.h"
 #include "engine/settings.h"
+#include "engine/world_definition.h"
 
 namespace rbx {
 

@@ -254,7 +254,7 @@ void register_response(const std::string& name, const std::string& description, 
       throw std::runtime_error(name + ": " + e.what());
     }
   };
-  b.dynamics = [response](const Scene& scene, const DynamicsOptions& opt) {
+  b.dynamics = [response](const WorldDefinition& scene, const DynamicsOptions& opt) {
     return custom_seed_dynamics_with(scene, opt, response);
   };
   b.library = true;

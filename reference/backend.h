@@ -16,8 +16,8 @@
 
 #include "engine/body.h"
 #include "engine/contact.h"
-#include "engine/scene.h"
 #include "engine/world.h"
+#include "engine/world_definition.h"
 #include "reference/contact_laws.h"
 
 namespace rbx {
@@ -198,7 +198,8 @@ struct MassResult {
 /// Contact query: bodies carry their poses. A and B in that order.
 using ContactFn = std::function<ContactResult(const RigidBody& a, const RigidBody& b)>;
 /// Dynamics run of a whole scene.
-using DynamicsFn = std::function<DynamicsResult(const Scene& scene, const DynamicsOptions& opt)>;
+using DynamicsFn =
+    std::function<DynamicsResult(const WorldDefinition& scene, const DynamicsOptions& opt)>;
 /// The library's own mass properties of a body's hull for the body's mass.
 using MassFn = std::function<MassResult(const RigidBody& body)>;
 
@@ -218,7 +219,7 @@ struct SoftParameter {
 /// order of `parameters`). Empty `parameters`: none to tune.
 struct SoftContact {
   std::vector<SoftParameter> parameters;
-  std::function<DynamicsResult(const Scene& scene, const DynamicsOptions& opt,
+  std::function<DynamicsResult(const WorldDefinition& scene, const DynamicsOptions& opt,
                                const std::vector<double>& values)>
       dynamics;
 };
@@ -302,7 +303,7 @@ template <class Settings>
 struct AtSettings {
   std::function<ContactResult(const RigidBody& a, const RigidBody& b, const Settings& settings)>
       contact;
-  std::function<DynamicsResult(const Scene& scene, const DynamicsOptions& opt,
+  std::function<DynamicsResult(const WorldDefinition& scene, const DynamicsOptions& opt,
                                const Settings& settings)>
       dynamics;
 };
@@ -313,6 +314,6 @@ const std::vector<QueryVariant>& query_variants();
 const QueryVariant* find_query_variant(const std::string& backend, const std::string& variant);
 
 /// Builds the engine bodies of a scene (shared by adapters so all use the same inputs).
-std::vector<RigidBody> make_bodies(const Scene& scene);
+std::vector<RigidBody> make_bodies(const WorldDefinition& scene);
 
 }  // namespace rbx

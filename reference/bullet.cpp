@@ -276,7 +276,7 @@ void make_solver_fair(btDiscreteDynamicsWorld& world, const BulletSettings& sett
 }
 
 /// Scene body `i` as a Bullet body, in the principal frame of its inertia. Not yet in a world.
-BulletBody make_bullet_body(const RigidBody& rb, int i, const Scene& scene,
+BulletBody make_bullet_body(const RigidBody& rb, int i, const WorldDefinition& scene,
                             const BulletSettings& settings) {
   const bool fair = settings.fair_world;
   BulletBody bb;
@@ -414,8 +414,8 @@ void check_finite(const std::vector<BulletBody>& bodies, const std::vector<std::
 /// Runs the scene in a btDiscreteDynamicsWorld. `settings.fair_world`: the single-impulse
 /// settings of docs/references.md; otherwise Bullet's defaults for the world, solver and bodies
 /// (the scene's shapes, masses, inertia, restitution and gravity are used either way).
-DynamicsResult run_world(const Scene& scene, const DynamicsOptions& opt,
-                         const BulletSettings& settings) {
+DynamicsResult run_bullet_world(const WorldDefinition& scene, const DynamicsOptions& opt,
+                                const BulletSettings& settings) {
   DynamicsResult result;
   try {
     const double dt = opt.dt > 0 ? opt.dt : scene.sim.dt;  // s
@@ -514,7 +514,7 @@ const AtSettings<BulletSettings>& bullet_at_settings() {
       [](const RigidBody& a, const RigidBody& b, const BulletSettings& settings) {
         return pair_query(a, b, settings);
       },
-      run_world};
+      run_bullet_world};
   return entries;
 }
 
@@ -540,8 +540,8 @@ ContactResult prebuilt_query(const RigidBody& a, const RigidBody& b) {
   return pair_query(a, b, Settings(), &cache);
 }
 template <BulletSettings (*Settings)()>
-DynamicsResult dynamics_run(const Scene& scene, const DynamicsOptions& opt) {
-  return run_world(scene, opt, Settings());
+DynamicsResult dynamics_run(const WorldDefinition& scene, const DynamicsOptions& opt) {
+  return run_bullet_world(scene, opt, Settings());
 }
 
 MassResult bullet_hull_mass(const RigidBody& body);

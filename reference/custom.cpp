@@ -39,8 +39,8 @@ BodyFinal final_of(const RigidBody& b) {
   return {b.name, b.position, b.orientation, b.velocity, b.angular_velocity};
 }
 
-DynamicsResult run_dynamics(const Scene& scene, const DynamicsOptions& opt, ContactModel model,
-                            const ResponseFn& response = {}) {
+DynamicsResult run_dynamics(const WorldDefinition& scene, const DynamicsOptions& opt,
+                            ContactModel model, const ResponseFn& response = {}) {
   DynamicsResult r;
   try {
     SimSettings sim = scene.sim;
@@ -48,9 +48,8 @@ DynamicsResult run_dynamics(const Scene& scene, const DynamicsOptions& opt, Cont
     // A swept budget caps the projections' sweeps per island solve (custom_budget).
     WorldSettings tunables;
     tunables.sweep_budget = opt.budget;
-    World world(sim, make_bodies(scene), DetectorVariant::Accelerated, BroadPhaseMethod::Tree,
-                tunables);
-    world.set_contact_model(model);
+    World world(sim, make_bodies(scene), model, DetectorVariant::Accelerated,
+                BroadPhaseMethod::Tree, tunables);
     world.set_response(response);
     const long steps = sim.steps();
     DynamicsRecorder recorder(r, opt, [&] {
@@ -84,19 +83,19 @@ DynamicsResult run_dynamics(const Scene& scene, const DynamicsOptions& opt, Cont
 }
 
 // `custom`: the extended engine (manifolds, Coulomb friction, resting contact, time of impact).
-DynamicsResult custom_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+DynamicsResult custom_dynamics(const WorldDefinition& scene, const DynamicsOptions& opt) {
   return run_dynamics(scene, opt, ContactModel::Extended);
 }
 
 // `custom-seed`: the seed's algorithm and its corrections only (first hit, single-point
 // frictionless impulse, no time of impact).
-DynamicsResult custom_seed_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+DynamicsResult custom_seed_dynamics(const WorldDefinition& scene, const DynamicsOptions& opt) {
   return run_dynamics(scene, opt, ContactModel::Seed);
 }
 
 }  // namespace
 
-DynamicsResult custom_seed_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+DynamicsResult custom_seed_dynamics_with(const WorldDefinition& scene, const DynamicsOptions& opt,
                                          const ResponseFn& response) {
   return run_dynamics(scene, opt, ContactModel::Seed, response);
 }

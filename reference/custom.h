@@ -16,7 +16,7 @@ namespace rbx {
 const Adapter& custom_adapter();
 /// `custom-seed` dynamics with each hit resolved by `response` (World::set_response): a
 /// researcher's own collision response over the seed's contacts.
-DynamicsResult custom_seed_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+DynamicsResult custom_seed_dynamics_with(const WorldDefinition& scene, const DynamicsOptions& opt,
                                          const ResponseFn& response);
 
 }  // namespace rbx

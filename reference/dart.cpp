@@ -339,7 +339,7 @@ void follow_slip(dart::simulation::World& world, const std::vector<DartBody>& db
   }
 }
 
-DynamicsResult dart_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+DynamicsResult dart_dynamics_with(const WorldDefinition& scene, const DynamicsOptions& opt,
                                   const DartSettings& settings) {
   // ContactConstraint's parameters are process-wide statics: one DART world at a time.
   static std::mutex world_lock;
@@ -467,11 +467,11 @@ ContactResult dart_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b)
   return prebuilt_query(a, b, dart_hull_settings(), cache);
 }
 
-DynamicsResult dart_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+DynamicsResult dart_dynamics(const WorldDefinition& scene, const DynamicsOptions& opt) {
   return dart_dynamics_with(scene, opt, DartSettings{});
 }
 
-DynamicsResult dart_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+DynamicsResult dart_hull_dynamics(const WorldDefinition& scene, const DynamicsOptions& opt) {
   return dart_dynamics_with(scene, opt, dart_hull_settings());
 }
 
@@ -503,7 +503,8 @@ SoftContact dart_soft(const DartSettings& base) {
             1e-9,
             1.0,
             {1e-9, 1e-7, 1e-5, 1e-3}}},
-          [base](const Scene& scene, const DynamicsOptions& opt, const std::vector<double>& v) {
+          [base](const WorldDefinition& scene, const DynamicsOptions& opt,
+                 const std::vector<double>& v) {
             DartSettings s = base;
             s.erp = v.at(0);
             s.cfm = v.at(1);

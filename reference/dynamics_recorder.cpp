@@ -6,7 +6,7 @@
 
 namespace rbx {
 
-std::vector<RigidBody> make_bodies(const Scene& scene) {
+std::vector<RigidBody> make_bodies(const WorldDefinition& scene) {
   std::vector<RigidBody> bodies;
   bodies.reserve(scene.bodies.size());
   for (const BodySpec& spec : scene.bodies) bodies.push_back(make_body(spec));

@@ -565,8 +565,9 @@ namespace {
 // The model options of a scene run at time step dt. Restitution goes through the soft
 // contact's damping (MuJoCo has no coefficient of restitution); `note` says when the scene's
 // restitution is below what the soft contact can reach.
-ModelOptions model_options(const Scene& scene, double dt, const std::vector<RigidBody>& bodies,
-                           const MujocoSettings& settings, std::string& note) {
+ModelOptions model_options(const WorldDefinition& scene, double dt,
+                           const std::vector<RigidBody>& bodies, const MujocoSettings& settings,
+                           std::string& note) {
   ModelOptions mo;
   mo.dt = dt;
   mo.gravity = scene.sim.gravity;
@@ -685,7 +686,7 @@ void record_contacts(const mjModel* mc, mjData* dd, const std::vector<int>& scen
 
 namespace {
 
-DynamicsResult mujoco_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+DynamicsResult mujoco_dynamics_with(const WorldDefinition& scene, const DynamicsOptions& opt,
                                     const MujocoSettings& settings) {
   DynamicsResult r;
   const double dt = opt.dt > 0.0 ? opt.dt : scene.sim.dt;
@@ -765,12 +766,12 @@ ContactResult mujoco_hull_contact(const RigidBody& a, const RigidBody& b) {
 }
 
 // `mujoco`: mj_step with e mapped to solref, native geoms.
-DynamicsResult mujoco_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+DynamicsResult mujoco_dynamics(const WorldDefinition& scene, const DynamicsOptions& opt) {
   return mujoco_dynamics_with(scene, opt, MujocoSettings{});
 }
 
 // `mujoco-hull`: the same on mesh geoms.
-DynamicsResult mujoco_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+DynamicsResult mujoco_hull_dynamics(const WorldDefinition& scene, const DynamicsOptions& opt) {
   return mujoco_dynamics_with(scene, opt, mujoco_hull_settings());
 }
 
@@ -822,7 +823,8 @@ SoftContact mujoco_soft(const MujocoSettings& base) {
             3.0,
             1000.0,
             {5, 10, 15, 25, 40, 60}}},
-          [base](const Scene& scene, const DynamicsOptions& opt, const std::vector<double>& v) {
+          [base](const WorldDefinition& scene, const DynamicsOptions& opt,
+                 const std::vector<double>& v) {
             MujocoSettings s = base;
             s.contact_steps = v.at(0);
             return mujoco_dynamics_with(scene, opt, s);

@@ -414,7 +414,7 @@ namespace {
 //    to 43 % of a body (6e-6 with the default); a 2 mm contact surface layer instead makes
 //    both stacks blow up (jitter 77-93 m/s). No world setting serves both, so ODE's e = 0
 //    impacts seen inside a step stay a measured limitation (the report's contact-phase table).
-void create_world(WorldOwner& w, const Scene& scene, const OdeSettings& settings) {
+void create_world(WorldOwner& w, const WorldDefinition& scene, const OdeSettings& settings) {
   w.world = dWorldCreate();
   w.space = dSimpleSpaceCreate(nullptr);
   w.contacts = dJointGroupCreate(0);
@@ -521,7 +521,7 @@ int points_of(const CollideContext& ctx, const std::vector<RigidBody>& bodies,
 
 namespace {
 
-DynamicsResult ode_dynamics_with(const Scene& scene, const DynamicsOptions& opt,
+DynamicsResult ode_dynamics_with(const WorldDefinition& scene, const DynamicsOptions& opt,
                                  const OdeSettings& settings) {
   // One ODE world steps at a time in the process: ODE 0.16's worlds share its default
   // self-threaded stepping implementation, and two dWorldStep calls on two threads (rbx report
@@ -632,12 +632,12 @@ ContactResult ode_hull_contact_prebuilt(const RigidBody& a, const RigidBody& b) 
 }
 
 // `ode`: dWorldStep with dContactBounce on the native geoms.
-DynamicsResult ode_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+DynamicsResult ode_dynamics(const WorldDefinition& scene, const DynamicsOptions& opt) {
   return ode_dynamics_with(scene, opt, OdeSettings{});
 }
 
 // `ode-hull`: the same world on convex geoms.
-DynamicsResult ode_hull_dynamics(const Scene& scene, const DynamicsOptions& opt) {
+DynamicsResult ode_hull_dynamics(const WorldDefinition& scene, const DynamicsOptions& opt) {
   return ode_dynamics_with(scene, opt, ode_hull_settings());
 }
 
@@ -675,7 +675,8 @@ SoftContact ode_soft(const OdeSettings& base) {
             0.0,
             1.0,
             {1e-10, 1e-7, 1e-5, 1e-3}}},
-          [base](const Scene& scene, const DynamicsOptions& opt, const std::vector<double>& v) {
+          [base](const WorldDefinition& scene, const DynamicsOptions& opt,
+                 const std::vector<double>& v) {
             OdeSettings s = base;
             s.erp = v.at(0);
             s.cfm = v.at(1);

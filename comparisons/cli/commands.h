@@ -8,8 +8,8 @@
 #include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/regression_check.h"
 #include "comparisons/eval/select_backends.h"
+#include "comparisons/scene/scene.h"
 #include "comparisons/scene/scene_collection.h"
-#include "engine/scene.h"
 
 namespace rbx {
 

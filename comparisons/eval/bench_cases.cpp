@@ -431,8 +431,8 @@ const StepRunner kStepRunners[] = {
      [](const Scene& s) {
        // The `custom` backend's engine (extended contact model) on the faithful detector and
        // the all-pairs bounding check.
-       World w(s.sim, make_bodies(s), DetectorVariant::Faithful, BroadPhaseMethod::AllPairs);
-       w.set_contact_model(ContactModel::Extended);
+       World w(s.sim, make_bodies(s), ContactModel::Extended, DetectorVariant::Faithful,
+               BroadPhaseMethod::AllPairs);
        const RunResult r = w.run();
        return r.ok ? std::string() : r.message;
      }},

@@ -10,6 +10,7 @@
 
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/measures.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

@@ -61,7 +61,7 @@ void time_contacts(const std::vector<const Backend*>& backends, std::vector<Cont
   }
 }
 
-TimedDynamics run_dynamics_isolated(const Backend& b, const Scene& scene,
+TimedDynamics run_dynamics_isolated(const Backend& b, const WorldDefinition& scene,
                                     const DynamicsOptions& opt) {
   auto run = [&] {
     TimedDynamics t;
@@ -80,7 +80,7 @@ TimedDynamics run_dynamics_isolated(const Backend& b, const Scene& scene,
 }
 
 DynamicsFn isolated_dynamics_fn(const Backend& b) {
-  return [&b](const Scene& scene, const DynamicsOptions& opt) {
+  return [&b](const WorldDefinition& scene, const DynamicsOptions& opt) {
     return run_dynamics_isolated(b, scene, opt).result;
   };
 }

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "comparisons/eval/timing.h"
+#include "comparisons/scene/scene.h"
 #include "reference/backend.h"
 #include "reference/isolate.h"
 
@@ -32,7 +33,7 @@ void time_contacts(const std::vector<const Backend*>& backends, std::vector<Cont
 /// Runs backend `b`'s dynamics on `scene` (a thrown exception becomes status Error); a library's
 /// run is isolated under its deadline (reference/isolate.h), so an abort or an endless loop is
 /// that run's `error` or `timeout`. The run time is the run's own, measured where it ran.
-TimedDynamics run_dynamics_isolated(const Backend& b, const Scene& scene,
+TimedDynamics run_dynamics_isolated(const Backend& b, const WorldDefinition& scene,
                                     const DynamicsOptions& opt);
 
 /// Backend `b`'s dynamics as a function that runs it through run_dynamics_isolated.

@@ -27,11 +27,12 @@ bool any_pair_touches(const std::vector<RigidBody>& bodies) {
   return false;
 }
 
-// Where the bodies are at the first step whose start has a touching pair: the custom engine's
-// motion (it is the only engine we can stop at a step), tested by the oracle before the engine
-// resolves anything. Sets `step` (-1: no pair touches within the run) and the stop reason.
+// Where the bodies are at the first step whose start has a touching pair: the seed model's motion
+// (`custom-seed`'s engine, which we can stop at a step), tested by the oracle before the engine
+// resolves anything.
+// Sets `step` (-1: no pair touches within the run) and the stop reason.
 std::vector<RigidBody> first_contact_state(const Scene& scene, long& step, std::string& why) {
-  World world(scene.sim, make_bodies(scene));
+  World world(scene.sim, make_bodies(scene), ContactModel::Seed);
   const long steps = scene.sim.steps();
   step = -1;
   while (true) {

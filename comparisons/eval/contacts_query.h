@@ -8,7 +8,7 @@
 
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/json_io.h"
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

@@ -13,7 +13,7 @@
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/json_io.h"
 #include "comparisons/eval/parallel.h"
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

@@ -16,6 +16,7 @@
 
 #include "comparisons/eval/json_io.h"
 #include "comparisons/eval/result_cache.h"
+#include "comparisons/scene/scene.h"
 #include "engine/math.h"
 #include "reference/backend.h"
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "comparisons/eval/explore.h"
+#include "comparisons/scene/scene.h"
 #include "engine/body.h"
 #include "reference/backend.h"
 

@@ -9,8 +9,8 @@
 
 #include "comparisons/eval/json_io.h"
 #include "comparisons/eval/timing.h"
+#include "comparisons/scene/scene.h"
 #include "comparisons/scene/scene_collection.h"  // scene_family, for the harness's users
-#include "engine/scene.h"
 #include "reference/backend.h"
 
 namespace rbx {

@@ -8,7 +8,7 @@
 
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/metrics.h"
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 #include "reference/backend.h"
 
 namespace rbx {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "comparisons/eval/timing.h"
+#include "comparisons/scene/scene.h"
 #include "engine/body.h"
 #include "engine/contact.h"
 #include "engine/world.h"

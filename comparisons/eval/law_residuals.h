@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "comparisons/eval/harness.h"
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 #include "reference/contact_laws.h"
 
 namespace rbx {

@@ -12,8 +12,8 @@
 
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/result_cache.h"
+#include "comparisons/scene/scene.h"
 #include "engine/body.h"
-#include "engine/scene.h"
 #include "reference/backend.h"
 #include "reference/exact.h"
 

@@ -10,6 +10,7 @@
 #include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/json_io.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

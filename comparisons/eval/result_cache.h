@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "comparisons/eval/timing.h"
+#include "comparisons/scene/scene.h"
 #include "engine/body.h"
-#include "engine/scene.h"
 #include "reference/backend.h"
 
 namespace rbx {

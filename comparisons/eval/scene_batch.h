@@ -6,6 +6,7 @@
 
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/parallel.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 #include "reference/backend.h"
 
 namespace rbx {

@@ -292,7 +292,7 @@ Backend toss_backend(const Backend& backend, const ContactParams& params) {
     values.push_back(v);
   }
   Backend out = backend;
-  out.dynamics = [run = backend.soft.dynamics, values](const Scene& scene,
+  out.dynamics = [run = backend.soft.dynamics, values](const WorldDefinition& scene,
                                                        const DynamicsOptions& opt) {
     return run(scene, opt, values);
   };

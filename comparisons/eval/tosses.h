@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "comparisons/eval/json_io.h"
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 #include "reference/backend.h"
 
 namespace rbx {

@@ -4,6 +4,7 @@
 #include <ostream>
 
 #include "comparisons/eval/contacts_query.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

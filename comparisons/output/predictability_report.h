@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "comparisons/eval/harness.h"
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

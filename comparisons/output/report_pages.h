@@ -10,7 +10,7 @@
 #include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/output/scorecard.h"
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

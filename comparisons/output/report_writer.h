@@ -7,7 +7,7 @@
 
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/json_io.h"
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

@@ -8,7 +8,7 @@
 
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/metrics.h"  // median_of, for the scorecard's users
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

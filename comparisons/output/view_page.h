@@ -11,7 +11,7 @@
 #include "comparisons/eval/json_io.h"
 #include "comparisons/eval/tosses.h"
 #include "comparisons/output/table.h"  // html_escape
-#include "engine/scene.h"
+#include "comparisons/scene/scene.h"
 
 namespace rbx {
 

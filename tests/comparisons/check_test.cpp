@@ -37,7 +37,7 @@ std::vector<Backend> table_with_broken_engine() {
       for (ContactPoint& c : r.contacts) c.normal = turn * c.normal;
       return r;
     };
-    b.dynamics = [](const Scene& s, const DynamicsOptions& o) {
+    b.dynamics = [](const WorldDefinition& s, const DynamicsOptions& o) {
       DynamicsResult r = custom.dynamics(s, o);
       for (BodyFinal& f : r.finals) f.velocity.x() += 1e-3;
       return r;

@@ -80,7 +80,7 @@ Backend recorder(const std::string& name, const FirstImpulse& record) {
   Backend b;
   b.name = name;
   b.description = "test: fixed first-impulse record";
-  b.dynamics = [record](const Scene& scene, const DynamicsOptions&) {
+  b.dynamics = [record](const WorldDefinition& scene, const DynamicsOptions&) {
     DynamicsResult r;
     for (const RigidBody& body : make_bodies(scene))
       r.finals.push_back(

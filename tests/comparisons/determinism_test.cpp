@@ -140,16 +140,19 @@ Scene built_scene(Integrator integrator) {
   return s;
 }
 
-// Two runs of `scene`: equal hashes of the final states, equal JSON; and the run really is
-// a many-collision run (the premise of the test, not an expected value).
+// Two runs of `scene` with each contact model (`custom-seed`'s and `custom`'s): equal hashes of
+// the final states, equal JSON; and the run really is a many-collision run (the premise of the
+// test, not an expected value).
 void expect_deterministic(const Scene& scene, size_t min_events) {
-  const RunResult first = run_scene(scene);
-  const RunResult second = run_scene(scene);
-  ASSERT_TRUE(first.ok) << first.message;
-  EXPECT_GE(first.events.size(), min_events) << "too few collisions to test anything";
-  std::printf("%zu collision events\n", first.events.size());
-  EXPECT_EQ(state_hash(first), state_hash(second));
-  EXPECT_EQ(first.events.size(), second.events.size());
+  for (const ContactModel model : {ContactModel::Seed, ContactModel::Extended}) {
+    const RunResult first = run_world(scene, model);
+    const RunResult second = run_world(scene, model);
+    ASSERT_TRUE(first.ok) << first.message;
+    EXPECT_GE(first.events.size(), min_events) << "too few collisions to test anything";
+    std::printf("%zu collision events\n", first.events.size());
+    EXPECT_EQ(state_hash(first), state_hash(second));
+    EXPECT_EQ(first.events.size(), second.events.size());
+  }
 
   const std::string json_first = custom_json(scene);
   const std::string json_second = custom_json(scene);
@@ -182,7 +185,8 @@ TEST(Determinism, HashSeesATinyChange) {
   const Scene scene = built_scene(Integrator::Symplectic);
   Scene nudged = scene;
   nudged.bodies[6].velocity.x() += 1e-9;
-  EXPECT_NE(state_hash(run_scene(scene)), state_hash(run_scene(nudged)));
+  for (const ContactModel model : {ContactModel::Seed, ContactModel::Extended})
+    EXPECT_NE(state_hash(run_world(scene, model)), state_hash(run_world(nudged, model)));
 }
 
 }  // namespace

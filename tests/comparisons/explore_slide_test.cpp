@@ -206,7 +206,7 @@ TEST(ExploreSlide, ARestTimeDisagreementIsReproducedFromTheWrittenScene) {
   if (!find_backend(creeper)) {
     Backend b = *find_backend("bullet");
     b.name = creeper;
-    b.dynamics = [](const Scene& scene, const DynamicsOptions& opt) {
+    b.dynamics = [](const WorldDefinition& scene, const DynamicsOptions& opt) {
       BulletSettings s = bullet_native_settings();
       s.processing_fraction = 0;
       s.split_turn_erp = -1;
@@ -241,7 +241,7 @@ TEST(ExploreSlide, BulletSettingsMeasuredOnTheFamily) {
     Backend b = *find_backend("bullet");
     b.name = name;
     b.library = false;  // in process: the test's speed, the same library calls
-    b.dynamics = [change](const Scene& scene, const DynamicsOptions& opt) {
+    b.dynamics = [change](const WorldDefinition& scene, const DynamicsOptions& opt) {
       BulletSettings s = bullet_native_settings();
       change(s);
       return bullet_at_settings().dynamics(scene, opt, s);

@@ -22,14 +22,14 @@ std::vector<Backend> table_with_failing_backends() {
                   [](const RigidBody&, const RigidBody&) -> ContactResult {
                     throw std::runtime_error("thrower: contact query failed");
                   },
-                  [](const Scene&, const DynamicsOptions&) -> DynamicsResult {
+                  [](const WorldDefinition&, const DynamicsOptions&) -> DynamicsResult {
                     throw std::runtime_error("thrower: dynamics run failed");
                   }};
   Backend failer{"failer", "test: returns error from every call",
                  [](const RigidBody&, const RigidBody&) {
                    return ContactResult{Status::Error, "failer: gave up", {}};
                  },
-                 [](const Scene&, const DynamicsOptions&) {
+                 [](const WorldDefinition&, const DynamicsOptions&) {
                    return DynamicsResult{Status::Error, "failer: diverged", {}, {}, {}, {}, {}};
                  }};
   return {thrower, *find_backend("custom"), *find_backend("exact"), failer};
@@ -105,7 +105,7 @@ TEST(Harness, BodiesThatStartStillAreJudgedAgainstTheMotionTheRunMade) {
     return BodyFinal{name, Vec3(v * t, 0, 0), Quat::Identity(), Vec3(v, 0, 0), Vec3(0, 0, w)};
   };
   Backend apart{"apart", "test: throws two bodies apart", nullptr,
-                [&](const Scene&, const DynamicsOptions&) {
+                [&](const WorldDefinition&, const DynamicsOptions&) {
                   DynamicsResult r;
                   for (double t : {0.01, 0.02})
                     r.samples.push_back({t, {state("A", 0.3, 1, t), state("B", 0.7, -1, t)}});
@@ -216,7 +216,7 @@ TEST(HarnessExpect, AnEngineRunThatStopsFailsItsExpectationAndReferencesDoNotBin
   EXPECT_TRUE(ev.json["expect"]["passed"].get<bool>()) << ev.json["expect"];
   // An engine whose run stops early: failed, not passed and not "not checked".
   std::vector<Backend> table = {*find_backend("custom")};
-  table[0].dynamics = [](const Scene&, const DynamicsOptions&) {
+  table[0].dynamics = [](const WorldDefinition&, const DynamicsOptions&) {
     DynamicsResult r;
     r.status = Status::Error;
     r.message = "energy grew past the guard";
@@ -245,7 +245,7 @@ TEST(HarnessExpect, ItBindsTheEnginesItNamesTheCustomEngineByDefault) {
       "0]\n[[body]]\nname = \"B\"\nposition = [1, 0, 0]\nvelocity = [-1, 0, 0]\n[expect]\n";
   const std::string body = "[expect.body.A]\nvelocity = [-1, 0, 0]\n";
   std::vector<Backend> table = {*find_backend("custom"), *find_backend("custom-seed")};
-  table[1].dynamics = [](const Scene& s, const DynamicsOptions&) {
+  table[1].dynamics = [](const WorldDefinition& s, const DynamicsOptions&) {
     DynamicsResult r;
     for (const BodySpec& b : s.bodies)
       r.finals.push_back({b.name, b.position, b.orientation, Vec3::Zero(), Vec3::Zero()});

@@ -97,6 +97,28 @@ TEST(Layers, EveryComparisonsSourceIsInALayer) {
     EXPECT_GE(layer_of(f), 0) << f << " is outside comparisons/{scene,eval,output,cli}/";
 }
 
+TEST(Layers, TheEngineAndTheAdaptersKnowNoComparisonsVocabulary) {
+  // A world is bodies, settings and a contact model (engine/world_definition.h); what the
+  // harness checks, expects, repeats or which backends it runs belongs to comparisons/scene/.
+  // Code only, comments aside: a comment may say what a caller does with a result.
+  static const std::regex word_re(
+      R"re(\b(Scene|CheckKind|Expect|ExpectBody|ExpectContact|EnsembleSpec|known_failure)\b)re");
+  std::size_t files = 0;
+  for (const char* folder : {"engine", "reference"})
+    for (const std::string& f : sources_under(folder)) {
+      ++files;
+      std::istringstream lines(read(f));
+      std::string line;
+      for (int n = 1; std::getline(lines, line); ++n) {
+        const std::string code = line.substr(0, line.find("//"));
+        std::smatch m;
+        if (std::regex_search(code, m, word_re))
+          ADD_FAILURE() << f << ":" << n << " names " << m[1] << ": " << line;
+      }
+    }
+  EXPECT_GT(files, 40u);  // the tree was found
+}
+
 // Lines of the .h and .cpp files under `folder`.
 std::size_t lines_under(const std::string& folder) {
   std::size_t n = 0;

@@ -153,7 +153,7 @@ TEST(ResultCache, ExploreSamplesReadALibrarysAnswersBack) {
     return fcl(a, b);
   };
   const auto bullet = table[2].dynamics;
-  table[2].dynamics = [bullet, log](const Scene& s, const DynamicsOptions& o) {
+  table[2].dynamics = [bullet, log](const WorldDefinition& s, const DynamicsOptions& o) {
     std::ofstream(log, std::ios::app) << 'x';
     return bullet(s, o);
   };

@@ -387,8 +387,11 @@ TEST(TossesEvaluate, ALibraryAbortingOnOneTossFailsThatTossAloneAndTheOthersAreK
   Backend aborting = *ode;
   aborting.name = "ode-aborting";
   aborting.library = true;
-  aborting.dynamics = [ode](const Scene& scene, const DynamicsOptions& opt) {
-    if (scene.name == "cube toss 2") std::abort();
+  // The second toss is the one whose cube starts at z = 0.3 (0.2 + 0.05 x 2).
+  const double second_z = tosses[1].samples[0].position.z();
+  aborting.dynamics = [ode, second_z](const WorldDefinition& scene, const DynamicsOptions& opt) {
+    for (const BodySpec& b : scene.bodies)
+      if (b.name == "cube" && b.position.z() == second_z) std::abort();
     return ode->dynamics(scene, opt);
   };
   const ContactParams params{0.5, 0.5, {}};

@@ -312,7 +312,8 @@ TEST(BroadPhase, WorldResultsDoNotDependOnTheMethod) {
   sim.duration = 0.3;
   std::vector<RunResult> results;
   for (BroadPhaseMethod m : kMethods)
-    results.push_back(World(sim, bodies, DetectorVariant::Accelerated, m).run());
+    results.push_back(
+        World(sim, bodies, ContactModel::Seed, DetectorVariant::Accelerated, m).run());
   const RunResult& oracle = results[0];
   ASSERT_TRUE(oracle.ok) << oracle.message;
   EXPECT_GT(oracle.events.size(), 50u);  // the scene is busy: the comparison is not vacuous

@@ -66,8 +66,7 @@ TEST(TimeOfImpact, AFallAtTheSpeedLimitIsCaughtAtItsClosedFormTime) {
   SimSettings sim;
   sim.dt = 1e-3;
   sim.duration = 0.002;
-  World world(sim, {cube, slab});
-  world.set_contact_model(ContactModel::Extended);
+  World world(sim, {cube, slab}, ContactModel::Extended);
   const RunResult r = world.run();
   ASSERT_TRUE(r.ok) << r.message;
   EXPECT_EQ(r.events.size(), 1u);
@@ -99,9 +98,8 @@ TEST(TimeOfImpact, ASearchPastItsSampleLimitIsNotCertified) {
   sim.duration = 0.01;
   WorldSettings tunables;
   tunables.toi_max_samples = 100;
-  World world(sim, {plate_over, floor}, DetectorVariant::Accelerated, BroadPhaseMethod::Tree,
-              tunables);
-  world.set_contact_model(ContactModel::Extended);
+  World world(sim, {plate_over, floor}, ContactModel::Extended, DetectorVariant::Accelerated,
+              BroadPhaseMethod::Tree, tunables);
   const RunResult r = world.run();
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.steps_taken, 1);
@@ -153,8 +151,7 @@ TEST(ExtendedWorld, ThinWallNeverTunnels) {
     SimSettings sim;
     sim.dt = dt;
     sim.duration = 0.05;
-    World world(sim, {plate(), wall()});
-    world.set_contact_model(ContactModel::Extended);
+    World world(sim, {plate(), wall()}, ContactModel::Extended);
     const RunResult r = world.run();
     ASSERT_TRUE(r.ok) << r.message;
     EXPECT_NEAR(r.bodies[0].velocity.x(), -100.0, 1e-9) << "dt " << dt;
@@ -173,8 +170,7 @@ TEST(ExtendedWorld, StackRestsWithoutAddingEnergy) {
                                             Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true)};
   for (int k = 0; k < 3; ++k)
     bodies.push_back(box_body("box", Vec3::Ones(), 1.0, Vec3(0, 0, 0.5 + k)));
-  World world(sim, bodies);
-  world.set_contact_model(ContactModel::Extended);
+  World world(sim, bodies, ContactModel::Extended);
   const double e0 = world.energy();
   for (int step = 0; step < 2000; ++step) {
     ASSERT_TRUE(world.step());
@@ -192,12 +188,13 @@ TEST(ExtendedWorld, DropNeverGainsEnergy) {
   sim.gravity = Vec3(0, 0, -9.81);
   sim.restitution = 0.5;
   sim.friction = 0.4;
-  World world(sim, {box_body("floor", Vec3(10, 10, 1), 1.0, Vec3(0, 0, -0.5), Quat::Identity(),
-                             Vec3::Zero(), Vec3::Zero(), true),
-                    box_body("cube", Vec3::Ones(), 1.0, Vec3(0, 0, 1.2),
-                             Quat(Eigen::AngleAxisd(0.3, Vec3(1, 2, 0).normalized())),
-                             Vec3(1, 0, 0), Vec3(0, 0, 2))});
-  world.set_contact_model(ContactModel::Extended);
+  World world(sim,
+              {box_body("floor", Vec3(10, 10, 1), 1.0, Vec3(0, 0, -0.5), Quat::Identity(),
+                        Vec3::Zero(), Vec3::Zero(), true),
+               box_body("cube", Vec3::Ones(), 1.0, Vec3(0, 0, 1.2),
+                        Quat(Eigen::AngleAxisd(0.3, Vec3(1, 2, 0).normalized())), Vec3(1, 0, 0),
+                        Vec3(0, 0, 2))},
+              ContactModel::Extended);
   double previous = world.energy();
   for (int step = 0; step < 3000; ++step) {
     ASSERT_TRUE(world.step());

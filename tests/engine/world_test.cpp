@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 #include "engine/response.h"
 #include "tests/common/fixtures.h"
@@ -28,7 +29,7 @@ TEST(World, HeadOnElasticEqualMassesExchangeVelocities) {
   std::vector<RigidBody> bodies = {
       box_body("A", Vec3::Ones(), 1, Vec3(-0.75, 0, 0), Quat::Identity(), Vec3(1, 0, 0)),
       box_body("B", Vec3::Ones(), 1, Vec3(0.75, 0, 0), Quat::Identity(), Vec3(-1, 0, 0))};
-  World w(sim_with(1e-3, 0.6, 1.0), bodies);
+  World w(sim_with(1e-3, 0.6, 1.0), bodies, ContactModel::Seed);
   const RunResult r = w.run();
   ASSERT_TRUE(r.ok) << r.message;
   ASSERT_EQ(r.events.size(), 1u);
@@ -56,7 +57,7 @@ TEST(World, CrossedBarsCollideEdgeOnEdge) {
                Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX())), Vec3(0, 0, -1)),
       box_body("B", Vec3(0.2, 2, 0.2), 1, Vec3(0, 0.3, 0),
                Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY())))};
-  World w(sim_with(1e-3, 0.15, 1.0), bodies);
+  World w(sim_with(1e-3, 0.15, 1.0), bodies, ContactModel::Seed);
   const RunResult r = w.run();
   ASSERT_TRUE(r.ok) << r.message;
   ASSERT_EQ(r.events.size(), 1u);
@@ -98,29 +99,38 @@ void expect_identical_runs(const RunResult& r1, const RunResult& r2) {
   }
 }
 
+// A world is built with its contact model named: no default picks the seed's for a caller who
+// meant the extended engine's.
+static_assert(!std::is_constructible_v<World, SimSettings, std::vector<RigidBody>>);
+static_assert(std::is_constructible_v<World, SimSettings, std::vector<RigidBody>, ContactModel>);
+
 TEST(World, RunsAreBitwiseDeterministic) {
-  World w1(sim_with(1e-3, 0.5, 0.8), six_boxes()), w2(sim_with(1e-3, 0.5, 0.8), six_boxes());
-  expect_identical_runs(w1.run(), w2.run());
+  for (const ContactModel model : {ContactModel::Seed, ContactModel::Extended}) {
+    World w1(sim_with(1e-3, 0.5, 0.8), six_boxes(), model),
+        w2(sim_with(1e-3, 0.5, 0.8), six_boxes(), model);
+    expect_identical_runs(w1.run(), w2.run());
+  }
 }
 
 // A response given as a function (World::set_response, the hook behind a researcher's own
 // response backend) replaces the seed's impulse: handed the seed's own impulse it reproduces the
 // seed's run bit for bit; handed e = 1 on an e = 0.5 scene it bounces elastically.
 TEST(World, AResponseFunctionReplacesTheSeedsImpulse) {
-  World seed(sim_with(1e-3, 0.5, 0.8), six_boxes()), hooked(sim_with(1e-3, 0.5, 0.8), six_boxes());
+  World seed(sim_with(1e-3, 0.5, 0.8), six_boxes(), ContactModel::Seed),
+      hooked(sim_with(1e-3, 0.5, 0.8), six_boxes(), ContactModel::Seed);
   hooked.set_response([](const RigidBody& a, const RigidBody& b, const ContactPoint& c,
                          double e) -> Vec3 { return impulse_magnitude(a, b, c, e) * c.normal; });
   expect_identical_runs(seed.run(), hooked.run());
   std::vector<RigidBody> pair = {
       box_body("A", Vec3::Ones(), 1, Vec3(-0.75, 0, 0), Quat::Identity(), Vec3(1, 0, 0)),
       box_body("B", Vec3::Ones(), 1, Vec3(0.75, 0, 0), Quat::Identity(), Vec3(-1, 0, 0))};
-  World elastic(sim_with(1e-3, 0.6, 0.5), pair);
+  World elastic(sim_with(1e-3, 0.6, 0.5), pair, ContactModel::Seed);
   elastic.set_response([](const RigidBody& a, const RigidBody& b, const ContactPoint& c,
                           double) -> Vec3 { return impulse_magnitude(a, b, c, 1.0) * c.normal; });
   const RunResult r = elastic.run();
   ASSERT_TRUE(r.ok) << r.message;
   EXPECT_LT((r.bodies[0].velocity - Vec3(-1, 0, 0)).norm(), 1e-12);  // e = 1's exchange
-  World broken(sim_with(1e-3, 0.6, 0.5), pair);
+  World broken(sim_with(1e-3, 0.6, 0.5), pair, ContactModel::Seed);
   broken.set_response([](const RigidBody&, const RigidBody&, const ContactPoint&, double) {
     return Vec3(NAN, 0, 0);
   });
@@ -130,7 +140,7 @@ TEST(World, AResponseFunctionReplacesTheSeedsImpulse) {
 TEST(World, NonFiniteStateStopsTheRunNamingBodyAndQuantity) {
   std::vector<RigidBody> bodies = {
       box_body("A", Vec3::Ones(), 1, Vec3::Zero(), Quat::Identity(), Vec3(NAN, 0, 0))};
-  World w(sim_with(1e-3, 1.0, 1.0), bodies);
+  World w(sim_with(1e-3, 1.0, 1.0), bodies, ContactModel::Seed);
   const RunResult r = w.run();
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.steps_taken, 1);
@@ -145,13 +155,13 @@ TEST(World, EnergyGuardStopsARunawayRun) {
   s.integrator = Integrator::Euler;
   s.gravity = Vec3(0, 0, -9.81);
   s.max_energy_ratio = 1.0 + 1e-9;
-  World w(s, {box_body("A", Vec3::Ones(), 1, Vec3::Zero())});
+  World w(s, {box_body("A", Vec3::Ones(), 1, Vec3::Zero())}, ContactModel::Seed);
   const RunResult r = w.run();
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.message.find("energy grew"), std::string::npos) << r.message;
   // The default guard (1e3) lets the same run finish.
   s.max_energy_ratio = 1e3;
-  World ok(s, {box_body("A", Vec3::Ones(), 1, Vec3::Zero())});
+  World ok(s, {box_body("A", Vec3::Ones(), 1, Vec3::Zero())}, ContactModel::Seed);
   EXPECT_TRUE(ok.run().ok);
 }
 
@@ -159,7 +169,8 @@ TEST(World, EnergyGuardCatchesAnInfiniteInitialEnergy) {
   // v = 1e155 m/s is finite, but 1/2 m v^2 = 5e309 J overflows to inf; the growth test then
   // compared inf - inf = NaN, which is never greater than a bound, and the run went on.
   World w(sim_with(1e-3, 1.0, 1.0),
-          {box_body("A", Vec3::Ones(), 1, Vec3::Zero(), Quat::Identity(), Vec3(1e155, 0, 0))});
+          {box_body("A", Vec3::Ones(), 1, Vec3::Zero(), Quat::Identity(), Vec3(1e155, 0, 0))},
+          ContactModel::Seed);
   const RunResult r = w.run();
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.steps_taken, 1);
@@ -172,7 +183,8 @@ TEST(World, EnergyGuardCatchesATotalThatOverflows) {
   const double v = 1.3e154;
   World w(sim_with(1e-3, 1.0, 1.0),
           {box_body("A", Vec3::Ones(), 2, Vec3::Zero(), Quat::Identity(), Vec3(v, 0, 0)),
-           box_body("B", Vec3::Ones(), 2, Vec3(0, 0, 10), Quat::Identity(), Vec3(v, 0, 0))});
+           box_body("B", Vec3::Ones(), 2, Vec3(0, 0, 10), Quat::Identity(), Vec3(v, 0, 0))},
+          ContactModel::Seed);
   const RunResult r = w.run();
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.steps_taken, 1) << r.message;
@@ -186,7 +198,7 @@ TEST(World, EnergyGuardMessageShowsTheRatioAsGiven) {
   s.integrator = Integrator::Euler;
   s.gravity = Vec3(0, 0, -9.81);
   s.max_energy_ratio = 1.000001;
-  World w(s, {box_body("A", Vec3::Ones(), 1, Vec3::Zero())});
+  World w(s, {box_body("A", Vec3::Ones(), 1, Vec3::Zero())}, ContactModel::Seed);
   const RunResult r = w.run();
   ASSERT_FALSE(r.ok);
   EXPECT_NE(r.message.find("(more than max_energy_ratio = 1.000001 times the budget) at step 1"),
@@ -201,7 +213,7 @@ TEST(World, StaticPairsAndDistantPairsProduceNoEvents) {
       box_body("B", Vec3::Ones(), 1, Vec3(0.5, 0, 0), Quat::Identity(), Vec3::Zero(), Vec3::Zero(),
                true),
       box_body("C", Vec3::Ones(), 1, Vec3(10, 0, 0), Quat::Identity(), Vec3(1, 0, 0))};
-  World w(sim_with(1e-3, 0.1, 1.0), bodies);
+  World w(sim_with(1e-3, 0.1, 1.0), bodies, ContactModel::Seed);
   const RunResult r = w.run();
   EXPECT_TRUE(r.ok);
   EXPECT_TRUE(r.events.empty());
@@ -218,7 +230,7 @@ TEST(World, VertexOnStaticSlabBouncesWithClosedFormSpin) {
       box_body("A", Vec3::Ones(), 1, Vec3(0, 0, h + 0.05), q, Vec3(0, 0, -1)),
       box_body("B", Vec3(4, 4, 1), 1, Vec3(0, 0, -0.5), Quat::Identity(), Vec3::Zero(),
                Vec3::Zero(), true)};
-  World w(sim_with(1e-3, 0.2, 0.5), bodies);
+  World w(sim_with(1e-3, 0.2, 0.5), bodies, ContactModel::Seed);
   const RunResult r = w.run();
   ASSERT_TRUE(r.ok) << r.message;
   ASSERT_GE(r.events.size(), 1u);
@@ -246,8 +258,7 @@ TEST(World, StepContactsAreTheSolvedPointsWithTheirImpulses) {
   const RigidBody floor = test::box_body("floor", Vec3(10.0, 10.0, 1.0), 1.0, Vec3(0.0, 0.0, -0.5),
                                          Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true);
   const RigidBody cube = test::box_body("cube", Vec3::Ones(), 2.0, Vec3(0.0, 0.0, 0.5));
-  World world(sim, {floor, cube});
-  world.set_contact_model(ContactModel::Extended);
+  World world(sim, {floor, cube}, ContactModel::Extended);
   EXPECT_TRUE(world.step_contacts().empty());
   for (int k = 0; k < 3; ++k) ASSERT_TRUE(world.step());
   Vec3 total = Vec3::Zero();

@@ -235,7 +235,7 @@ TEST(BulletContact, SeparatedHasNoContacts) {
 // Dynamics
 
 /// Total kinetic energy of finals, with masses and inertias from the scene (isotropic cubes).
-double kinetic_energy(const Scene& scene, const DynamicsResult& r) {
+double kinetic_energy(const WorldDefinition& scene, const DynamicsResult& r) {
   double e = 0;
   for (size_t i = 0; i < scene.bodies.size(); ++i) {
     if (scene.bodies[i].is_static) continue;
@@ -252,8 +252,8 @@ double kinetic_energy(const Scene& scene, const DynamicsResult& r) {
 /// moving at v2, B turned 45 deg about x. Facing faces are x = -0.5 (A) and x = 0 (B); the
 /// overlap patch is an octagon centred on the x axis, so the impulse passes through both
 /// centres of mass, and no side faces are coplanar (KnownDefectEpaCoplanarSides).
-Scene head_on(double m1, double v1, double m2, double v2, double e) {
-  Scene s;
+WorldDefinition head_on(double m1, double v1, double m2, double v2, double e) {
+  WorldDefinition s;
   s.sim.dt = 1e-3;
   s.sim.duration = 1.0;
   s.sim.restitution = e;
@@ -272,7 +272,7 @@ Scene head_on(double m1, double v1, double m2, double v2, double e) {
 // Contact at t* = gap / closing speed = 0.5 / 1.5 = 1/3 s; final positions at T = 1:
 //   x1 = -1 + t* v1 + (T - t*) v1' = -1.125,  x2 = 0.5 + t* v2 + (T - t*) v2' = 0.375.
 TEST(BulletDynamics, HeadOnUnequalMasses) {
-  const Scene s = head_on(1, 1, 3, -0.5, 0.5);
+  const WorldDefinition s = head_on(1, 1, 3, -0.5, 0.5);
   const DynamicsResult r = bullet_hull.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.finals.size(), 2u);
@@ -330,7 +330,7 @@ TEST(BulletDynamics, CubeCornerOnStaticSlab) {
 
   for (double e : {1.0, 0.5}) {
     SCOPED_TRACE("e = " + std::to_string(e));
-    Scene s;
+    WorldDefinition s;
     s.sim.dt = 1e-3;
     s.sim.duration = 0.15;
     s.sim.restitution = e;
@@ -372,7 +372,7 @@ TEST(BulletDynamics, CubeCornerOnStaticSlab) {
 // The fair settings give the elastic answer: velocities swap (A 0, B 1), energy stays 0.5.
 // Tolerance: round-off (d / dt carries ~1e-13).
 TEST(BulletDynamics, DefaultWorldDefectAndFairFix) {
-  const Scene s = head_on(1, 1, 1, 0, 1.0);
+  const WorldDefinition s = head_on(1, 1, 1, 0, 1.0);
 
   const DynamicsResult def = bullet_at_settings().dynamics(s, {}, bullet_default_world_settings());
   ASSERT_EQ(def.status, Status::Ok) << def.message;
@@ -395,7 +395,7 @@ TEST(BulletDynamics, DefaultWorldDefectAndFairFix) {
 // at positive distance through GJK, which gets the normal right, and fails by the
 // inelasticity above instead.)
 TEST(BulletDynamics, KnownDefectAlignedFaceFaceSpins) {
-  Scene s = head_on(1, 1, 1, 0, 1.0);
+  WorldDefinition s = head_on(1, 1, 1, 0, 1.0);
   s.bodies[1].orientation = Quat::Identity();
   const DynamicsResult r = bullet_hull.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
@@ -423,7 +423,7 @@ BodySpec turned_box(const Quat& local) {
 TEST(BulletDynamics, NonDiagonalInertiaPrincipalFrame) {
   const Quat local(Eigen::AngleAxisd(0.4, Vec3(1, 1, 0).normalized()));
   const Quat r0(Eigen::AngleAxisd(0.7, Vec3(0, 1, 2).normalized()));
-  Scene s;
+  WorldDefinition s;
   s.sim.dt = 1e-3;
   s.sim.duration = 0.5;
   BodySpec spec = turned_box(local);
@@ -454,7 +454,7 @@ TEST(BulletDynamics, NonDiagonalInertiaPrincipalFrame) {
 //  - first-order convergence: the drift at dt = 1e-3 is 10x that at 1e-4 (band 7..13 for the
 //    O(dt^2) remainder), and kinetic energy never increases (implicit Euler dissipates).
 TEST(BulletDynamics, GyroscopicImplicitBodyConservesAngularMomentum) {
-  Scene s;
+  WorldDefinition s;
   s.sim.duration = 2.0;
   s.bodies.push_back(box_spec("G", Vec3(1, 2, 3), Vec3::Zero()));
   s.bodies.back().angular_velocity = Vec3(1, 2, 3);
@@ -494,7 +494,7 @@ TEST(BulletDynamics, GyroscopicImplicitBodyConservesAngularMomentum) {
 // Samples at t = 0 and every `sample_every` steps; opt.dt overrides sim.dt; a run that cannot
 // start reports Status::Error with the reason.
 TEST(BulletDynamics, SamplesAndErrors) {
-  Scene s;
+  WorldDefinition s;
   s.sim.dt = 1e-2;
   s.sim.duration = 1.0;
   s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero()));
@@ -512,7 +512,7 @@ TEST(BulletDynamics, SamplesAndErrors) {
   }
   EXPECT_TRUE(r.events.empty());
 
-  Scene bad = s;
+  WorldDefinition bad = s;
   bad.sim.dt = 0;
   const DynamicsResult err = bullet_hull.dynamics(bad, {});
   EXPECT_EQ(err.status, Status::Error);

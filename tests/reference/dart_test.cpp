@@ -90,8 +90,8 @@ TEST(DartContact, TriangleMeshPathGivesSideNormalsOnAFaceContact) {
 
 // A box of full extents `size` standing on a static 10 m slab (top face z = 0), sliding at `v`
 // (horizontal), mu = 0.5, e = 0, gravity 9.81, for `duration` s at steps of `dt`.
-Scene sliding_on_floor(const Vec3& size, const Vec3& v, double duration, double dt) {
-  Scene s;
+WorldDefinition sliding_on_floor(const Vec3& size, const Vec3& v, double duration, double dt) {
+  WorldDefinition s;
   s.sim.dt = dt;
   s.sim.duration = duration;
   s.sim.gravity = Vec3(0, 0, -9.81);
@@ -107,7 +107,7 @@ Scene sliding_on_floor(const Vec3& size, const Vec3& v, double duration, double 
 
 // A unit cube sliding at `v`: Coulomb's law stops it after |v| / (mu g) s, |v|^2 / (2 mu g) m
 // along v.
-Scene sliding_cube(const Vec3& v) { return sliding_on_floor(Vec3::Ones(), v, 0.5, 1e-3); }
+WorldDefinition sliding_cube(const Vec3& v) { return sliding_on_floor(Vec3::Ones(), v, 0.5, 1e-3); }
 
 TEST(DartDynamics, FrictionPyramidIsExactAlongItsDirectionsAndStrongerAcross) {
   // DART bounds each of its two friction directions by mu times the normal impulse (a boxed
@@ -154,7 +154,7 @@ TEST(DartDynamics, BoxedFrictionBoundsComeFromAFrictionlessPass) {
   // Coulomb cone violation) and the sliding front edge carries |j_t| = 0.40 j_n, less than mu
   // (a maximal-dissipation violation): the box slides on faster and tips less than the closed
   // form (velocity error 0.079, the same as ODE's, whose solver it is).
-  const Scene s = sliding_on_floor(Vec3(0.2, 0.2, 1.0), Vec3(2, 0, 0), 0.05, 1e-4);
+  const WorldDefinition s = sliding_on_floor(Vec3(0.2, 0.2, 1.0), Vec3(2, 0, 0), 0.05, 1e-4);
   const DynamicsResult r = dart.dynamics(s, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_TRUE(r.laws.measured);
@@ -173,7 +173,7 @@ TEST(DartDynamics, BoxedFrictionBoundsComeFromAFrictionlessPass) {
 TEST(DartDynamics, RestitutionIsTheSceneCoefficientOnEveryPair) {
   // DART multiplies the two bodies' coefficients; each gets sqrt(e). Head-on unit cubes at
   // +-1 m/s with e = 0.25 (exactly representable root 0.5) leave at -+0.25 m/s.
-  Scene s;
+  WorldDefinition s;
   s.sim.restitution = 0.25;
   BodySpec a = box_spec("A", Vec3::Ones(), Vec3(-1, 0, 0)),
            b = box_spec("B", Vec3::Ones(), Vec3(1, 0, 0));

@@ -53,7 +53,7 @@ constexpr double kWrong = 1e-3;
 /// A closed-form dynamics scene: the scene and the expected final velocities of each body.
 struct Case {
   std::string name;
-  Scene scene;
+  WorldDefinition scene;
   std::vector<Vec3> velocity;          // m/s, per body (static bodies: ignored)
   std::vector<Vec3> angular_velocity;  // rad/s, world frame
 };
@@ -175,8 +175,8 @@ double measured(const char* what, const Case& c, double err) {
 }
 
 /// stress/resting_stack: three unit cubes stacked on a static floor under gravity, e = 0, 2 s.
-Scene resting_stack() {
-  Scene s;
+WorldDefinition resting_stack() {
+  WorldDefinition s;
   s.sim.duration = 2;
   s.sim.gravity = Vec3(0, 0, -9.81);
   s.sim.restitution = 0;
@@ -685,7 +685,7 @@ TEST(DartSettingsMeasured, BounceLimitsAreCompiledIn) {
 /// against the slip stops it after v^2 / (2 mu g) along the launch direction, without turning.
 /// The box cannot tip (mu 0.2 < 0.3, its narrower half width over its half height).
 struct Slide {
-  Scene scene;
+  WorldDefinition scene;
   Vec3 direction;     // unit, horizontal
   double stop = 0.0;  // m, distance along `direction`
 };
@@ -757,7 +757,7 @@ constexpr double kTurnMark = 1e-3;
 
 TEST(MujocoSettingsMeasured, EllipticConeAgainstThePyramid) {
   const auto with = [](void (*change)(MujocoSettings&)) {
-    return [change](const Scene& scene) {
+    return [change](const WorldDefinition& scene) {
       MujocoSettings m;
       change(m);
       return mujoco_at_settings().dynamics(scene, {}, m);
@@ -790,7 +790,7 @@ TEST(MujocoSettingsMeasured, EllipticConeAgainstThePyramid) {
 
 TEST(OdeSettingsMeasured, FirstFrictionDirectionAlongTheSlip) {
   const auto with = [](bool along) {
-    return [along](const Scene& scene) {
+    return [along](const WorldDefinition& scene) {
       OdeSettings o;
       o.friction_along_slip = along;
       return ode_at_settings().dynamics(scene, {}, o);
@@ -806,7 +806,7 @@ TEST(OdeSettingsMeasured, FirstFrictionDirectionAlongTheSlip) {
 
 TEST(DartSettingsMeasured, FirstFrictionDirectionAlongTheSlip) {
   const auto with = [](bool along) {
-    return [along](const Scene& scene) {
+    return [along](const WorldDefinition& scene) {
       DartSettings d;
       d.friction_along_slip = along;
       return dart_at_settings().dynamics(scene, {}, d);
@@ -821,8 +821,8 @@ TEST(DartSettingsMeasured, FirstFrictionDirectionAlongTheSlip) {
 }
 
 TEST(BulletSettingsMeasured, FrictionOnTheSlideFamily) {
-  const SlideError e =
-      worst_slide("bullet", [](const Scene& scene) { return bullet.dynamics(scene, {}); });
+  const SlideError e = worst_slide(
+      "bullet", [](const WorldDefinition& scene) { return bullet.dynamics(scene, {}); });
   EXPECT_LT(e.across, kSlideMark);
   EXPECT_LT(e.along, kSlideMark);
   EXPECT_LT(e.turn, kTurnMark);

@@ -329,7 +329,7 @@ TEST(IsolatedDynamics, DartsAssertionOnANonFiniteStateIsItsError) {
   // aborts. Isolated, as every library call in rbx's runs is, that is the backend's error naming
   // the signal, and this process goes on.
   for (const char* name : {"dart", "dart-hull"}) {
-    Scene s;
+    WorldDefinition s;
     s.sim.duration = 0.01;
     BodySpec a;
     a.name = "A";

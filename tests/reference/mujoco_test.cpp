@@ -268,7 +268,7 @@ TEST(MujocoKnownDefect, BoxBoxReturnsMetresDeepPointsUnderABoxAt45Degrees) {
   // 1.01 m tall), and the box leaves at some 76 m/s. Pinned through the adapter's contact-law
   // record (the penetration law's worst is the deepest point MuJoCo reported); the same box
   // unturned stays at rest.
-  Scene s;
+  WorldDefinition s;
   s.sim.duration = 0.103;
   s.sim.gravity = Vec3(0, 0, -9.81);
   s.sim.restitution = 0;
@@ -304,7 +304,7 @@ TEST(MujocoKnownDefect, ASlidingBoxLeavesItsSurfaceAtMuTimesItsSlip) {
   constexpr double theta = 30 * kPi / 180, mu = 0.9, dt = 1e-3;
   const Quat tilt(Eigen::AngleAxisd(theta, Vec3::UnitY()));
   const Vec3 n = tilt * Vec3::UnitZ(), up = -(tilt * Vec3::UnitX());
-  Scene s;
+  WorldDefinition s;
   s.sim.dt = dt;
   s.sim.duration = 2 * dt;
   s.sim.gravity = Vec3(0, 0, -9.81);
@@ -454,8 +454,8 @@ TEST(MujocoErrors, EveryFailedAllocationIsAStatusError) {
 
 // Head-on scene: A (m1 = 1, diagonal along x) at v1 = +1, B (m2 = 3, axis-aligned) at v2 = -1.
 // A's leading vertex starts `gap` short of B's face at x = 0.
-Scene head_on(double restitution, double gap, double dt) {
-  Scene s;
+WorldDefinition head_on(double restitution, double gap, double dt) {
+  WorldDefinition s;
   s.sim.dt = dt;
   s.sim.duration = 0.1;  // the soft contact lasts ~25 steps = 25 ms
   s.sim.restitution = restitution;
@@ -530,7 +530,7 @@ TEST(MujocoDynamics, CubeCornerOnStaticSlab) {
   const double j = (1 + e) / (1 + 6 * rx * rx);
   // dt = 0.1 ms; the slab top 0.15 mm below the vertex: entry phase 1/2 (see above).
   const double dt = 1e-4;
-  Scene s;
+  WorldDefinition s;
   s.sim.dt = dt;
   s.sim.duration = 0.006;  // contact ~2.5 ms; the next vertex is still 0.17 m up
   s.sim.restitution = e;
@@ -560,7 +560,7 @@ TEST(MujocoDynamics, FreeRotationStaysInTheWorldFrame) {
   // missing conversion would show here, since the cube starts turned.
   const Vec3 w(1, 2, 3);  // rad/s, world
   const Quat q0(Eigen::AngleAxisd(0.7, Vec3(1, -2, 0.5).normalized()));
-  Scene s;
+  WorldDefinition s;
   s.sim.dt = 1e-3;
   s.sim.duration = 0.1;
   s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero(), 1.0, q0));
@@ -577,7 +577,7 @@ TEST(MujocoDynamics, FreeFallSamples) {
   // Semi-implicit Euler from rest: v_n = g n dt, x_n = x0 + g dt^2 n (n + 1) / 2 exactly (up to
   // round-off). Samples every 10 steps over 100 steps: t = 0, 0.01, ..., 0.1 (11 samples).
   const double g = -9.81, dt = 1e-3;
-  Scene s;
+  WorldDefinition s;
   s.sim.dt = dt;
   s.sim.duration = 0.1;
   s.sim.gravity = Vec3(0, 0, g);
@@ -598,7 +598,7 @@ TEST(MujocoDynamics, FreeFallSamples) {
 
 TEST(MujocoDynamics, NonFiniteStateIsAnError) {
   // MuJoCo warns about a NaN velocity and silently resets the state; the adapter must say so.
-  Scene s;
+  WorldDefinition s;
   s.sim.duration = 0.01;
   s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   s.bodies.back().velocity = Vec3(std::nan(""), 0, 0);

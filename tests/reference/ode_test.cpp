@@ -177,8 +177,8 @@ TEST(OdeKnownBehaviour, ConvexConvexReturnsOnePoint) {
 
 // Head-on scene: A (m1 = 1, diagonal along x) at v1 = +1, B (m2 = 3) at v2 = -1; A's leading
 // vertex starts 3 mm short of B's face (seen 1 mm deep two steps later at dt = 1 ms).
-Scene head_on(double restitution) {
-  Scene s;
+WorldDefinition head_on(double restitution) {
+  WorldDefinition s;
   s.sim.dt = 1e-3;
   s.sim.duration = 0.02;
   s.sim.restitution = restitution;
@@ -235,7 +235,7 @@ TEST(OdeDynamics, FaceFaceImpactConservesMomentum) {
   // equal and opposite at a common point, so linear momentum stays (-2, 0, 0) and angular
   // momentum about the origin stays 0 (the initial velocities lie on the x axis through both
   // centres); round-off only.
-  Scene s = head_on(0.5);
+  WorldDefinition s = head_on(0.5);
   s.bodies[0].orientation = Quat::Identity();
   s.bodies[0].position = Vec3(-0.5 - 0.003, 0, 0);
   const DynamicsResult r = ode_hull.dynamics(s, {});
@@ -270,7 +270,7 @@ TEST(OdeDynamics, CubeCornerOnStaticSlab) {
   const double slab_z = rz - 0.5 - 0.002 + 1e-6;
   // Both orders of the bodies in the scene: the static slab first must not change anything.
   for (bool slab_first : {false, true}) {
-    Scene s;
+    WorldDefinition s;
     s.sim.dt = 1e-3;
     s.sim.duration = 0.01;
     s.sim.restitution = 0.5;
@@ -306,7 +306,7 @@ TEST(OdeDynamics, AQuickStepRunDoesNotDependOnTheRunsBeforeIt) {
   // per process. A cube sliding flat on a slab (four contact points with friction, so the order
   // matters) run three times in one process: the third run must repeat the first bit for bit,
   // though the second advanced the generator.
-  Scene s;
+  WorldDefinition s;
   s.sim.dt = 1e-3;
   s.sim.duration = 0.1;
   s.sim.gravity = Vec3(0, 0, -9.81);
@@ -346,7 +346,7 @@ TEST(OdeDynamics, FrictionIsCoulombMuTimesTheNormalImpulse) {
   // the vertex, CFM ~1e-7 relative).
   const double h = std::sqrt(3.0) / 2;
   const double dt = 1e-3;
-  Scene s;
+  WorldDefinition s;
   s.sim.dt = dt;
   s.sim.duration = 0.01;  // impact at step 2; the cube has left the slab well before the end
   s.sim.restitution = 0.5;
@@ -375,7 +375,7 @@ TEST(OdeDynamics, FreeRotationStaysInTheWorldFrame) {
   // ODE's finite rotation mode, exact for constant w). Round-off over 100 steps.
   const Vec3 w(1, 2, 3);  // rad/s, world
   const Quat q0(Eigen::AngleAxisd(0.7, Vec3(1, -2, 0.5).normalized()));
-  Scene s;
+  WorldDefinition s;
   s.sim.dt = 1e-3;
   s.sim.duration = 0.1;
   s.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero(), 1.0, q0));
@@ -390,7 +390,7 @@ TEST(OdeDynamics, FreeRotationStaysInTheWorldFrame) {
 TEST(OdeDynamics, FreeFallSamples) {
   // dWorldStep is semi-implicit Euler: v_n = g n dt, x_n = x0 + g dt^2 n (n + 1) / 2.
   const double g = -9.81, dt = 1e-3;
-  Scene s;
+  WorldDefinition s;
   s.sim.dt = dt;
   s.sim.duration = 0.1;
   s.sim.gravity = Vec3(0, 0, g);
@@ -411,14 +411,14 @@ TEST(OdeDynamics, FreeFallSamples) {
 TEST(OdeDynamics, OdeErrorsBecomeStatusError) {
   // A negative mass fails dMassCheck inside dBodySetMass, which calls dDebug (abort by
   // default): the handler must turn it into an error result instead.
-  Scene bad_mass;
+  WorldDefinition bad_mass;
   bad_mass.sim.duration = 0.01;
   bad_mass.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero(), -1.0));
   const DynamicsResult r = ode_hull.dynamics(bad_mass, {});
   EXPECT_EQ(r.status, Status::Error);
   EXPECT_NE(r.message.find("ODE"), std::string::npos) << r.message;
   // A NaN velocity propagates silently in ODE: the adapter reports the non-finite state.
-  Scene nan_state;
+  WorldDefinition nan_state;
   nan_state.sim.duration = 0.01;
   nan_state.bodies.push_back(box_spec("A", Vec3::Ones(), Vec3::Zero()));
   nan_state.bodies.back().velocity = Vec3(std::nan(""), 0, 0);

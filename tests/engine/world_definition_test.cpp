@@ -1,5 +1,5 @@
-// Scene settings: the step count a run takes.
-#include "engine/scene.h"
+// A world definition's settings: the step count a run takes.
+#include "engine/world_definition.h"
 
 #include <gtest/gtest.h>
 
