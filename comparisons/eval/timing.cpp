@@ -69,7 +69,15 @@ std::vector<Rounds> time_rounds(const std::vector<TimedSubject>& subjects, const
   for (size_t i = 0; i < n; ++i) {
     // The warm-up call, untimed (unless the caller made it), then one call to size the rounds.
     const double warm = plan.warmed_up ? 0.0 : timed_round(subjects[i], 1);
-    const double one = warm < 0 ? warm : timed_round(subjects[i], 1);
+    double one = warm < 0 ? warm : timed_round(subjects[i], 1);
+    // One call can be slow for a reason of its own (a page fault, caches refilled after the
+    // warm-up) and would size every round a few calls long: each round would then time mostly
+    // what the other subjects' turns evicted. For calls shorter than the minimum time (two more
+    // cost at most twice that), the fastest of three sizes the rounds.
+    for (int k = 0; k < 2 && one >= 0 && one < plan.min_time_s; ++k) {
+      const double again = timed_round(subjects[i], 1);
+      one = again < 0 ? again : std::min(one, again);
+    }
     if (one < 0) {
       at[i].failed = true;
       continue;

@@ -36,9 +36,10 @@ TEST(Timing, EveryRoundIsLongerThanTheClocksFloorAndEachSubjectGetsItsMinimum) {
     EXPECT_EQ(x.calls % x.rounds, 0) << "every round makes the same number of calls";
   }
   // A call that does almost nothing is repeated within a round, so that a round is long enough
-  // to time (round_floor_s); two calls of the warm-up and the sizing come before the rounds.
+  // to time (round_floor_s); the warm-up and three sizing calls (the fastest sizes the rounds)
+  // come before them.
   EXPECT_GT(t[0].calls / t[0].rounds, 1);
-  EXPECT_EQ(fast_calls, t[0].calls + 2);
+  EXPECT_EQ(fast_calls, t[0].calls + 4);
   EXPECT_GE(t[1].median_s, 2e-5);
   EXPECT_GE(t[1].q25_s, 2e-5);
   EXPECT_EQ(t[0].cold_s, 0.0) << "the cold call is the caller's: the one that answered";
@@ -92,6 +93,26 @@ TEST(Timing, AWarmedUpCallThatLastsTheMinimumTimeIsARoundItself) {
     EXPECT_EQ(calls, warmed_up ? rounds : rounds + 2) << "warmed up: " << warmed_up;
     for (double t : r[0].per_call_s) EXPECT_GE(t, 3e-3);
   }
+}
+
+TEST(Timing, OneSlowSizingCallDoesNotMakeTheRoundsShort) {
+  // A subject of 5 µs calls whose first call after the warm-up takes 2 ms (a page fault, a cache
+  // refilled): sized from that call alone, its rounds would be ~2 calls long; the fastest of three
+  // sizes them near the target round (the larger of 20 µs and min_time / 14).
+  TimingPlan plan;
+  plan.min_time_s = 7e-3;  // target round: 0.5 ms, about 100 calls of 5 µs
+  plan.min_rounds = 7;
+  int calls = 0;
+  const std::vector<Rounds> r = time_rounds({{"hiccup", false,
+                                              [&] {
+                                                ++calls;
+                                                spin(calls == 2 ? 2e-3 : 5e-6);
+                                              }}},
+                                            plan);
+  ASSERT_EQ(r.size(), 1u);
+  // 0.5 ms / 5 µs = 100 calls; the clock and the loop add a little to each call.
+  EXPECT_GE(r[0].per_round, 50) << "sized from the slow call alone";
+  EXPECT_LE(r[0].per_round, 100);
 }
 
 TEST(Timing, SubjectsTakeTurnsRoundByRound) {
