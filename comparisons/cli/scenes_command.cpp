@@ -18,18 +18,14 @@ std::string scene_table_markdown(const std::vector<std::string>& inputs) {
     const Scene s = load_scene(f);
     std::string checks;
     for (const std::string& c : s.check_names()) checks += (checks.empty() ? "" : ", ") + c;
-    // Backends that serve the scene's checks (fcl-box only where the first pair is two boxes).
+    // Backends that serve the scene's checks.
     std::vector<std::string> names;
     auto add = [&](const std::vector<std::string>& list) {
       for (const std::string& n : list)
         if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
     };
     if (s.has_check(CheckKind::Contact)) {
-      std::vector<std::string> c = select_backends(s, "", Capability::Contact);
-      const bool boxes = s.bodies.size() >= 2 && s.bodies[0].shape_kind == ShapeKind::Box &&
-                         s.bodies[1].shape_kind == ShapeKind::Box;
-      if (!boxes) c.erase(std::remove(c.begin(), c.end(), "fcl-box"), c.end());
-      add(c);
+      add(select_backends(s, "", Capability::Contact));
     }
     if (s.has_check(CheckKind::Impulse) || s.has_check(CheckKind::Trajectory) ||
         s.has_check(CheckKind::Stability))

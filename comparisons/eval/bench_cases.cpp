@@ -91,7 +91,7 @@ std::vector<NarrowBackend> narrow_backends() {
     return find_query_variant(name, v)->contact;
   };
   return {
-      {"custom", "accelerated", registry("custom"), 8192, 2048},
+      {"custom", "default", registry("custom"), 8192, 2048},
       {"custom", "faithful", variant("custom", "faithful"), 2048, 512},
       {"exact", "default", registry("exact"), 2048, 512},
       {"fcl", "default", registry("fcl"), 8192, 2048},
@@ -105,8 +105,8 @@ std::vector<NarrowBackend> narrow_backends() {
       // DART: BoxShapes on its own detector for the box pair, meshes on FCL for the hulls.
       {"dart", "default", registry("dart"), 2048, 512},
       {"dart", "prebuilt", variant("dart", "prebuilt"), 2048, 512},
-      // `fcl` on two box bodies runs fcl::Box (boxBoxIntersect); the row keeps its old name.
-      {"fcl-box", "default", registry("fcl"), 8, 8, true},
+      // `fcl` on two box bodies runs fcl::Box (boxBoxIntersect): the variant "boxes".
+      {"fcl", "boxes", registry("fcl"), 8, 8, true},
   };
 }
 
@@ -426,7 +426,7 @@ struct StepRunner {
   SceneRun run;
 };
 const StepRunner kStepRunners[] = {
-    {"custom", "accelerated", [](const Scene& s) { return run_registry_backend("custom", s); }},
+    {"custom", "default", [](const Scene& s) { return run_registry_backend("custom", s); }},
     {"custom", "faithful",
      [](const Scene& s) {
        // The `custom` backend's engine (extended contact model) on the faithful detector and

@@ -62,8 +62,8 @@ BenchPlan bench_plan(bool quick);
 /// One contact backend as benchmarked: a row of the narrow-phase table.
 struct NarrowBackend {
   std::string backend;  // registry name
-  std::string variant;  // "accelerated" | "faithful" (the detector) for custom; "prebuilt" for fcl;
-                        // "default" otherwise
+  std::string variant;  // "faithful" (the detector) for custom; "prebuilt" for fcl; "boxes" for
+                        // fcl on box bodies (fcl::Box); "default" otherwise
   ContactFn contact;
   int max_vertices_full;   // largest hull size timed in the full run
   int max_vertices_quick;  // in the quick run

@@ -96,8 +96,8 @@ def step(rows, out):
     if not bars:
         return
     fig, ax = plt.subplots(figsize=(7, 4))
-    # The variant on a line of its own: side by side, "custom (accelerated)" and "custom
-    # (faithful)" ran into each other.
+    # The variant on a line of its own: side by side, "custom" and "custom (faithful)" ran into
+    # each other.
     labels = [f'{r["scene"]}\n{r["backend"]}' + ("" if r["variant"] == "default"
                                                  else f'\n({r["variant"]})') for r in bars]
     colours = [backend_style.colour(r["backend"], [r["backend"] for r in bars]) for r in bars]

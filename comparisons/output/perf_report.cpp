@@ -228,7 +228,7 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
     md << " (the seed loops cost about 16 N^2 primitive tests per query; bullet-sat rebuilds its "
           "polyhedral features on every call; DART collides the hulls as triangle meshes; Bullet "
           "and ODE build their shapes from the points on every call, about 2 s a query at "
-          "N = 8192; `fcl-box` takes boxes only).\n\n";
+          "N = 8192; `fcl (boxes)` is fcl on box bodies only).\n\n";
   }
   for (const PoseKind& k : kPoseKinds) {
     md << "### " << k.name << "\n\n| backend | variant |";
@@ -296,8 +296,7 @@ std::string step_markdown(const BenchResults& results) {
   std::ostringstream md;
   md << "## Whole step\n\nscenes/many/ through each engine for two durations; microseconds per "
         "moving body per step = (time of the long run - time of the short run) / (extra steps x "
-        "moving bodies), so building the world and the shapes cancels. `custom (accelerated)` is "
-        "the "
+        "moving bodies), so building the world and the shapes cancels. `custom` is the "
         "registry's dynamics (accelerated detector, tree broad phase); `custom (faithful)` is the "
         "same engine (friction, manifolds, time of impact) on the faithful detector (the seed's "
         "loops) with the all-pairs check; "

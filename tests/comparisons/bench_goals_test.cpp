@@ -34,7 +34,7 @@ PerfGoal detector_goal(double ratio) {
     fcl.ns_per_query = rounds_of(1000.0 * n, {1.0, 1.1, 0.9});
     NarrowRow custom = fcl;
     custom.backend = "custom";
-    custom.variant = "accelerated";
+    custom.variant = "default";
     custom.ns_per_query = rounds_of(ratio * 1000.0 * n, {1.0, 1.1, 0.9});
     results.narrow.push_back(fcl);
     results.narrow.push_back(custom);
@@ -90,7 +90,7 @@ TEST(PerfReport, AStepGoalIsJudgedOnTheMedianRatio) {
     bullet.us_per_body_step = rounds_of(0.5, {1.0, 1.0, 1.0});
     StepRow custom = bullet;
     custom.backend = "custom";
-    custom.variant = "accelerated";
+    custom.variant = "default";
     // Two rounds of three faster than Bullet: the median ratio is 0.9, met, though one round
     // is slower.
     custom.us_per_body_step = rounds_of(0.5, {0.9, 1.2, 0.9});
