@@ -187,12 +187,6 @@ TEST(FclEpa, FacePairConventionBothOrdersAndRotated) {
   check_face_pair(fcl_epa.contact, kEpaTolerance);
 }
 
-TEST(FclEpa, SeparatedIsNoContact) {
-  const ContactResult r = fcl_epa.contact(unit_cube("A", Vec3::Zero()), separated_b());
-  EXPECT_EQ(r.status, Status::Ok);
-  EXPECT_TRUE(r.contacts.empty());
-}
-
 TEST(FclEpa, TouchingHasNoNormalAndIsReportedAsTouching) {
   // Pinned: at gap 0 FCL returns min_distance 0 and two coincident nearest points, and 0.7's
   // DistanceResult carries no normal; the adapter says so (status Touching) instead of
@@ -381,12 +375,6 @@ TEST(FclIndep, DiagonalCubeGetsTheMinimumPenetrationWithTheSignDefect) {
         << r.contacts[0].normal.transpose();
     EXPECT_NEAR(r.contacts[0].depth, -kDiagonalDepth, kRoundOff);
   }
-}
-
-TEST(FclIndep, SeparatedIsNoContact) {
-  const ContactResult r = fcl_indep.contact(unit_cube("A", Vec3::Zero()), separated_b());
-  EXPECT_EQ(r.status, Status::Ok);
-  EXPECT_TRUE(r.contacts.empty());
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -78,15 +78,6 @@ TEST(Libccd, FacePairConventionBothOrdersAndRotated) {
   }
 }
 
-TEST(Libccd, SeparatedIsNoContact) {
-  // Gap 0.1 along x: both algorithms report no intersection.
-  const Both r = both(unit_cube("A", Vec3::Zero()), unit_cube("B", Vec3(1.1, 0, 0)));
-  for (const ContactResult* x : {&r.mpr, &r.epa}) {
-    EXPECT_EQ(x->status, Status::Ok);
-    EXPECT_TRUE(x->contacts.empty());
-  }
-}
-
 TEST(Libccd, TouchingGjkHasNoDirectionPinned) {
   // Pinned: at gap 0, MPR reports no intersection while ccdGJKPenetration reports one with
   // depth 0 and a NaN direction; the adapter returns status Touching (no normal, libccd's

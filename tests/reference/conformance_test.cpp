@@ -1,0 +1,154 @@
+// What every registered backend must do, whatever its library: one suite run over the registry
+// (backends()), so a new adapter is held to the conventions by its registry entry alone.
+//
+// Contact: a separated pair has no contact; on an overlapping pair every point is finite, every
+// normal unit, every depth non-negative, and a normal near the true axis points from B toward A;
+// the other body order turns it round; the same query twice gives the same answer, bit for bit.
+// Dynamics: a lone body in free fall follows the closed form within the integrator's own error.
+// These are the interface's conventions, not accuracy: a normal far from the truth (DART's
+// triangle normals on hulls) is the report's business, measured and labelled there, so the
+// direction is checked only where a normal lies within 60 degrees of the axis. A backend that
+// passes a library's defect on unpatched says so in its result's message ("known defects":
+// fcl-indep's negative depth and unrotated normal); such a result is held to the rest.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "reference/backend.h"
+#include "tests/common/fixtures.h"
+
+namespace rbx {
+namespace {
+
+std::vector<std::string> names_with(bool contact) {
+  std::vector<std::string> names;
+  for (const Backend& b : backends())
+    if (contact ? static_cast<bool>(b.contact) : static_cast<bool>(b.dynamics))
+      names.push_back(b.name);
+  return names;
+}
+
+// A test name may hold letters, digits and '_' only.
+std::string test_name(const ::testing::TestParamInfo<std::string>& info) {
+  std::string s = info.param;
+  for (char& c : s)
+    if (c == '-') c = '_';
+  return s;
+}
+
+class ContactConformance : public ::testing::TestWithParam<std::string> {
+ protected:
+  const Backend& backend() const { return *find_backend(GetParam()); }
+};
+
+// Two unit cubes, B at the origin, A above it at `gap` (negative: overlapping) along z, offset
+// across so that no two faces are flush (a generic face contact), A turned about z.
+std::pair<RigidBody, RigidBody> stacked(double gap) {
+  const Quat turn(Eigen::AngleAxisd(0.3, Vec3::UnitZ()));
+  return {test::unit_cube("A", Vec3(0.2, 0.1, 1.0 + gap), turn),
+          test::unit_cube("B", Vec3::Zero())};
+}
+
+TEST_P(ContactConformance, SeparatedBodiesHaveNoContact) {
+  for (const double gap : {0.5, 0.01, 0.001}) {
+    const auto [a, b] = stacked(gap);
+    const ContactResult r = backend().contact(a, b);
+    ASSERT_EQ(r.status, Status::Ok) << r.message;
+    EXPECT_TRUE(r.contacts.empty()) << "gap " << gap << ": " << r.contacts.size() << " contacts";
+  }
+}
+
+// A result that passes a library's defect on unpatched, as its message says.
+bool labelled_defect(const ContactResult& r) {
+  return r.message.find("known defects") != std::string::npos;
+}
+
+// Within 60 degrees of the true axis (z): near enough that its sign is the convention's.
+bool near_axis(const Vec3& n) { return std::abs(n.z()) >= 0.5; }
+
+TEST_P(ContactConformance, AnOverlappingPairFollowsTheContactConventions) {
+  const auto [a, b] = stacked(-0.1);
+  const ContactResult r = backend().contact(a, b);
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_FALSE(r.contacts.empty());
+  const bool labelled = labelled_defect(r);
+  int checked = 0;
+  for (const ContactPoint& c : r.contacts) {
+    EXPECT_TRUE(c.point.allFinite());
+    if (!labelled) {
+      EXPECT_GE(c.depth, 0.0);
+    }
+    // At most the smaller body's size: 0.1 m deep, anything past 1 m is not this pair.
+    EXPECT_LE(std::abs(c.depth), 1.0);
+    if (c.depth <= kTouchingDepth && !c.normal.allFinite()) continue;  // touching, no normal
+    // Unit to round-off of a normalised double vector.
+    EXPECT_NEAR(c.normal.norm(), 1.0, 1e-9);
+    // From B toward A: A lies above.
+    if (!labelled && near_axis(c.normal)) {
+      EXPECT_GT(c.normal.z(), 0.0) << c.normal.transpose();
+      ++checked;
+    }
+  }
+  std::printf("%s: %zu points, %d normals near the axis%s\n", GetParam().c_str(),
+              r.contacts.size(), checked, labelled ? " (labelled defect)" : "");
+}
+
+TEST_P(ContactConformance, TheOtherBodyOrderTurnsTheNormalRound) {
+  const auto [a, b] = stacked(-0.1);
+  const ContactResult ab = backend().contact(a, b), ba = backend().contact(b, a);
+  ASSERT_EQ(ab.status, Status::Ok) << ab.message;
+  ASSERT_EQ(ba.status, Status::Ok) << ba.message;
+  ASSERT_FALSE(ab.contacts.empty());
+  ASSERT_FALSE(ba.contacts.empty());
+  // The first contact of each order: A above B, so A's normal points up and B's down.
+  const Vec3 &n_ab = ab.contacts.front().normal, &n_ba = ba.contacts.front().normal;
+  if (labelled_defect(ab) || !near_axis(n_ab) || !near_axis(n_ba)) return;
+  EXPECT_GT(n_ab.z(), 0.0);
+  EXPECT_LT(n_ba.z(), 0.0);
+}
+
+TEST_P(ContactConformance, TheSameQueryTwiceGivesTheSameAnswer) {
+  const auto [a, b] = stacked(-0.1);
+  const ContactResult first = backend().contact(a, b), second = backend().contact(a, b);
+  ASSERT_EQ(first.status, second.status);
+  ASSERT_EQ(first.contacts.size(), second.contacts.size());
+  for (size_t k = 0; k < first.contacts.size(); ++k) {
+    const ContactPoint &x = first.contacts[k], &y = second.contacts[k];
+    EXPECT_EQ(x.depth, y.depth) << k;
+    EXPECT_TRUE(x.point == y.point) << k;
+    EXPECT_TRUE(x.normal == y.normal || (!x.normal.allFinite() && !y.normal.allFinite())) << k;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryContactBackend, ContactConformance,
+                         ::testing::ValuesIn(names_with(true)), test_name);
+
+class DynamicsConformance : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(DynamicsConformance, ALoneBodyFallsAsTheClosedFormSays) {
+  // A unit cube dropped from rest for 0.1 s at dt = 1 ms, far from anything: z = z0 - g t^2 / 2
+  // and v = -g t. Any first-order integrator is off by at most g dt t (semi-implicit Euler by
+  // g dt t / 2 in position); that bounds every backend's error.
+  WorldDefinition world;
+  world.sim.dt = 1e-3;
+  world.sim.duration = 0.1;
+  world.bodies = {test::box_spec("cube", Vec3::Ones(), Vec3(0.0, 0.0, 10.0))};
+  const DynamicsResult r = find_backend(GetParam())->dynamics(world, {});
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  ASSERT_EQ(r.finals.size(), 1u);
+  const double g = -world.sim.gravity.z(), t = world.sim.duration;
+  const double bound = g * world.sim.dt * t;
+  EXPECT_NEAR(r.finals[0].position.z(), 10.0 - 0.5 * g * t * t, bound);
+  EXPECT_NEAR(r.finals[0].velocity.z(), -g * t, bound);
+  EXPECT_NEAR(r.finals[0].position.x(), 0.0, 1e-12);
+  EXPECT_TRUE(r.events.empty()) << r.events.size() << " collision events in free fall";
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryDynamicsBackend, DynamicsConformance,
+                         ::testing::ValuesIn(names_with(false)), test_name);
+
+}  // namespace
+}  // namespace rbx
