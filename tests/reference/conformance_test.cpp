@@ -4,7 +4,8 @@
 // Contact: a separated pair has no contact; on an overlapping pair every point is finite, every
 // normal unit, every depth non-negative, and a normal near the true axis points from B toward A;
 // the other body order turns it round; the same query twice gives the same answer, bit for bit.
-// Dynamics: a lone body in free fall follows the closed form within the integrator's own error.
+// Dynamics: a lone body in free fall follows the closed form within the integrator's own error,
+// and the same run twice ends in the same state, bit for bit.
 // These are the interface's conventions, not accuracy: a normal far from the truth (DART's
 // triangle normals on hulls) is the report's business, measured and labelled there, so the
 // direction is checked only where a normal lies within 60 degrees of the axis. A backend that
@@ -92,8 +93,8 @@ TEST_P(ContactConformance, AnOverlappingPairFollowsTheContactConventions) {
       ++checked;
     }
   }
-  std::printf("%s: %zu points, %d normals near the axis%s\n", GetParam().c_str(),
-              r.contacts.size(), checked, labelled ? " (labelled defect)" : "");
+  std::printf("%s: %zu points, %d normals near the axis%s\n", GetParam().c_str(), r.contacts.size(),
+              checked, labelled ? " (labelled defect)" : "");
 }
 
 TEST_P(ContactConformance, TheOtherBodyOrderTurnsTheNormalRound) {
@@ -145,6 +146,40 @@ TEST_P(DynamicsConformance, ALoneBodyFallsAsTheClosedFormSays) {
   EXPECT_NEAR(r.finals[0].velocity.z(), -g * t, bound);
   EXPECT_NEAR(r.finals[0].position.x(), 0.0, 1e-12);
   EXPECT_TRUE(r.events.empty()) << r.events.size() << " collision events in free fall";
+}
+
+TEST_P(DynamicsConformance, TheSameRunTwiceEndsInTheSameState) {
+  // Two cubes meeting head-on, one turned, on a floor: collisions, friction and resting contact.
+  // A run is a function of its input: the second run's final state equals the first's, bit for
+  // bit (no state kept between runs, no clock or thread order in the result).
+  WorldDefinition world;
+  world.sim.dt = 1e-3;
+  world.sim.duration = 0.3;
+  world.sim.restitution = 0.5;
+  world.sim.friction = 0.4;
+  BodySpec floor = test::box_spec("floor", Vec3(10.0, 10.0, 1.0), Vec3(0.0, 0.0, -0.5));
+  floor.is_static = true;
+  BodySpec a = test::box_spec("A", Vec3::Ones(), Vec3(-1.0, 0.0, 0.55), 1.0,
+                              Quat(Eigen::AngleAxisd(0.4, Vec3::UnitZ())));
+  BodySpec b = test::box_spec("B", Vec3::Ones(), Vec3(1.0, 0.0, 0.55), 2.0);
+  a.velocity = Vec3(3.0, 0.0, 0.0);
+  b.velocity = Vec3(-2.0, 0.0, 0.0);
+  world.bodies = {floor, a, b};
+  const Backend& backend = *find_backend(GetParam());
+  const DynamicsResult first = backend.dynamics(world, {}), second = backend.dynamics(world, {});
+  ASSERT_EQ(first.status, Status::Ok) << first.message;
+  ASSERT_EQ(second.status, Status::Ok) << second.message;
+  ASSERT_EQ(first.finals.size(), second.finals.size());
+  for (size_t k = 0; k < first.finals.size(); ++k) {
+    const BodyFinal &x = first.finals[k], &y = second.finals[k];
+    EXPECT_TRUE(x.position == y.position) << x.name;
+    EXPECT_TRUE(x.velocity == y.velocity) << x.name;
+    EXPECT_TRUE(x.angular_velocity == y.angular_velocity) << x.name;
+    EXPECT_TRUE(x.orientation.coeffs() == y.orientation.coeffs()) << x.name;
+  }
+  EXPECT_EQ(first.events.size(), second.events.size());
+  // The premise: the cubes met (friction alone never turns A back), so the run holds contacts.
+  EXPECT_LT(first.finals[1].velocity.x(), 0.0) << "the cubes never met";
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryDynamicsBackend, DynamicsConformance,
