@@ -21,7 +21,7 @@ void Evaluator::contact_check() {
 }
 
 void Evaluator::contact_pair(const RigidBody& a, const RigidBody& b, bool first_pair,
-                  const std::vector<std::string>& names, const Backend& exact) {
+                             const std::vector<std::string>& names, const Backend& exact) {
   const std::string pair = pair_name(a, b);
   const SatResult sat = sat_query(*a.shape, a.pose(), *b.shape, b.pose());
   // Truth: the [expect.contact] closed form for the first pair, else the exact oracle.
@@ -137,13 +137,12 @@ void Evaluator::contact_pair(const RigidBody& a, const RigidBody& b, bool first_
   }
 }
 
-void Evaluator::touching_answer(const std::string& name, const std::string& pair, const ContactResult& r,
-                     const ContactTruth& t, double depth_tol, const std::string& touch_src,
-                     const std::string& depth_src) {
+void Evaluator::touching_answer(const std::string& name, const std::string& pair,
+                                const ContactResult& r, const ContactTruth& t, double depth_tol,
+                                const std::string& touch_src, const std::string& depth_src) {
   metric("contact", name, pair, "touching_err", t.touching ? 0.0 : 1.0, touch_src);
   if (!t.touching)
-    out_.disagreements.push_back(name + " on " + pair +
-                                 ": reports a contact where there is none");
+    out_.disagreements.push_back(name + " on " + pair + ": reports a contact where there is none");
   if (t.touching) metric("contact", name, pair, "depth_err", t.depth, depth_src);
   if (t.touching && t.depth > depth_tol)
     (t.depth > kMarkDepthRel * t.size ? out_.disagreements : out_.deviations)

@@ -81,7 +81,8 @@ Evaluator::DynamicsFrame Evaluator::dynamics_frame() {
   return fr;
 }
 
-void Evaluator::backend_dynamics(const std::string& name, const DynRun& main, const DynamicsFrame& fr) {
+void Evaluator::backend_dynamics(const std::string& name, const DynRun& main,
+                                 const DynamicsFrame& fr) {
   Json& bj = backend_json(name);
   bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
   if (main.cached) bj["cached"] = true;
@@ -96,8 +97,7 @@ void Evaluator::backend_dynamics(const std::string& name, const DynRun& main, co
   }
   const SweepRuns sw = sweep_runs(backend(name), main, fr);
   std::string against;
-  const std::vector<std::optional<RefState>> ref =
-      velocity_reference(name, main, sw, fr, against);
+  const std::vector<std::optional<RefState>> ref = velocity_reference(name, main, sw, fr, against);
   contact_phases(name, main, fr, bj);
   if (fr.wants_sweep && !against.empty()) {
     const auto error_of = [&](const std::vector<BodyFinal>& finals) {
@@ -106,8 +106,8 @@ void Evaluator::backend_dynamics(const std::string& name, const DynRun& main, co
     for (const DynRun& r : sw.runs) {
       if (r.result.status != Status::Ok) continue;
       if (!fr.have_expect && &r == &sw.runs.back()) continue;  // zero by construction
-      out_.sweep.push_back({name, "dynamics", r.dt, Timing::once(r.runtime_s),
-                            error_of(r.result.finals), against});
+      out_.sweep.push_back(
+          {name, "dynamics", r.dt, Timing::once(r.runtime_s), error_of(r.result.finals), against});
     }
     const std::vector<SweepPoint> budgets = budget_points(
         backend(name), scene_, main, cache_, inputs_, error_of, against, &out_.skipped);
@@ -130,8 +130,7 @@ void Evaluator::backend_dynamics(const std::string& name, const DynRun& main, co
   if (scene_.expect)
     mark_expect_disagreement(
         name, main.result.finals,
-        fr.have_expect ? ke_norm_error(inputs_, main.result.finals, fr.expected, fr.e0_kin)
-                       : 0.0);
+        fr.have_expect ? ke_norm_error(inputs_, main.result.finals, fr.expected, fr.e0_kin) : 0.0);
   if (scene_.has_check(CheckKind::Stability)) stability(name, main, fr);
   // The verdict at every other swept step (report rows; not metrics of the check).
   if (sw.stability_sweep)
@@ -142,14 +141,14 @@ void Evaluator::backend_dynamics(const std::string& name, const DynRun& main, co
 void Evaluator::stopped_run(const std::string& name, const DynRun& main, const DynamicsFrame& fr) {
   if (scene_.has_check(CheckKind::Stability)) stability(name, main, fr);
   if (binds(name) && !scene_.expect->bodies.empty()) {
-    out_.expect_failures.push_back(
-        name + ": the run stopped before t = duration: " + main.result.message);
+    out_.expect_failures.push_back(name +
+                                   ": the run stopped before t = duration: " + main.result.message);
     expect_bodies_bound_ = true;
   }
 }
 
 void Evaluator::conservation(const std::string& name, const std::vector<BodyFinal>& f,
-                  const DynamicsFrame& fr) {
+                             const DynamicsFrame& fr) {
   if (fr.closed) {
     const auto [p_scale, h_scale] = drift_scales(inputs_, f, fr.p_scale, fr.h_scale);
     metric(primary_check(), name, "", "momentum_drift_err",
@@ -175,8 +174,9 @@ void Evaluator::check_expect_bodies(const std::string& name, const std::vector<B
     out_.expect_failures.push_back(s);
 }
 
-void Evaluator::mark_expect_disagreement(const std::string& name, const std::vector<BodyFinal>& finals,
-                              double velocity_err) {
+void Evaluator::mark_expect_disagreement(const std::string& name,
+                                         const std::vector<BodyFinal>& finals,
+                                         double velocity_err) {
   const auto v = expect_violations(name, *scene_.expect, finals);
   if (v.empty()) return;
   const std::string text = v.front() + (v.size() > 1 ? " (and more)" : "");

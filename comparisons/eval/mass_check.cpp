@@ -8,8 +8,8 @@ void Evaluator::mass_check() {
   const std::vector<std::string> wanted =
       select_backends(scene_, opt_.backends, Capability::Contact, table_);
   for (const Backend& b : table_)
-    if (b.mass && (opt_.backends.empty() ||
-                   std::find(wanted.begin(), wanted.end(), b.name) != wanted.end()))
+    if (b.mass &&
+        (opt_.backends.empty() || std::find(wanted.begin(), wanted.end(), b.name) != wanted.end()))
       libs.push_back(&b);
   for (size_t i = 0; i < inputs_.size(); ++i) {
     const RigidBody& body = inputs_[i];
@@ -45,8 +45,7 @@ void Evaluator::mass_check() {
     // The engines' own rows: `custom` with the model it simulates this body with (the
     // scene's mass_model, solid by default), `custom-seed` with the seed's point masses at the
     // vertices.
-    const MassProperties own =
-        mass_properties(*body.shape, body.mass, scene_.bodies[i].mass_model);
+    const MassProperties own = mass_properties(*body.shape, body.mass, scene_.bodies[i].mass_model);
     record("custom", {Status::Ok, "", own.mass, -1.0, own.center_of_mass, own.inertia});
     const MassProperties seed = vertex_mass_properties(*body.shape, body.mass);
     record("custom-seed", {Status::Ok, "", seed.mass, -1.0, seed.center_of_mass, seed.inertia});

@@ -7,8 +7,8 @@ void Evaluator::stability(const std::string& name, const DynRun& run, const Dyna
                           bool swept) {
   const StabilityGeometry geo = stability_geometry(inputs_);
   StabilityInvariants inv{fr.e0, fr.p0, fr.h0, fr.closed, fr.p_scale, fr.h_scale};
-  const StabilityTrace tr = trace_stability(inputs_, run.result, sample_overlaps(run, geo), geo,
-                                            inv, scene_.sim.gravity);
+  const StabilityTrace tr =
+      trace_stability(inputs_, run.result, sample_overlaps(run, geo), geo, inv, scene_.sim.gravity);
   const double jitter = rest_jitter(inputs_, run.result.samples, scene_.sim.gravity);
   Json s;
   s["status"] = to_string(run.result.status);

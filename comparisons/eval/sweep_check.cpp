@@ -3,7 +3,8 @@
 
 namespace rbx::eval_detail {
 
-Evaluator::SweepRuns Evaluator::sweep_runs(const Backend& be, const DynRun& main, const DynamicsFrame& fr) {
+Evaluator::SweepRuns Evaluator::sweep_runs(const Backend& be, const DynRun& main,
+                                           const DynamicsFrame& fr) {
   SweepRuns sw;
   // Velocity errors belong to the impulse and trajectory checks: a stability-only scene
   // does not pay for the self-consistency run.
@@ -34,9 +35,10 @@ Evaluator::SweepRuns Evaluator::sweep_runs(const Backend& be, const DynRun& main
 }
 
 std::vector<std::optional<RefState>> Evaluator::velocity_reference(const std::string& name,
-                                                        const DynRun& main, const SweepRuns& sw,
-                                                        const DynamicsFrame& fr,
-                                                        std::string& against) {
+                                                                   const DynRun& main,
+                                                                   const SweepRuns& sw,
+                                                                   const DynamicsFrame& fr,
+                                                                   std::string& against) {
   std::vector<std::optional<RefState>> ref;
   if (fr.have_expect) {
     against = scene_.expect->truth;
@@ -45,10 +47,9 @@ std::vector<std::optional<RefState>> Evaluator::velocity_reference(const std::st
     against = fmt_dt(fr.finest);
     ref.resize(inputs_.size());
     for (size_t i = 0; i < inputs_.size(); ++i)
-      ref[i] =
-          RefState{sw.fine->result.finals[i].velocity,
-                   fr.angular ? std::optional<Vec3>(sw.fine->result.finals[i].angular_velocity)
-                              : std::nullopt};
+      ref[i] = RefState{sw.fine->result.finals[i].velocity,
+                        fr.angular ? std::optional<Vec3>(sw.fine->result.finals[i].angular_velocity)
+                                   : std::nullopt};
   }
   if (!against.empty() &&
       !(sw.fine && !fr.have_expect && std::abs(fr.finest - scene_.sim.dt) < 1e-15)) {
@@ -61,7 +62,7 @@ std::vector<std::optional<RefState>> Evaluator::velocity_reference(const std::st
 }
 
 void Evaluator::contact_phases(const std::string& name, const DynRun& main, const DynamicsFrame& fr,
-                    Json& bj) {
+                               Json& bj) {
   double worst = 0.0, written = 0.0;
   std::string worst_phase = "written";
   if (fr.have_expect)
@@ -101,14 +102,14 @@ void Evaluator::contact_phases(const std::string& name, const DynRun& main, cons
       std::max(written, worst) > kMarkVelocityErr) {
     // The scene as written explains itself when it misses; else the worst phase does.
     const bool as_written = written > kMarkVelocityErr;
-    out_.causes.push_back(impact_cause(
-        scene_, inputs_, name, as_written ? main.result.first_impulse : worst_fi,
-        as_written ? inputs_ : worst_start, written, worst, worst_phase, fr.expected));
+    out_.causes.push_back(
+        impact_cause(scene_, inputs_, name, as_written ? main.result.first_impulse : worst_fi,
+                     as_written ? inputs_ : worst_start, written, worst, worst_phase, fr.expected));
   }
 }
 
-void Evaluator::trajectory_divergence(const std::string& name, const DynRun& main, const SweepRuns& sw,
-                           const DynamicsFrame& fr) {
+void Evaluator::trajectory_divergence(const std::string& name, const DynRun& main,
+                                      const SweepRuns& sw, const DynamicsFrame& fr) {
   if (!scene_.has_check(CheckKind::Trajectory) || !sw.fine || sw.fine->result.samples.empty() ||
       std::abs(fr.finest - scene_.sim.dt) <= 1e-15)
     return;

@@ -15,6 +15,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -184,6 +186,24 @@ TEST_P(DynamicsConformance, TheSameRunTwiceEndsInTheSameState) {
 
 INSTANTIATE_TEST_SUITE_P(EveryDynamicsBackend, DynamicsConformance,
                          ::testing::ValuesIn(names_with(false)), test_name);
+
+TEST(Registry, EveryBackendIsNamedInTheContractAndInTheBackendsTable) {
+  // docs/contract.md names every backend and docs/backends.md gives each a row: a backend added
+  // to the registry without its documentation fails here.
+  auto read = [](const std::string& path) {
+    std::ifstream in(std::string(RBX_SOURCE_DIR) + "/" + path);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  const std::string contract = read("docs/contract.md"), table = read("docs/backends.md");
+  ASSERT_FALSE(contract.empty());
+  ASSERT_FALSE(table.empty());
+  for (const Backend& b : backends()) {
+    EXPECT_NE(contract.find("`" + b.name + "`"), std::string::npos) << b.name;
+    EXPECT_NE(table.find("| `" + b.name + "` |"), std::string::npos) << b.name;
+  }
+}
 
 }  // namespace
 }  // namespace rbx
