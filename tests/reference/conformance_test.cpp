@@ -5,7 +5,7 @@
 // normal unit, every depth non-negative, and a normal near the true axis points from B toward A;
 // the other body order turns it round; the same query twice gives the same answer, bit for bit.
 // Dynamics: a lone body in free fall follows the closed form within the integrator's own error,
-// and the same run twice ends in the same state, bit for bit.
+// the same run twice ends in the same state, bit for bit, and a non-finite start is an error.
 // These are the interface's conventions, not accuracy: a normal far from the truth (DART's
 // triangle normals on hulls) is the report's business, measured and labelled there, so the
 // direction is checked only where a normal lies within 60 degrees of the axis. A backend that
@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "reference/backend.h"
+#include "reference/isolate.h"
 #include "tests/common/fixtures.h"
 
 namespace rbx {
@@ -182,6 +183,24 @@ TEST_P(DynamicsConformance, TheSameRunTwiceEndsInTheSameState) {
   EXPECT_EQ(first.events.size(), second.events.size());
   // The premise: the cubes met (friction alone never turns A back), so the run holds contacts.
   EXPECT_LT(first.finals[1].velocity.x(), 0.0) << "the cubes never met";
+}
+
+TEST_P(DynamicsConformance, ANonFiniteStartIsTheBackendsErrorNeverOkNorACrash) {
+  // A NaN velocity (an API caller's, past the scene loader that refuses it): the run is the
+  // backend's `error` with a message, in an isolated child as every library run is (DART's own
+  // assertion aborts it), never `ok` with NaN states and never this process's crash.
+  WorldDefinition world;
+  world.sim.dt = 1e-3;
+  world.sim.duration = 0.01;
+  BodySpec cube = test::box_spec("cube", Vec3::Ones(), Vec3(0.0, 0.0, 1.0));
+  cube.velocity = Vec3(std::nan(""), 0.0, 0.0);
+  world.bodies = {cube};
+  const Backend* backend = find_backend(GetParam());
+  const TimedDynamics r = isolated_dynamics(GetParam(), 30.0, [&] {
+    return TimedDynamics{backend->dynamics(world, {}), 0.0};
+  });
+  EXPECT_EQ(r.result.status, Status::Error) << r.result.message;
+  EXPECT_FALSE(r.result.message.empty());
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryDynamicsBackend, DynamicsConformance,
