@@ -228,7 +228,10 @@ std::string scene_slug(const std::string& family, const std::string& file) {
   return family + "_" + std::filesystem::path(file).stem().string();
 }
 
-std::string md_escape(const std::string& s) {
+std::string md_escape(const std::string& text) {
+  // Leading spaces and tabs would indent a line into a code block or a nested list; they say
+  // nothing in a name or a description, so they are dropped.
+  const std::string s = text.substr(std::min(text.find_first_not_of(" \t"), text.size()));
   // A list marker opens a list only at the start of a line: escaping it there (a digit run's
   // '.' or ')', a leading '-' or '+') keeps the text a paragraph wherever it is placed.
   size_t digits = 0;

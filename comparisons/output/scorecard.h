@@ -16,8 +16,8 @@ namespace rbx {
 std::string scene_slug(const std::string& family, const std::string& file);
 
 /// Text safe in Markdown (table cells, link text, a paragraph): \ ` * _ [ ] < > | # & ~ escaped,
-/// and a list marker that would open the text ("- ", "+ ", "1. ") escaped too; line breaks are
-/// spaces.
+/// and a list marker that would open the text ("- ", "+ ", "1. ") escaped too; leading spaces
+/// and tabs dropped (they would indent it into code); line breaks are spaces.
 std::string md_escape(const std::string& s);
 
 /// What a scorecard row's error measures: a contact query's normal angle and depth, a dynamic

@@ -212,10 +212,14 @@ TEST(MarkdownHtml, AnyTextThroughMdEscapeStaysOneParagraphOfText) {
       "&lt;b&gt; &amp; &#60;",
       "> not a quote",
       "line one\nline two",
+      "    four spaces: not code",
+      "\tindented by a tab",
+      "  - indented list",
   };
   for (const std::string& text : hostile) {
     const std::string html = markdown_to_html(md_escape(text) + "\n");
-    std::string flat = text;
+    // What is shown: the text without its leading indentation, line breaks as spaces.
+    std::string flat = text.substr(text.find_first_not_of(" \t"));
     for (char& c : flat)
       if (c == '\n') c = ' ';
     EXPECT_EQ(html, "<p>" + html_escape(flat) + "</p>\n") << text;

@@ -111,7 +111,9 @@ TEST(Timing, OneSlowSizingCallDoesNotMakeTheRoundsShort) {
                                             plan);
   ASSERT_EQ(r.size(), 1u);
   // 0.5 ms / 5 µs = 100 calls; the clock and the loop add a little to each call.
-  EXPECT_GE(r[0].per_round, 50) << "sized from the slow call alone";
+  // Sized from the slow call alone it would be 1; a loaded machine may stretch a 5 µs call, so
+  // the bound is loose (a quarter of the ideal 100).
+  EXPECT_GE(r[0].per_round, 25) << "sized from the slow call alone";
   EXPECT_LE(r[0].per_round, 100);
 }
 

@@ -109,7 +109,8 @@ TEST_P(ContactConformance, TheOtherBodyOrderTurnsTheNormalRound) {
   ASSERT_FALSE(ba.contacts.empty());
   // The first contact of each order: A above B, so A's normal points up and B's down.
   const Vec3 &n_ab = ab.contacts.front().normal, &n_ba = ba.contacts.front().normal;
-  if (labelled_defect(ab) || !near_axis(n_ab) || !near_axis(n_ba)) return;
+  if (labelled_defect(ab) || labelled_defect(ba) || !near_axis(n_ab) || !near_axis(n_ba))
+    GTEST_SKIP() << "a labelled defect or a normal far from the axis: the report's business";
   EXPECT_GT(n_ab.z(), 0.0);
   EXPECT_LT(n_ba.z(), 0.0);
 }
@@ -117,7 +118,9 @@ TEST_P(ContactConformance, TheOtherBodyOrderTurnsTheNormalRound) {
 TEST_P(ContactConformance, TheSameQueryTwiceGivesTheSameAnswer) {
   const auto [a, b] = stacked(-0.1);
   const ContactResult first = backend().contact(a, b), second = backend().contact(a, b);
+  ASSERT_EQ(first.status, Status::Ok) << first.message;
   ASSERT_EQ(first.status, second.status);
+  ASSERT_FALSE(first.contacts.empty());
   ASSERT_EQ(first.contacts.size(), second.contacts.size());
   for (size_t k = 0; k < first.contacts.size(); ++k) {
     const ContactPoint &x = first.contacts[k], &y = second.contacts[k];
@@ -139,6 +142,7 @@ TEST_P(DynamicsConformance, ALoneBodyFallsAsTheClosedFormSays) {
   WorldDefinition world;
   world.sim.dt = 1e-3;
   world.sim.duration = 0.1;
+  world.sim.gravity = Vec3(0.0, 0.0, -9.81);  // a scene's default is none
   world.bodies = {test::box_spec("cube", Vec3::Ones(), Vec3(0.0, 0.0, 10.0))};
   const DynamicsResult r = find_backend(GetParam())->dynamics(world, {});
   ASSERT_EQ(r.status, Status::Ok) << r.message;
@@ -158,6 +162,7 @@ TEST_P(DynamicsConformance, TheSameRunTwiceEndsInTheSameState) {
   WorldDefinition world;
   world.sim.dt = 1e-3;
   world.sim.duration = 0.3;
+  world.sim.gravity = Vec3(0.0, 0.0, -9.81);  // the cubes land on the floor and slide
   world.sim.restitution = 0.5;
   world.sim.friction = 0.4;
   BodySpec floor = test::box_spec("floor", Vec3(10.0, 10.0, 1.0), Vec3(0.0, 0.0, -0.5));
@@ -181,8 +186,9 @@ TEST_P(DynamicsConformance, TheSameRunTwiceEndsInTheSameState) {
     EXPECT_TRUE(x.orientation.coeffs() == y.orientation.coeffs()) << x.name;
   }
   EXPECT_EQ(first.events.size(), second.events.size());
-  // The premise: the cubes met (friction alone never turns A back), so the run holds contacts.
-  EXPECT_LT(first.finals[1].velocity.x(), 0.0) << "the cubes never met";
+  // The premise: the cubes met. Friction alone (mu g = 3.9 m/s^2 for at most 0.3 s) leaves A
+  // above 1.8 m/s; only the collision takes it below 1 m/s.
+  EXPECT_LT(first.finals[1].velocity.x(), 1.0) << "the cubes never met";
 }
 
 TEST_P(DynamicsConformance, ANonFiniteStartIsTheBackendsErrorNeverOkNorACrash) {
