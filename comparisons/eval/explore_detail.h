@@ -1,7 +1,8 @@
-// What explore.cpp (contact kind), explore_dynamics.cpp (impact and landing kinds) and
-// explore_slide.cpp (slide kind) share: bodies built as the scene loader builds them, random
-// bodies, scene text, dynamics runs judged against a closed form, and the shrinking. Internal to
-// comparisons/eval/explore*.cpp.
+// What the explore files share (explore.cpp and explore_shrink.cpp: contact kind;
+// explore_dynamics.cpp, explore_landing.cpp, explore_slide.cpp, explore_tunnel.cpp: the closed-form
+// kinds; explore_group_shrink.cpp and explore_campaign.cpp: the campaign): bodies built as the
+// scene loader builds them, random bodies, scene text, dynamics runs judged against a closed form,
+// and the shrinking. Internal to comparisons/eval/explore*.cpp.
 #pragma once
 
 #include <functional>
@@ -12,6 +13,8 @@
 #include <vector>
 
 #include "comparisons/eval/explore.h"
+#include "comparisons/eval/explore_campaign.h"
+#include "comparisons/eval/json_io.h"
 #include "comparisons/scene/scene.h"
 #include "engine/body.h"
 #include "reference/backend.h"
@@ -76,6 +79,15 @@ std::string box_at_rest_expect(const std::string& speed_name, double speed, doub
 /// yaw 0 to 90 degrees.
 void draw_box(SampleRng& r, double& friction, Vec3& size, double& mass, double& yaw_deg,
               double no_tip_margin);
+
+// One line on what a backend did wrong on a sample, as a shrunk scene's comment and a group's
+// "first_error" say it.
+std::string describe_outcome(const BackendOutcome& b);
+
+// One disagreement group of a campaign shrunk (explore_group_shrink.cpp): its first sample
+// simplified while `group`'s backend still shows its signature, as the JSON text rank 0 collects
+// ("ok", "text" with the scene and its [expect], "reproduced", the kind's measures).
+std::string shrink_group(const Json& group, const ExploreSettings& set);
 
 // The first of up to `attempts` draws from the sample's own stream that `draw` realizes (draw
 // fills the sample and says whether it is valid); throws when none is.

@@ -1,0 +1,267 @@
+// Shrinking one of `rbx explore`'s disagreement groups: its first sample simplified while the
+// disagreement stays, written as a scene with its truth as [expect] and the comment that says
+// where it was found and how to reproduce it, and checked through the harness.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "comparisons/eval/explore.h"
+#include "comparisons/eval/explore_detail.h"
+#include "comparisons/eval/json_io.h"
+#include "comparisons/eval/metrics.h"
+#include "comparisons/scene/mesh_io.h"
+#include "comparisons/scene/scene_file.h"
+#include "engine/bounding.h"
+#include "engine/format.h"
+#include "reference/exact.h"
+
+namespace rbx::explore_detail {
+
+namespace {
+// The [expect] block of a shrunk scene: the exact oracle's answer at the t = 0 poses.
+std::string expect_block(const std::string& text) {
+  const Scene scene = parse_scene(text, "explore.toml");
+  const std::vector<RigidBody> bodies = make_bodies(scene);
+  const SatResult sat =
+      sat_query(*bodies[0].shape, bodies[0].pose(), *bodies[1].shape, bodies[1].pose());
+  const double size = std::min(shape_size(*bodies[0].shape), shape_size(*bodies[1].shape));
+  NumberFormat full;  // every digit, as the oracle computed it
+  full.digits = 17;
+  full.signed_zero = true;
+  std::ostringstream o;
+  o << "# Truth: the exact oracle (separating axes over faces and edge pairs), not a closed form.\n"
+       "# Tolerance: 1e-6 of the smaller body (round-off of exact methods is ~1e-15 relative;\n"
+       "# the disagreements explore looks for are above 1 degree or 1 % of that size).\n";
+  o << "[expect]\ntruth = \"exact\"\n";
+  o << "tolerance = " << fmt_num(std::max(1e-12, 1e-6 * size), 3) << "\n[expect.contact]\n"
+    << "touching = " << (sat.touching ? "true" : "false") << "\n";
+  if (sat.touching) {
+    o << "normal = [" << format_number(sat.normal.x(), full) << ", "
+      << format_number(sat.normal.y(), full) << ", " << format_number(sat.normal.z(), full)
+      << "]\ndepth = " << format_number(std::max(sat.depth, 0.0), full) << "\n";
+  }
+  return o.str();
+}
+
+}  // namespace
+
+std::string describe_outcome(const BackendOutcome& b) {
+  std::ostringstream o;
+  if (b.error == "error" || b.error == "timeout") {
+    // One line: the message goes into a scene file's comment.
+    std::string m = b.message;
+    std::replace(m.begin(), m.end(), '\n', ' ');
+    std::replace(m.begin(), m.end(), '\r', ' ');
+    return "status " + b.error + ": " + m;
+  }
+  if (b.error == "misses") return "misses a contact";
+  if (b.error == "no_normal") return "reports touching with no normal on a penetrating pair";
+  if (b.error == "false_contact") return "reports a contact where there is none";
+  if (b.error == "missed") return "the body flew on untouched (no impulse)";
+  if (b.error == "tunnel")
+    return "ends past the wall's near face (through it or inside), " +
+           fmt_num(b.position_err_m, 3) + " m from the closed form, velocity error " +
+           fmt_num(b.velocity_err_ke, 3);
+  if (b.error == "velocity")
+    return "bounces off the wall with velocity error " + fmt_num(b.velocity_err_ke, 3) +
+           " (energy norm)";
+  if (b.error == "impulse" || b.error == "spin")
+    return "velocity error " + fmt_num(b.velocity_err_ke, 3) + ", momentum error " +
+           fmt_num(b.momentum_err_ke, 3) + " (energy norm; " +
+           (b.error == "impulse" ? "the impulse is wrong"
+                                 : "the impulse is right, the spin after it is not") +
+           ")";
+  if (b.error == "deep_contact")
+    return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
+           fmt_num(b.turn_rad, 3) + " rad, after its collider reported a contact " +
+           fmt_num(b.reported_depth_m, 3) + " m deep (no landing or resting box is)";
+  if (b.error == "lift_off")
+    return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
+           fmt_num(b.turn_rad, 3) + " rad, its time to rest off by " +
+           fmt_num(b.rest_time_err_s, 3) + " s, after it rose " + fmt_num(b.rise_m, 3) +
+           " m off its surface while sliding (the closed form's box never leaves it)";
+  if (b.error == "late_landing")
+    return "rests " + fmt_num(b.position_err_m, 3) +
+           " m further along its launch, the slide of the rest of its step after the touch: the "
+           "landing resolved at the step after it (no time of impact)";
+  if (b.error == "position" || b.error == "turn" || b.error == "rest_time")
+    return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
+           fmt_num(b.turn_rad, 3) + " rad, its time to rest off by " +
+           fmt_num(b.rest_time_err_s, 3) + " s";
+  o << "normal off by " << fmt_num(b.normal_err_deg, 3) << " deg, depth off by "
+    << fmt_num(b.depth_err_rel, 3) << " and point off by " << fmt_num(b.point_err_rel, 3)
+    << " of the smaller body";
+  return o.str();
+}
+
+namespace {
+
+// The outcome of `backend` on a sample (an empty error when it is not there).
+BackendOutcome outcome_of(const SampleOutcome& o, const std::string& backend) {
+  BackendOutcome found;
+  for (const BackendOutcome& b : o.backends)
+    if (b.backend == backend) found = b;
+  return found;
+}
+
+// What a group's shrink sends back to rank 0, as JSON text: the scene, whether the harness
+// shows the disagreement on it, and the kind's own `fields`.
+std::string shrunk_json(const std::string& text, const BackendOutcome& found, Json fields) {
+  std::string detail;
+  fields["ok"] = true;
+  fields["text"] = text;
+  fields["reproduced"] = harness_reproduces(text, "explore.toml", found, &detail);
+  fields["harness"] = detail;
+  fields["message"] = found.message;
+  return fields.dump();
+}
+
+// "from N to M points (K simplifications kept, E tried)".
+std::string points_shrunk(int before, int after, int kept, int tried) {
+  return "from " + std::to_string(before) + " to " + std::to_string(after) + " points (" +
+         std::to_string(kept) + " simplifications kept, " + std::to_string(tried) + " tried)";
+}
+
+// The leading comment of a shrunk closed-form scene (impact, landing kinds): where it was
+// found, what the backend does on it, how it was shrunk (`shrunk`), how to reproduce it.
+std::string closed_form_header(const std::string& kind, uint64_t seed, long count, uint64_t index,
+                               const Json& g, const BackendOutcome& found,
+                               const std::string& shrunk) {
+  const std::string backend = g["backend"], sig = g["signature"];
+  std::ostringstream h;
+  h << "# Found by `rbx explore --kind " << kind << " --seed " << seed << " --count " << count
+    << "`: sample " << index << ", group '" << sig << "',\n# " << g["count"].get<long>()
+    << " samples. " << backend << " against the closed form: " << describe_outcome(found) << ".\n"
+    << "# Shrunk " << shrunk << ", while the disagreement stayed.\n"
+    << "# Reproduce: rbx compare THIS_FILE --backends " << backend << "\n";
+  return h.str();
+}
+
+// One contact group's shrink: the scene's [expect] is the exact oracle's answer.
+std::string shrink_contact_group(const Json& g, uint64_t seed, long count, int budget) {
+  const ContactSample start = make_contact_sample(seed, g["first_sample"].get<uint64_t>());
+  const std::string backend = g["backend"], sig = g["signature"];
+  const ShrinkResult r = shrink(start, backend, sig, budget);
+  const BackendOutcome found = outcome_of(r.outcome, backend);
+  // The start's own text not showing the signature should not happen (the text is built as
+  // the sample is); it is reported instead of writing a scene that shows nothing.
+  if (found.error.empty()) return Json{{"ok", false}}.dump();
+  std::ostringstream h;
+  h << "# Found by `rbx explore --seed " << seed << " --count " << count << "`: sample "
+    << start.index << " (" << start.pose_class << " pose), group '" << sig << "',\n# "
+    << g["count"].get<long>() << " samples. " << backend
+    << " against the exact oracle: " << describe_outcome(found) << ".\n# Shrunk "
+    << points_shrunk(r.vertices_before, r.vertices_after, r.steps_accepted, r.evaluations)
+    << ", while the disagreement stayed.\n# Reproduce: rbx compare THIS_FILE --backends " << backend
+    << "\n";
+  const std::string body = sample_scene_text(r.sample, h.str());
+  return shrunk_json(body + "\n" + expect_block(body), found,
+                     {{"points_before", r.vertices_before},
+                      {"points_after", r.vertices_after},
+                      {"evaluations", r.evaluations},
+                      {"normal_err_deg", found.normal_err_deg},
+                      {"depth_err_rel", found.depth_err_rel},
+                      {"point_err_rel", found.point_err_rel}});
+}
+
+// One closed-form group's shrink (impact, landing kinds): the scene carries its closed form
+// ([expect]) already. `make` and `shrink` are the kind's sampler and shrinker; `how` says how
+// the shrink went and `numbers` are the kind's measures in the record, both from its result.
+template <class Make, class Shrink, class How, class Numbers>
+std::string shrink_closed_form_group(const char* kind, const Json& g, uint64_t seed, long count,
+                                     int budget, Make make, Shrink shrink, How how,
+                                     Numbers numbers) {
+  const auto start = make(seed, g["first_sample"].get<uint64_t>());
+  const std::string backend = g["backend"], sig = g["signature"];
+  const auto r = shrink(start, backend, sig, budget);
+  const BackendOutcome found = outcome_of(r.outcome, backend);
+  if (found.error.empty()) return Json{{"ok", false}}.dump();
+  return shrunk_json(
+      closed_form_header(kind, seed, count, start.index, g, found, how(r)) + r.sample.text, found,
+      numbers(r, found));
+}
+
+std::string shrink_impact_group(const Json& g, uint64_t seed, long count, int budget) {
+  return shrink_closed_form_group(
+      "impact", g, seed, count, budget, make_impact_sample, shrink_impact,
+      [](const ImpactShrinkResult& r) {
+        return points_shrunk(r.vertices_before, r.vertices_after, r.steps_accepted, r.evaluations);
+      },
+      [](const ImpactShrinkResult& r, const BackendOutcome& found) {
+        return Json{{"points_before", r.vertices_before},
+                    {"points_after", r.vertices_after},
+                    {"evaluations", r.evaluations},
+                    {"phase", r.sample.phase},
+                    {"velocity_err_ke", found.velocity_err_ke},
+                    {"momentum_err_ke", found.momentum_err_ke}};
+      });
+}
+
+// A landing's box keeps its 8 points: its shrink moves numbers toward round ones.
+std::string shrink_landing_group(const Json& g, uint64_t seed, long count, int budget) {
+  return shrink_closed_form_group(
+      "landing", g, seed, count, budget, make_landing_sample, shrink_landing,
+      [](const LandingShrinkResult& r) {
+        return "toward round numbers (" + std::to_string(r.steps_accepted) +
+               " simplifications kept, " + std::to_string(r.evaluations) + " tried)";
+      },
+      [](const LandingShrinkResult& r, const BackendOutcome& found) {
+        return Json{{"evaluations", r.evaluations},
+                    {"phase", r.sample.phase},
+                    {"position_err_m", found.position_err_m},
+                    {"turn_rad", found.turn_rad},
+                    {"rest_time_err_s", found.rest_time_err_s}};
+      });
+}
+
+// A slide's box, too: its shrink moves numbers toward round ones.
+std::string shrink_slide_group(const Json& g, uint64_t seed, long count, int budget) {
+  return shrink_closed_form_group(
+      "slide", g, seed, count, budget, make_slide_sample, shrink_slide,
+      [](const SlideShrinkResult& r) {
+        return "toward round numbers (" + std::to_string(r.steps_accepted) +
+               " simplifications kept, " + std::to_string(r.evaluations) + " tried)";
+      },
+      [](const SlideShrinkResult& r, const BackendOutcome& found) {
+        return Json{{"evaluations", r.evaluations},
+                    {"position_err_m", found.position_err_m},
+                    {"turn_rad", found.turn_rad},
+                    {"rest_time_err_s", found.rest_time_err_s}};
+      });
+}
+
+// A projectile's box keeps its 8 points: its shrink moves numbers toward round ones.
+std::string shrink_tunnel_group(const Json& g, uint64_t seed, long count, int budget) {
+  return shrink_closed_form_group(
+      "tunnel", g, seed, count, budget, make_tunnel_sample, shrink_tunnel,
+      [](const TunnelShrinkResult& r) {
+        return "toward round numbers (" + std::to_string(r.steps_accepted) +
+               " simplifications kept, " + std::to_string(r.evaluations) + " tried)";
+      },
+      [](const TunnelShrinkResult& r, const BackendOutcome& found) {
+        return Json{{"evaluations", r.evaluations},
+                    {"phase", r.sample.phase},
+                    {"velocity_err_ke", found.velocity_err_ke},
+                    {"position_err_m", found.position_err_m}};
+      });
+}
+
+}  // namespace
+
+std::string shrink_group(const Json& group, const ExploreSettings& set) {
+  try {
+    if (set.kind == "impact")
+      return shrink_impact_group(group, set.seed, set.count, std::min(set.shrink_budget, 120));
+    if (set.kind == "landing")
+      return shrink_landing_group(group, set.seed, set.count, std::min(set.shrink_budget, 60));
+    if (set.kind == "slide")
+      return shrink_slide_group(group, set.seed, set.count, std::min(set.shrink_budget, 60));
+    if (set.kind == "tunnel")
+      return shrink_tunnel_group(group, set.seed, set.count, std::min(set.shrink_budget, 60));
+    return shrink_contact_group(group, set.seed, set.count, set.shrink_budget);
+  } catch (const std::exception& e) {
+    return Json{{"ok", false}, {"message", e.what()}}.dump();
+  }
+}
+
+}  // namespace rbx::explore_detail
