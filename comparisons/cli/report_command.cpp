@@ -192,7 +192,8 @@ int report_command(const ReportOptions& opt) {
     in.views_ok = views_ok;
     // Real impacts: every tosses data set under the inputs (comparisons/output/tosses_report.cpp).
     for (const std::string& dir : find_toss_datasets(opt.inputs))
-      in.tosses += tosses_report_section(dir, tmp.string(), opt.backends, par.threads());
+      in.tosses += tosses_report_section(run_toss_report_study(dir, opt.backends, par.threads()),
+                                         tmp.string());
     parts.end("tosses");
     const std::string summary = report_summary_markdown(scenes, evs, in);
     const std::string details =

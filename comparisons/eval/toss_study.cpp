@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 
+#include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/parallel.h"
 #include "comparisons/eval/select_backends.h"
 #include "comparisons/eval/tosses.h"
@@ -18,6 +19,18 @@ namespace fs = std::filesystem;
 namespace rbx {
 
 namespace {
+
+// The best, median and worst toss of `best` (label, toss id); none when it has no tosses.
+std::vector<std::pair<std::string, long>> toss_picks(const BackendTosses& best) {
+  if (best.tosses.empty()) return {};
+  std::vector<TossErrors> sorted = best.tosses;
+  std::stable_sort(sorted.begin(), sorted.end(), [](const TossErrors& a, const TossErrors& b) {
+    return a.position < b.position;
+  });
+  return {{"best", sorted.front().toss_id},
+          {"median", sorted[(sorted.size() - 1) / 2].toss_id},
+          {"worst", sorted.back().toss_id}};
+}
 
 Json model_json(const CubeTossModel& m) {
   return {{"cube_width_m", 2.0 * m.half_width},
@@ -256,6 +269,37 @@ std::vector<std::string> find_toss_datasets(const std::vector<std::string>& inpu
   }
   std::sort(found.begin(), found.end());
   return found;
+}
+
+TossReportStudy run_toss_report_study(const std::string& dir, const std::string& backend_list,
+                                      int threads) {
+  TossReportStudy study;
+  study.data = toss_test_split(dir);
+  const std::vector<Toss> all = read_tosses(study.data);
+  study.all_tosses = all.size();
+  study.flagged = energy_gains(all);
+  study.tosses = without_energy_gains(all, study.flagged);
+  study.params_path = (fs::path(dir) / "params.json").string();
+  const auto stored = read_params_file(study.params_path);
+  // Backends without dynamics named in the report's --backends are simply not tossed.
+  for (const Backend* b : select_toss_backends(backend_list))
+    if (b->dynamics) study.chosen.push_back(b);
+  if (study.chosen.empty()) return study;
+  Stopwatch clock;
+  study.ev = evaluate_tosses(study.chosen, study.tosses, stored, threads);
+  study.eval_s = clock.seconds();
+  study.order = toss_ranking(study.ev.stored);
+  for (const auto& [label, id] : toss_picks(study.ev.stored[study.order.front()])) {
+    PickedToss pick{label, id, {}};
+    const Toss& t = *std::find_if(study.tosses.begin(), study.tosses.end(),
+                                  [&, id = id](const Toss& x) { return x.id == id; });
+    for (size_t k = 0; k < study.chosen.size(); ++k)
+      pick.runs.emplace_back(
+          study.chosen[k]->name,
+          simulate_toss(isolated_dynamics_fn(*study.chosen[k]), t, study.ev.stored[k].params));
+    study.picks.push_back(std::move(pick));
+  }
+  return study;
 }
 
 }  // namespace rbx

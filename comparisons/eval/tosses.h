@@ -240,6 +240,36 @@ std::vector<std::string> find_toss_datasets(const std::vector<std::string>& inpu
 /// The test split of a data set folder: DIR/test.csv.gz, else DIR/test.csv.
 std::string toss_test_split(const std::string& dir);
 
+/// One toss picked for the report's figures and replays (the best, median and worst of the best
+/// backend) with every chosen backend's run of it at its stored parameters.
+struct PickedToss {
+  std::string label;                                  // "best", "median" or "worst"
+  long id = 0;                                        // the toss's id
+  std::vector<std::pair<std::string, TossRun>> runs;  // backend name, its run
+};
+
+/// The report's "Real impacts" study of one data set: the test split with the tosses that gain
+/// energy left out, every chosen backend at both parameter sets, and the picked tosses' runs.
+struct TossReportStudy {
+  std::string data;         // the test split's file
+  std::string params_path;  // params.json beside it
+  size_t all_tosses = 0;    // in the split, before the energy-gain flags
+  std::vector<EnergyGain> flagged;
+  std::vector<Toss> tosses;  // those scored
+  std::vector<const Backend*> chosen;
+  TossEvaluation ev;
+  double eval_s = 0.0;            // wall time of the evaluation at both parameter sets
+  std::vector<size_t> order;      // toss_ranking(ev.stored)
+  std::vector<PickedToss> picks;  // empty: no backend scored a toss
+};
+
+/// Runs the data set in folder `dir` (test.csv[.gz] with params.json) through every dynamics
+/// backend (or those of them named in `backend_list`) at the stored and at the published
+/// parameters, and the best backend's best, median and worst toss through every chosen backend.
+/// Empty `chosen`: no backend with dynamics was named. `threads`: as evaluate_tosses.
+TossReportStudy run_toss_report_study(const std::string& dir, const std::string& backend_list,
+                                      int threads = 0);
+
 /// A backend's stored (fitted) parameters, or the published ones when it has none; `source`
 /// (when given) gets "fitted" or "published (none stored)".
 ContactParams stored_params(const std::vector<std::pair<std::string, ContactParams>>& stored,

@@ -7,7 +7,6 @@
 #include <iostream>
 #include <sstream>
 
-#include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/trajectory.h"
 #include "comparisons/output/figure_script.h"
 #include "comparisons/output/view_page.h"
@@ -85,51 +84,32 @@ void write_error_time_csv(const fs::path& out, const TossEvaluation& ev) {
   write_text((out / "tosses_error_time.csv").string(), over.str());
 }
 
-// The best, median and worst toss of `best` (label, toss id); none when it has no tosses.
-std::vector<std::pair<std::string, long>> toss_picks(const BackendTosses& best) {
-  if (best.tosses.empty()) return {};
-  std::vector<TossErrors> sorted = best.tosses;
-  std::stable_sort(sorted.begin(), sorted.end(), [](const TossErrors& a, const TossErrors& b) {
-    return a.position < b.position;
-  });
-  return {{"best", sorted.front().toss_id},
-          {"median", sorted[(sorted.size() - 1) / 2].toss_id},
-          {"worst", sorted.back().toss_id}};
-}
-
 // The picked tosses drawn for every backend: their height and angle in tosses_traj.csv and one
 // 3-D replay each (every backend's cube, the measured cube as a ghost). Returns the replays'
 // file names in pick order ("" : not written).
-std::vector<std::string> write_picked_tosses(const fs::path& out,
-                                             const std::vector<std::pair<std::string, long>>& picks,
-                                             const std::vector<Toss>& tosses,
-                                             const std::vector<const Backend*>& chosen,
-                                             const TossEvaluation& ev, const std::string& best) {
+std::vector<std::string> write_picked_tosses(const fs::path& out, const TossReportStudy& study) {
   const double rate = CubeTossModel{}.sample_rate;
   std::ostringstream traj;
   traj << "pick,toss,source,t,z,angle_deg\n";
   std::vector<std::string> replays;
   const fs::path views = out / "views";
-  for (const auto& pick : picks) {
-    // Named copies, not a structured binding: the lambda below captures id (C++17 does not
-    // allow capturing a binding; clang refuses it).
-    const std::string& label = pick.first;
-    const long id = pick.second;
-    const Toss& t =
-        *std::find_if(tosses.begin(), tosses.end(), [&](const Toss& x) { return x.id == id; });
+  const std::string& best = study.ev.stored[study.order.front()].name;
+  for (const PickedToss& pick : study.picks) {
+    // Named copies: the lambda below captures id.
+    const std::string& label = pick.label;
+    const long id = pick.id;
+    const Toss& t = *std::find_if(study.tosses.begin(), study.tosses.end(),
+                                  [&](const Toss& x) { return x.id == id; });
     const Quat q0 = t.samples.front().orientation;
     for (const TossSample& s : t.samples)
       traj << label << "," << id << ",measured," << fmt_num(s.time - t.samples.front().time, 6)
            << "," << fmt_num(s.position.z(), 7) << ","
            << fmt_num(rotation_angle_deg(q0, s.orientation), 6) << "\n";
-    std::vector<std::pair<std::string, TossRun>> runs;
-    for (size_t k = 0; k < chosen.size(); ++k) {
-      runs.emplace_back(chosen[k]->name,
-                        simulate_toss(isolated_dynamics_fn(*chosen[k]), t, ev.stored[k].params));
-      const TossRun& run = runs.back().second;
+    const std::vector<std::pair<std::string, TossRun>>& runs = pick.runs;
+    for (const auto& [name, run] : runs) {
       if (run.status != Status::Ok) continue;
       for (size_t i = 0; i < run.track.position.size(); ++i)
-        traj << label << "," << id << "," << chosen[k]->name << "," << fmt_num(i / rate, 6) << ","
+        traj << label << "," << id << "," << name << "," << fmt_num(i / rate, 6) << ","
              << fmt_num(run.track.position[i].z(), 7) << ","
              << fmt_num(rotation_angle_deg(q0, run.track.orientation[i]), 6) << "\n";
     }
@@ -191,36 +171,22 @@ std::string error_over_time_table(const TossEvaluation& ev, const std::vector<si
 
 }  // namespace
 
-std::string tosses_report_section(const std::string& dir, const std::string& out_dir,
-                                  const std::string& backend_list, int threads) {
-  const fs::path d(dir);
-  const std::string data = toss_test_split(dir);
-  const std::vector<Toss> all = read_tosses(data);
-  const std::vector<EnergyGain> flagged = energy_gains(all);
-  const std::vector<Toss> tosses = without_energy_gains(all, flagged);
-  const std::string params_path = (d / "params.json").string();
-  const auto stored = read_params_file(params_path);
-  // Backends without dynamics named in the report's --backends are simply not tossed.
-  std::vector<const Backend*> chosen;
-  for (const Backend* b : select_toss_backends(backend_list))
-    if (b->dynamics) chosen.push_back(b);
-  if (chosen.empty()) return "";
-
-  Stopwatch clock;
-  const TossEvaluation ev = evaluate_tosses(chosen, tosses, stored, threads);
-  const double eval_s = clock.seconds();
+std::string tosses_report_section(const TossReportStudy& study, const std::string& out_dir) {
+  if (study.chosen.empty()) return "";
+  const std::vector<Toss>& tosses = study.tosses;
+  const TossEvaluation& ev = study.ev;
   const fs::path out(out_dir);
-  Json study = toss_evaluation_json(data, tosses, params_path, ev);
-  study["energy_gain"] = energy_gains_json(flagged, tosses.size());
-  write_json((out / "tosses.json").string(), study);
+  Json doc = toss_evaluation_json(study.data, tosses, study.params_path, ev);
+  doc["energy_gain"] = energy_gains_json(study.flagged, tosses.size());
+  write_json((out / "tosses.json").string(), doc);
   write_per_toss_csv(out, ev);
   write_error_time_csv(out, ev);
-  const std::vector<size_t> order = toss_ranking(ev.stored);
-  const BackendTosses& best = ev.stored[order.front()];
-  const std::vector<std::pair<std::string, long>> picks = toss_picks(best);
-  const std::vector<std::string> replays =
-      write_picked_tosses(out, picks, tosses, chosen, ev, best.name);
+  const std::vector<std::string> replays = write_picked_tosses(out, study);
   const bool figures_ok = draw_tosses_figures(out_dir);
+  const BackendTosses& best = ev.stored[study.order.front()];
+  const std::vector<PickedToss>& picks = study.picks;
+  const std::string& data = study.data;
+  const std::string& params_path = study.params_path;
 
   size_t samples = 0;
   for (const Toss& t : tosses) samples += t.samples.size();
@@ -229,16 +195,16 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
   md << tosses.size() << " test tosses (" << samples << " samples) of a real 10.48 cm, 0.37 kg "
      << "cube onto a floor, tracked by motion capture at 148 Hz (ContactNets data, "
      << "`" << data << "`; the split and the source are in the README beside it); "
-     << flagged.size() << " of its " << all.size()
+     << study.flagged.size() << " of its " << study.all_tosses
      << " tosses left out for an energy gain across an impact beyond the tracking noise"
-     << energy_gains_list(flagged) << ". "
+     << energy_gains_list(study.flagged) << ". "
      << "Each toss is simulated from its first measured sample (pose, velocity, angular "
      << "velocity) for its recorded duration, dt = 1/1480 s (10 substeps per sample), and "
      << "compared at every sample: **position error** = mean |p_sim - p_real| over the toss in "
      << "cube widths, **angle error** = mean rotation angle between simulated and measured "
      << "orientation, **final** = the position error at the last (resting) sample. Median / "
      << "mean / 90th percentile over tosses; ranked by the median position error. All "
-     << chosen.size() << " backends at both parameter sets took " << fmt_num(eval_s, 3)
+     << study.chosen.size() << " backends at both parameter sets took " << fmt_num(study.eval_s, 3)
      << " s.\n\n";
   md << "### At each backend's fitted parameters (`" << params_path << "`, fitted on the "
      << "training tosses)\n\n"
@@ -251,7 +217,7 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
         "already at rest counts with its last sample; the first measured impact comes at 0.115 s "
         "(median; 0.07 to 0.18 s)) and the horizontal (x, y) part of the final error, at the "
         "fitted parameters:\n\n"
-     << error_over_time_table(ev, order) << "\n";
+     << error_over_time_table(ev, study.order) << "\n";
   if (figures_ok) {
     md << "![toss error distribution](figures/tosses_errors.png)\n\n"
        << "Left: position error per toss, every backend (fitted and published parameters). "
@@ -262,8 +228,8 @@ std::string tosses_report_section(const std::string& dir, const std::string& out
       md << "![toss trajectories](figures/tosses_trajectories.png)\n\n"
          << "Height of the centre and rotation angle from the release orientation, measured "
             "(black) and simulated, for the best (toss "
-         << picks[0].second << "), median (toss " << picks[1].second << ") and worst (toss "
-         << picks[2].second << ") toss of the best backend, `" << best.name << "`.\n\n";
+         << picks[0].id << "), median (toss " << picks[1].id << ") and worst (toss " << picks[2].id
+         << ") toss of the best backend, `" << best.name << "`.\n\n";
     if (replays.size() == 3 && !replays[0].empty())
       md << "3-D replays of these tosses, every backend side by side with the measured cube as "
             "a grey ghost: [best](views/"
