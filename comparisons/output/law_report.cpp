@@ -94,7 +94,7 @@ std::string contact_laws_markdown(const std::vector<Scene>& scenes,
   for (const std::string& f : families) {
     const std::string file = "figures/contact_laws_" + f + ".png";
     if (figures_ok && std::filesystem::exists(std::filesystem::path(report_dir) / file))
-      md << "![contact laws, " << md_escape(f) << "](" << file << ")\n\n";
+      md << "![contact laws, " << md_escape(f) << "](" << md_url(file) << ")\n\n";
   }
   return md.str();
 }

@@ -28,7 +28,7 @@ std::string figure_line(const std::string& title, const std::string& slug,
                         const std::string& report_dir, bool figures_ok) {
   const std::string file = "figures/ensemble_" + slug + ".png";
   if (!figures_ok || !std::filesystem::exists(std::filesystem::path(report_dir) / file)) return "";
-  return "![final positions of the copies, " + md_escape(title) + "](" + file + ")\n\n";
+  return "![final positions of the copies, " + md_escape(title) + "](" + md_url(file) + ")\n\n";
 }
 
 // What the section measures, as both versions open it.
@@ -104,8 +104,7 @@ std::string scene_part(const std::string& title, const std::string& slug, const 
       continue;
     }
     const Json& first = b["contact_sequences"][0];
-    md << "`" << md_escape(first.value("sequence", "")) << "` (" << first.value("copies", 0L)
-       << ")\n";
+    md << md_code(first.value("sequence", "")) << " (" << first.value("copies", 0L) << ")\n";
   }
   md << "\n" << figure_line(title, slug, report_dir, figures_ok);
   return md.str();

@@ -320,7 +320,9 @@ void write_report_pages(const std::string& dir, const std::vector<Scene>& scenes
          << "</td><td>" << html_escape(checks) << "</td><td>"
          << html_escape(bad.empty() ? "none" : bad) << "</td><td><a href=\"details.html#"
          << html_escape(heading_anchor(md_escape(name))) << "\">numbers</a></td><td>"
-         << (views_ok ? "<a href=\"views/" + html_escape(slug) + ".html\">replay</a>" : "-")
+         << (views_ok
+                 ? "<a href=\"" + html_escape(md_url("views/" + slug + ".html")) + "\">replay</a>"
+                 : "-")
          << "</td></tr>\n";
   }
   body << "</tbody>\n</table>\n";

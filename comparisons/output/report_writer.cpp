@@ -100,7 +100,8 @@ std::string summary_section(const std::vector<Scene>& scenes,
     std::string against;
     std::vector<std::string> row = {md_escape(evs[i].family + "/" + scenes[i].name), "", ""};
     if (views_ok)
-      row[0] = "[" + row[0] + "](views/" + scene_slug(evs[i].family, scenes[i].file) + ".html)";
+      row[0] = "[" + row[0] + "](" +
+               md_url("views/" + scene_slug(evs[i].family, scenes[i].file) + ".html") + ")";
     std::string checks;
     for (const std::string& c : scenes[i].check_names()) checks += (checks.empty() ? "" : ", ") + c;
     row[1] = checks;
@@ -234,11 +235,11 @@ std::string scene_details_section(const std::vector<Scene>& scenes,
   md << "## Scenes\n\n";
   for (size_t i = 0; i < evs.size(); ++i) {
     const SceneEvaluation& ev = evs[i];
-    const std::string slug = ev.family + "_" + fs::path(scenes[i].file).stem().string();
+    const std::string slug = scene_slug(ev.family, scenes[i].file);
     md << "### " << md_escape(ev.family + "/" + scenes[i].name) << "\n\n";
     if (!scenes[i].description.empty()) md << md_escape(scenes[i].description) << "\n\n";
-    md << "`" << scenes[i].file << "`";
-    if (views_ok) md << " — [3-D replay](views/" << slug << ".html)";
+    md << md_code(scenes[i].file);
+    if (views_ok) md << " — [3-D replay](" << md_url("views/" + slug + ".html") << ")";
     md << "\n\n";
     Table status({"backend", "status", "run time (s)", "message"});
     for (const auto& [name, bj] : ev.json["backends"].items())
@@ -266,10 +267,10 @@ std::string scene_details_section(const std::vector<Scene>& scenes,
       md << "  - known failure: " << scenes[i].expect->known_failure << "\n";
     if (figures_ok) {
       if (scenes[i].has_check(CheckKind::Contact) && !ev.json["geometry"].empty())
-        md << "\n![contacts](figures/contact_" << slug << ".png)\n";
+        md << "\n![contacts](" << md_url("figures/contact_" + slug + ".png") << ")\n";
       if (find_metric(ev, "custom", "velocity_err_ke") || ev.json["backends"].contains("bullet"))
         if (scenes[i].has_check(CheckKind::Impulse))
-          md << "\n![velocities](figures/velocity_" << slug << ".png)\n";
+          md << "\n![velocities](" << md_url("figures/velocity_" + slug + ".png") << ")\n";
     }
     md << "\n";
   }
@@ -320,7 +321,7 @@ std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs,
   for (const std::string& f : families) {
     const std::string file = "figures/error_vs_runtime_" + f + ".png";
     if (figures_ok && std::filesystem::exists(std::filesystem::path(report_dir) / file))
-      md << "![error against run time, " << f << "](" << file << ")\n\n";
+      md << "![error against run time, " << md_escape(f) << "](" << md_url(file) << ")\n\n";
   }
   if (!budget_rows(evs).empty())
     md << "Along each solver's iteration budget (the right-hand panels): the smallest budget "

@@ -251,6 +251,37 @@ std::string md_escape(const std::string& text) {
   return out;
 }
 
+std::string md_url(const std::string& path) {
+  static const char* hex = "0123456789ABCDEF";
+  std::string out;
+  for (const unsigned char c : path) {
+    if (std::isalnum(c) || std::string("-._~/").find(static_cast<char>(c)) != std::string::npos) {
+      out += static_cast<char>(c);
+    } else {
+      out += '%';
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  return out;
+}
+
+std::string md_code(const std::string& text) {
+  std::string s = text;
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  std::replace(s.begin(), s.end(), '\r', ' ');
+  size_t longest = 0, run = 0;
+  for (const char c : s) {
+    run = c == '`' ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  const std::string fence(longest + 1, '`');
+  // CommonMark strips one space from each end of a code span that starts and ends with one.
+  const bool pad =
+      !s.empty() && (s.front() == '`' || s.back() == '`' || (s.front() == ' ' && s.back() == ' '));
+  return fence + (pad ? " " : "") + s + (pad ? " " : "") + fence;
+}
+
 std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
                                  const std::vector<SceneEvaluation>& evs,
                                  const std::vector<std::string>& backends,
@@ -429,7 +460,7 @@ std::string causes_markdown(const std::vector<FailureCause>& causes, bool compac
   if (causes.empty()) md << "Every backend is within tolerance on every scene it ran.\n";
   auto link = [&](const SceneRef& s) {
     const std::string name = md_escape(s.name);
-    return views ? "[" + name + "](views/" + s.slug + ".html)" : name;
+    return views ? "[" + name + "](" + md_url("views/" + s.slug + ".html") + ")" : name;
   };
   for (size_t k = 0; k < causes.size(); ++k) {
     const FailureCause& f = causes[k];

@@ -20,6 +20,17 @@ std::string scene_slug(const std::string& family, const std::string& file);
 /// and tabs dropped (they would indent it into code); line breaks are spaces.
 std::string md_escape(const std::string& s);
 
+/// A relative path as a link's destination in Markdown or HTML: every byte but letters, digits,
+/// "-._~/" percent-encoded, so that a scene's file or folder name with a space, a parenthesis, a
+/// quote or any other character ends neither the link nor the attribute, and the browser finds
+/// the file by its name.
+std::string md_url(const std::string& path);
+
+/// Text as one Markdown code span (outside a table): fenced with one backtick more than its
+/// longest run of backticks, padded with a space where it starts or ends with one; line breaks
+/// are spaces. Shown exactly as written, whatever it holds.
+std::string md_code(const std::string& text);
+
 /// What a scorecard row's error measures: a contact query's normal angle and depth, a dynamic
 /// run's post-impact velocity, or mass properties. It comes from the scene's checks, so that a
 /// folder mixing contact and dynamics scenes gets one row per kind, each in its own unit.

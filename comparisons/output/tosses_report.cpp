@@ -9,6 +9,7 @@
 
 #include "comparisons/eval/trajectory.h"
 #include "comparisons/output/figure_script.h"
+#include "comparisons/output/scorecard.h"
 #include "comparisons/output/view_page.h"
 #include "comparisons/scene/repo_path.h"
 
@@ -194,7 +195,7 @@ std::string tosses_report_section(const TossReportStudy& study, const std::strin
   md << "## Real impacts: measured cube tosses\n\n";
   md << tosses.size() << " test tosses (" << samples << " samples) of a real 10.48 cm, 0.37 kg "
      << "cube onto a floor, tracked by motion capture at 148 Hz (ContactNets data, "
-     << "`" << data << "`; the split and the source are in the README beside it); "
+     << md_code(data) << "; the split and the source are in the README beside it); "
      << study.flagged.size() << " of its " << study.all_tosses
      << " tosses left out for an energy gain across an impact beyond the tracking noise"
      << energy_gains_list(study.flagged) << ". "
@@ -206,7 +207,7 @@ std::string tosses_report_section(const TossReportStudy& study, const std::strin
      << "mean / 90th percentile over tosses; ranked by the median position error. All "
      << study.chosen.size() << " backends at both parameter sets took " << fmt_num(study.eval_s, 3)
      << " s.\n\n";
-  md << "### At each backend's fitted parameters (`" << params_path << "`, fitted on the "
+  md << "### At each backend's fitted parameters (" << md_code(params_path) << ", fitted on the "
      << "training tosses)\n\n"
      << toss_results_table(ev.stored, true).markdown() << "\n";
   md << "### At the dataset's published parameters (e = 0.125, mu = 0.18)\n\n"
@@ -229,7 +230,7 @@ std::string tosses_report_section(const TossReportStudy& study, const std::strin
          << "Height of the centre and rotation angle from the release orientation, measured "
             "(black) and simulated, for the best (toss "
          << picks[0].id << "), median (toss " << picks[1].id << ") and worst (toss " << picks[2].id
-         << ") toss of the best backend, `" << best.name << "`.\n\n";
+         << ") toss of the best backend, " << md_code(best.name) << ".\n\n";
     if (replays.size() == 3 && !replays[0].empty())
       md << "3-D replays of these tosses, every backend side by side with the measured cube as "
             "a grey ghost: [best](views/"

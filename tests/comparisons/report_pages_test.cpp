@@ -13,10 +13,12 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "comparisons/output/backend_style.h"
 #include "comparisons/output/markdown_html.h"
-#include "comparisons/output/scorecard.h"  // md_escape
+#include "comparisons/output/scorecard.h"  // md_escape, md_code, md_url
 #include "comparisons/output/table.h"      // html_escape
 
 namespace fs = std::filesystem;
@@ -48,6 +50,23 @@ int report(const std::string& args) {
 
 // A folder mixing a contact scene and dynamics scenes (one family, two measures), one of them
 // with a description that is markup.
+const char* const kOddFamily = "odd (fam) #1";
+const char* const kOddFile = "a b(1)`c\"d.toml";
+
+// A link's target with its %XX escapes decoded: the file name the browser asks for.
+std::string url_decoded(const std::string& s) {
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '%' && i + 2 < s.size()) {
+      out += static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+
 fs::path mixed_folder(const fs::path& dir) {
   const fs::path mixed = dir / "mixed";
   fs::create_directories(mixed);
@@ -60,6 +79,10 @@ fs::path mixed_folder(const fs::path& dir) {
   text = std::regex_replace(text, std::regex("\ndescription = \"[^\"]*\""),
                             "\ndescription = \"<b>bold</b> *x* [l](javascript:alert(1))\"");
   std::ofstream(mixed / "markup.toml") << text;
+  // A folder and a file whose names hold what would end a link, a code span, an attribute or a
+  // heading's anchor: their figures, replays and anchors must still be found.
+  fs::create_directories(dir / kOddFamily);
+  fs::copy_file(RBX_SOURCE_DIR "/scenes/analytic/headon_e05.toml", dir / kOddFamily / kOddFile);
   return mixed;
 }
 
@@ -76,7 +99,7 @@ void expect_html_links_resolve(const fs::path& page) {
     ASSERT_NE(target.rfind("javascript:", 0), 0u) << page << ": " << target;
     const size_t hash = target.find('#');
     const std::string file = target.substr(0, hash);
-    const fs::path path = file.empty() ? page : page.parent_path() / file;
+    const fs::path path = file.empty() ? page : page.parent_path() / url_decoded(file);
     EXPECT_TRUE(fs::exists(path)) << page << " links " << target;
     if (hash != std::string::npos && fs::exists(path)) {
       EXPECT_NE(read(path).find("id=\"" + target.substr(hash + 1) + "\""), std::string::npos)
@@ -95,7 +118,8 @@ void expect_markdown_links_resolve(const fs::path& md_file) {
   int checked = 0;
   for (auto it = std::sregex_iterator(md.begin(), md.end(), link); it != std::sregex_iterator();
        ++it) {
-    EXPECT_TRUE(fs::exists(md_file.parent_path() / (*it)[2].str())) << md_file << ": " << (*it)[2];
+    EXPECT_TRUE(fs::exists(md_file.parent_path() / url_decoded((*it)[2].str())))
+        << md_file << ": " << (*it)[2];
     ++checked;
   }
   EXPECT_GT(checked, 0) << md_file;
@@ -106,8 +130,9 @@ void expect_markdown_links_resolve(const fs::path& md_file) {
 TEST(ReportPages, LinksResolveUnitsFollowTheMetricAndSceneTextStaysText) {
   const fs::path dir = temp_dir("report_pages");
   const fs::path mixed = mixed_folder(dir), out = dir / "out";
-  ASSERT_EQ(report("'" + mixed.string() + "' '" + (dir / "touch").string() +
-                   "' scenes/mass/box_1x2x3.toml --out '" + out.string() + "'"),
+  ASSERT_EQ(report("'" + mixed.string() + "' '" + (dir / "touch").string() + "' '" +
+                   (dir / kOddFamily).string() + "' scenes/mass/box_1x2x3.toml --out '" +
+                   out.string() + "'"),
             0);
   // Every link and image resolves.
   for (const char* page : {"index.html", "details.html"}) expect_html_links_resolve(out / page);
@@ -117,6 +142,13 @@ TEST(ReportPages, LinksResolveUnitsFollowTheMetricAndSceneTextStaysText) {
   EXPECT_NE(index.find("<img src=\"figures/error_vs_runtime_"), std::string::npos);
   EXPECT_NE(index.find("href=\"details.html#mixed-headon_e05"), std::string::npos) << index;
   EXPECT_NE(index.find("href=\"views/mixed_headon_e05.html\""), std::string::npos);
+  // The odd names: the replay's file is named as the scene's, its link percent-encoded, the
+  // file name shown whole in its code span.
+  EXPECT_TRUE(fs::exists(out / "views" / (std::string(kOddFamily) + "_a b(1)`c\"d.html")));
+  EXPECT_NE(index.find("href=\"views/odd%20%28fam%29%20%231_a%20b%281%29%60c%22d.html\""),
+            std::string::npos)
+      << index;
+  EXPECT_NE(read(out / "details.html").find("a b(1)`c&quot;d.toml</code>"), std::string::npos);
   // The colour key of the figures names each backend in its colour (assets/backend_style.json),
   // and a replay page's data carries the same colour for its panel.
   EXPECT_NE(index.find("background:" + backend_colour("custom") + "\"></span> custom<"),
@@ -168,6 +200,23 @@ TEST(ReportPages, LinksResolveUnitsFollowTheMetricAndSceneTextStaysText) {
     EXPECT_NE(html.find("&lt;b&gt;bold&lt;/b&gt;"), std::string::npos) << page;
   }
   fs::remove_all(dir);
+}
+
+TEST(MarkdownHtml, ACodeSpanShowsAnyTextAndALinkTargetFindsAnyFileName) {
+  // Each text comes back exactly (HTML-escaped), one code span, whatever backticks and spaces it
+  // holds; a line break is a space.
+  const std::vector<std::pair<std::string, std::string>> spans = {
+      {"plain", "plain"},   {"a`b", "a`b"},   {"``x``", "``x``"},     {"`lead", "`lead"},
+      {"trail`", "trail`"}, {" sp ", " sp "}, {"a*b*_c_", "a*b*_c_"}, {"<i>&", "&lt;i&gt;&amp;"},
+      {"a\nb", "a b"}};
+  for (const auto& [text, shown] : spans)
+    EXPECT_EQ(markdown_to_html("x " + md_code(text) + " y"),
+              "<p>x <code>" + shown + "</code> y</p>\n")
+        << text;
+  // A target with spaces, parentheses, a quote and a '#' stays one link to that name.
+  EXPECT_EQ(md_url("views/odd (fam) #1_a\"b.html"), "views/odd%20%28fam%29%20%231_a%22b.html");
+  EXPECT_EQ(markdown_to_html("[l](" + md_url("f/a (b).png") + ")"),
+            "<p><a href=\"f/a%20%28b%29.png\">l</a></p>\n");
 }
 
 TEST(MarkdownHtml, RendersTheReportsMarkdownWithHeadingAnchorsAndTables) {
