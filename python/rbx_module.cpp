@@ -87,6 +87,8 @@ py::list backend_rows() {
     d["library"] = b.library;
     d["friction"] = b.friction;
     d["user"] = b.user;
+    d["colour"] = b.style.colour;
+    d["marker"] = b.style.marker;
     rows.append(d);
   }
   return rows;

@@ -224,6 +224,22 @@ struct SoftContact {
       dynamics;
 };
 
+/// How a backend is drawn in every figure and page (comparisons/output/backend_style.h): a
+/// library keeps one hue, its other rows darker or lighter shades of it, each with a marker of its
+/// own, so that two neighbours in a legend never share both and greyscale still tells them apart.
+/// The hues start from Okabe & Ito's colour-blind-safe set.
+struct BackendStyle {
+  std::string colour;  // "#RRGGBB"; empty: a grey the figures choose
+  std::string marker;  // a matplotlib marker ("o", "s", "^", "D", "*", ...)
+};
+
+/// Where `rbx bench` times a contact query: the largest hull (vertices) in a full and in a quick
+/// run (comparisons/eval/bench_cases.h); 0: not timed.
+struct BenchSizes {
+  int full = 0;
+  int quick = 0;
+};
+
 struct Backend {
   std::string name;          // as in JSON and reports
   std::string description;   // one line: library, algorithm
@@ -235,6 +251,21 @@ struct Backend {
   bool user = false;         // registered at run time (register_backend): never cached
   SolverBudget budget = {};  // the solver's iteration budget, when it has one
   SoftContact soft = {};     // its contact softness, when it has some to tune
+  BackendStyle style = {};   // its colour and marker
+  BenchSizes bench = {};     // the hulls `rbx bench` times its contact query on
+
+  /// This row drawn in `colour` with `marker`.
+  Backend drawn(std::string colour, std::string marker) const {
+    Backend b = *this;
+    b.style = {std::move(colour), std::move(marker)};
+    return b;
+  }
+  /// This row's contact query timed by `rbx bench` on hulls up to `full` (`quick`) vertices.
+  Backend timed(int full, int quick) const {
+    Backend b = *this;
+    b.bench = {full, quick};
+    return b;
+  }
 };
 
 /// `b` with its contact softness.
@@ -273,6 +304,8 @@ struct QueryVariant {
   std::string variant;      // e.g. "prebuilt"
   std::string description;  // one line: what differs
   ContactFn contact;
+  BenchSizes bench = {};    // the hulls `rbx bench` times it on (0: not timed)
+  bool boxes_only = false;  // timed on the box pair only (a path a library takes for boxes)
 };
 
 /// One library adapter as a table: the backends it provides and their query variants, each row

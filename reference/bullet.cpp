@@ -597,15 +597,20 @@ const Adapter& bullet_adapter() {
           with_budget(
               {"bullet", "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
                query<bullet_native_settings>, dynamics_run<bullet_native_settings>, bullet_mass},
-              bullet_budget()),
+              bullet_budget())
+              .drawn("#009E73", "o")
+              .timed(2048, 2048),
           // Every body a zero-margin btConvexHullShape through GJK + EPA (one point).
           with_budget(
               {"bullet-hull", "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",
                query<bullet_hull_settings>, dynamics_run<bullet_hull_settings>, bullet_hull_mass},
-              bullet_budget()),
+              bullet_budget())
+              .drawn("#00543D", "s"),
           // Every body a polyhedral hull (boxes too), SAT + clipping; contact queries only.
-          {"bullet-sat", "Bullet 3.24 double: polyhedral hull SAT + clipping, boxes too",
-           query<bullet_sat_settings>, nullptr},
+          Backend{"bullet-sat", "Bullet 3.24 double: polyhedral hull SAT + clipping, boxes too",
+                  query<bullet_sat_settings>, nullptr}
+              .drawn("#7FD4B6", "D")
+              .timed(512, 128),
       },
       {
           {"bullet", "prebuilt", "each btBoxShape or polyhedral hull built once and kept",

@@ -121,16 +121,21 @@ const Adapter& custom_adapter() {
                "(Moore & Wilhelms tests where overlap is not proved), contact manifolds, Coulomb "
                "friction, resting contact, time of impact for every new contact",
                custom_contact, custom_dynamics, nullptr, false},
-              custom_budget()),
-          {"custom-seed",
-           "rbx engine, the seed's algorithm: first hit, single-point frictionless impulse",
-           nullptr, custom_seed_dynamics, nullptr, false, false},
+              custom_budget())
+              .drawn("#0072B2", "o")
+              .timed(8192, 2048),
+          Backend{"custom-seed",
+                  "rbx engine, the seed's algorithm: first hit, single-point frictionless impulse",
+                  nullptr, custom_seed_dynamics, nullptr, false, false}
+              .drawn("#56B4E9", "s"),
       },
       {
-          {"custom", "faithful",
+          {"custom",
+           "faithful",
            "custom on the faithful detector: the seed's loops over every primitive (the "
            "accelerated detector's oracle), the same chosen plane",
-           custom_faithful_contact},
+           custom_faithful_contact,
+           {2048, 512}},
       }};
   return adapter;
 }

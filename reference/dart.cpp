@@ -522,17 +522,24 @@ const Adapter& dart_adapter() {
                            dart_contact, dart_dynamics,
                            [](const RigidBody& b) { return mass_of(b, true); }},
                           dart_budget()),
-              dart_soft(DartSettings{})),
+              dart_soft(DartSettings{}))
+              .drawn("#999933", "o")
+              .timed(2048, 512),
           with_soft(with_budget(
                         {"dart-hull", "DART 6.12 MeshShape of the hull on FCL; boxed LCP (Dantzig)",
                          dart_hull_contact, dart_hull_dynamics,
                          [](const RigidBody& b) { return mass_of(b, false); }},
                         dart_budget()),
-                    dart_soft(dart_hull_settings())),
+                    dart_soft(dart_hull_settings()))
+              .drawn("#5C5C1F", "s"),
       },
       {
-          {"dart", "prebuilt", "each pair's shapes, detector and groups built once and kept",
-           dart_contact_prebuilt},
+          // DART: BoxShapes on its own detector for the box pair, meshes on FCL for the hulls.
+          {"dart",
+           "prebuilt",
+           "each pair's shapes, detector and groups built once and kept",
+           dart_contact_prebuilt,
+           {2048, 512}},
           {"dart-hull", "prebuilt", "each pair's meshes, detector and groups built once and kept",
            dart_hull_contact_prebuilt},
       }};

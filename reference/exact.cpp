@@ -720,8 +720,11 @@ ContactResult exact_contact(const RigidBody& a, const RigidBody& b) {
 const Adapter& exact_adapter() {
   // Our own code, not isolated (library = false).
   static const Adapter adapter = {
-      {{"exact", "rbx oracle: separating-axis test over faces and edge pairs, clipped manifold",
-        exact_contact, nullptr, nullptr, false}},
+      {Backend{"exact",
+               "rbx oracle: separating-axis test over faces and edge pairs, clipped manifold",
+               exact_contact, nullptr, nullptr, false}
+           .drawn("#000000", "*")
+           .timed(2048, 512)},
       {}};
   return adapter;
 }

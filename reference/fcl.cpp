@@ -333,18 +333,33 @@ MassResult fcl_hull_mass(const RigidBody& body) {
 const Adapter& fcl_adapter() {
   static const Adapter adapter = {
       {
-          {"fcl", "FCL 0.7: Box (boxBoxIntersect) or Convex (libccd MPR)", fcl_contact, nullptr,
-           fcl_mass},
-          {"fcl-hull", "FCL 0.7 Convex, GST_LIBCCD (libccd MPR)", fcl_hull_contact, nullptr,
-           fcl_hull_mass},
-          {"fcl-epa", "FCL 0.7 signed distance (GJK + EPA)", fcl_epa_contact, nullptr},
-          {"fcl-indep", "FCL 0.7 Convex, GST_INDEP (known defects shown)", fcl_indep_contact,
-           nullptr},
+          Backend{"fcl", "FCL 0.7: Box (boxBoxIntersect) or Convex (libccd MPR)", fcl_contact,
+                  nullptr, fcl_mass}
+              .drawn("#E69F00", "o")
+              .timed(8192, 2048),
+          Backend{"fcl-hull", "FCL 0.7 Convex, GST_LIBCCD (libccd MPR)", fcl_hull_contact, nullptr,
+                  fcl_hull_mass}
+              .drawn("#A35F00", "s"),
+          Backend{"fcl-epa", "FCL 0.7 signed distance (GJK + EPA)", fcl_epa_contact, nullptr}
+              .drawn("#F3C363", "^")
+              .timed(8192, 2048),
+          Backend{"fcl-indep", "FCL 0.7 Convex, GST_INDEP (known defects shown)", fcl_indep_contact,
+                  nullptr}
+              .drawn("#6B4E16", "D"),
       },
       {
-          {"fcl", "prebuilt",
+          {"fcl",
+           "prebuilt",
            "each fcl::Box or Convex built once and kept, as a user holding FCL objects",
-           fcl_contact_prebuilt},
+           fcl_contact_prebuilt,
+           {8192, 2048}},
+          // `fcl` on two box bodies runs fcl::Box (boxBoxIntersect): timed apart on the boxes.
+          {"fcl",
+           "boxes",
+           "fcl on two box bodies: fcl::Box, boxBoxIntersect",
+           fcl_contact,
+           {8, 8},
+           true},
           {"fcl-hull", "prebuilt", "each fcl::Convex built once and kept",
            fcl_hull_contact_prebuilt},
       }};

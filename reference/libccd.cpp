@@ -183,10 +183,15 @@ ContactResult libccd_epa_contact(const RigidBody& a, const RigidBody& b) {
 const Adapter& libccd_adapter() {
   static const Adapter adapter = {
       {
-          {"libccd-mpr", "libccd 2.1 MPR (ccdMPRPenetration); libccd's box support for boxes",
-           libccd_mpr_contact, nullptr},
-          {"libccd-epa", "libccd 2.1 GJK + EPA (ccdGJKPenetration); libccd's box support for boxes",
-           libccd_epa_contact, nullptr},
+          Backend{"libccd-mpr",
+                  "libccd 2.1 MPR (ccdMPRPenetration); libccd's box support for boxes",
+                  libccd_mpr_contact, nullptr}
+              .drawn("#CC79A7", "o")
+              .timed(8192, 2048),
+          Backend{"libccd-epa",
+                  "libccd 2.1 GJK + EPA (ccdGJKPenetration); libccd's box support for boxes",
+                  libccd_epa_contact, nullptr}
+              .drawn("#882255", "^"),
       },
       {}};
   return adapter;

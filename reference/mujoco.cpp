@@ -839,13 +839,16 @@ const Adapter& mujoco_adapter() {
                                  "negative solref",
                                  mujoco_contact, mujoco_dynamics, mujoco_mass},
                                 mujoco_budget()),
-                    mujoco_soft(MujocoSettings{})),
+                    mujoco_soft(MujocoSettings{}))
+              .drawn("#D55E00", "o")
+              .timed(8192, 512),
           with_soft(with_budget({"mujoco-hull",
                                  "MuJoCo 2.2.2 mesh geoms (MPR, one point); mj_step, negative "
                                  "solref",
                                  mujoco_hull_contact, mujoco_hull_dynamics, mujoco_hull_mass},
                                 mujoco_budget()),
-                    mujoco_soft(mujoco_hull_settings())),
+                    mujoco_soft(mujoco_hull_settings()))
+              .drawn("#7A2E00", "s"),
       },
       {
           {"mujoco", "prebuilt", "the pair's model compiled once and kept (poses set, mj_forward)",

@@ -692,12 +692,15 @@ const Adapter& ode_adapter() {
                                  "bounce = e",
                                  ode_contact, ode_dynamics},
                                 ode_budget()),
-                    ode_soft(OdeSettings{})),
+                    ode_soft(OdeSettings{}))
+              .drawn("#6A3D9A", "o")
+              .timed(2048, 512),
           with_soft(with_budget({"ode-hull",
                                  "ODE 0.16.2 dCreateConvex (libccd MPR); dWorldStep, bounce = e",
                                  ode_hull_contact, ode_hull_dynamics},
                                 ode_budget()),
-                    ode_soft(ode_hull_settings())),
+                    ode_soft(ode_hull_settings()))
+              .drawn("#B39DDB", "s"),
       },
       {
           {"ode", "prebuilt", "each dBox or dConvex geom built once and kept",

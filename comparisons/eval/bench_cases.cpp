@@ -80,34 +80,22 @@ BenchPlan bench_plan(bool quick) {
   return p;
 }
 
-// The caps keep the full run under ten minutes on two cores; each is named, with its reason, in
-// perf.md: the seed loops' 16 N^2 primitive tests, bullet-sat's polyhedral features rebuilt on
-// every call, the exact oracle's, ODE's, MuJoCo's and DART's (triangle meshes) cost at the
-// largest sizes, Bullet's and ODE's shapes built from 8,192 points on every call (about 2 s a
-// query, 10 s a call of five poses).
+// Every row timed is named in its registry entry (Backend::bench, QueryVariant::bench), in
+// registry order, each backend's variants after it. The caps there keep the full run under ten
+// minutes on two cores; each is named, with its reason, in perf.md: the seed loops' 16 N^2
+// primitive tests, bullet-sat's polyhedral features rebuilt on every call, the exact oracle's,
+// ODE's, MuJoCo's and DART's (triangle meshes) cost at the largest sizes, Bullet's and ODE's
+// shapes built from 8,192 points on every call (about 2 s a query, 10 s a call of five poses).
 std::vector<NarrowBackend> narrow_backends() {
-  auto registry = [](const std::string& name) { return find_backend(name)->contact; };
-  auto variant = [](const std::string& name, const std::string& v) {
-    return find_query_variant(name, v)->contact;
-  };
-  return {
-      {"custom", "default", registry("custom"), 8192, 2048},
-      {"custom", "faithful", variant("custom", "faithful"), 2048, 512},
-      {"exact", "default", registry("exact"), 2048, 512},
-      {"fcl", "default", registry("fcl"), 8192, 2048},
-      {"fcl", "prebuilt", variant("fcl", "prebuilt"), 8192, 2048},
-      {"fcl-epa", "default", registry("fcl-epa"), 8192, 2048},
-      {"libccd-mpr", "default", registry("libccd-mpr"), 8192, 2048},
-      {"bullet", "default", registry("bullet"), 2048, 2048},
-      {"bullet-sat", "default", registry("bullet-sat"), 512, 128},
-      {"mujoco", "default", registry("mujoco"), 8192, 512},
-      {"ode", "default", registry("ode"), 2048, 512},
-      // DART: BoxShapes on its own detector for the box pair, meshes on FCL for the hulls.
-      {"dart", "default", registry("dart"), 2048, 512},
-      {"dart", "prebuilt", variant("dart", "prebuilt"), 2048, 512},
-      // `fcl` on two box bodies runs fcl::Box (boxBoxIntersect): the variant "boxes".
-      {"fcl", "boxes", registry("fcl"), 8, 8, true},
-  };
+  std::vector<NarrowBackend> rows;
+  for (const Backend& b : backends()) {
+    if (b.contact && b.bench.full > 0)
+      rows.push_back({b.name, "default", b.contact, b.bench.full, b.bench.quick});
+    for (const QueryVariant& v : query_variants())
+      if (v.backend == b.name && v.bench.full > 0)
+        rows.push_back({b.name, v.variant, v.contact, v.bench.full, v.bench.quick, v.boxes_only});
+  }
+  return rows;
 }
 
 namespace {

@@ -1,15 +1,14 @@
 #include "comparisons/output/backend_style.h"
 
-#include <nlohmann/json.hpp>
-
-#include "asset_backend_style_json.h"
+#include "comparisons/eval/json_io.h"
 #include "comparisons/output/table.h"  // html_escape
+#include "reference/backend.h"
 
 namespace rbx {
 
 std::string backend_colour(const std::string& name) {
-  static const nlohmann::json table = nlohmann::json::parse(kBackendStyle);
-  return table.contains(name) ? table[name][0].get<std::string>() : "#777777";
+  const Backend* b = find_backend(name);
+  return b && !b->style.colour.empty() ? b->style.colour : "#777777";
 }
 
 std::string backend_legend_html(const std::vector<std::string>& names) {
@@ -19,6 +18,13 @@ std::string backend_legend_html(const std::vector<std::string>& names) {
          "height:.9em;vertical-align:-.1em;background:" +
          backend_colour(n) + "\"></span> " + html_escape(n) + "</span>";
   return h + "</p>\n";
+}
+
+std::string backend_style_json() {
+  Json styles = Json::object();
+  for (const Backend& b : backends())
+    if (!b.style.colour.empty()) styles[b.name] = Json::array({b.style.colour, b.style.marker});
+  return styles.dump();
 }
 
 }  // namespace rbx

@@ -1,5 +1,6 @@
-// One colour per backend in every figure and page: the table is output/assets/backend_style.json,
-// read by the figure scripts (backend_style.py) and embedded here for the pages.
+// One colour per backend in every figure and page: each registry entry's style
+// (reference/backend.h), read here for the pages and handed to the figure scripts
+// (backend_style.py) by run_figure_script.
 #pragma once
 
 #include <string>
@@ -9,6 +10,10 @@ namespace rbx {
 
 /// The backend's colour ("#RRGGBB"); a name the table does not list gets grey.
 std::string backend_colour(const std::string& name);
+
+/// Every registered backend's style as the figure scripts read it (RBX_BACKEND_STYLE):
+/// {"name": ["#RRGGBB", "marker"], ...} in registry order.
+std::string backend_style_json();
 
 /// An HTML line naming each backend in its colour (a square swatch before the name), the key
 /// to every figure of a report.

@@ -4,7 +4,9 @@ explore, bench).
 A library keeps one hue and its variants take darker or lighter shades of it, each with its own
 marker, so two neighbours in a legend never share both colour and marker, and in greyscale the
 marker still tells them apart. The colours start from Okabe & Ito's colour-blind-safe set.
-A name not listed (a new backend) gets a grey shade and a marker of its own, by its position in
+Each backend's style is its registry entry's (reference/backend.h): rbx hands the table to every
+figure script in RBX_BACKEND_STYLE; a script run from Python takes it from the rbx module.
+A name not listed (a backend without a style) gets a grey shade and a marker of its own, by its position in
 the sorted list of unlisted names it is drawn with.
 
 save() is how every figure is written: PNG for the pages, SVG for print, at one resolution.
@@ -12,10 +14,18 @@ save() is how every figure is written: PNG for the pages, SVG for print, at one 
 import json
 import os
 
-# name: (colour, marker), in assets/backend_style.json, which the report's pages read too.
-with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "assets",
-                       "backend_style.json")) as _f:
-    STYLE = {name: tuple(pair) for name, pair in json.load(_f).items()}
+
+
+def _registry_styles():
+    """name: (colour, marker), in registry order."""
+    text = os.environ.get("RBX_BACKEND_STYLE")
+    if text:
+        return {name: tuple(pair) for name, pair in json.loads(text).items()}
+    import rbx  # a script run from Python, with the rbx module importable
+    return {b["name"]: (b["colour"], b["marker"]) for b in rbx.backends() if b["colour"]}
+
+
+STYLE = _registry_styles()
 ORDER = list(STYLE)
 _GREYS = ["#777777", "#AAAAAA", "#444444", "#CCCCCC"]
 _MARKERS = "hpX<>dH8"

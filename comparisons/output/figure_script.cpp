@@ -8,6 +8,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "comparisons/output/backend_style.h"
+
 extern char** environ;
 
 namespace rbx {
@@ -31,8 +33,15 @@ int run_figure_script(const std::string& script, const std::vector<std::string>&
   posix_spawn_file_actions_init(&files);
   posix_spawn_file_actions_addopen(&files, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_adddup2(&files, 1, 2);
+  // The backends' colours and markers come from the registry, through the environment.
+  std::vector<std::string> env_words = {"RBX_BACKEND_STYLE=" + backend_style_json()};
+  for (char** e = environ; *e; ++e)
+    if (std::strncmp(*e, "RBX_BACKEND_STYLE=", 18) != 0) env_words.emplace_back(*e);
+  std::vector<char*> env;
+  for (std::string& w : env_words) env.push_back(w.data());
+  env.push_back(nullptr);
   pid_t pid = 0;
-  const int rc = posix_spawn(&pid, python.c_str(), &files, nullptr, argv.data(), environ);
+  const int rc = posix_spawn(&pid, python.c_str(), &files, nullptr, argv.data(), env.data());
   posix_spawn_file_actions_destroy(&files);
   if (rc != 0) return fail("cannot start " + python + ": " + std::strerror(rc));
   int status = 0;

@@ -176,14 +176,15 @@ def _with_json(args, show_progress=False):
 # -- the commands ----------------------------------------------------------------------------
 
 def backends():
-    """Every backend: name, description, kind (a list of "contact", "dynamics"), and whether it
-    is an outside library's, applies friction, or was registered from Python (user)."""
+    """Every backend: name, description, kind (a list of "contact", "dynamics"), whether it is
+    an outside library's, applies friction, or was registered from Python (user), and its colour
+    and marker in every figure ("" where it has none)."""
     rows = []
     for b in _rbx.backends():
         kind = [k for k in ("contact", "dynamics") if b[k]]
         rows.append({"name": b["name"], "description": b["description"], "kind": kind,
                      "mass": b["mass"], "library": b["library"], "friction": b["friction"],
-                     "user": b["user"]})
+                     "user": b["user"], "colour": b["colour"], "marker": b["marker"]})
     return rows
 
 

@@ -149,7 +149,7 @@ TEST(ReportPages, LinksResolveUnitsFollowTheMetricAndSceneTextStaysText) {
             std::string::npos)
       << index;
   EXPECT_NE(read(out / "details.html").find("a b(1)`c&quot;d.toml</code>"), std::string::npos);
-  // The colour key of the figures names each backend in its colour (assets/backend_style.json),
+  // The colour key of the figures names each backend in its colour (its registry entry),
   // and a replay page's data carries the same colour for its panel.
   EXPECT_NE(index.find("background:" + backend_colour("custom") + "\"></span> custom<"),
             std::string::npos);
