@@ -7,7 +7,7 @@
 // methods only decide which pairs get the exact test: each bounding sphere is enclosed in an
 // axis-aligned box padded far beyond round-off, boxes that do not overlap cannot hold spheres
 // that do, and every surviving pair is then tested with the seed's own sphere expression.
-//   - all-pairs: the seed's loop, O(N^2); kept as the oracle.
+//   - all-pairs: the seed's loop, O(N^2); kept as the reference.
 //   - sweep-and-prune: boxes sorted along the axis of largest spread (kept from call to call, so
 //     a small motion costs an insertion sort), then swept; O(N log N + pairs overlapping on that
 //     axis), which for bodies spread through a volume grows like N^(5/3).

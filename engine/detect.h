@@ -20,7 +20,7 @@
 namespace rbx {
 
 /// Which implementation of the tests to run (the detector; the contact model is the other axis,
-/// ContactModel). `Faithful` loops over every primitive as the seed does and is the oracle;
+/// ContactModel). `Faithful` loops over every primitive as the seed does and is the reference;
 /// `Accelerated` culls with bounding volume trees and must return the same answers bit for bit
 /// (tests/engine/accelerated_detect_test.cpp). Both `custom` and `custom-seed` run Accelerated;
 /// the bench's "faithful" rows and custom's "faithful" query variant run Faithful.

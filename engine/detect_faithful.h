@@ -1,5 +1,5 @@
 // The faithful detector's shape view: the seed's loops over every primitive, on copies of both
-// shapes placed in the world. It is the oracle of the accelerated view (engine/features.h).
+// shapes placed in the world. It is the reference of the accelerated view (engine/features.h).
 #pragma once
 
 #include <optional>

@@ -13,7 +13,7 @@ void SeedStep::advance(WorldState& world) {
   // whole step and the broad phase can find them all first; it returns them in the seed's
   // (i, j) order, so the contacts are resolved in the same order as by the double loop.
   if (world.broad_phase.method() == BroadPhaseMethod::AllPairs) {
-    // The seed's double loop, kept as it was (the oracle of the broad phase).
+    // The seed's double loop, kept as it was (the reference of the broad phase).
     const int n = static_cast<int>(world.bodies.size());
     for (int i = 0; i < n; ++i)
       for (int j = i + 1; j < n; ++j) collide_pair(world, i, j, false);

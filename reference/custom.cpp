@@ -30,7 +30,7 @@ ContactResult custom_contact(const RigidBody& a, const RigidBody& b) {
 }
 
 // Variant "faithful" of `custom`: the seed's loops over every primitive (the accelerated
-// detector's oracle) where a detector is needed; the same answer, slower on touching poses.
+// detector's reference) where a detector is needed; the same answer, slower on touching poses.
 ContactResult custom_faithful_contact(const RigidBody& a, const RigidBody& b) {
   return engine_contact(a, b, DetectorVariant::Faithful);
 }
@@ -133,7 +133,7 @@ const Adapter& custom_adapter() {
           {"custom",
            "faithful",
            "custom on the faithful detector: the seed's loops over every primitive (the "
-           "accelerated detector's oracle), the same chosen plane",
+           "accelerated detector's reference), the same chosen plane",
            custom_faithful_contact,
            {2048, 512}},
       }};

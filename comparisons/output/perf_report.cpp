@@ -267,7 +267,7 @@ std::string broad_markdown(const BenchPlan& plan, const BenchResults& results) {
         "keep their pairs from step to step while no centre has moved more than a tenth of the "
         "median bounding radius (here about 1 mm per axis per step against 17 mm of room, so most "
         "steps "
-        "reuse them); all-pairs, the oracle, tests every pair on every step.\n\n| method |";
+        "reuse them); all-pairs, the reference, tests every pair on every step.\n\n| method |";
   for (int n : plan.crowd_sizes) md << " " << n << " |";
   md << " exponent | pairs per step |\n|---|";
   for (std::size_t i = 0; i < plan.crowd_sizes.size(); ++i) md << "---:|";

@@ -1,6 +1,6 @@
-// The accelerated detector against the faithful seed loops (its oracle): on thousands of fixed-seed
-// poses of boxes, prisms and (sheared) icospheres from 8 to 642 vertices, touching, deep and
-// separated, the fast path returns the same hit or miss, feature, point, normal and depth as
+// The accelerated detector against the faithful seed loops (its reference): on thousands of
+// fixed-seed poses of boxes, prisms and (sheared) icospheres from 8 to 642 vertices, touching, deep
+// and separated, the fast path returns the same hit or miss, feature, point, normal and depth as
 // the seed path, for the full detector and for each feature test alone (the world calls those).
 #include <gtest/gtest.h>
 
@@ -89,7 +89,7 @@ void compare_at(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedro
 
 // Under the sanitizers (RBX_SANITIZE, CMakeLists.txt) a third of the random poses: there they look
 // for memory errors and undefined behaviour, which the same code paths meet at a third of the
-// count, while the seed oracle's tests cost ten times more; the Release pass runs every pose.
+// count, while the seed reference's tests cost ten times more; the Release pass runs every pose.
 #if defined(RBX_SANITIZE)
 constexpr int kPoseDivisor = 3;
 #else
@@ -195,7 +195,7 @@ TEST(AcceleratedDetect, IcospheresMatchSeed) {
   const ConvexPolyhedron i2 = make_icosphere(0.5, 2), i3 = make_icosphere(0.5, 3);
   const ConvexPolyhedron box = make_box(Vec3(1, 1, 1));
   Tally t;
-  // Counts kept so that the seed oracle (~16 N^2 primitive tests a pose) runs in about a second.
+  // Counts kept so that the seed reference (~16 N^2 primitive tests a pose) runs in about a second.
   random_poses(s1, s2, 600, 5, "sheared42-sheared162", t);
   random_poses(box, s2, 400, 6, "box-sheared162", t);
   random_poses(i2, s2, 200, 7, "ico162-sheared162", t);
@@ -212,7 +212,7 @@ TEST(AcceleratedDetect, HullsThatSearchTheirTreesMatchSeed) {
   ASSERT_GT(static_cast<int>(s3.vertices().size()), detail::kLinearVertices);
   ASSERT_LE(static_cast<int>(s2.vertices().size()), detail::kLinearVertices);
   Tally t;
-  // Counts kept so that the seed oracle (~16 N^2 primitive tests a pose) runs in seconds.
+  // Counts kept so that the seed reference (~16 N^2 primitive tests a pose) runs in seconds.
   random_poses(s3, i3, 90, 10, "sheared642-ico642", t);
   random_poses(s3, s2, 90, 11, "sheared642-sheared162", t);
   random_poses(box, s3, 90, 12, "box-sheared642", t);

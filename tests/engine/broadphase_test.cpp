@@ -1,5 +1,5 @@
 // Broad phase: sweep and prune and the tree find exactly the pairs of the seed's all-pairs
-// bounding check (the oracle: bounding_check over every pair), in (i, j) order, on random
+// bounding check (the reference: bounding_check over every pair), in (i, j) order, on random
 // crowds of mixed sizes, after small motions (the sweep keeps its order between calls), with
 // exactly touching spheres; and a world gives identical events and states with every method.
 #include "engine/broadphase.h"
@@ -19,7 +19,7 @@ namespace {
 constexpr BroadPhaseMethod kMethods[] = {BroadPhaseMethod::AllPairs,
                                          BroadPhaseMethod::SweepAndPrune, BroadPhaseMethod::Tree};
 
-// The oracle: the seed's double loop over bounding_check.
+// The reference: the seed's double loop over bounding_check.
 std::vector<BodyPair> oracle_pairs(const std::vector<RigidBody>& bodies) {
   std::vector<BodyPair> pairs;
   for (int i = 0; i < static_cast<int>(bodies.size()); ++i)
@@ -28,7 +28,7 @@ std::vector<BodyPair> oracle_pairs(const std::vector<RigidBody>& bodies) {
   return pairs;
 }
 
-// The grown oracle: the pairs whose bounding spheres, each grown by `grow` (m), touch.
+// The grown reference: the pairs whose bounding spheres, each grown by `grow` (m), touch.
 std::vector<BodyPair> grown_oracle_pairs(const std::vector<RigidBody>& bodies, double grow) {
   std::vector<BodyPair> pairs;
   for (int i = 0; i < static_cast<int>(bodies.size()); ++i)
@@ -120,7 +120,7 @@ TEST(BroadPhase, TheGridFindsTheOraclePairs) {
   // 800 moving boxes of like size (0.3 to 0.5 m: within 2x of the median, so the tree takes
   // its hashed grid), centred on the origin so that cells have negative coordinates too, two
   // static slabs among them; then moved and stretched as above. The grid's pairs are the
-  // oracle's, in order; moving boxes of widely mixed sizes take the hierarchy.
+  // reference's, in order; moving boxes of widely mixed sizes take the hierarchy.
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> g(0.0, 1.0);
@@ -155,7 +155,7 @@ TEST(BroadPhase, TheGridFindsTheOraclePairs) {
 
 TEST(BroadPhase, ManyStaticBodiesGoIntoTheTree) {
   // 60 static boxes (beyond the 32 kept apart) among 240 moving ones, sizes mixed: every pair,
-  // static against static included, is the oracle's, in order.
+  // static against static included, is the reference's, in order.
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<RigidBody> bodies;
@@ -175,7 +175,7 @@ TEST(BroadPhase, ManyStaticBodiesGoIntoTheTree) {
 // The pairs kept from call to call: bodies creeping toward and away from each other across the
 // touching distance, a growth that changes from call to call (up to near the kept pairs' room to
 // move, so that a bound forgetting the growth fails), and now and then a jump (the kept pairs no
-// longer hold): every call gives the grown oracle's pairs, in order, on the grid and on
+// longer hold): every call gives the grown reference's pairs, in order, on the grid and on
 // the hierarchy; and most calls reuse the kept pairs (so the reuse is what is being checked).
 TEST(BroadPhase, KeptPairsGiveTheOraclePairsFromCallToCall) {
   std::mt19937_64 rng(17);
@@ -220,7 +220,7 @@ TEST(BroadPhase, KeptPairsGiveTheOraclePairsFromCallToCall) {
 TEST(BroadPhase, TheThresholdsChooseTheIndexNotThePairs) {
   // 100 moving boxes of like size and two static slabs: by default the grid (at least
   // grid_min_moving moving bodies) with the statics apart; with the thresholds moved, the
-  // hierarchy, and the statics in it. The pairs are the oracle's every time.
+  // hierarchy, and the statics in it. The pairs are the reference's every time.
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<RigidBody> bodies;
@@ -314,24 +314,24 @@ TEST(BroadPhase, WorldResultsDoNotDependOnTheMethod) {
   for (BroadPhaseMethod m : kMethods)
     results.push_back(
         World(sim, bodies, ContactModel::Seed, DetectorVariant::Accelerated, m).run());
-  const RunResult& oracle = results[0];
-  ASSERT_TRUE(oracle.ok) << oracle.message;
-  EXPECT_GT(oracle.events.size(), 50u);  // the scene is busy: the comparison is not vacuous
+  const RunResult& reference = results[0];
+  ASSERT_TRUE(reference.ok) << reference.message;
+  EXPECT_GT(reference.events.size(), 50u);  // the scene is busy: the comparison is not vacuous
   for (std::size_t k = 1; k < results.size(); ++k) {
     const RunResult& r = results[k];
-    ASSERT_EQ(r.events.size(), oracle.events.size()) << to_string(kMethods[k]);
+    ASSERT_EQ(r.events.size(), reference.events.size()) << to_string(kMethods[k]);
     for (std::size_t e = 0; e < r.events.size(); ++e) {
-      EXPECT_EQ(r.events[e].step, oracle.events[e].step);
-      EXPECT_EQ(r.events[e].body_a, oracle.events[e].body_a);
-      EXPECT_EQ(r.events[e].body_b, oracle.events[e].body_b);
-      EXPECT_EQ(r.events[e].contact.point, oracle.events[e].contact.point);
-      EXPECT_EQ(r.events[e].contact.normal, oracle.events[e].contact.normal);
-      EXPECT_EQ(r.events[e].impulse, oracle.events[e].impulse);
+      EXPECT_EQ(r.events[e].step, reference.events[e].step);
+      EXPECT_EQ(r.events[e].body_a, reference.events[e].body_a);
+      EXPECT_EQ(r.events[e].body_b, reference.events[e].body_b);
+      EXPECT_EQ(r.events[e].contact.point, reference.events[e].contact.point);
+      EXPECT_EQ(r.events[e].contact.normal, reference.events[e].contact.normal);
+      EXPECT_EQ(r.events[e].impulse, reference.events[e].impulse);
     }
     for (std::size_t b = 0; b < r.bodies.size(); ++b) {
-      EXPECT_EQ(r.bodies[b].position, oracle.bodies[b].position) << r.bodies[b].name;
-      EXPECT_EQ(r.bodies[b].velocity, oracle.bodies[b].velocity) << r.bodies[b].name;
-      EXPECT_EQ(r.bodies[b].angular_velocity, oracle.bodies[b].angular_velocity)
+      EXPECT_EQ(r.bodies[b].position, reference.bodies[b].position) << r.bodies[b].name;
+      EXPECT_EQ(r.bodies[b].velocity, reference.bodies[b].velocity) << r.bodies[b].name;
+      EXPECT_EQ(r.bodies[b].angular_velocity, reference.bodies[b].angular_velocity)
           << r.bodies[b].name;
     }
   }

@@ -1,7 +1,7 @@
 // Moore & Wilhelms detector: face, vertex and edge tests on hand-built poses, the argument-order
 // symmetry, separated and touching bodies, rotated poses, one test per docs/seed_corrections.md
 // correction (1, 2, 8, 9, 10) that fails on the literal seed text, and a fixed-seed cross-check
-// against an independent separating-axis oracle.
+// against an independent separating-axis reference.
 #include "engine/detect.h"
 
 #include <gtest/gtest.h>
@@ -497,9 +497,9 @@ TEST(SeedCorrection, EdgeNormalIsEaCrossEb) {
   }
 }
 
-// ---- Cross-check against a separating-axis oracle ------------------------------------------
+// ---- Cross-check against a separating-axis reference ------------------------------------------
 
-// Independent oracle: two convex polyhedra are disjoint iff some axis among their face normals
+// Independent reference: two convex polyhedra are disjoint iff some axis among their face normals
 // and the cross products of their edge directions separates them. Returns the smallest overlap
 // over those axes (the true penetration depth when positive; negative = separated).
 double sat_min_overlap(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
@@ -529,7 +529,7 @@ double sat_min_overlap(const ConvexPolyhedron& a, const Pose& pa, const ConvexPo
 TEST(Detect, AgreesWithSeparatingAxisOracle) {
   // Random poses (fixed seed) of a box against an icosahedron and against a prism, with centre
   // distances spread so roughly half the pairs touch. Invariants whatever the feature: a hit iff
-  // the oracle says the shapes overlap; unit normal; the point inside both shapes; the depth at
+  // the reference says the shapes overlap; unit normal; the point inside both shapes; the depth at
   // least the true penetration (overlap along any direction bounds the minimum from above).
   // Pairs within 1e-6 of touching are skipped: there the verdict rests on the 1e-9 tolerance.
   std::mt19937 rng(12345);
@@ -547,7 +547,7 @@ TEST(Detect, AgreesWithSeparatingAxisOracle) {
       const double truth = sat_min_overlap(box, pa, other, pb);
       if (std::abs(truth) < 1e-6) continue;
       const auto hit = detect(box, pa, other, pb);
-      ASSERT_EQ(hit.has_value(), truth > 0) << "trial " << trial << " oracle overlap " << truth;
+      ASSERT_EQ(hit.has_value(), truth > 0) << "trial " << trial << " reference overlap " << truth;
       if (!hit) {
         ++misses;
         continue;

@@ -305,7 +305,7 @@ TEST(PolyhedronValidation, NonConvexNamesTheVertexAndFace) {
 }
 
 TEST(PolyhedronValidation, PrunedConvexityCheckNamesWhatTheFullScanNames) {
-  // The convexity check prunes with a box tree over the vertices. Oracle: the plain scan of
+  // The convexity check prunes with a box tree over the vertices. Reference: the plain scan of
   // every vertex against every face plane, with the check's tolerance (1e-9 of the size), which
   // names the first face with an outside vertex and its lowest-numbered outside vertex. Every
   // 7th vertex of a 642-vertex icosphere in turn is pushed out by 5% of the radius (a face
