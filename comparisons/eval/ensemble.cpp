@@ -403,7 +403,10 @@ void run_scene_ensembles(const std::vector<Scene>& scenes, const std::string& ba
     Scene scene = scenes[i];
     apply_ensemble_table(scene, settings, false);
     const EnsembleResult r = run_ensemble(scene, names, settings, par);
-    if (par.root() && i < evs.size()) evs[i].json["ensemble"] = ensemble_json(r);
+    if (par.root() && i < evs.size()) {
+      evs[i].json["ensemble"] = ensemble_json(r);
+      evs[i].ensemble = std::make_shared<const EnsembleResult>(r);
+    }
   }
 }
 

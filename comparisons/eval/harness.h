@@ -4,6 +4,7 @@
 // time step (self-consistency, Erez, Tassa & Todorov 2015), else another backend (marked).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,8 @@ struct SweepPoint {
   int budget = 0;  // the solver budget (kind "budget"; Backend::budget), else 0: as configured
 };
 
+struct EnsembleResult;  // comparisons/eval/ensemble.h
+
 /// Everything the harness learned about one scene.
 struct SceneEvaluation {
   std::string family;  // folder under scenes/, or "scenes"
@@ -85,6 +88,9 @@ struct SceneEvaluation {
   std::vector<std::string> disagreements;  // clearly different from the truth (see kMark*)
   std::vector<std::string> deviations;     // beyond the scene's tolerance, yet close
   std::vector<Cause> causes;               // why each impact miss happened, measured
+  // The scene's [ensemble] run (the report's, run_scene_ensembles), also in `json` as
+  // "ensemble"; null when none ran.
+  std::shared_ptr<const EnsembleResult> ensemble;
 };
 
 /// Thresholds between a deviation and a disagreement: a contact normal more than 1 degree off or

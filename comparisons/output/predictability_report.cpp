@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "comparisons/eval/ensemble.h"
 #include "comparisons/output/scorecard.h"
 #include "comparisons/output/table.h"
 
@@ -11,16 +12,20 @@ namespace rbx {
 
 namespace {
 
-// A JSON number as the tables show it.
-std::string num(const Json& j, const char* key) {
-  return j.contains(key) && j[key].is_number() ? fmt_num(j[key].get<double>(), 2) : "-";
-}
+// A number as the tables show it.
+std::string num(double x) { return fmt_num(x, 2); }
 
 // "the physics'" / "the engine's" / "-": whose spread the step test says it is.
-std::string verdict_text(const Json& b) {
-  if (!b.contains("step_test")) return "-";
-  const std::string v = b["step_test"].value("verdict", "none");
-  return v == "physics" ? "the physics'" : v == "engine" ? "the engine's" : "-";
+std::string verdict_text(const BackendEnsemble& b) {
+  if (!b.step_tested) return "-";
+  return b.verdict == "physics" ? "the physics'" : b.verdict == "engine" ? "the engine's" : "-";
+}
+
+// Backend `name`'s ensemble in `e`, or null.
+const BackendEnsemble* backend_in(const EnsembleResult& e, const std::string& name) {
+  for (const BackendEnsemble& b : e.backends)
+    if (b.backend == name) return &b;
+  return nullptr;
 }
 
 // The figure line of a scene's ensemble, when the figure was drawn.
@@ -48,20 +53,18 @@ const char* kIntro =
     "amplification over a family's ensembles.\n\n";
 
 // One scene's part: its nudges, the table, the sequences and the figure.
-std::string scene_part(const std::string& title, const std::string& slug, const Json& e,
+std::string scene_part(const std::string& title, const std::string& slug, const EnsembleResult& e,
                        const std::string& report_dir, bool figures_ok) {
   std::ostringstream md;
-  const Json& in = e["input_spread"];
+  const Nudge& nudge = e.settings.nudge;
   md << "### " << md_escape(title) << "\n\n"
-     << e.value("count", 0L) << " copies of " << num(e, "duration") << " s at dt = " << num(e, "dt")
-     << " s, every moving body "
-     << "nudged by Gaussian amounts of " << num(e["perturb"], "position") << " m, "
-     << num(e["perturb"], "orientation") << " rad, " << num(e["perturb"], "velocity") << " m/s and "
-     << num(e["perturb"], "angular_velocity") << " rad/s per component (input spread: position "
-     << num(in, "position_m") << " m, velocity " << num(in, "velocity_m_s") << " m/s).\n\n";
-  bool step_test = false;
-  for (const auto& [name, b] : e["backends"].items())
-    step_test = step_test || b.contains("step_test");
+     << e.settings.count << " copies of " << num(e.duration) << " s at dt = " << num(e.dt)
+     << " s, every moving body nudged by Gaussian amounts of " << num(nudge.position) << " m, "
+     << num(nudge.orientation) << " rad, " << num(nudge.velocity) << " m/s and "
+     << num(nudge.angular_velocity) << " rad/s per component (input spread: position "
+     << num(e.input.position) << " m, velocity " << num(e.input.velocity) << " m/s).\n\n";
+  const bool step_test = std::any_of(e.backends.begin(), e.backends.end(),
+                                     [](const BackendEnsemble& b) { return b.step_tested; });
   std::vector<std::string> header = {
       "backend",           "copies (failed)", "position spread (m)",      "5-95 % (m)",
       "orientation (rad)", "velocity (m/s)",  "amplification (position)", "(velocity)",
@@ -71,40 +74,34 @@ std::string scene_part(const std::string& title, const std::string& slug, const 
     header.push_back("spread is");
   }
   Table t(header);
-  for (const auto& [name, b] : e["backends"].items()) {
-    const Json& s = b["spread"];
-    const long failed = b.value("failed", 0L);
+  for (const BackendEnsemble& b : e.backends) {
     std::vector<std::string> cells = {
-        "**" + md_escape(name) + "**",
-        std::to_string(b.value("runs", 0L)) + (failed ? " (" + std::to_string(failed) + ")" : ""),
-        num(s, "position_m"),
-        num(s, "position_range_m"),
-        num(s, "orientation_rad"),
-        num(s, "velocity_m_s"),
-        num(b, "amplification"),
-        num(b, "velocity_amplification"),
-        std::to_string(b["contact_sequences"].size()),
-        std::to_string(b.value("clusters", 0))};
+        "**" + md_escape(b.backend) + "**",
+        std::to_string(b.runs) + (b.failed ? " (" + std::to_string(b.failed) + ")" : ""),
+        num(b.spread.position),
+        num(b.spread.position_range),
+        num(b.spread.orientation),
+        num(b.spread.velocity),
+        num(b.amplification),
+        num(b.velocity_amplification),
+        std::to_string(b.sequences.size()),
+        std::to_string(b.clusters)};
     if (step_test) {
-      cells.push_back(b.contains("step_test") ? num(b["step_test"], "ratio") : "-");
+      cells.push_back(b.step_tested ? num(b.step_ratio) : "-");
       cells.push_back(verdict_text(b));
     }
     t.add(cells);
   }
   md << t.markdown() << "\n";
   // Each backend's most frequent contact sequence (pair:feature in the order first touched).
-  md << "Most frequent contact sequence (copies of " << e.value("count", 0L) << "):\n\n";
-  for (const auto& [name, b] : e["backends"].items()) {
-    md << "- " << md_escape(name) << ": ";
-    if (b["contact_sequences"].empty()) {
-      md << (b.value("failed", 0L) > 0
-                 ? "every copy failed: " + md_escape(b.value("first_failure", ""))
-                 : "none")
-         << "\n";
+  md << "Most frequent contact sequence (copies of " << e.settings.count << "):\n\n";
+  for (const BackendEnsemble& b : e.backends) {
+    md << "- " << md_escape(b.backend) << ": ";
+    if (b.sequences.empty()) {
+      md << (b.failed > 0 ? "every copy failed: " + md_escape(b.first_failure) : "none") << "\n";
       continue;
     }
-    const Json& first = b["contact_sequences"][0];
-    md << md_code(first.value("sequence", "")) << " (" << first.value("copies", 0L) << ")\n";
+    md << md_code(b.sequences.front().first) << " (" << b.sequences.front().second << ")\n";
   }
   md << "\n" << figure_line(title, slug, report_dir, figures_ok);
   return md.str();
@@ -118,10 +115,11 @@ std::string predictability_summary_markdown(const std::vector<Scene>& scenes,
   std::vector<size_t> with;        // scenes with an ensemble
   std::vector<std::string> names;  // backends, in the order the ensembles list them
   for (size_t i = 0; i < scenes.size() && i < evs.size(); ++i) {
-    if (!evs[i].json.contains("ensemble")) continue;
+    if (!evs[i].ensemble) continue;
     with.push_back(i);
-    for (const auto& [name, b] : evs[i].json["ensemble"]["backends"].items())
-      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    for (const BackendEnsemble& b : evs[i].ensemble->backends)
+      if (std::find(names.begin(), names.end(), b.backend) == names.end())
+        names.push_back(b.backend);
   }
   if (with.empty()) return "";
   std::vector<std::string> header = {"backend"};
@@ -130,14 +128,13 @@ std::string predictability_summary_markdown(const std::vector<Scene>& scenes,
   for (const std::string& name : names) {
     std::vector<std::string> cells = {"**" + md_escape(name) + "**"};
     for (size_t i : with) {
-      const Json& bs = evs[i].json["ensemble"]["backends"];
-      if (!bs.contains(name)) {
+      const BackendEnsemble* b = backend_in(*evs[i].ensemble, name);
+      if (!b) {
         cells.push_back("·");
         continue;
       }
-      const Json& b = bs[name];
-      const std::string verdict = verdict_text(b);
-      cells.push_back(num(b, "amplification") + (verdict == "-" ? "" : ", " + verdict));
+      const std::string verdict = verdict_text(*b);
+      cells.push_back(num(b->amplification) + (verdict == "-" ? "" : ", " + verdict));
     }
     t.add(cells);
   }
@@ -160,10 +157,10 @@ std::string predictability_markdown(const std::vector<Scene>& scenes,
                                     const std::string& report_dir, bool figures_ok) {
   std::ostringstream parts;
   for (size_t i = 0; i < scenes.size() && i < evs.size(); ++i) {
-    if (!evs[i].json.contains("ensemble")) continue;
+    if (!evs[i].ensemble) continue;
     parts << scene_part(evs[i].family + "/" + scenes[i].name,
-                        scene_slug(evs[i].family, scenes[i].file), evs[i].json["ensemble"],
-                        report_dir, figures_ok);
+                        scene_slug(evs[i].family, scenes[i].file), *evs[i].ensemble, report_dir,
+                        figures_ok);
   }
   if (parts.str().empty()) return "";
   return std::string("## Predictability\n\n") + kIntro + parts.str();

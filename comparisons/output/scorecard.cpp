@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "comparisons/eval/contact_cause.h"
+#include "comparisons/eval/ensemble.h"
 #include "comparisons/eval/law_residuals.h"
 #include "comparisons/output/table.h"
 #include "engine/format.h"
@@ -126,10 +127,9 @@ void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, con
     }
   }
   // The ensemble's amplification, where the scene has one and the backend's copies ran.
-  if (ev.json.contains("ensemble") && ev.json["ensemble"]["backends"].contains(b)) {
-    const Json& e = ev.json["ensemble"]["backends"][b];
-    if (e.value("runs", 0L) > 0) row.amplification.push_back(e.value("amplification", 0.0));
-  }
+  if (ev.ensemble)
+    for (const BackendEnsemble& e : ev.ensemble->backends)
+      if (e.backend == b && e.runs > 0) row.amplification.push_back(e.amplification);
   const long steps = scene.sim.steps();
   if (steps > 0 && bj.contains("runtime_s"))
     row.time.push_back(bj["runtime_s"].get<double>() / static_cast<double>(steps));

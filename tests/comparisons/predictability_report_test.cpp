@@ -1,30 +1,36 @@
 // The report's Predictability section (output/predictability_report.h) and the scorecard's
-// predictability column (output/scorecard.h), from ensembles as the report stores them.
+// predictability column (output/scorecard.h), from the ensembles' typed results.
 #include "comparisons/output/predictability_report.h"
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "comparisons/eval/ensemble.h"
 #include "comparisons/output/scorecard.h"
 
 namespace rbx {
 namespace {
 
-// One backend's ensemble as ensemble_json writes it: `amplification`, and a step test when
-// `verdict` is not empty.
-Json backend_ensemble(double amplification, const std::string& verdict = "") {
-  Json b = {
-      {"runs", 50},
-      {"failed", 0},
-      {"spread", {{"position_m", 1e-4}, {"position_range_m", 3e-4}}},
-      {"amplification", amplification},
-      {"velocity_amplification", 2.0},
-      {"clusters", 2},
-      {"contact_sequences", Json::array({{{"sequence", "A-B:edge > A-B:face"}, {"copies", 30}},
-                                         {{"sequence", "A-B:face"}, {"copies", 20}}})}};
-  if (!verdict.empty()) b["step_test"] = {{"dt", 1e-4}, {"ratio", 0.1}, {"verdict", verdict}};
+// One backend's ensemble: `amplification`, and a step test when `verdict` is not empty.
+BackendEnsemble backend_ensemble(const std::string& name, double amplification,
+                                 const std::string& verdict = "") {
+  BackendEnsemble b;
+  b.backend = name;
+  b.runs = 50;
+  b.spread.position = 1e-4;
+  b.spread.position_range = 3e-4;
+  b.amplification = amplification;
+  b.velocity_amplification = 2.0;
+  b.clusters = 2;
+  b.sequences = {{"A-B:edge > A-B:face", 30}, {"A-B:face", 20}};
+  if (!verdict.empty()) {
+    b.step_tested = true;
+    b.step_ratio = 0.1;
+    b.verdict = verdict;
+  }
   return b;
 }
 
@@ -40,17 +46,16 @@ void add_scene(std::vector<Scene>& scenes, std::vector<SceneEvaluation>& evs,
   s.checks = {CheckKind::Trajectory};
   SceneEvaluation ev;
   ev.family = family;
-  Json ensemble = {{"count", 50},
-                   {"dt", 1e-3},
-                   {"duration", 0.2},
-                   {"perturb", {{"position", 1e-6}}},
-                   {"input_spread", {{"position_m", 1.7e-6}}},
-                   {"backends", Json::object()}};
+  EnsembleResult ensemble;
+  ensemble.settings.count = 50;
+  ensemble.dt = 1e-3;
+  ensemble.duration = 0.2;
+  ensemble.input.position = 1.7e-6;
   for (const auto& [b, a] : amplification) {
     ev.json["backends"][b] = {{"status", "ok"}};
-    ensemble["backends"][b] = backend_ensemble(a, verdict);
+    ensemble.backends.push_back(backend_ensemble(b, a, verdict));
   }
-  if (!amplification.empty()) ev.json["ensemble"] = ensemble;
+  if (!amplification.empty()) ev.ensemble = std::make_shared<const EnsembleResult>(ensemble);
   scenes.push_back(s);
   evs.push_back(ev);
 }
