@@ -20,10 +20,11 @@ packages=(cmake g++ pkg-config libeigen3-dev libbullet-dev libfcl-dev libccd-dev
           libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libmujoco-dev
           libode-dev libqhull-dev libtinyobjloader-dev python3-matplotlib zlib1g-dev
           libjs-three chromium python3-pil libopenmpi-dev openmpi-bin python3-dev pybind11-dev
-          python3-numpy python3-pytest libdart-dev libmd4c-dev libmd4c-html0-dev)
+          python3-numpy python3-pytest libdart-dev libmd4c-dev libmd4c-html0-dev lld)
 # python3-dev, pybind11-dev, python3-numpy, python3-pytest: the Python module (`./rbx python`,
 # python/) and its tests.
 # libmd4c-dev, libmd4c-html0-dev: md4c, which renders the report's Markdown as its HTML pages.
+# lld: LLVM's linker, which links the test executables faster than GNU ld (CMakeLists.txt).
 # libjs-three: three.js for the replay pages (`rbx view`, report views/); chromium and python3-pil:
 # the browser test of those pages (headless screenshots read with PIL).
 # `./rbx format [--check]` needs clang-format (Debian's `clang-format`, version 14 here).
