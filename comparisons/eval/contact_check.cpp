@@ -1,5 +1,6 @@
 // The contact check: every pair in bounding range, each backend against the truth.
 #include "comparisons/eval/evaluator.h"
+#include "comparisons/eval/patch_cover.h"
 
 namespace rbx::eval_detail {
 
@@ -104,9 +105,7 @@ void Evaluator::contact_pair(const RigidBody& a, const RigidBody& b, bool first_
     const double derr = std::abs(c->depth - true_depth);
     metric("contact", name, pair, "normal_err_deg", angle, normal_src);
     metric("contact", name, pair, "depth_err", derr, depth_src);
-    if (sat.touching && !sat.manifold.empty())
-      metric("contact", name, pair, "point_err_rel",
-             contact_point_error(c->point, a, b, sat.manifold) / size, "exact");
+    if (sat.touching && !sat.manifold.empty()) point_metrics(name, pair, run.result, *c, sat, a, b);
     out_.sweep.push_back({name, "contact", 0.0, run.timing, angle, normal_src});
     // The same query with the library's shapes built once (its "prebuilt" variant): the
     // figures time both, so that the cost of building a shape shows apart from the query.
@@ -135,6 +134,21 @@ void Evaluator::contact_pair(const RigidBody& a, const RigidBody& b, bool first_
     if (binds(name) && ex)
       expect_contact_failures(name, *ex, touch, c->normal, c->depth, tol, out_.expect_failures);
   }
+}
+
+void Evaluator::point_metrics(const std::string& name, const std::string& pair,
+                              const ContactResult& r, const ContactPoint& deepest,
+                              const SatResult& sat, const RigidBody& a, const RigidBody& b) {
+  const double size = std::min(body_size(a), body_size(b));
+  metric("contact", name, pair, "point_err_rel",
+         contact_point_error(deepest.point, a, b, sat.manifold) / size, "exact");
+  // The whole set against the exact patch (patch_cover.h): a backend that returns one right
+  // point and one that returns the patch differ here, not in point_err_rel.
+  const PatchCover cover = patch_cover(r.contacts, a, b, sat.manifold, sat.normal);
+  metric("contact", name, pair, "contact_points", cover.points, "exact");
+  metric("contact", name, pair, "worst_point_err_rel", cover.worst_point_err / size, "exact");
+  metric("contact", name, pair, "coverage_err_rel", cover.coverage_err / size, "exact");
+  if (cover.support_err) metric("contact", name, pair, "support_err", *cover.support_err, "exact");
 }
 
 void Evaluator::touching_answer(const std::string& name, const std::string& pair,

@@ -59,8 +59,8 @@ std::string mark_of(double angle, double derr, double size, double tol) {
 
 // One backend's row on pair (a, b): its JSON into `bj`, its mark into `marks`.
 ContactsRow compare_row(const std::string& name, const ContactRun& run, const ContactPoint* t,
-                        const RigidBody& a, const RigidBody& b, double tol, Json& bj,
-                        std::vector<std::string>& marks) {
+                        const SatResult& sat, const RigidBody& a, const RigidBody& b, double tol,
+                        Json& bj, std::vector<std::string>& marks) {
   ContactsRow row;
   row.backend = name;
   row.run = run;
@@ -92,6 +92,14 @@ ContactsRow compare_row(const std::string& name, const ContactRun& run, const Co
       row.angle += " (tie)";
     }
     row.mark = mark_of(angle, std::abs(c->depth - t->depth), size, tol);
+    if (sat.touching && !sat.manifold.empty()) {
+      row.cover = patch_cover(run.result.contacts, a, b, sat.manifold, sat.normal);
+      row.size = std::min(body_size(a), body_size(b));
+      pair["contact_points"] = row.cover->points;
+      pair["worst_point_err_rel"] = row.cover->worst_point_err / row.size;
+      pair["coverage_err_rel"] = row.cover->coverage_err / row.size;
+      if (row.cover->support_err) pair["support_err"] = *row.cover->support_err;
+    }
     if (!row.mark.empty())
       marks.push_back(row.mark + ": " + name + " on " + a.name + "-" + b.name + ": normal off by " +
                       row.angle + " deg, depth off by " +
@@ -156,6 +164,8 @@ ContactsComparison compare_contacts(const Scene& scene, const std::vector<std::s
         if (name != "exact") subjects.push_back(find_backend(name));
       const PairRuns runs = contact_runs(subjects, a, b, ResultCache(), budget_s);
       ContactsPair p{a.name, b.name, runs.runs[0], {}};
+      // The oracle's patch, which every backend's set of points is measured against.
+      const SatResult sat = sat_query(*a.shape, a.pose(), *b.shape, b.pose());
       const ContactPoint* truth = deepest(p.truth_run.result);
       bool any = truth != nullptr;
       for (const ContactRun& r : runs.runs) any = any || !r.result.contacts.empty();
@@ -163,7 +173,7 @@ ContactsComparison compare_contacts(const Scene& scene, const std::vector<std::s
       for (size_t k = 0, other = 1; k < names.size(); ++k) {
         const ContactRun& run = names[k] == "exact" ? runs.runs[0] : runs.runs[other++];
         p.rows.push_back(
-            compare_row(names[k], run, truth, a, b, tol, backends_json[names[k]], c.marks));
+            compare_row(names[k], run, truth, sat, a, b, tol, backends_json[names[k]], c.marks));
       }
       c.pairs.push_back(std::move(p));
     }

@@ -2,12 +2,14 @@
 // poses or at the first step where a pair touches, each against the `exact` oracle.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/json_io.h"
+#include "comparisons/eval/patch_cover.h"
 #include "comparisons/scene/scene.h"
 
 namespace rbx {
@@ -18,6 +20,10 @@ struct ContactsRow {
   ContactRun run;
   std::string angle = "-", depth_diff = "-";  // as printed ("-": not comparable)
   std::string mark;                           // "" | "deviates" | "disagrees"
+  /// The points against the exact patch (patch_cover.h), where both the backend and the oracle
+  /// find a contact; its errors relative to the smaller body, as in `rbx compare`.
+  std::optional<PatchCover> cover;
+  double size = 0.0;  // m, the smaller body's size, what the cover's errors are relative to
 };
 
 /// One pair that some backend (or the oracle) finds touching.

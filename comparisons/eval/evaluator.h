@@ -118,6 +118,10 @@ class Evaluator {
   void contact_pair(const RigidBody& a, const RigidBody& b, bool first_pair,
                     const std::vector<std::string>& names, const Backend& exact);
 
+  // The deepest point's and the whole set's metrics against the exact patch `sat.manifold`.
+  void point_metrics(const std::string& name, const std::string& pair, const ContactResult& r,
+                     const ContactPoint& deepest, const SatResult& sat, const RigidBody& a,
+                     const RigidBody& b);
   // A touching answer with no normal: a library's convention at zero depth, right when the pair
   // touches there; a false contact when it does not; a miss when the pair penetrates beyond
   // `depth_tol` (its depth, zero, is scored as such; there is no normal to score).

@@ -11,6 +11,7 @@
 #include "comparisons/eval/explore_detail.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/metrics.h"
+#include "comparisons/eval/patch_cover.h"
 #include "comparisons/scene/mesh_io.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/body.h"
@@ -380,6 +381,9 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
     o.depth_err_rel = std::abs(c->depth - true_depth) / size;
     o.point_err_rel =
         sat.manifold.empty() ? 0.0 : contact_point_error(c->point, a, b, sat.manifold) / size;
+    if (!sat.manifold.empty())
+      o.coverage_err_rel =
+          patch_cover(run.result.contacts, a, b, sat.manifold, sat.normal).coverage_err / size;
     // Clear disagreements, by the harness's marks (harness.h): 1 degree, 1 % of the size.
     if (!(angle <= kMarkAngleDeg))
       o.error = "normal";
@@ -423,8 +427,8 @@ std::string encode(const SampleOutcome& s) {
   for (const BackendOutcome& b : s.backends)
     j["b"].push_back({b.backend, b.error, b.measured, b.normal_err_deg, b.depth_err_rel,
                       b.point_err_rel, b.message, b.velocity_err_ke, b.momentum_err_ke,
-                      b.position_err_m, b.turn_rad, b.rest_time_err_s, b.reported_depth_m,
-                      b.rise_m});
+                      b.position_err_m, b.turn_rad, b.rest_time_err_s, b.reported_depth_m, b.rise_m,
+                      b.coverage_err_rel});
   if (s.phase >= 0) j["ph"] = s.phase;
   return j.dump();
 }
@@ -439,8 +443,8 @@ SampleOutcome decode(const std::string& text) {
   s.touching = j["t"];
   s.depth_rel = j["d"];
   for (const Json& b : j["b"])
-    s.backends.push_back(
-        {b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11], b[12], b[13]});
+    s.backends.push_back({b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11],
+                          b[12], b[13], b[14]});
   s.phase = j.value("ph", -1.0);
   return s;
 }

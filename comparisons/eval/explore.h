@@ -95,6 +95,9 @@ struct BackendOutcome {
   double reported_depth_m = 0.0;
   // Slide kind: the highest the box's centre rose off the surface, along its normal (m).
   double rise_m = 0.0;
+  // Contact kind (measured): how far the points fall short of the exact patch / size
+  // (patch_cover.h); counted, not yet a disagreement (docs/explore.md).
+  double coverage_err_rel = 0.0;
 };
 
 /// Everything measured on one sample.

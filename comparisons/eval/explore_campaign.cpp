@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "comparisons/eval/explore_detail.h"
+#include "comparisons/eval/harness.h"
 #include "comparisons/eval/select_backends.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/bounding.h"
@@ -24,9 +25,9 @@ using explore_detail::shrink_group;
 
 namespace {
 
-const char* const kMetrics[] = {"normal_err_deg",  "depth_err_rel",   "point_err_rel",
-                                "velocity_err_ke", "momentum_err_ke", "position_err_m",
-                                "turn_rad",        "rest_time_err_s"};
+const char* const kMetrics[] = {"normal_err_deg",   "depth_err_rel",   "point_err_rel",
+                                "coverage_err_rel", "velocity_err_ke", "momentum_err_ke",
+                                "position_err_m",   "turn_rad",        "rest_time_err_s"};
 
 // The metrics of one kind of sample.
 std::vector<std::string> metrics_of(const std::string& kind) {
@@ -34,7 +35,7 @@ std::vector<std::string> metrics_of(const std::string& kind) {
   if (kind == "landing" || kind == "slide")
     return {"position_err_m", "turn_rad", "velocity_err_ke", "rest_time_err_s"};
   if (kind == "tunnel") return {"velocity_err_ke", "position_err_m"};
-  return {"normal_err_deg", "depth_err_rel", "point_err_rel"};
+  return {"normal_err_deg", "depth_err_rel", "point_err_rel", "coverage_err_rel"};
 }
 
 // One metric of a backend's outcome, by its name in explore.json.
@@ -42,6 +43,7 @@ double metric_value(const BackendOutcome& b, const std::string& m) {
   if (m == "normal_err_deg") return b.normal_err_deg;
   if (m == "depth_err_rel") return b.depth_err_rel;
   if (m == "point_err_rel") return b.point_err_rel;
+  if (m == "coverage_err_rel") return b.coverage_err_rel;
   if (m == "velocity_err_ke") return b.velocity_err_ke;
   if (m == "momentum_err_ke") return b.momentum_err_ke;
   if (m == "position_err_m") return b.position_err_m;
@@ -119,6 +121,7 @@ struct BackendTally {
   std::map<std::string, std::vector<double>> values;  // metric -> measured values
   // Impact, landing: samples and disagreements by the quarter of its step the contact falls in.
   long phase_samples[4] = {0, 0, 0, 0}, phase_disagreements[4] = {0, 0, 0, 0};
+  long coverage_misses = 0;  // contact: measured answers whose points miss the patch by > 1 %
 };
 
 // Everything rank 0 counts over the samples.
@@ -152,6 +155,7 @@ Tallies tally_samples(const std::vector<std::string>& raw, const std::vector<std
       }
       if (b.measured)
         for (const std::string& m : metrics_of(kind)) bt.values[m].push_back(metric_value(b, m));
+      if (b.measured && b.coverage_err_rel > kMarkDepthRel) ++bt.coverage_misses;
       if (b.error.empty()) continue;
       ++bt.disagreements;
       const std::string sig = signature(s, b);
@@ -269,6 +273,7 @@ Json backend_json(BackendTally& t, const std::string& kind, const Json& groups,
   b["disagreements"] = t.disagreements;
   b["rate"] = t.samples ? static_cast<double>(t.disagreements) / t.samples : 0.0;
   b["errors"] = error_distributions(t, kind);
+  if (kind == "contact") b["coverage_misses"] = t.coverage_misses;
   if (kind == "impact" || kind == "landing" || kind == "tunnel")
     b["by_phase_quarter"] = phase_quarters(t);
   b["groups"] = Json::array();

@@ -27,6 +27,7 @@ void tally(const std::string& scene, const std::vector<std::string>& encoded,
       if (!b.measured) continue;
       values[b.backend]["normal_err_deg"].push_back(b.normal_err_deg);
       values[b.backend]["depth_err_rel"].push_back(b.depth_err_rel);
+      values[b.backend]["coverage_err_rel"].push_back(b.coverage_err_rel);
       values[b.backend]["velocity_err_ke"].push_back(b.velocity_err_ke);
       values[b.backend]["position_err_m"].push_back(b.position_err_m);
       values[b.backend]["turn_rad"].push_back(b.turn_rad);
@@ -66,7 +67,7 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
                     return encode(evaluate_contact_sample(make_contact_sample(set.seed, i),
                                                           contact_backends, table, cache));
                   }),
-          {"normal_err_deg", "depth_err_rel"}, "exact", out);
+          {"normal_err_deg", "depth_err_rel", "coverage_err_rel"}, "exact", out);
   if (!impact_backends.empty() && set.impact > 0)
     tally("explore/impact",
           run.map(static_cast<size_t>(set.impact),

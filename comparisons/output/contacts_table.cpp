@@ -17,7 +17,7 @@ void print_contacts(std::ostream& out, const Scene& scene, const ContactsCompari
         << (t ? "depth " + fmt_num(t->depth) + ", normal " + fmt_vec(t->normal) : "no contact")
         << "\n";
     Table table({"backend", "status", "points", "normal", "depth", "point", "angle vs exact",
-                 "depth - exact", "mark", "time (µs)", "25-75 %", "cold call (µs)"});
+                 "depth - exact", "coverage", "mark", "time (µs)", "25-75 %", "cold call (µs)"});
     for (const ContactsRow& r : p.rows) {
       const ContactPoint* q = deepest(r.run.result);
       const bool timed = r.run.timing.rounds > 0;
@@ -25,6 +25,7 @@ void print_contacts(std::ostream& out, const Scene& scene, const ContactsCompari
           {r.backend, to_string(r.run.result.status), std::to_string(r.run.result.contacts.size()),
            q ? fmt_vec(q->normal) : "-", q ? fmt_num(q->depth, 5) : "-",
            q ? fmt_vec(q->point) : "-", r.angle, r.depth_diff,
+           r.cover ? fmt_num(r.cover->coverage_err / r.size, 3) : "-",
            r.mark == "disagrees"  ? "✗"
            : r.mark == "deviates" ? "~"
                                   : "",
@@ -40,7 +41,10 @@ void print_contacts(std::ostream& out, const Scene& scene, const ContactsCompari
   }
   for (const std::string& m : c.marks) out << "  " << m << "\n";
   if (!c.pairs.empty()) {
-    out << "\ntime: per query, the median over rounds of repeated calls (warmed up, backends "
+    out << "\ncoverage: how far the points fall short of the exact contact patch, the largest "
+           "distance from a corner of the patch to the hull of the points across the normal, "
+           "relative to the smaller body (0: they span it; docs/contact_manifold.md)\n";
+    out << "time: per query, the median over rounds of repeated calls (warmed up, backends "
            "interleaved; docs/bench.md) with its 25-75 % range; the cold call is the first, "
            "which gave the answer, timed alone\n";
     return;

@@ -19,17 +19,21 @@ import backend_style  # noqa: E402
 FLOOR = 1e-17  # errors at round-off are drawn at this floor on log axes
 METRICS = [("normal_err_deg", "normal error (deg)"),
            ("depth_err_rel", "depth error / smaller body size"),
-           ("point_err_rel", "point error / smaller body size")]
+           ("point_err_rel", "point error / smaller body size"),
+           ("coverage_err_rel", "patch coverage error / smaller body size")]
 
 
 def main(out):
     j = json.load(open(os.path.join(out, "explore.json")))
-    fig, axes = plt.subplots(1, len(METRICS), figsize=(5 * len(METRICS), 4.2), sharey=True)
     names = list(j["backends"])
-    for ax, (key, label) in zip(axes, METRICS):
+    # The metrics the document has (one written before patch coverage was measured has none).
+    metrics = [(key, label) for key, label in METRICS
+               if any(key in j["backends"][n]["errors"] for n in names)]
+    fig, axes = plt.subplots(1, len(metrics), figsize=(5 * len(metrics), 4.2), sharey=True)
+    for ax, (key, label) in zip(axes, metrics):
         for k, name in enumerate(names):
-            e = j["backends"][name]["errors"][key]
-            if not e["n"]:
+            e = j["backends"][name]["errors"].get(key)
+            if not e or not e["n"]:
                 continue
             q = [max(v, FLOOR) for v in e["quantiles_every_5"]]
             frac = [p / 100 for p in range(0, 101, 5)]

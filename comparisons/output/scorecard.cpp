@@ -104,6 +104,7 @@ void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, con
       row.error.push_back(a);
       row.depth_error.push_back(std::max(truth_metric(ev, b, "depth_err"), 0.0));
     }
+    if (const double c = truth_metric(ev, b, "coverage_err_rel"); c >= 0) row.coverage.push_back(c);
     for (const SweepPoint& p : ev.sweep) {
       if (p.backend == b && (p.kind == "contact" || p.kind == "contact-touching"))
         row.time.push_back(p.timing.median_s);
@@ -213,6 +214,12 @@ std::string ScoreRow::time_text() const {
 std::string ScoreRow::predictability_text() const {
   if (amplification.empty()) return "—";
   return fmt_num(median_of(amplification), 2) + " (" + std::to_string(amplification.size()) + ")";
+}
+
+std::string ScoreRow::coverage_text() const {
+  if (coverage.empty()) return "—";
+  return fmt_err(median_of(coverage), "") + " / " + fmt_err(max_of(coverage), "") + " (" +
+         std::to_string(coverage.size()) + ")";
 }
 
 std::string ScoreRow::law_text() const {
@@ -352,7 +359,11 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
         "truth to compare with (the others have none). Run time: median, "
         "wall clock; a library builds its shapes inside each query, custom reuses its hulls; "
         "in brackets the same query with the library's shapes prebuilt, the fair comparison "
-        "with custom. *Worst contact-law residual* (dynamics): the largest residual of the "
+        "with custom. *Coverage error* (contacts): how far the backend's points fall short of the "
+        "true contact patch, the largest distance from a corner of the `exact` patch to the hull "
+        "of the points across the normal, relative to the smaller body (0: the points span the "
+        "patch), median and worst over the n scenes with a patch (docs/contact_manifold.md). "
+        "*Worst contact-law residual* (dynamics): the largest residual of the "
         "contact laws over the family's scenes, relative to its scene's scale, and its law "
         "(the \"Contact laws\" section). *Predictability* (families with ensembles): the "
         "median over the family's ensembles of how many times the nudge the final positions "
@@ -371,6 +382,9 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
     std::vector<std::string> header = {
         "rank",         "backend",     "scenes run",     "within tolerance",
         "median error", "worst error", "median run time"};
+    // Contact groups: how much of the true patch the points span (patch_cover.h).
+    const bool cover = rows[k].measure == Measure::Contact;
+    if (cover) header.push_back("coverage error, median / worst (n)");
     if (laws) header.push_back("worst contact-law residual");
     if (ensembles) header.push_back("predictability (median amplification)");
     Table t(header);
@@ -380,6 +394,7 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
           std::to_string(rows[r].run), rows[r].within_text(),
           rows[r].median_text(),       rows[r].worst_text(),
           rows[r].time_text()};
+      if (cover) cells.push_back(rows[r].coverage_text());
       if (laws) cells.push_back(rows[r].law_text());
       if (ensembles) cells.push_back(rows[r].predictability_text());
       t.add(cells);

@@ -45,6 +45,9 @@ struct ScoreRow {
   /// contact normal angle (deg), velocity error (kinetic-energy norm) or mass relative error.
   std::vector<double> error;
   std::vector<double> depth_error;  // contact: depth error (m), beside `error`
+  /// Contact: per scene with an exact patch, the largest coverage_err_rel over its pairs (how
+  /// far the backend's points fall short of the patch, relative to the smaller body).
+  std::vector<double> coverage;
   /// Run time (s) per query (contact) or per step (dynamics); prebuilt: the library's shapes
   /// built once (its "prebuilt" variant, where it has one).
   std::vector<double> time, prebuilt;
@@ -56,9 +59,10 @@ struct ScoreRow {
   /// backend's position amplification.
   std::vector<double> amplification;
   /// The row's cells as text: within tolerance, median and worst error, run time, worst
-  /// contact-law residual, predictability (the median amplification).
+  /// contact-law residual, predictability (the median amplification), coverage (median and
+  /// worst).
   std::string within_text() const, median_text() const, worst_text() const, time_text() const,
-      law_text() const, predictability_text() const;
+      law_text() const, predictability_text() const, coverage_text() const;
 };
 
 /// A scene named in a report: FAMILY/NAME and its slug (views/SLUG.html is its replay page).
