@@ -7,6 +7,8 @@
 #include <utility>
 
 #include "engine/contact_plane.h"
+#include "engine/contact_plane_detail.h"
+#include "engine/contact_region.h"
 
 namespace rbx {
 
@@ -52,6 +54,28 @@ bool crossing(const Vec3& p0, const Vec3& d0, const Vec3& q0, const Vec3& d1, Ve
   return true;
 }
 
+// The deepest of the points, by a key of the geometry: of the points within round-off of the
+// greatest depth (1e-12 of the largest coordinate: the depths are differences of projections),
+// the one last by position. Several points are often equally deep (A's lowest vertex inside B
+// and B's highest inside A are both as deep as the shapes overlap), and round-off orders them
+// differently in either body order; a key of the points keeps the same one in both.
+const ManifoldPoint& deepest_of(const std::vector<ManifoldPoint>& pts) {
+  double most = -std::numeric_limits<double>::infinity(), scale = 0.0;
+  for (const ManifoldPoint& p : pts) {
+    most = std::max(most, p.depth);
+    scale = std::max(scale, p.point.cwiseAbs().maxCoeff());
+  }
+  const double round_off = 1e-12 * std::max(scale, std::abs(most));
+  const ManifoldPoint* best = nullptr;
+  for (const ManifoldPoint& p : pts) {
+    if (!(p.depth >= most - round_off)) continue;
+    if (!best || std::lexicographical_compare(best->point.data(), best->point.data() + 3,
+                                              p.point.data(), p.point.data() + 3))
+      best = &p;
+  }
+  return *best;
+}
+
 // The points that span the contact region: the corners of its outline in the contact plane.
 // Departure from collecting every point: a point inside the outline, or within `slack` of the
 // line through its two neighbours on it, adds no contact wrench the others cannot give (normal
@@ -65,8 +89,12 @@ bool crossing(const Vec3& p0, const Vec3& d0, const Vec3& q0, const Vec3& d1, Ve
 std::vector<ManifoldPoint> support_corners(const std::vector<ManifoldPoint>& pts, const Vec3& n,
                                            double slack) {
   if (pts.size() <= 1) return pts;
-  const Vec3 t1 = (std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
-  const Vec3 t2 = n.cross(t1);
+  // The plane's frame from the sign-free axis, so that either body order (the normal reversed)
+  // sorts the points alike and keeps the same corners of near-coincident ones.
+  const Vec3 axis = plane_detail::canonical(n);
+  const Vec3 t1 =
+      (std::abs(axis.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY()).cross(axis).normalized();
+  const Vec3 t2 = axis.cross(t1);
   struct Planar {
     double u, v;
     size_t index;
@@ -109,9 +137,7 @@ std::vector<ManifoldPoint> support_corners(const std::vector<ManifoldPoint>& pts
   if (hull.size() == 1 ||
       (hull.size() == 2 && std::hypot(hull[1].u - hull[0].u, hull[1].v - hull[0].v) <= slack)) {
     // A region within `slack` of a point: its deepest point.
-    const auto deepest = std::max_element(
-        pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.depth < b.depth; });
-    return {*deepest};
+    return {deepest_of(pts)};
   }
   // In the order the points were found (deterministic, and the solver sweeps in that order).
   std::vector<size_t> kept;
@@ -124,7 +150,7 @@ std::vector<ManifoldPoint> support_corners(const std::vector<ManifoldPoint>& pts
   // where it is deeper than every corner by more than `slack`, a corner within `slack` of it
   // takes its depth, else it is kept as well.
   auto shallower = [](const ManifoldPoint& a, const ManifoldPoint& b) { return a.depth < b.depth; };
-  const ManifoldPoint& deepest = *std::max_element(pts.begin(), pts.end(), shallower);
+  const ManifoldPoint& deepest = deepest_of(pts);
   if (!(deepest.depth > std::max_element(out.begin(), out.end(), shallower)->depth + slack))
     return out;
   const Vec3& pd = deepest.point;
@@ -233,7 +259,13 @@ std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const P
   }
   // The corners of the region, to the slack the position projection leaves alone.
   m.points = support_corners(m.points, n, support_slack * std::min(shape_size(a), shape_size(b)));
-  if (m.points.empty()) m.points.push_back({hit->point, m.depth});
+  // No vertex inside and no crossing (a thin plate pierced through a face): the centre of the
+  // contact region on the plane, the same from either body order (the detector's first hit is
+  // not).
+  if (m.points.empty()) {
+    std::string feature;
+    m.points.push_back({contact_region_centre(a, pa, b, pb, plane, feature, scratch), m.depth});
+  }
   // No point is deeper than the shapes overlap.
   for (ManifoldPoint& p : m.points) p.depth = std::min(p.depth, m.depth);
   return m;

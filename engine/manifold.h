@@ -47,7 +47,8 @@ struct ContactManifold {
 /// size) of the line through its neighbours on its outline, is dropped (it adds no contact wrench
 /// the corners cannot give; engine/manifold.cpp, support_corners), except the deepest point when
 /// it is deeper than every corner by more than the slack. When no point qualifies (a face
-/// centroid inside, no vertex), the detector's point is the manifold.
+/// centroid inside, no vertex), the centre of the contact region on the plane
+/// (engine/contact_region.h) is the manifold. Either body order gives the same points.
 /// The detector runs on `cache` and the plane on `scratch`, the caller's (a world's step keeps
 /// one of each); the answer does not depend on them.
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,

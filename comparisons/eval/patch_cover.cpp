@@ -52,8 +52,8 @@ std::vector<Vec2> hull(std::vector<Vec2> pts) {
 
 double to_segment(const Vec2& p, const Vec2& a, const Vec2& b) {
   const Vec2 ab = b - a;
-  const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
-                                        : 0.0;
+  const double t =
+      ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
   return (a + t * ab - p).norm();
 }
 
@@ -98,7 +98,8 @@ PatchCover patch_cover(const std::vector<ContactPoint>& points, const RigidBody&
   const std::vector<Vec2> theirs = projected_hull(at, across);
   const std::vector<Vec2> truth = projected_hull(patch, across);
   for (const Vec3& corner : patch)
-    c.coverage_err = std::max(c.coverage_err, std::max(signed_distance(across(corner), theirs), 0.0));
+    c.coverage_err =
+        std::max(c.coverage_err, std::max(signed_distance(across(corner), theirs), 0.0));
 
   // The support polygon: a centre is held when it lies inside the hull by more than round-off
   // (1e-9 of the larger shape, the engine's point-in-mesh tolerance), so a hull without area

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "comparisons/scene/scene_file.h"
+#include "engine/manifold.h"
 #include "reference/custom.h"
 #include "reference/exact.h"
 
@@ -44,16 +45,15 @@ TEST(PatchCover, OnePointLeavesThePatchUncoveredByItsFarthestCorner) {
   EXPECT_NEAR(one.coverage_err, std::sqrt(0.5), kRoundOff);
   // The four corners cover it, wherever across the overlap each sits (on A's face, on B's,
   // midway): coverage is measured in the plane.
-  const PatchCover four = patch_cover(
-      at({{-0.5, -0.5, 0.48}, {0.5, -0.5, 0.5}, {0.5, 0.5, 0.49}, {-0.5, 0.5, 0.48}}), in[0],
-      in[1], kSquare, Vec3::UnitZ());
+  const PatchCover four =
+      patch_cover(at({{-0.5, -0.5, 0.48}, {0.5, -0.5, 0.5}, {0.5, 0.5, 0.49}, {-0.5, 0.5, 0.48}}),
+                  in[0], in[1], kSquare, Vec3::UnitZ());
   EXPECT_EQ(four.points, 4);
   EXPECT_EQ(four.worst_point_err, 0.0);
   EXPECT_NEAR(four.coverage_err, 0.0, kRoundOff);
   // Two corners of one edge: the far corners are a side away.
-  const PatchCover edge =
-      patch_cover(at({{-0.5, -0.5, 0.49}, {0.5, -0.5, 0.49}}), in[0], in[1], kSquare,
-                  Vec3::UnitZ());
+  const PatchCover edge = patch_cover(at({{-0.5, -0.5, 0.49}, {0.5, -0.5, 0.49}}), in[0], in[1],
+                                      kSquare, Vec3::UnitZ());
   EXPECT_NEAR(edge.coverage_err, 1.0, kRoundOff);
 }
 
@@ -61,8 +61,8 @@ TEST(PatchCover, TheWorstPointIsTheFarthestFromTheTrueRegion) {
   const auto in = bodies_of(kResting);
   // One corner right, one point 0.3 beside the patch's edge at its height: outside A, so its
   // distance to the patch, 0.3, is its error.
-  const PatchCover c = patch_cover(at({{0.5, 0.5, 0.49}, {0.8, 0.0, 0.49}}), in[0], in[1], kSquare,
-                                   Vec3::UnitZ());
+  const PatchCover c =
+      patch_cover(at({{0.5, 0.5, 0.49}, {0.8, 0.0, 0.49}}), in[0], in[1], kSquare, Vec3::UnitZ());
   EXPECT_NEAR(c.worst_point_err, 0.3, kRoundOff);
 }
 
@@ -73,8 +73,7 @@ TEST(PatchCover, SupportAsksWhetherThePointsHoldTheCentreWhereThePatchDoes) {
   const auto four = patch_cover(at(kSquare), in[0], in[1], kSquare, Vec3::UnitZ());
   ASSERT_TRUE(four.support_err.has_value());
   EXPECT_EQ(*four.support_err, 0.0);
-  const auto edge =
-      patch_cover(at({kSquare[0], kSquare[1]}), in[0], in[1], kSquare, Vec3::UnitZ());
+  const auto edge = patch_cover(at({kSquare[0], kSquare[1]}), in[0], in[1], kSquare, Vec3::UnitZ());
   ASSERT_TRUE(edge.support_err.has_value());
   EXPECT_EQ(*edge.support_err, 1.0);
   // A patch with no area (a segment) holds no centre: not measured.
@@ -90,9 +89,9 @@ TEST(PatchCover, SupportAsksWhetherThePointsHoldTheCentreWhereThePatchDoes) {
       {1.8, -0.5, 0.49}, {2.0, -0.5, 0.49}, {2.0, 0.5, 0.49}, {1.8, 0.5, 0.49}};
   const auto right = patch_cover(at(strip), over[0], over[1], strip, Vec3::UnitZ());
   EXPECT_EQ(right.support_err.value_or(-1), 0.0);
-  const auto wrong = patch_cover(at({{1.8, -0.5, 0.49}, {2.8, -0.5, 0.49}, {2.8, 0.5, 0.49},
-                                     {1.8, 0.5, 0.49}}),
-                                 over[0], over[1], strip, Vec3::UnitZ());
+  const auto wrong =
+      patch_cover(at({{1.8, -0.5, 0.49}, {2.8, -0.5, 0.49}, {2.8, 0.5, 0.49}, {1.8, 0.5, 0.49}}),
+                  over[0], over[1], strip, Vec3::UnitZ());
   EXPECT_EQ(wrong.support_err.value_or(-1), 1.0);
 }
 
@@ -109,9 +108,11 @@ TEST(PatchCover, DistanceToAHullIsMeasuredAcrossTheNormal) {
 }
 
 // Chrono's face_rot_offset case, as the oracle computes its patch: a unit cube turned 30 degrees
-// about z and offset, resting on a larger box. Its own points cover the patch; `custom`'s
-// query answers with one point (the region's centre), which a face contact's coverage fails.
-TEST(PatchCover, TheOraclesPatchIsCoveredByItsOwnPointsAndNotByOne) {
+// about z and offset, resting on a larger box. The oracle's own points cover the patch, and so
+// does the manifold `custom`'s world steps with; `custom`'s contact query answers with one
+// point, the region's centre, which leaves each corner half the face's diagonal away and cannot
+// hold the cube.
+TEST(PatchCover, TheOraclesPatchIsCoveredByItsOwnPointsAndTheStepsManifoldNotByOnePoint) {
   const auto in = bodies_of(
       "[[body]]\nname = \"A\"\nposition = [0.3, 0.2, 0.99]\nrotation = [0, 0, 30]\n"
       "[[body]]\nname = \"B\"\nsize = [3, 3, 1]\nstatic = true\n");
@@ -123,10 +124,20 @@ TEST(PatchCover, TheOraclesPatchIsCoveredByItsOwnPointsAndNotByOne) {
   EXPECT_LE(own.coverage_err, 1e-12);
   EXPECT_EQ(own.worst_point_err, 0.0);
   EXPECT_EQ(own.support_err.value_or(-1), 0.0);
+  const auto m = build_manifold(*in[0].shape, in[0].pose(), *in[1].shape, in[1].pose(),
+                                DetectorVariant::Accelerated);
+  ASSERT_TRUE(m);
+  std::vector<ContactPoint> step;
+  for (const ManifoldPoint& p : m->points) step.push_back({p.point, m->normal, p.depth, "step"});
+  ASSERT_EQ(step.size(), 4u);
+  const PatchCover stepped = patch_cover(step, in[0], in[1], sat.manifold, sat.normal);
+  // A's vertices inside B, 0.01 below the patch's height: across the normal they are the
+  // patch's corners (round-off of the rotation).
+  EXPECT_LE(stepped.coverage_err, 1e-12);
+  EXPECT_EQ(stepped.support_err.value_or(-1), 0.0);
   const ContactResult one = find_backend("custom")->contact(in[0], in[1]);
   ASSERT_EQ(one.contacts.size(), 1u);
   const PatchCover short_answer = patch_cover(one.contacts, in[0], in[1], sat.manifold, sat.normal);
-  // Its point is the patch's centre: every corner is half the face's diagonal away.
   EXPECT_NEAR(short_answer.coverage_err, std::sqrt(0.5), 1e-9);
   EXPECT_EQ(short_answer.support_err.value_or(-1), 1.0);
 }

@@ -330,6 +330,33 @@ TEST(ContactPlane, TheInnerPolytopeBoundsOverlappingShapesOnly) {
   EXPECT_EQ(narrowed, 100);
 }
 
+TEST(ContactPlane, AThinBoxTouchingAnInclineToRoundOffIsNotProvedToOverlap) {
+  // Found by `rbx explore --kind slide --seed 5151` (sample 115, 22 steps into its slide): a
+  // 0.49 x 0.20 x 0.049 box lying on a 2 x 2 x 1 slab turned 8 degrees, touching it to round-off
+  // (the exact oracle: depth 0). The inner polytope of A - B lost the triangles of its flat side
+  // and converged on the far one, claiming an overlap of the whole far extent; the
+  // plane came out reversed, the box was pushed through the slab. No proof now: the detector
+  // decides, and the plane is the incline's normal at depth 0 (round-off of the projections).
+  const ConvexPolyhedron box =
+      make_box(Vec3(0.49186999693005107, 0.20303316519286502, 0.04851776049023319));
+  const ConvexPolyhedron slab = make_box(Vec3(2.0, 2.0, 1.0));
+  const Pose pa{
+      Vec3(-0.024349626091067424, -0.00082976707039938166, 0.021004003527903884),
+      Quat(0.74784455522919169, -0.045377256200631641, -0.055088174476571057, 0.66002630164758869)};
+  const Pose pb{Vec3(0.0711475739288374, 0.0024245100834058343, -0.4949061976525411),
+                Quat(0.9974498471865847, 0.0024307087621943373, -0.071329474990163, 0.0)};
+  ContactScratch scratch;
+  EXPECT_FALSE(choose_overlap_plane(box, pa, slab, pb, scratch));
+  EXPECT_FALSE(choose_overlap_plane(slab, pb, box, pa, scratch));
+  const Vec3 up = pb.orientation * Vec3::UnitZ();
+  for (const PlaneMethod m :
+       {PlaneMethod::Automatic, PlaneMethod::Scan, PlaneMethod::WholeSearch}) {
+    const ContactPlane p = choose_contact_plane(box, pa, slab, pb, m);
+    EXPECT_GT(p.normal.dot(up), 1.0 - 1e-12) << static_cast<int>(m);
+    EXPECT_LE(p.depth, 1e-12) << static_cast<int>(m);
+  }
+}
+
 TEST(ContactPlane, TheInnerPolytopeProvesOverlapOnPosesOfRoundCoordinates) {
   ContactScratch scratch;  // reused by every query below: answers do not depend on it
   // Stacked axis-aligned boxes at offsets of round decimals, as scenes place them: GJK's

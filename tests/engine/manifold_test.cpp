@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
 
 #include "engine/detect.h"
 
@@ -124,6 +127,53 @@ TEST(Manifold, NothingWhenApart) {
   const ConvexPolyhedron cube = make_box(Vec3::Ones());
   EXPECT_FALSE(build_manifold(cube, at(Vec3(0, 0, 1.01)), cube, at(Vec3::Zero()),
                               DetectorVariant::Faithful));
+}
+
+Quat random_rotation(std::mt19937& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  return Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
+}
+
+TEST(Manifold, EitherBodyOrderGivesTheSamePointsWithTheNormalReversed) {
+  // 1,000 random pairs (boxes of several proportions, a prism, an icosphere; centres 0 to 1.2
+  // apart, so most touch, some deeply): the same points from (A, B) and from (B, A), to
+  // round-off of the poses' products (1e-9 of the larger shape), and the normal reversed. What
+  // broke it before: equally deep points taken in the order found, the detector's first hit
+  // where no point qualified, and the plane's frame flipping with the normal, so that
+  // near-coincident corners sorted differently.
+  const std::vector<ConvexPolyhedron> shapes = {
+      make_box(Vec3(1.0, 0.6, 0.3)), make_box(Vec3::Ones()), make_prism(0.4, 1.2, 7),
+      make_icosphere(0.5, 2), make_box(Vec3(2.0, 2.0, 0.5))};
+  std::mt19937 rng(5150);
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(shapes.size()) - 1);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  DetectionCache cache;
+  ContactScratch scratch;
+  int compared = 0;
+  for (int trial = 0; trial < 1000; ++trial) {
+    const ConvexPolyhedron& a = shapes[pick(rng)];
+    const ConvexPolyhedron& b = shapes[pick(rng)];
+    const Pose pa{random_rotation(rng) * Vec3::UnitX() * unit(rng) * 1.2, random_rotation(rng)};
+    const Pose pb{Vec3::Zero(), random_rotation(rng)};
+    const double slop = WorldSettings{}.position_slop;
+    const auto ab =
+        build_manifold(a, pa, b, pb, DetectorVariant::Accelerated, slop, cache, scratch);
+    const auto ba =
+        build_manifold(b, pb, a, pa, DetectorVariant::Accelerated, slop, cache, scratch);
+    ASSERT_EQ(ab.has_value(), ba.has_value()) << "trial " << trial;
+    if (!ab) continue;
+    ++compared;
+    EXPECT_LE((ab->normal + ba->normal).norm(), 1e-12) << "trial " << trial;
+    ASSERT_EQ(ab->points.size(), ba->points.size()) << "trial " << trial;
+    const double tol = 1e-9 * std::max(shape_size(a), shape_size(b));
+    for (const ManifoldPoint& p : ab->points) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const ManifoldPoint& q : ba->points)
+        nearest = std::min(nearest, (p.point - q.point).norm());
+      EXPECT_LE(nearest, tol) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(compared, 500);
 }
 
 }  // namespace
