@@ -273,12 +273,9 @@ bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& 
   // The proof's claim checked where round-off can spoil the polytope: with the origin on D's
   // boundary to round-off (a thin box touching a face), the expansion can lose the triangles of
   // the flat side and converge on the far one, claiming an overlap of the whole far extent. The
-  // origin is inside D only if D reaches beyond it along every direction; the one opposite the
-  // converged triangle and the six of the frame catch a lost side.
-  for (const Vec3& d :
-       {Vec3(-upper_dir), Vec3(Vec3::UnitX()), Vec3(-Vec3::UnitX()), Vec3(Vec3::UnitY()),
-        Vec3(-Vec3::UnitY()), Vec3(Vec3::UnitZ()), Vec3(-Vec3::UnitZ())})
-    if (!(support(a, b, d, upper_at).w.dot(d) > tie)) return false;
+  // origin is inside D only if D reaches beyond it along every direction, and the lost side lies
+  // opposite the converged triangle: D must reach beyond the origin there.
+  if (!(support(a, b, -upper_dir, upper_at).w.dot(-upper_dir) > tie)) return false;
 
   // Along a direction u that meets triangle g, D reaches at least dist_g / (u . n_g) (the ray
   // meets g there, and g lies in D). A candidate within the tie margin of the answer reaches no
