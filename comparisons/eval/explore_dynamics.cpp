@@ -19,7 +19,6 @@
 #include "comparisons/scene/scene_file.h"
 #include "engine/body.h"
 #include "engine/bounding.h"
-#include "engine/detect.h"
 #include "engine/format.h"
 #include "reference/exact.h"
 
