@@ -44,4 +44,10 @@ struct ContactPoint {
   std::string feature;
 };
 
+/// One point of a contact manifold (engine/manifold.h): the points of a pair share its normal.
+struct ManifoldPoint {
+  Vec3 point = Vec3::Zero();  // m, world
+  double depth = 0.0;         // m, >= 0, penetration along the manifold normal at this point
+};
+
 }  // namespace rbx

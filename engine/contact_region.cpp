@@ -300,7 +300,7 @@ Incident incident_feature(const plane_detail::Side& is, const Vec3& m, double ep
 
 Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                            const Pose& pb, const ContactPlane& plane, std::string& feature,
-                           ContactScratch& scratch) {
+                           ContactScratch& scratch, std::vector<ManifoldPoint>* patch) {
   plane_detail::Scratch& lists = scratch.lists();
   if (!lists.region) lists.region.reset(new RegionLists);
   RegionLists& w = *lists.region;
@@ -313,7 +313,10 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   const double eps = point_in_mesh_tolerance(a, b);
   if (plane.axis == PlaneAxis::EdgeEdge) {
     feature = "edge";
-    return edge_pair_centre(sa, sb, plane, eps, w);
+    const Vec3 c = edge_pair_centre(sa, sb, plane, eps, w);
+    // The patch of an edge pair is its one point (as the oracle's).
+    if (patch) patch->assign(1, {c, plane.depth});
+    return c;
   }
 
   // A face axis: the reference face (the face whose normal is the axis, outward m) and the
@@ -340,52 +343,77 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   Projected &ref = w.ref, &inc = w.inc;
   project(ref_pts, t1, t2, axis, ref, w.heights, w.chain);
   project(inc_pts, t1, t2, axis, inc, w.heights, w.chain);
+  // Heights along m: the reference plane's, and the incident face's over the plane's point
+  // (u, v), on its plane inc_n . x = inc_offset.
+  const double ref_height = up * ref.height;
+  const double a0 = inc_offset / inc_n.dot(m), au = -inc_n.dot(t1) / inc_n.dot(m),
+               av = -inc_n.dot(t2) / inc_n.dot(m);
+  auto inc_height = [&](const Vec2& p) { return a0 + au * p.x() + av * p.y(); };
+  auto place = [&](const Vec2& p, double height) {
+    return Vec3(p.x() * t1 + p.y() * t2 + height * m);
+  };
   // Parallel faces (the incident one within round-off of against m): the plane's keys may have
-  // taken either as the reference, so the two are ordered by the geometry instead.
+  // taken either as the reference, so the two are ordered by the geometry instead, and the
+  // patch is their overlap, each corner as deep as the two faces' planes are apart there.
+  std::vector<Vec2>&region = w.region, &kept = w.kept;
   if (1.0 + inc_n.dot(m) <= 1e-12) {
     const bool ref_first = !before(inc, ref);
     const Projected& x = ref_first ? ref : inc;
     const Projected& y = ref_first ? inc : ref;
-    w.region = y.hull;
-    clip_by(w.region, x.hull, eps, w.cut);
-    const Vec2 c = centroid2(w.region.empty() ? y.hull : w.region, eps);
+    region = y.hull;
+    clip_by(region, x.hull, eps, w.cut);
+    if (patch) {
+      patch->clear();
+      for (const Vec2& p : region)
+        patch->push_back({place(p, 0.5 * (inc_height(p) + ref_height)),
+                          std::min(std::max(ref_height - inc_height(p), 0.0), plane.depth)});
+    }
+    const Vec2 c = centroid2(region.empty() ? y.hull : region, eps);
+    if (patch && patch->empty())
+      patch->push_back({place(c, 0.5 * up * (x.height + y.height)), plane.depth});
     return c.x() * t1 + c.y() * t2 + (0.5 * (x.height + y.height)) * axis;
   }
-  // Heights along m from here on.
-  ref.height *= up;
-  // The incident face's height along m over the plane's point (u, v): on its plane
-  // inc_n . x = inc_offset.
-  const double a0 = inc_offset / inc_n.dot(m), au = -inc_n.dot(t1) / inc_n.dot(m),
-               av = -inc_n.dot(t2) / inc_n.dot(m);
-  auto inc_height = [&](const Vec2& p) { return a0 + au * p.x() + av * p.y(); };
   // The incident feature clipped to the reference face's sides, and of its corners those at or
-  // below the reference plane (the manifold's points, as Box2D keeps them); none left: the
-  // deepest vertex. The centre is their centroid, midway between the incident surface and the
-  // reference plane.
-  std::vector<Vec2>&region = w.region, &kept = w.kept;
+  // below the reference plane (the manifold's points, as Box2D keeps them). None there, all
+  // above it by a gap (touching within the detector's tolerance): the lowest, to `eps`. None
+  // at all: the deepest vertex. The centre is their centroid, midway between the incident
+  // surface and the reference plane.
   region = inc.hull;
   clip_by(region, ref.hull, eps, w.cut);
+  double lowest = plane_detail::kInf;
+  for (const Vec2& p : region) lowest = std::min(lowest, inc_height(p) - ref_height);
+  const double floor = std::max(lowest, 0.0) + eps;
   kept.clear();
   for (const Vec2& p : region)
-    if (inc_height(p) - ref.height <= eps) kept.push_back(p);
+    if (inc_height(p) - ref_height <= floor) kept.push_back(p);
   if (kept.empty()) {
     const Vec3 x = is.world(inc_face.deep);
     kept.emplace_back(x.dot(t1), x.dot(t2));
   }
+  if (patch) {
+    patch->clear();
+    for (const Vec2& p : kept)
+      patch->push_back({place(p, 0.5 * (inc_height(p) + ref_height)),
+                        std::min(std::max(ref_height - inc_height(p), 0.0), plane.depth)});
+  }
   hull2(kept, w.chain);
   const Vec2 c = centroid2(kept, eps);
-  return c.x() * t1 + c.y() * t2 + (0.5 * (inc_height(c) + ref.height)) * m;
+  return place(c, 0.5 * (inc_height(c) + ref_height));
 }
 
 std::optional<ContactPoint> find_contact(const ConvexPolyhedron& a, const Pose& pa,
                                          const ConvexPolyhedron& b, const Pose& pb,
                                          DetectorVariant variant, DetectionCache& cache,
-                                         ContactScratch& scratch) {
+                                         ContactScratch& scratch,
+                                         std::vector<ManifoldPoint>* patch) {
+  // 1. The features in contact and 2. the chosen plane: proved to overlap, or found by the
+  // detector and the plane chosen for its hit.
   if (const auto plane = choose_overlap_plane(a, pa, b, pb, scratch)) {
     ContactPoint c;
     c.normal = plane->normal;
     c.depth = plane->depth;
-    c.point = contact_region_centre(a, pa, b, pb, *plane, c.feature, scratch);
+    // 3. The patch clipped on the plane, with its centre.
+    c.point = contact_region_centre(a, pa, b, pb, *plane, c.feature, scratch, patch);
     return c;
   }
   auto c = detect(a, pa, b, pb, variant, cache);
@@ -394,6 +422,10 @@ std::optional<ContactPoint> find_contact(const ConvexPolyhedron& a, const Pose& 
       choose_contact_plane(a, pa, b, pb, c->normal, c->depth, PlaneMethod::Automatic, scratch);
   c->normal = plane.normal;
   c->depth = plane.depth;
+  if (patch) {
+    std::string feature;
+    contact_region_centre(a, pa, b, pb, plane, feature, scratch, patch);
+  }
   return c;
 }
 

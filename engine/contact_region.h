@@ -12,6 +12,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "engine/contact.h"
 #include "engine/contact_plane.h"
@@ -25,18 +26,25 @@ namespace rbx {
 /// along the normal, projected on the plane, midway between the two features. The same point
 /// from either body order (to the last bit). `feature` names the pair of features: "vertex"
 /// when either is a single vertex, "edge" for two edges, "face" otherwise.
+/// With `patch`, also the contact patch (docs/contact_manifold.md, the oracle's definition):
+/// on a face axis, the corners of the incident feature clipped to the reference face that lie
+/// at or below its plane (all above it, touching across a gap: the lowest), each midway between
+/// the two surfaces with its own depth; on an edge axis, the centre. Not yet reduced.
 Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                            const Pose& pb, const ContactPlane& plane, std::string& feature,
-                           ContactScratch& scratch);
+                           ContactScratch& scratch, std::vector<ManifoldPoint>* patch = nullptr);
 
-/// The extended engine's contact of a pair (what `custom` answers a contact query with). Shapes
-/// proved to overlap (choose_overlap_plane) take the chosen plane and the centre of the contact
-/// region, with no detector. The others (touching within the tolerance, apart, or too close to
-/// tell) are left to the detector `variant` (both give the same answer); a hit takes the chosen
-/// plane (the overlap along the tests' normal bounding it) and keeps the detector's point.
+/// The extended engine's contact of a pair (what `custom` answers a contact query with), the
+/// first stages of its contact pipeline (docs/contact_plane.md). Shapes proved to overlap
+/// (choose_overlap_plane) take the chosen plane and the centre of the contact region, with no
+/// detector. The others (touching within the tolerance, apart, or too close to tell) are left
+/// to the detector `variant` (both give the same answer); a hit takes the chosen plane (the
+/// overlap along the tests' normal bounding it) and keeps the detector's point. With `patch`,
+/// also the contact patch on that plane (contact_region_centre), which build_manifold reduces.
 std::optional<ContactPoint> find_contact(const ConvexPolyhedron& a, const Pose& pa,
                                          const ConvexPolyhedron& b, const Pose& pb,
                                          DetectorVariant variant, DetectionCache& cache,
-                                         ContactScratch& scratch);
+                                         ContactScratch& scratch,
+                                         std::vector<ManifoldPoint>* patch = nullptr);
 
 }  // namespace rbx

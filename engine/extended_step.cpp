@@ -151,7 +151,7 @@ std::vector<double> ExtendedStep::record_events(WorldState& world,
   }
   for (size_t m = 0; m < manifolds.size(); ++m) {
     if (!collision[m] || !(impulse[m] > 0.0)) continue;
-    ContactPoint c = manifolds[m].manifold.detector_contact;
+    ContactPoint c = manifolds[m].manifold.contact;
     c.point = moment[m] / impulse[m];
     c.normal = manifolds[m].manifold.normal;
     c.depth = manifolds[m].manifold.depth;

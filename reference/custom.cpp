@@ -2,25 +2,35 @@
 
 #include <exception>
 
-#include "engine/contact_region.h"
 #include "engine/detect.h"
+#include "engine/manifold.h"
 #include "reference/dynamics_recorder.h"
 
 namespace rbx {
 
 namespace {
 
-// The contact of the `custom` backend on either detector: the plane of least overlap
-// (engine/contact_plane.h) and the centre of the contact region (engine/contact_region.h) for
-// shapes proved to overlap; the detector for the rest, from either body order alike. One
-// detection cache and one contact scratch per thread, reused by every query as a world's step
-// reuses its own: their lists are allocated once. Answers do not depend on them.
+// The contact of the `custom` backend on either detector: the manifold its world steps with
+// (engine/manifold.h), its one-point contact first (the plane of least overlap and the centre of
+// the contact region for shapes proved to overlap, the detector's point for the rest), then every
+// point of the manifold, all on the manifold's normal. One detection cache and one contact
+// scratch per thread, reused by every query as a world's step reuses its own: their lists are
+// allocated once. Answers do not depend on them.
 ContactResult engine_contact(const RigidBody& a, const RigidBody& b, DetectorVariant variant) {
   thread_local DetectionCache cache;
   thread_local ContactScratch scratch;
   ContactResult r;
-  if (auto c = find_contact(*a.shape, a.pose(), *b.shape, b.pose(), variant, cache, scratch))
-    r.contacts.push_back(*c);
+  const auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant,
+                                WorldSettings{}.position_slop, cache, scratch);
+  if (!m) return r;
+  r.contacts.reserve(1 + m->points.size());
+  r.contacts.push_back(m->contact);
+  for (const ManifoldPoint& p : m->points) {
+    ContactPoint c = m->contact;
+    c.point = p.point;
+    c.depth = p.depth;
+    r.contacts.push_back(c);
+  }
   return r;
 }
 

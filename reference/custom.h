@@ -6,10 +6,11 @@
 
 namespace rbx {
 
-/// The engine's backends: `custom` (the plane is the direction of least overlap,
-/// engine/contact_plane.h; the point the centre of the contact region for shapes proved to
-/// overlap, engine/contact_region.h, else the Moore & Wilhelms tests decide and give it; the
-/// extended engine's dynamics: manifolds, Coulomb friction, resting contact, time of impact)
+/// The engine's backends: `custom` (the manifold its world steps with, engine/manifold.h: the
+/// plane is the direction of least overlap, engine/contact_plane.h; the points its one point,
+/// the centre of the contact region for shapes proved to overlap, else the Moore & Wilhelms
+/// tests' point, then the corners of the patch clipped on the plane, engine/contact_region.h;
+/// the extended engine's dynamics: manifolds, Coulomb friction, resting contact, time of impact)
 /// with its "faithful" variant (the seed's loops where a detector is needed, the same answer),
 /// and `custom-seed` (the seed's algorithm: first hit, single-point frictionless impulse, no time
 /// of impact).

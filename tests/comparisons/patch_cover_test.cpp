@@ -112,7 +112,7 @@ TEST(PatchCover, DistanceToAHullIsMeasuredAcrossTheNormal) {
 // does the manifold `custom`'s world steps with; `custom`'s contact query answers with one
 // point, the region's centre, which leaves each corner half the face's diagonal away and cannot
 // hold the cube.
-TEST(PatchCover, TheOraclesPatchIsCoveredByItsOwnPointsAndTheStepsManifoldNotByOnePoint) {
+TEST(PatchCover, TheOraclesPatchIsCoveredByItsOwnPointsAndCustomsManifoldNotByOnePoint) {
   const auto in = bodies_of(
       "[[body]]\nname = \"A\"\nposition = [0.3, 0.2, 0.99]\nrotation = [0, 0, 30]\n"
       "[[body]]\nname = \"B\"\nsize = [3, 3, 1]\nstatic = true\n");
@@ -131,13 +131,24 @@ TEST(PatchCover, TheOraclesPatchIsCoveredByItsOwnPointsAndTheStepsManifoldNotByO
   for (const ManifoldPoint& p : m->points) step.push_back({p.point, m->normal, p.depth, "step"});
   ASSERT_EQ(step.size(), 4u);
   const PatchCover stepped = patch_cover(step, in[0], in[1], sat.manifold, sat.normal);
-  // A's vertices inside B, 0.01 below the patch's height: across the normal they are the
-  // patch's corners (round-off of the rotation).
+  // The clipped patch's corners, midway across the 0.01 overlap: across the normal they are the
+  // oracle's corners (round-off of the rotation).
   EXPECT_LE(stepped.coverage_err, 1e-12);
   EXPECT_EQ(stepped.support_err.value_or(-1), 0.0);
-  const ContactResult one = find_backend("custom")->contact(in[0], in[1]);
-  ASSERT_EQ(one.contacts.size(), 1u);
-  const PatchCover short_answer = patch_cover(one.contacts, in[0], in[1], sat.manifold, sat.normal);
+  // `custom` answers with the step's manifold (one pipeline): its one-point contact first, then
+  // the same points.
+  const ContactResult answer = find_backend("custom")->contact(in[0], in[1]);
+  ASSERT_EQ(answer.contacts.size(), 1 + step.size());
+  for (size_t i = 0; i < step.size(); ++i) {
+    EXPECT_EQ(answer.contacts[i + 1].point, step[i].point);
+    EXPECT_EQ(answer.contacts[i + 1].depth, step[i].depth);
+  }
+  EXPECT_LE(patch_cover(answer.contacts, in[0], in[1], sat.manifold, sat.normal).coverage_err,
+            1e-12);
+  // Its one point alone (the centre of the region) falls short of the square's corners by half
+  // its diagonal and holds nothing.
+  const PatchCover short_answer =
+      patch_cover({answer.contacts[0]}, in[0], in[1], sat.manifold, sat.normal);
   EXPECT_NEAR(short_answer.coverage_err, std::sqrt(0.5), 1e-9);
   EXPECT_EQ(short_answer.support_err.value_or(-1), 1.0);
 }

@@ -49,7 +49,7 @@ TEST(ContactSolver, OnePointFrictionlessIsTheSeedImpulse) {
   ASSERT_EQ(m.size(), 1u);
   ASSERT_EQ(m[0].manifold.points.size(), 1u);
   std::vector<RigidBody> seed = bodies;
-  ContactPoint c = m[0].manifold.detector_contact;
+  ContactPoint c = m[0].manifold.contact;
   c.point = m[0].manifold.points[0].point;
   apply_impulse(seed[0], seed[1], c, 0.5);
   solve_contact_velocities(bodies, m, normal_velocities(bodies, m), settings(0.5, 0.0));
