@@ -58,17 +58,20 @@ struct Candidates {
 };
 
 /// Each query file's own lists (defined in that file: the search's, the scan's, the inner
-/// polytope's, the contact region's), made on first use and kept by a Scratch.
+/// polytope's, the contact region's, the manifold's reduction), made on first use and kept by a
+/// Scratch.
 struct SearchLists;
 struct ScanLists;
 struct PolytopeLists;
 struct RegionLists;
+struct ManifoldLists;
 /// Frees a file's lists where their type is complete (one overload defined in each file).
 struct ListsDeleter {
   void operator()(SearchLists* p) const;
   void operator()(ScanLists* p) const;
   void operator()(PolytopeLists* p) const;
   void operator()(RegionLists* p) const;
+  void operator()(ManifoldLists* p) const;
 };
 
 /// What a ContactScratch holds (engine/contact_scratch.h): the candidates of choose_contact_plane
@@ -79,6 +82,7 @@ struct Scratch {
   std::unique_ptr<ScanLists, ListsDeleter> scan;
   std::unique_ptr<PolytopeLists, ListsDeleter> polytope;
   std::unique_ptr<RegionLists, ListsDeleter> region;
+  std::unique_ptr<ManifoldLists, ListsDeleter> manifold;
 };
 
 /// Shapes with at most this many vertices take their support by a scan, larger ones by a climb:

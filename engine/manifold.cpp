@@ -43,7 +43,24 @@ const ManifoldPoint& deepest_of(const std::vector<ManifoldPoint>& pts) {
 // Andrew's monotone chain; then the corner nearest the line of its neighbours is dropped while
 // it is within `slack`. A region within `slack` of a segment keeps its two ends; of a point,
 // its deepest point. The deepest point always stays (see below).
-void support_corners(std::vector<ManifoldPoint>& pts, const Vec3& n, double slack) {
+}  // namespace
+
+// The reduction's lists, kept by the caller's scratch between queries (a point of the plane and
+// the index of the manifold point it came from).
+struct plane_detail::ManifoldLists {
+  struct Planar {
+    double u, v;
+    size_t index;
+  };
+  std::vector<Planar> sorted, hull;
+};
+
+void plane_detail::ListsDeleter::operator()(ManifoldLists* p) const { delete p; }
+
+namespace {
+
+void support_corners(std::vector<ManifoldPoint>& pts, const Vec3& n, double slack,
+                     plane_detail::ManifoldLists& w) {
   if (pts.size() <= 1) return;
   // The plane's frame from the sign-free axis, so that either body order (the normal reversed)
   // sorts the points alike and keeps the same corners of near-coincident ones.
@@ -51,12 +68,9 @@ void support_corners(std::vector<ManifoldPoint>& pts, const Vec3& n, double slac
   const Vec3 t1 =
       (std::abs(axis.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY()).cross(axis).normalized();
   const Vec3 t2 = axis.cross(t1);
-  struct Planar {
-    double u, v;
-    size_t index;
-  };
-  std::vector<Planar> q;
-  q.reserve(pts.size());
+  using Planar = plane_detail::ManifoldLists::Planar;
+  std::vector<Planar>& q = w.sorted;
+  q.clear();
   for (size_t i = 0; i < pts.size(); ++i)
     q.push_back({pts[i].point.dot(t1), pts[i].point.dot(t2), i});
   std::sort(q.begin(), q.end(), [](const Planar& a, const Planar& b) {
@@ -66,8 +80,8 @@ void support_corners(std::vector<ManifoldPoint>& pts, const Vec3& n, double slac
     return (a.u - o.u) * (b.v - o.v) - (a.v - o.v) * (b.u - o.u);
   };
   // Lower and upper chains, counter-clockwise, collinear points dropped.
-  std::vector<Planar> hull;
-  hull.reserve(2 * pts.size());
+  std::vector<Planar>& hull = w.hull;
+  hull.clear();
   for (int pass = 0; pass < 2; ++pass) {
     const size_t base = hull.size();
     for (const Planar& p : q) {
@@ -87,9 +101,15 @@ void support_corners(std::vector<ManifoldPoint>& pts, const Vec3& n, double slac
   };
   while (hull.size() > 2) {
     size_t nearest = 0;
-    for (size_t k = 1; k < hull.size(); ++k)
-      if (off_line(k) < off_line(nearest)) nearest = k;
-    if (!(off_line(nearest) <= slack)) break;
+    double least = off_line(0);
+    for (size_t k = 1; k < hull.size(); ++k) {
+      const double off = off_line(k);
+      if (off < least) {
+        nearest = k;
+        least = off;
+      }
+    }
+    if (!(least <= slack)) break;
     hull.erase(hull.begin() + static_cast<std::ptrdiff_t>(nearest));
   }
   const ManifoldPoint deepest = deepest_of(pts);
@@ -139,6 +159,7 @@ std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const P
   // 1-3. The features in contact, the chosen plane and the patch clipped on it: the query's
   // own pipeline (engine/contact_region.h), so that `custom` answers with this manifold.
   ContactManifold m;
+  m.points.reserve(8);  // a face contact's corners, and a few clipped ones, in one allocation
   const auto contact = find_contact(a, pa, b, pb, variant, cache, scratch, &m.points);
   if (!contact) return std::nullopt;
   m.contact = *contact;
@@ -146,18 +167,21 @@ std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const P
   m.depth = contact->depth;
   // Merge coincident points (a clipped corner on a corner of the reference face), the first of
   // each kept.
-  const double merge = 1e-7 * std::max(shape_size(a), shape_size(b));
+  const double merge = 1e-7 * std::max(shape_size(a), shape_size(b)), merge2 = merge * merge;
   size_t kept = 0;
   for (size_t i = 0; i < m.points.size(); ++i) {
     const Vec3& p = m.points[i].point;
     if (std::none_of(m.points.begin(), m.points.begin() + static_cast<std::ptrdiff_t>(kept),
-                     [&](const ManifoldPoint& q) { return (q.point - p).norm() <= merge; }))
+                     [&](const ManifoldPoint& q) { return (q.point - p).squaredNorm() <= merge2; }))
       m.points[kept++] = m.points[i];
   }
   m.points.resize(kept);
   // 4. The reduction: the corners of the region, to the slack the position projection leaves
   // alone.
-  support_corners(m.points, m.normal, support_slack * std::min(shape_size(a), shape_size(b)));
+  plane_detail::Scratch& lists = scratch.lists();
+  if (!lists.manifold) lists.manifold.reset(new plane_detail::ManifoldLists);
+  support_corners(m.points, m.normal, support_slack * std::min(shape_size(a), shape_size(b)),
+                  *lists.manifold);
   return m;
 }
 

@@ -25,12 +25,8 @@ ContactResult engine_contact(const RigidBody& a, const RigidBody& b, DetectorVar
   if (!m) return r;
   r.contacts.reserve(1 + m->points.size());
   r.contacts.push_back(m->contact);
-  for (const ManifoldPoint& p : m->points) {
-    ContactPoint c = m->contact;
-    c.point = p.point;
-    c.depth = p.depth;
-    r.contacts.push_back(c);
-  }
+  for (const ManifoldPoint& p : m->points)
+    r.contacts.push_back({p.point, m->normal, p.depth, m->contact.feature});
   return r;
 }
 
