@@ -21,6 +21,31 @@ void Evaluator::contact_check() {
   if (pairs == 0) out_.skipped.push_back("contact: no pair of bodies within bounding range");
 }
 
+namespace {
+
+// [expect.contact] binds the oracle, whatever backends run: if the exact answer (computed for
+// the pair anyway) disagrees with the closed form, the derivation or the oracle is wrong.
+void exact_expect_failures(const ExpectContact& ex, const SatResult& sat, const RigidBody& a,
+                           const RigidBody& b, const Vec3& true_normal, double tol,
+                           std::vector<std::string>& failures) {
+  expect_contact_failures("exact", ex, sat.touching, sat.normal, std::max(sat.depth, 0.0), tol,
+                          failures);
+  if (!sat.touching) return;
+  // A stated point is one model's representative point of the contact (on A, on B or between
+  // them): it is right when it lies in the true contact region, where every backend's point is
+  // scored too (point_err_rel): inside both bodies, or on the oracle's manifold.
+  if (ex.point) {
+    const double off = contact_point_error(*ex.point, a, b, sat.manifold);
+    if (off > tol)
+      failures.push_back("exact: [expect.contact] point " + fmt_vec(*ex.point, 8) + " lies " +
+                         fmt_num(off, 3) + " m from the true contact region");
+  }
+  // A stated patch binds the oracle's corners the same way, across the true normal.
+  expect_patch_failures("exact", ex.patch, sat.manifold, true_normal, tol, failures);
+}
+
+}  // namespace
+
 void Evaluator::contact_pair(const RigidBody& a, const RigidBody& b, bool first_pair,
                              const std::vector<std::string>& names, const Backend& exact) {
   const std::string pair = pair_name(a, b);
@@ -38,21 +63,9 @@ void Evaluator::contact_pair(const RigidBody& a, const RigidBody& b, bool first_
   const std::string depth_src = have_depth ? stated : "exact";
   const double size = std::min(body_size(a), body_size(b));
   const double tol = scene_.expect ? scene_.expect->tolerance : 1e-6;
-  // [expect.contact] binds the oracle, whatever backends run: if the exact answer (computed
-  // here anyway) disagrees with the closed form, the derivation or the oracle is wrong.
-  if (ex)
-    expect_contact_failures("exact", *ex, sat.touching, sat.normal, std::max(sat.depth, 0.0), tol,
-                            out_.expect_failures);
-  if (ex) expect_contact_bound_ = true;
-  // A stated point is one model's representative point of the contact (on A, on B or between
-  // them): it is right when it lies in the true contact region, where every backend's point is
-  // scored too (point_err_rel): inside both bodies, or on the oracle's manifold.
-  if (ex && ex->point && sat.touching) {
-    const double off = contact_point_error(*ex->point, a, b, sat.manifold);
-    if (off > tol)
-      out_.expect_failures.push_back("exact: [expect.contact] point " + fmt_vec(*ex->point, 8) +
-                                     " lies " + fmt_num(off, 3) +
-                                     " m from the true contact region");
+  if (ex) {
+    exact_expect_failures(*ex, sat, a, b, true_normal, tol, out_.expect_failures);
+    expect_contact_bound_ = true;
   }
 
   std::vector<const Backend*> subjects;
@@ -131,8 +144,15 @@ void Evaluator::contact_pair(const RigidBody& a, const RigidBody& b, bool first_
     }
     // [expect.contact] binds the engine under test too, like [expect.body]: a violation
     // fails the scene unless the scene documents it as a known failure.
-    if (binds(name) && ex)
+    if (binds(name) && ex) {
       expect_contact_failures(name, *ex, touch, c->normal, c->depth, tol, out_.expect_failures);
+      std::vector<Vec3> points;
+      for (const ContactPoint& p : run.result.contacts) points.push_back(p.point);
+      // Across the engine's own normal where it is one of the tied axes the truth allows (two
+      // coincident cubes: any face's; angle 0 above), else across the truth's.
+      const Vec3 across = !have_normal && angle == 0.0 ? c->normal.normalized() : true_normal;
+      expect_patch_failures(name, ex->patch, points, across, tol, out_.expect_failures);
+    }
   }
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "comparisons/eval/json_io.h"
+#include "comparisons/eval/patch_cover.h"
 #include "engine/detect.h"
 #include "engine/format.h"
 #include "reference/isolate.h"
@@ -127,6 +128,23 @@ void expect_contact_failures(const std::string& who, const ExpectContact& ex, bo
   if (ex.depth && std::abs(depth - *ex.depth) > tol)
     failures.push_back(who + ": contact depth " + fmt_num(depth, 10) + ", expected " +
                        fmt_num(*ex.depth, 10));
+}
+
+void expect_patch_failures(const std::string& who, const std::vector<Vec3>& patch,
+                           const std::vector<Vec3>& points, const Vec3& normal, double tol,
+                           std::vector<std::string>& failures) {
+  if (patch.empty() || points.empty()) return;
+  double short_by = 0.0, off_by = 0.0;
+  for (const Vec3& corner : patch)
+    short_by = std::max(short_by, distance_to_hull_across(corner, points, normal));
+  for (const Vec3& p : points) off_by = std::max(off_by, distance_to_hull_across(p, patch, normal));
+  if (short_by > tol)
+    failures.push_back(who + ": " + std::to_string(points.size()) +
+                       (points.size() == 1 ? " contact point falls" : " contact points fall") +
+                       " short of the [expect.contact] patch by " + fmt_num(short_by, 3) + " m");
+  if (off_by > tol)
+    failures.push_back(who + ": a contact point lies " + fmt_num(off_by, 3) +
+                       " m off the [expect.contact] patch");
 }
 
 Vec3 centres_direction(const RigidBody& a, const RigidBody& b) {

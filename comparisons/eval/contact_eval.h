@@ -58,6 +58,13 @@ void expect_contact_failures(const std::string& who, const ExpectContact& ex, bo
                              const Vec3& normal, double depth, double tol,
                              std::vector<std::string>& failures);
 
+/// Violations of [expect.contact]'s patch by one subject's points (world), across the unit
+/// `normal`: a corner of the stated patch more than `tol` from the points' hull (they do not
+/// span it), or a point more than `tol` from the patch (it lies off the contact).
+void expect_patch_failures(const std::string& who, const std::vector<Vec3>& patch,
+                           const std::vector<Vec3>& points, const Vec3& normal, double tol,
+                           std::vector<std::string>& failures);
+
 /// The unit direction from B's centre of mass toward A's (zero where they coincide): the ray
 /// along which MPR searches.
 Vec3 centres_direction(const RigidBody& a, const RigidBody& b);

@@ -40,6 +40,10 @@ struct ExpectContact {
   bool either_sign = false;    // the normal is right with either sign (a tie by symmetry)
   std::optional<double> depth;
   std::optional<Vec3> point;
+  /// The contact patch's corners, world (one: a point; two: a segment's ends; more: a convex
+  /// polygon's corners, in any order), compared across the normal: the bound engines' and the
+  /// oracle's points must span it and lie on it (docs/contact_manifold.md). Empty: not stated.
+  std::vector<Vec3> patch;
 };
 
 /// The [expect] block: closed-form ground truth with an absolute tolerance (SI).

@@ -242,6 +242,54 @@ void read_sim(const Reader& r, const toml::table& sim, SimSettings& s, bool forc
       refuse(s.sweep_dt[k], "sim.sweep_dt[" + std::to_string(k) + "]", n->as_array()->get(k));
 }
 
+// [expect.contact] (node `n` of [expect] `t`): between the first two bodies at t = 0.
+ExpectContact read_expect_contact(const Reader& r, const toml::table& t, const toml::node& n,
+                                  const std::vector<BodySpec>& bodies) {
+  const toml::table& c = r.table(n, "expect.contact");
+  r.check_keys(c, "expect.contact.", keys_under("expect.contact."), false);
+  if (bodies.size() < 2)
+    r.fail(key_line(t, "contact"), "expect.contact",
+           "a contact is between the first two bodies, but the scene has " +
+               std::to_string(bodies.size()),
+           "add a second [[body]] or remove [expect.contact]");
+  ExpectContact ec;
+  if (const toml::node* v = c.get("touching"))
+    ec.touching = r.boolean(*v, "expect.contact.touching", "expect.contact.touching");
+  if (const toml::node* v = c.get("normal")) {
+    const Vec3 normal = r.vec3(*v, "expect.contact.normal", "expect.contact.normal");
+    // Any non-zero direction is accepted and normalised: the expectation is a direction, and
+    // hand-written ones like [1, 1, 0] are meant as such.
+    if (!(normal.norm() > 0))
+      r.fail(line_of(v), "expect.contact.normal", "the zero vector has no direction",
+             "give the unit normal from B toward A, e.g. normal = [-1, 0, 0]");
+    ec.normal = normal.normalized();
+  }
+  if (const toml::node* v = c.get("either_sign")) {
+    ec.either_sign = r.boolean(*v, "expect.contact.either_sign", "expect.contact.either_sign");
+    if (!ec.normal)
+      r.fail(line_of(v), "expect.contact.either_sign", "either_sign qualifies a normal",
+             "give normal = [...] beside it, or remove either_sign");
+  }
+  if (const toml::node* v = c.get("depth")) {
+    ec.depth = r.number(*v, "expect.contact.depth", "expect.contact.depth");
+    if (*ec.depth < 0)
+      r.fail(line_of(v), "expect.contact.depth",
+             "penetration depth must be >= 0 m, got " + num(*ec.depth),
+             "depth is the overlap along the normal (use touching = false for separated bodies)");
+  }
+  if (const toml::node* v = c.get("point"))
+    ec.point = r.vec3(*v, "expect.contact.point", "expect.contact.point");
+  if (const toml::node* v = c.get("patch")) {
+    const toml::array& corners = r.array(*v, "expect.contact.patch", "expect.contact.patch");
+    if (corners.empty())
+      r.fail(line_of(v), "expect.contact.patch", "a patch has at least one corner",
+             "list its corners, e.g. patch = [[0, -0.5, 0], [0, 0.5, 0]], or remove it");
+    for (size_t k = 0; k < corners.size(); ++k)
+      ec.patch.push_back(r.vec3(*corners.get(k), "expect.contact.patch", "expect.contact.point"));
+  }
+  return ec;
+}
+
 Expect read_expect(const Reader& r, const toml::table& t, const std::vector<BodySpec>& bodies) {
   Expect e;
   r.check_keys(t, "expect.", keys_under("expect."), true);
@@ -320,44 +368,7 @@ Expect read_expect(const Reader& r, const toml::table& t, const std::vector<Body
     }
   }
 
-  // [expect.contact]: between the first two bodies at t = 0.
-  if (const toml::node* n = t.get("contact")) {
-    const toml::table& c = r.table(*n, "expect.contact");
-    r.check_keys(c, "expect.contact.", keys_under("expect.contact."), false);
-    if (bodies.size() < 2)
-      r.fail(key_line(t, "contact"), "expect.contact",
-             "a contact is between the first two bodies, but the scene has " +
-                 std::to_string(bodies.size()),
-             "add a second [[body]] or remove [expect.contact]");
-    ExpectContact ec;
-    if (const toml::node* v = c.get("touching"))
-      ec.touching = r.boolean(*v, "expect.contact.touching", "expect.contact.touching");
-    if (const toml::node* v = c.get("normal")) {
-      const Vec3 normal = r.vec3(*v, "expect.contact.normal", "expect.contact.normal");
-      // Any non-zero direction is accepted and normalised: the expectation is a direction, and
-      // hand-written ones like [1, 1, 0] are meant as such.
-      if (!(normal.norm() > 0))
-        r.fail(line_of(v), "expect.contact.normal", "the zero vector has no direction",
-               "give the unit normal from B toward A, e.g. normal = [-1, 0, 0]");
-      ec.normal = normal.normalized();
-    }
-    if (const toml::node* v = c.get("either_sign")) {
-      ec.either_sign = r.boolean(*v, "expect.contact.either_sign", "expect.contact.either_sign");
-      if (!ec.normal)
-        r.fail(line_of(v), "expect.contact.either_sign", "either_sign qualifies a normal",
-               "give normal = [...] beside it, or remove either_sign");
-    }
-    if (const toml::node* v = c.get("depth")) {
-      ec.depth = r.number(*v, "expect.contact.depth", "expect.contact.depth");
-      if (*ec.depth < 0)
-        r.fail(line_of(v), "expect.contact.depth",
-               "penetration depth must be >= 0 m, got " + num(*ec.depth),
-               "depth is the overlap along the normal (use touching = false for separated bodies)");
-    }
-    if (const toml::node* v = c.get("point"))
-      ec.point = r.vec3(*v, "expect.contact.point", "expect.contact.point");
-    e.contact = ec;
-  }
+  if (const toml::node* n = t.get("contact")) e.contact = read_expect_contact(r, t, *n, bodies);
   return e;
 }
 

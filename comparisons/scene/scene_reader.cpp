@@ -60,6 +60,7 @@ const KeyInfo kKeys[] = {
     {"expect.contact.either_sign", "true"},
     {"expect.contact.depth", "0.1"},
     {"expect.contact.point", "[0, 0, 0]"},
+    {"expect.contact.patch", "[[0, -0.5, 0], [0, 0.5, 0]]"},
     {"ensemble.count", "50"},
     {"ensemble.step_test", "true"},
     {"ensemble.duration", "0.5"},

@@ -275,6 +275,51 @@ TEST(HarnessExpect, ItBindsTheEnginesItNamesTheCustomEngineByDefault) {
   EXPECT_EQ(ev.expect_failures[0].rfind("custom-seed: ", 0), 0u);
 }
 
+TEST(HarnessExpect, AStatedPatchBindsTheOracleAndTheEnginesAcrossTheNormal) {
+  // FCL's all-contacts case: a unit cube turned 45 deg about y, its lowest edge 0.707 m into a
+  // size-3 cube's top face. The patch is that edge's segment, x = 0, -0.5 <= y <= 0.5, stated
+  // at the height FCL publishes (z = -sqrt(2)/4); it is compared across the normal (+z), so
+  // that height is not the oracle's own (midway) nor the seed's.
+  const std::string text =
+      "checks = [\"contact\"]\n[[body]]\nname = \"A\"\nrotation = [0, 45, 0]\n[[body]]\n"
+      "name = \"B\"\nsize = [3, 3, 3]\nposition = [0, 0, -1.5]\n[expect]\ntolerance = 1e-9\n";
+  const auto patch = [](double x) {
+    return "[expect.contact]\npatch = [[" + std::to_string(x) + ", -0.5, -0.35355339059327373], [" +
+           std::to_string(x) + ", 0.5, -0.35355339059327373]]\n";
+  };
+  std::vector<Backend> table = {*find_backend("custom")};
+  HarnessOptions opt;
+  opt.sweep = false;
+  opt.registry = &table;
+  const auto run = [&](const std::string& expect, double x) {
+    return evaluate_scene(parse_scene(text + expect + patch(x), "patch.toml"), opt);
+  };
+  // The oracle's and custom's points span the segment and lie on it.
+  SceneEvaluation ev = run("", 0.0);
+  EXPECT_TRUE(ev.expect_failures.empty()) << ev.json["expect"];
+  // A stand-in for custom answering with its one point only cannot span it: bound, it falls
+  // short by half the segment.
+  std::vector<Backend> one_point = {*find_backend("custom")};
+  one_point[0].contact = [](const RigidBody& a, const RigidBody& b) {
+    ContactResult r = find_backend("custom")->contact(a, b);
+    r.contacts.resize(1);
+    return r;
+  };
+  opt.registry = &one_point;
+  ev = run("", 0.0);
+  ASSERT_EQ(ev.expect_failures.size(), 1u) << ev.json["expect"];
+  EXPECT_EQ(ev.expect_failures[0],
+            "custom: 1 contact point falls short of the [expect.contact] patch by 0.5 m");
+  opt.registry = &table;
+  // A patch stated 0.1 m off: the oracle and custom both fall short by 0.1 and lie 0.1 off it.
+  ev = run("", 0.1);
+  ASSERT_EQ(ev.expect_failures.size(), 4u) << ev.json["expect"];
+  for (const std::string& f : ev.expect_failures) {
+    EXPECT_TRUE(f.rfind("exact: ", 0) == 0 || f.rfind("custom: ", 0) == 0) << f;
+    EXPECT_NE(f.find("0.1 m"), std::string::npos) << f;
+  }
+}
+
 TEST(HarnessExpect, AKnownFailureExcusesAnEngineItBinds) {
   const std::string text = "[[body]]\nname = \"A\"\n[expect]\n";
   // Plain text, as the format's example shows it, excuses the custom engine.
