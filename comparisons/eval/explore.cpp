@@ -390,6 +390,8 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
       o.error = "depth";
     else if (!(o.point_err_rel <= kMarkDepthRel))
       o.error = "point";
+    else if (!(o.coverage_err_rel <= kMarkDepthRel))
+      o.error = "coverage";  // its points fall short of the patch (docs/contact_manifold.md)
     out.backends.push_back(o);
   }
   return out;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "comparisons/eval/contact_eval.h"
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/explore_detail.h"
 #include "comparisons/eval/json_io.h"
@@ -40,6 +41,21 @@ std::string expect_block(const std::string& text) {
       << format_number(sat.normal.y(), full) << ", " << format_number(sat.normal.z(), full)
       << "]\ndepth = " << format_number(std::max(sat.depth, 0.0), full) << "\n";
   }
+  // A pair as deep along the reversed normal (a body centred in another) is a tie by symmetry:
+  // either sign is right, and each takes the patch on its own side, so none is stated.
+  const bool mirrored =
+      sat.touching && ties_true_depth(bodies[0], bodies[1], -sat.normal, sat.depth, size);
+  if (mirrored) o << "either_sign = true\n";
+  if (sat.touching && !sat.manifold.empty() && !mirrored) {
+    // The oracle's contact patch (docs/contact_manifold.md), compared across the normal.
+    o << "patch = [";
+    for (size_t k = 0; k < sat.manifold.size(); ++k) {
+      const Vec3& c = sat.manifold[k];
+      o << (k ? ",\n         [" : "[") << format_number(c.x(), full) << ", "
+        << format_number(c.y(), full) << ", " << format_number(c.z(), full) << "]";
+    }
+    o << "]\n";
+  }
   return o.str();
 }
 
@@ -55,6 +71,9 @@ std::string describe_outcome(const BackendOutcome& b) {
     return "status " + b.error + ": " + m;
   }
   if (b.error == "misses") return "misses a contact";
+  if (b.error == "coverage")
+    return "its points fall short of the exact contact patch by " + fmt_num(b.coverage_err_rel, 3) +
+           " of the smaller body";
   if (b.error == "no_normal") return "reports touching with no normal on a penetrating pair";
   if (b.error == "false_contact") return "reports a contact where there is none";
   if (b.error == "missed") return "the body flew on untouched (no impulse)";

@@ -214,6 +214,9 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
   } else if (b.error == "point") {
     ok = metric("point_err_rel") > kMarkDepthRel;
     d << "point_err_rel " << metric("point_err_rel");
+  } else if (b.error == "coverage") {
+    ok = metric("coverage_err_rel") > kMarkDepthRel;
+    d << "coverage_err_rel " << metric("coverage_err_rel");
   } else if (b.error == "tunnel" && status == "ok") {
     // Tunnel kind: the harness's final position of the projectile against the wall's near face
     // (the second body's top face).

@@ -16,6 +16,7 @@
 
 #include "comparisons/cli/commands.h"
 #include "comparisons/eval/explore_campaign.h"
+#include "comparisons/eval/explore_detail.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/parallel.h"
 #include "comparisons/scene/scene_file.h"
@@ -66,6 +67,32 @@ TEST(ExploreContact, TouchingWithNoNormalIsAMissOnAPenetratingPair) {
   }
   EXPECT_GT(deep, 0);
   EXPECT_GT(apart, 0);
+}
+
+TEST(ExploreContact, AOnePointAnswerToAFacePatchIsACoverageMiss) {
+  // A backend that answers with the oracle's own first point only (the patch's centroid, its
+  // normal and depth): right on every pair whose patch is a point (an edge pair, a vertex), a
+  // coverage miss wherever the patch spans more than 1 % of the smaller body.
+  const std::vector<Backend> table = {
+      *find_backend("exact"), Backend{"centroid", "test: the oracle's first point alone",
+                                      [](const RigidBody& a, const RigidBody& b) {
+                                        ContactResult r = find_backend("exact")->contact(a, b);
+                                        if (r.contacts.size() > 1) r.contacts.resize(1);
+                                        return r;
+                                      },
+                                      nullptr}};
+  int misses = 0, right = 0;
+  for (uint64_t i = 0; i < 100; ++i) {
+    const SampleOutcome o =
+        evaluate_contact_sample(make_contact_sample(1, i), {"centroid"}, &table);
+    ASSERT_EQ(o.backends.size(), 1u);
+    const BackendOutcome& b = o.backends[0];
+    if (!b.measured) continue;
+    EXPECT_EQ(b.error, b.coverage_err_rel > 0.01 ? "coverage" : "") << i;
+    ++(b.error.empty() ? right : misses);
+  }
+  EXPECT_GT(misses, 10);
+  EXPECT_GT(right, 10);
 }
 
 std::string read(const fs::path& p) {
@@ -219,6 +246,33 @@ TEST(ExploreShrink, ShrunkSceneReproducesThroughTheHarness) {
   BackendOutcome exact = found;
   exact.backend = "exact";
   EXPECT_FALSE(harness_reproduces(text, "shrunk.toml", exact, &detail)) << detail;
+}
+
+TEST(ExploreShrink, ACoverageMissShrinksToASceneThatStatesThePatch) {
+  // libccd's MPR answers one point: its first coverage miss, shrunk, is a scene whose [expect]
+  // states the oracle's patch; the harness shows the same miss on it, and custom passes it.
+  ContactSample s;
+  SampleOutcome o;
+  ASSERT_TRUE(first_disagreement("libccd-mpr", "coverage", &s, &o));
+  std::string sig;
+  for (const BackendOutcome& b : o.backends)
+    if (b.error == "coverage") sig = signature(o, b);
+  ExploreSettings set;
+  set.seed = 1;
+  set.count = 300;
+  set.shrink_budget = 100;
+  const Json g = {
+      {"first_sample", s.index}, {"backend", "libccd-mpr"}, {"signature", sig}, {"count", 1}};
+  const Json shrunk = Json::parse(explore_detail::shrink_group(g, set));
+  ASSERT_TRUE(shrunk["ok"].get<bool>()) << shrunk.dump();
+  EXPECT_TRUE(shrunk["reproduced"].get<bool>()) << shrunk["harness"];
+  const std::string text = shrunk["text"];
+  EXPECT_NE(text.find("\npatch = [["), std::string::npos) << text;
+  HarnessOptions opt;
+  opt.backends = "custom";
+  opt.sweep = false;
+  const SceneEvaluation ev = evaluate_scene(parse_scene(text, "shrunk.toml"), opt);
+  EXPECT_TRUE(ev.json["expect"]["passed"].get<bool>()) << ev.json["expect"];
 }
 
 // ---------------------------------------------------------------------------------------------
