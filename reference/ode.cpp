@@ -253,6 +253,7 @@ struct CollideContext {
   double restitution = 1.0;
   double friction = 0.0;
   bool friction_along_slip = false;  // OdeSettings::friction_along_slip
+  int max_contacts = kMaxContacts;   // OdeSettings::max_contacts
   std::vector<StepContact> contacts;
   std::deque<dJointFeedback> feedback;  // deque: stable addresses while growing
 };
@@ -282,7 +283,7 @@ void near_callback(void* data, dGeomID o1, dGeomID o2) {
     std::swap(b1, b2);
   }
   dContact contact[kMaxContacts] = {};
-  const int n = dCollide(o1, o2, kMaxContacts, &contact[0].geom, sizeof(dContact));
+  const int n = dCollide(o1, o2, ctx->max_contacts, &contact[0].geom, sizeof(dContact));
   for (int i = 0; i < n; ++i) {
     dContact& c = contact[i];
     // dContactBounce: restitution as a target separation speed (joints/contact.cpp, getInfo2:
@@ -365,7 +366,8 @@ KeptGeom keep_geom(const RigidBody& b, bool native) {
 /// dCollide of the two bodies; geoms built in the query, or kept in `prebuilt` (one cache per
 /// variant: the shape alone is the key).
 ContactResult contact_query(const RigidBody& a, const RigidBody& b, bool native,
-                            PrebuiltCache<KeptGeom>* prebuilt = nullptr) {
+                            PrebuiltCache<KeptGeom>* prebuilt = nullptr,
+                            int max_contacts = kMaxContacts) {
   init_ode();
   ContactResult r;
   KeptGeom ga = prebuilt ? prebuilt->get(a.shape, nullptr, [&] { return keep_geom(a, native); })
@@ -379,8 +381,8 @@ ContactResult contact_query(const RigidBody& a, const RigidBody& b, bool native,
   int n = 0;
   t_trap.clear_warning();
   const dGeomID g1 = ga->geom, g2 = gb->geom;
-  const bool ok =
-      guarded([&] { n = dCollide(g1, g2, kMaxContacts, contacts, sizeof(dContactGeom)); });
+  const int most = std::clamp(max_contacts, 1, kMaxContacts);
+  const bool ok = guarded([&] { n = dCollide(g1, g2, most, contacts, sizeof(dContactGeom)); });
   if (!ok) return {Status::Error, t_trap.error, {}};
   if (t_trap.has_warning()) r.message = t_trap.warning;
   for (int i = 0; i < n; ++i) r.contacts.push_back(convert_contact(contacts[i], feature));
@@ -564,6 +566,7 @@ DynamicsResult ode_dynamics_with(const WorldDefinition& scene, const DynamicsOpt
   ctx.restitution = scene.sim.restitution;
   ctx.friction = scene.sim.friction;
   ctx.friction_along_slip = settings.friction_along_slip;
+  ctx.max_contacts = std::clamp(settings.max_contacts, 1, kMaxContacts);
   t_trap.clear_warning();
   t_trap.warning_count = 0;
   long first_message_step = -1;
@@ -646,7 +649,7 @@ DynamicsResult ode_hull_dynamics(const WorldDefinition& scene, const DynamicsOpt
 const AtSettings<OdeSettings>& ode_at_settings() {
   static const AtSettings<OdeSettings> entries = {
       [](const RigidBody& a, const RigidBody& b, const OdeSettings& settings) {
-        return contact_query(a, b, settings.native_boxes);
+        return contact_query(a, b, settings.native_boxes, nullptr, settings.max_contacts);
       },
       ode_dynamics_with};
   return entries;

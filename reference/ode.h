@@ -15,6 +15,9 @@ struct OdeSettings {
   // First friction direction along the contact's tangential slip (dContactFDir1), where there
   // is slip; false: both directions from dPlaneSpace (ODE's default), fixed whatever the slip.
   bool friction_along_slip = true;
+  // The most contacts dCollide returns for a pair (1 to 32): dBoxBox's face manifold has up to
+  // 8 points, culled by ODE to this many; the convex path returns what it finds.
+  int max_contacts = 32;
 };
 
 /// `ode-hull`: every body a dCreateConvex geom, ODE's default world.

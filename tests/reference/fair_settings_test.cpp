@@ -15,6 +15,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -919,6 +921,70 @@ TEST(FairReferences, NativeBoxQueriesGiveTheFourCornerFaceManifold) {
   EXPECT_EQ(ode_hull.contact(a, b).contacts.size(), 1u);
   EXPECT_EQ(fcl_hull.contact(a, b).contacts.size(), 1u);
   EXPECT_EQ(mujoco_hull.contact(a, b).contacts.size(), 1u);
+}
+
+// The largest distance, across the unit normal `n`, from a corner of `patch` to the nearest of
+// the points: 0 when every corner is among them (an upper bound of the harness's coverage,
+// comparisons/eval/patch_cover.h, which measures to the points' hull).
+double farthest_corner(const std::vector<Vec3>& patch, const ContactResult& r, const Vec3& n) {
+  double worst = 0.0;
+  for (const Vec3& corner : patch) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const ContactPoint& c : r.contacts) {
+      const Vec3 d = c.point - corner;
+      nearest = std::min(nearest, (d - d.dot(n) * n).norm());
+    }
+    worst = std::max(worst, nearest);
+  }
+  return worst;
+}
+
+TEST(OdeSettingsMeasured, ContactCountKeepsEveryCornerOfTheFacePatch) {
+  // dCollide's count on dBoxBox (the `ode` backend's path for two boxes). A unit cube 1 mm
+  // into another's top face: the patch is the square's four corners; the same cube turned
+  // 45 deg about the normal: an octagon, eight corners. ODE's count culls its clipped points
+  // to the count asked for (dBoxBox keeps the deepest and spreads the rest): at 1, one point
+  // (a corner: the opposite one is a diagonal away); at 4, the square but not the octagon; at
+  // the backend's 32, every corner of both.
+  const RigidBody base = cube("B", Vec3::Zero());
+  const RigidBody square = cube("A", Vec3(0, 0, 0.999));
+  RigidBody turned = square;
+  turned.orientation = Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()));
+  std::vector<Vec3> square_patch, octagon_patch;
+  for (double x : {-0.5, 0.5})
+    for (double y : {-0.5, 0.5}) square_patch.emplace_back(x, y, 0.4995);
+  const double h = std::sqrt(0.5), c = h - 0.5;  // the turned square's corner, and the cut
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Rotation2Dd q(k * M_PI / 2);
+    for (const Eigen::Vector2d& p : {Eigen::Vector2d(0.5, c), Eigen::Vector2d(0.5, -c)}) {
+      const Eigen::Vector2d r = q * p;
+      octagon_patch.emplace_back(r.x(), r.y(), 0.4995);
+    }
+  }
+  const Vec3 n = Vec3::UnitZ();
+  std::map<int, std::pair<double, double>> figure;  // count -> (square, octagon)
+  for (int count : {1, 4, 32}) {
+    OdeSettings s;
+    s.max_contacts = count;
+    const ContactResult a = ode_at_settings().contact(square, base, s);
+    const ContactResult b = ode_at_settings().contact(turned, base, s);
+    ASSERT_EQ(a.status, Status::Ok) << a.message;
+    ASSERT_EQ(b.status, Status::Ok) << b.message;
+    EXPECT_LE(a.contacts.size(), static_cast<size_t>(count));
+    figure[count] = {farthest_corner(square_patch, a, n), farthest_corner(octagon_patch, b, n)};
+    std::printf(
+        "[measured] ode max_contacts %-2d  square: %zu points, farthest corner %.3g; "
+        "octagon: %zu points, farthest corner %.3g\n",
+        count, a.contacts.size(), figure[count].first, b.contacts.size(), figure[count].second);
+  }
+  EXPECT_GT(figure[1].first, 1.0);
+  EXPECT_GT(figure[1].second, 0.5);
+  EXPECT_LT(figure[4].first, 1e-9);
+  EXPECT_GT(figure[4].second, 0.1);
+  // The backend's count: every corner of both patches, to ODE's round-off.
+  EXPECT_EQ(OdeSettings{}.max_contacts, 32);
+  EXPECT_LT(figure[32].first, 1e-9);
+  EXPECT_LT(figure[32].second, 1e-9);
 }
 
 TEST(FairReferences, NativeBoxMassRoutinesAreTheSolidBox) {
