@@ -39,9 +39,9 @@ Json trajectory_json(const std::vector<StateSample>& samples, const std::vector<
 
 /// Events kept per backend in results.json: a resting stack reports a contact every step
 /// (16 000 for Bullet), which made results.json 27.8 MB; the count is kept as `contacts_total`.
-/// The first 20 show how each backend's contacts begin; `rbx run SCENE --json` writes every
-/// event.
-constexpr size_t kResultsMaxEvents = 20;
+/// The first 10 show how each backend's contacts begin (20 outgrew the file's budget once the
+/// resting family came); `rbx run SCENE --json` writes every event.
+constexpr size_t kResultsMaxEvents = 10;
 
 /// The mass properties a body entry may carry (bodies.NAME.*, docs/contract.md).
 inline constexpr const char* kMassProperties[] = {"mass", "static", "center_of_mass", "inertia"};

@@ -88,8 +88,11 @@ std::string fmt_err(double x, const std::string& unit) {
 
 double max_of(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
 
-// What a scene measures: its checks decide, whatever errors the backends produced.
+// What a scene measures: its checks decide, whatever errors the backends produced. A scene that
+// checks a contact and the motion it leads to (scenes/resting) is scored on the motion.
 Measure measure_of(const Scene& scene) {
+  if (scene.has_check(CheckKind::Trajectory) || scene.has_check(CheckKind::Impulse))
+    return Measure::Dynamics;
   if (scene.has_check(CheckKind::Contact)) return Measure::Contact;
   if (scene.has_check(CheckKind::Mass)) return Measure::Mass;
   return Measure::Dynamics;

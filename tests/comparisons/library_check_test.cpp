@@ -40,7 +40,7 @@ TEST(LibraryCheck, EveryMetricOfTheSceneFamiliesIsNoWorseThanTheBaseline) {
   // under the sanitizers.
   ReportOptions opt;
   for (const char* family :
-       {"analytic", "contact", "friction", "many", "mass", "real", "seed", "stress"})
+       {"analytic", "contact", "friction", "many", "mass", "real", "resting", "seed", "stress"})
     opt.inputs.push_back(std::string(RBX_SOURCE_DIR) + "/scenes/" + family);
   // Prints every changed metric under its scene and backend; 1 when any is worse.
   EXPECT_EQ(check_command(opt), 0);
