@@ -123,9 +123,10 @@ const Adapter& custom_adapter() {
       {
           with_budget(
               {"custom",
-               "rbx engine, extended: the plane of least overlap, the contact region's centre "
-               "(Moore & Wilhelms tests where overlap is not proved), contact manifolds, Coulomb "
-               "friction, resting contact, time of impact for every new contact",
+               "rbx engine, extended: the plane of least overlap, the contact patch clipped on "
+               "it (Moore & Wilhelms tests where overlap is not proved), the same manifold for "
+               "the query and the step, Coulomb friction, resting contact, time of impact for "
+               "every new contact",
                custom_contact, custom_dynamics, nullptr, false},
               custom_budget())
               .drawn("#0072B2", "o")

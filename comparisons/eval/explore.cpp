@@ -378,11 +378,13 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
     o.measured = true;
     o.normal_err_deg = angle;
     o.depth_err_rel = std::abs(c->depth - true_depth) / size;
-    o.point_err_rel =
-        sat.manifold.empty() ? 0.0 : contact_point_error(c->point, a, b, sat.manifold) / size;
-    if (!sat.manifold.empty())
-      o.coverage_err_rel =
-          patch_cover(run.result.contacts, a, b, sat.manifold, sat.normal).coverage_err / size;
+    // Every point of the answer, not only the deepest, against the true region; and the whole
+    // set against the patch.
+    if (!sat.manifold.empty()) {
+      const PatchCover cover = patch_cover(run.result.contacts, a, b, sat.manifold, sat.normal);
+      o.point_err_rel = cover.worst_point_err / size;
+      o.coverage_err_rel = cover.coverage_err / size;
+    }
     // Clear disagreements, by the harness's marks (harness.h): 1 degree, 1 % of the size.
     if (!(angle <= kMarkAngleDeg))
       o.error = "normal";

@@ -82,7 +82,7 @@ struct BackendOutcome {
   bool measured = false;        // both touch: the three errors below are set
   double normal_err_deg = 0.0;  // against exact, ties counted as right (as the harness does)
   double depth_err_rel = 0.0;   // |depth - exact depth| / smaller body size
-  double point_err_rel = 0.0;   // distance of the point from the intersection / size
+  double point_err_rel = 0.0;   // the worst point's distance from the true region / size
   std::string message;          // the backend's message when status is error
   // Impact and landing kinds (measured = the run finished):
   double velocity_err_ke = 0.0;  // final velocities against the closed form, KE norm (harness)

@@ -108,7 +108,7 @@ std::string describe_outcome(const BackendOutcome& b) {
            fmt_num(b.turn_rad, 3) + " rad, its time to rest off by " +
            fmt_num(b.rest_time_err_s, 3) + " s";
   o << "normal off by " << fmt_num(b.normal_err_deg, 3) << " deg, depth off by "
-    << fmt_num(b.depth_err_rel, 3) << " and point off by " << fmt_num(b.point_err_rel, 3)
+    << fmt_num(b.depth_err_rel, 3) << " and its worst point off by " << fmt_num(b.point_err_rel, 3)
     << " of the smaller body";
   return o.str();
 }

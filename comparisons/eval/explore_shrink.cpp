@@ -212,8 +212,8 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
     ok = metric("depth_err") > kMarkDepthRel * size;
     d << "depth_err " << metric("depth_err") << " m (size " << size << " m)";
   } else if (b.error == "point") {
-    ok = metric("point_err_rel") > kMarkDepthRel;
-    d << "point_err_rel " << metric("point_err_rel");
+    ok = metric("worst_point_err_rel") > kMarkDepthRel;
+    d << "worst_point_err_rel " << metric("worst_point_err_rel");
   } else if (b.error == "coverage") {
     ok = metric("coverage_err_rel") > kMarkDepthRel;
     d << "coverage_err_rel " << metric("coverage_err_rel");

@@ -207,8 +207,9 @@ std::string explore_markdown(const Json& j, bool have_figure) {
     << "Every sample is a random convex pair (boxes, hulls of 4 to 2,000 points, slivers; size "
        "ratios up to 1e3) at a pose biased toward hard cases, checked against the exact oracle. A "
        "disagreement is a status error, a touching mismatch beyond 1e-9 of the smaller body, a "
-       "normal more than 1 degree off (ties counted as right), or a depth or point more than 1 % "
-       "of the smaller body off, or points that fall short of the exact contact patch by more "
+       "normal more than 1 degree off (ties counted as right), a depth or any of its points more "
+       "than 1 % of the smaller body off, or points that fall short of the exact contact patch by "
+       "more "
        "than 1 % of it (*coverage*: the largest distance from a corner of the patch to the hull "
        "of the points, across the normal, relative to the smaller body; 0 when they span it, "
        "docs/contact_manifold.md). A one-point answer to a face contact is such a miss: it "
@@ -216,7 +217,7 @@ std::string explore_markdown(const Json& j, bool have_figure) {
        "else the answer misses.\n\n";
   o << "## Backends\n\n";
   Table t({"backend", "samples", "disagreements", "rate", "normal p50/p90/p99 (deg)",
-           "depth p50/p90/p99 (rel)", "point p99 (rel)", "coverage p50/p90/p99 (rel)",
+           "depth p50/p90/p99 (rel)", "worst point p99 (rel)", "coverage p50/p90/p99 (rel)",
            "coverage misses (> 1 %)"});
   for (const auto& [name, b] : j["backends"].items()) {
     const Json& e = b["errors"];
