@@ -646,16 +646,45 @@ SatResult sat_query(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyh
   return sat_query(SatShape(a), pa, SatShape(b), pb);
 }
 
-SatResult sat_query(const SatShape& a, const Pose& pa, const SatShape& b, const Pose& pb) {
-  // Query origin: midpoint of the two poses (symmetric in the arguments).
-  const Vec3 origin = 0.5 * (pa.position + pb.position);
-  const Placed sa = place(a, pa, origin);
-  const Placed sb = place(b, pb, origin);
+namespace {
+
+// Both shapes placed about the midpoint of their poses (symmetric in the arguments), with the
+// query's tolerances from the pair's largest coordinate.
+struct PlacedPair {
+  Vec3 origin;
+  Placed a, b;
+  double roundoff = 0.0;  // m: round-off of a support difference
+  double prefer = 0.0;    // m: how much better an edge pair must be than the best face
+};
+
+PlacedPair place_pair(const SatShape& a, const Pose& pa, const SatShape& b, const Pose& pb) {
+  PlacedPair q;
+  q.origin = 0.5 * (pa.position + pb.position);
+  q.a = place(a, pa, q.origin);
+  q.b = place(b, pb, q.origin);
   double length = 0.0;  // m: largest coordinate magnitude of the pair
-  for (const Vec3& p : sa.x) length = std::max(length, p.norm());
-  for (const Vec3& p : sb.x) length = std::max(length, p.norm());
-  const double roundoff = kRoundoffRelative * length;
-  const double prefer = kPreferRelative * length;
+  for (const Vec3& p : q.a.x) length = std::max(length, p.norm());
+  for (const Vec3& p : q.b.x) length = std::max(length, p.norm());
+  q.roundoff = kRoundoffRelative * length;
+  q.prefer = kPreferRelative * length;
+  return q;
+}
+
+// The patch of a face axis: the incident face clipped to the reference face, in the world.
+std::vector<Vec3> face_patch(const PlacedPair& q, const Axis& face) {
+  const Placed& ref = face.owner == 0 ? q.a : q.b;
+  const Placed& inc = face.owner == 0 ? q.b : q.a;
+  std::vector<Vec3> patch = face_manifold(ref, face.face, inc, q.roundoff);
+  for (Vec3& p : patch) p += q.origin;
+  return patch;
+}
+
+}  // namespace
+
+SatResult sat_query(const SatShape& a, const Pose& pa, const SatShape& b, const Pose& pb) {
+  const PlacedPair q = place_pair(a, pa, b, pb);
+  const Placed &sa = q.a, &sb = q.b;
+  const double roundoff = q.roundoff, prefer = q.prefer;
 
   // Face axes: the tied set within `prefer` of the minimum, then the slot-free reference order.
   std::vector<Axis> faces;
@@ -689,14 +718,42 @@ SatResult sat_query(const SatShape& a, const Pose& pa, const SatShape& b, const 
   if (!r.touching) return r;
 
   if (use_edge) {
-    r.manifold.push_back(edge_manifold(sa, best.class_a, sb, best.class_b, best.normal));
+    r.manifold.push_back(edge_manifold(sa, best.class_a, sb, best.class_b, best.normal) + q.origin);
   } else {
-    const Placed& ref = best.owner == 0 ? sa : sb;
-    const Placed& inc = best.owner == 0 ? sb : sa;
-    r.manifold = face_manifold(ref, best.face, inc, roundoff);
+    r.manifold = face_patch(q, best);
   }
-  for (Vec3& p : r.manifold) p += origin;
   return r;
+}
+
+std::optional<SatPatch> sat_patch_along(const ConvexPolyhedron& a, const Pose& pa,
+                                        const ConvexPolyhedron& b, const Pose& pb,
+                                        const Vec3& normal) {
+  const SatShape shape_a(a), shape_b(b);  // the placed shapes point into their topologies
+  const PlacedPair q = place_pair(shape_a, pa, shape_b, pb);
+  std::vector<Axis> faces;
+  face_axes(q.a, q.b, 0, faces);
+  face_axes(q.b, q.a, 1, faces);
+  double least = std::numeric_limits<double>::infinity();
+  for (const Axis& ax : faces) least = std::min(least, ax.overlap);
+  for (const Axis& ax : edge_axes(q.a, q.b)) least = std::min(least, ax.overlap);
+  if (!(least >= -q.roundoff)) return std::nullopt;
+  // The tied face axis nearest the direction, within 1 degree of it (a normal further off is
+  // wrong, not another tied axis).
+  const Vec3 n = normal.normalized();
+  const Axis* nearest = nullptr;
+  double most = std::cos(M_PI / 180.0);
+  for (const Axis& ax : faces) {
+    if (!(ax.overlap <= least + q.prefer)) continue;
+    const double along = ax.normal.dot(n);
+    // Two faces on one axis (a face resting on a face): sat_query's reference order.
+    const bool same = nearest && std::abs(along - most) <= 1e-12;
+    if (same ? better_reference(ax, *nearest) : along > most) {
+      nearest = &ax;
+      most = std::max(most, along);
+    }
+  }
+  if (!nearest) return std::nullopt;
+  return SatPatch{nearest->normal, face_patch(q, *nearest)};
 }
 
 ContactResult exact_contact(const RigidBody& a, const RigidBody& b) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 
 #include "reference/backend.h"
 
@@ -42,6 +43,19 @@ SatResult sat_query(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyh
 
 /// The same query on prepared shapes (same answer, without rebuilding their topology).
 SatResult sat_query(const SatShape& a, const Pose& pa, const SatShape& b, const Pose& pb);
+
+/// The exact contact patch of a tied axis: where the least overlap is reached along several face
+/// normals (a cube on another's diagonal: x, y and z; two coincident cubes: all six), the patch
+/// of the tied face axis nearest `normal` (from B toward A), within 1 degree of it; nothing when
+/// no tied face axis lies that near, or the pair is apart. On the oracle's own axis it is
+/// sat_query's manifold.
+struct SatPatch {
+  Vec3 normal = Vec3::UnitZ();  // unit, world, from B toward A: the tied axis
+  std::vector<Vec3> corners;    // its contact polygon (world)
+};
+std::optional<SatPatch> sat_patch_along(const ConvexPolyhedron& a, const Pose& pa,
+                                        const ConvexPolyhedron& b, const Pose& pb,
+                                        const Vec3& normal);
 
 /// Backend `exact`: one contact per manifold point, each with the SAT normal and depth;
 /// the first contact is the manifold centroid.

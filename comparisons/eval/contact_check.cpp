@@ -164,7 +164,8 @@ void Evaluator::point_metrics(const std::string& name, const std::string& pair,
          contact_point_error(deepest.point, a, b, sat.manifold) / size, "exact");
   // The whole set against the exact patch (patch_cover.h): a backend that returns one right
   // point and one that returns the patch differ here, not in point_err_rel.
-  const PatchCover cover = patch_cover(r.contacts, a, b, sat.manifold, sat.normal);
+  const SatPatch truth = true_patch(r, a, b, sat);
+  const PatchCover cover = patch_cover(r.contacts, a, b, truth.corners, truth.normal);
   metric("contact", name, pair, "contact_points", cover.points, "exact");
   metric("contact", name, pair, "worst_point_err_rel", cover.worst_point_err / size, "exact");
   metric("contact", name, pair, "coverage_err_rel", cover.coverage_err / size, "exact");

@@ -93,7 +93,8 @@ ContactsRow compare_row(const std::string& name, const ContactRun& run, const Co
     }
     row.mark = mark_of(angle, std::abs(c->depth - t->depth), size, tol);
     if (sat.touching && !sat.manifold.empty()) {
-      row.cover = patch_cover(run.result.contacts, a, b, sat.manifold, sat.normal);
+      const SatPatch truth = true_patch(run.result, a, b, sat);
+      row.cover = patch_cover(run.result.contacts, a, b, truth.corners, truth.normal);
       row.size = std::min(body_size(a), body_size(b));
       pair["contact_points"] = row.cover->points;
       pair["worst_point_err_rel"] = row.cover->worst_point_err / row.size;

@@ -381,7 +381,8 @@ SampleOutcome evaluate_bodies(const RigidBody& a, const RigidBody& b,
     // Every point of the answer, not only the deepest, against the true region; and the whole
     // set against the patch.
     if (!sat.manifold.empty()) {
-      const PatchCover cover = patch_cover(run.result.contacts, a, b, sat.manifold, sat.normal);
+      const SatPatch truth = true_patch(run.result, a, b, sat);
+      const PatchCover cover = patch_cover(run.result.contacts, a, b, truth.corners, truth.normal);
       o.point_err_rel = cover.worst_point_err / size;
       o.coverage_err_rel = cover.coverage_err / size;
     }

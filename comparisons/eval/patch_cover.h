@@ -10,6 +10,8 @@
 
 #include "engine/body.h"
 #include "engine/contact.h"
+#include "reference/backend.h"
+#include "reference/exact.h"
 
 namespace rbx {
 
@@ -38,6 +40,14 @@ struct PatchCover {
 /// empty, nor `patch`.
 PatchCover patch_cover(const std::vector<ContactPoint>& points, const RigidBody& a,
                        const RigidBody& b, const std::vector<Vec3>& patch, const Vec3& normal);
+
+/// The exact patch an answer is measured against: the oracle's (`sat.manifold`, across
+/// `sat.normal`), or, where the answer's deepest normal is another axis tied for the least
+/// overlap (a cube on another's diagonal: x, y and z are equally right), that axis's patch
+/// across it (sat_patch_along), so that a right choice among ties is not scored as a miss.
+/// `sat` must be touching with a patch.
+SatPatch true_patch(const ContactResult& r, const RigidBody& a, const RigidBody& b,
+                    const SatResult& sat);
 
 /// Distance (m), in the plane across the unit `normal`, from `p` to the convex hull of `set`
 /// projected on that plane: 0 inside it (or on its outline). `set` must not be empty.

@@ -153,5 +153,43 @@ TEST(PatchCover, TheOraclesPatchIsCoveredByItsOwnPointsAndCustomsManifoldNotByOn
   EXPECT_EQ(short_answer.support_err.value_or(-1), 1.0);
 }
 
+TEST(PatchCover, ATiedAxisIsMeasuredAgainstItsOwnPatch) {
+  // A 0.1 m cube on a unit cube's diagonal near its corner: the least overlap, 0.15, is reached
+  // along x, y and z alike. The oracle takes one of them; an answer on another tied axis is
+  // measured against that axis's patch (the small cube's face on the big cube's face: a 0.1 m
+  // square), not against the oracle's, across which it would fall short by 0.433 of the small
+  // cube. A normal off every tied axis keeps the oracle's patch.
+  const auto in = bodies_of(
+      "[[body]]\nname = \"A\"\nsize = [0.1, 0.1, 0.1]\nposition = [0.4, 0.4, 0.4]\n"
+      "[[body]]\nname = \"B\"\n");
+  const SatResult sat = sat_query(*in[0].shape, in[0].pose(), *in[1].shape, in[1].pose());
+  ASSERT_TRUE(sat.touching);
+  ASSERT_NEAR(sat.depth, 0.15, 1e-12);
+  for (const Vec3& axis : {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}) {
+    ContactResult r;
+    r.contacts.push_back({Vec3(0.4, 0.4, 0.4), axis, 0.15, "face"});
+    const SatPatch truth = true_patch(r, in[0], in[1], sat);
+    EXPECT_NEAR((truth.normal - axis).norm(), 0.0, 1e-12);
+    ASSERT_EQ(truth.corners.size(), 4u);
+    // The square spans 0.35 to 0.45 across the axis, in both other coordinates.
+    for (const Vec3& c : truth.corners) {
+      for (int k = 0; k < 3; ++k) {
+        if (axis[k] == 0.0) {
+          EXPECT_NEAR(std::abs(c[k] - 0.4), 0.05, 1e-12);
+        }
+      }
+    }
+    // On the oracle's own axis, its own patch.
+    if ((axis - sat.normal).norm() < 1e-12) {
+      EXPECT_EQ(truth.corners, sat.manifold);
+    }
+  }
+  ContactResult off;
+  off.contacts.push_back({Vec3(0.4, 0.4, 0.4), Vec3(1, 1, 1).normalized(), 0.26, "mpr"});
+  const SatPatch kept = true_patch(off, in[0], in[1], sat);
+  EXPECT_EQ(kept.normal, sat.normal);
+  EXPECT_EQ(kept.corners, sat.manifold);
+}
+
 }  // namespace
 }  // namespace rbx
