@@ -352,6 +352,14 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   auto place = [&](const Vec2& p, double height) {
     return Vec3(p.x() * t1 + p.y() * t2 + height * m);
   };
+  // The patch: each corner midway between the two surfaces, as deep as they are apart there.
+  auto write_patch = [&](const std::vector<Vec2>& corners) {
+    if (!patch) return;
+    patch->clear();
+    for (const Vec2& p : corners)
+      patch->push_back({place(p, 0.5 * (inc_height(p) + ref_height)),
+                        std::min(std::max(ref_height - inc_height(p), 0.0), plane.depth)});
+  };
   // Parallel faces (the incident one within round-off of against m): the plane's keys may have
   // taken either as the reference, so the two are ordered by the geometry instead, and the
   // patch is their overlap, each corner as deep as the two faces' planes are apart there.
@@ -362,12 +370,7 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
     const Projected& y = ref_first ? inc : ref;
     region = y.hull;
     clip_by(region, x.hull, eps, w.cut);
-    if (patch) {
-      patch->clear();
-      for (const Vec2& p : region)
-        patch->push_back({place(p, 0.5 * (inc_height(p) + ref_height)),
-                          std::min(std::max(ref_height - inc_height(p), 0.0), plane.depth)});
-    }
+    write_patch(region);
     const Vec2 c = centroid2(region.empty() ? y.hull : region, eps);
     if (patch && patch->empty())
       patch->push_back({place(c, 0.5 * up * (x.height + y.height)), plane.depth});
@@ -382,20 +385,15 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
   clip_by(region, ref.hull, eps, w.cut);
   double lowest = plane_detail::kInf;
   for (const Vec2& p : region) lowest = std::min(lowest, inc_height(p) - ref_height);
-  const double floor = std::max(lowest, 0.0) + eps;
+  const double keep_below = std::max(lowest, 0.0) + eps;
   kept.clear();
   for (const Vec2& p : region)
-    if (inc_height(p) - ref_height <= floor) kept.push_back(p);
+    if (inc_height(p) - ref_height <= keep_below) kept.push_back(p);
   if (kept.empty()) {
     const Vec3 x = is.world(inc_face.deep);
     kept.emplace_back(x.dot(t1), x.dot(t2));
   }
-  if (patch) {
-    patch->clear();
-    for (const Vec2& p : kept)
-      patch->push_back({place(p, 0.5 * (inc_height(p) + ref_height)),
-                        std::min(std::max(ref_height - inc_height(p), 0.0), plane.depth)});
-  }
+  write_patch(kept);
   hull2(kept, w.chain);
   const Vec2 c = centroid2(kept, eps);
   return place(c, 0.5 * (inc_height(c) + ref_height));
