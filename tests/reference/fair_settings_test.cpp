@@ -10,6 +10,9 @@
 // sequential-impulse or LCP solve of a few contact rows in double rounds to ~1e-15; ODE's
 // CFM = 1e-10 softens each row by ~1e-7, hence its own bound); "clearly wrong" means above
 // 1e-3, the report's disagreement mark (0.1 %).
+#include <fcl/geometry/shape/box.h>
+#include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/collision_object.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -939,39 +942,45 @@ double farthest_corner(const std::vector<Vec3>& patch, const ContactResult& r, c
   return worst;
 }
 
-TEST(OdeSettingsMeasured, ContactCountKeepsEveryCornerOfTheFacePatch) {
-  // dCollide's count on dBoxBox (the `ode` backend's path for two boxes). A unit cube 1 mm
-  // into another's top face: the patch is the square's four corners; the same cube turned
-  // 45 deg about the normal: an octagon, eight corners. ODE's count culls its clipped points
-  // to the count asked for (dBoxBox keeps the deepest and spreads the rest): at 1, one point
-  // (a corner: the opposite one is a diagonal away); at 4, the square but not the octagon; at
-  // the backend's 32, every corner of both.
-  const RigidBody base = cube("B", Vec3::Zero());
-  const RigidBody square = cube("A", Vec3(0, 0, 0.999));
+// A unit cube 1 mm into another's top face (the patch: the square's four corners) and the same
+// cube turned 45 deg about the normal (an octagon, eight corners), on the mid-plane z = 0.4995.
+struct FacePatches {
+  RigidBody base = cube("B", Vec3::Zero());
+  RigidBody square = cube("A", Vec3(0, 0, 0.999));
   RigidBody turned = square;
-  turned.orientation = Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()));
   std::vector<Vec3> square_patch, octagon_patch;
-  for (double x : {-0.5, 0.5})
-    for (double y : {-0.5, 0.5}) square_patch.emplace_back(x, y, 0.4995);
-  const double h = std::sqrt(0.5), c = h - 0.5;  // the turned square's corner, and the cut
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Rotation2Dd q(k * M_PI / 2);
-    for (const Eigen::Vector2d& p : {Eigen::Vector2d(0.5, c), Eigen::Vector2d(0.5, -c)}) {
-      const Eigen::Vector2d r = q * p;
-      octagon_patch.emplace_back(r.x(), r.y(), 0.4995);
+  FacePatches() {
+    turned.orientation = Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()));
+    for (double x : {-0.5, 0.5})
+      for (double y : {-0.5, 0.5}) square_patch.emplace_back(x, y, 0.4995);
+    const double h = std::sqrt(0.5), c = h - 0.5;  // the turned square's corner, and the cut
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Rotation2Dd q(k * M_PI / 2);
+      for (const Eigen::Vector2d& p : {Eigen::Vector2d(0.5, c), Eigen::Vector2d(0.5, -c)}) {
+        const Eigen::Vector2d r = q * p;
+        octagon_patch.emplace_back(r.x(), r.y(), 0.4995);
+      }
     }
   }
+};
+
+TEST(OdeSettingsMeasured, ContactCountKeepsEveryCornerOfTheFacePatch) {
+  // dCollide's count on dBoxBox (the `ode` backend's path for two boxes). ODE's count culls its
+  // clipped points to the count asked for (dBoxBox keeps the deepest and spreads the rest): at
+  // 1, one point (a corner: the opposite one is a diagonal away); at 4, the square but not the
+  // octagon; at the backend's 32, every corner of both.
+  const FacePatches f;
   const Vec3 n = Vec3::UnitZ();
   std::map<int, std::pair<double, double>> figure;  // count -> (square, octagon)
   for (int count : {1, 4, 32}) {
     OdeSettings s;
     s.max_contacts = count;
-    const ContactResult a = ode_at_settings().contact(square, base, s);
-    const ContactResult b = ode_at_settings().contact(turned, base, s);
+    const ContactResult a = ode_at_settings().contact(f.square, f.base, s);
+    const ContactResult b = ode_at_settings().contact(f.turned, f.base, s);
     ASSERT_EQ(a.status, Status::Ok) << a.message;
     ASSERT_EQ(b.status, Status::Ok) << b.message;
     EXPECT_LE(a.contacts.size(), static_cast<size_t>(count));
-    figure[count] = {farthest_corner(square_patch, a, n), farthest_corner(octagon_patch, b, n)};
+    figure[count] = {farthest_corner(f.square_patch, a, n), farthest_corner(f.octagon_patch, b, n)};
     std::printf(
         "[measured] ode max_contacts %-2d  square: %zu points, farthest corner %.3g; "
         "octagon: %zu points, farthest corner %.3g\n",
@@ -985,6 +994,66 @@ TEST(OdeSettingsMeasured, ContactCountKeepsEveryCornerOfTheFacePatch) {
   EXPECT_EQ(OdeSettings{}.max_contacts, 32);
   EXPECT_LT(figure[32].first, 1e-9);
   EXPECT_LT(figure[32].second, 1e-9);
+}
+
+// FCL's count: fcl::collide on two fcl::Box (the `fcl` backend's path for two boxes) at
+// CollisionRequest::num_max_contacts = `count`, contacts converted as the adapter does (points
+// as FCL gives them; only their spread across the normal is measured here).
+ContactResult fcl_boxes(const RigidBody& a, const RigidBody& b, std::size_t count) {
+  auto place = [](const RigidBody& body) {
+    fcl::Transform3d tf = fcl::Transform3d::Identity();
+    tf.linear() = body.orientation.toRotationMatrix();
+    tf.translation() = body.position;
+    return tf;
+  };
+  auto unit_box = std::make_shared<fcl::Boxd>(1.0, 1.0, 1.0);
+  fcl::CollisionObjectd oa(unit_box, place(a)), ob(unit_box, place(b));
+  fcl::CollisionRequestd request(count, true);
+  request.gjk_solver_type = fcl::GST_LIBCCD;
+  fcl::CollisionResultd result;
+  fcl::collide(&oa, &ob, request, result);
+  std::vector<fcl::Contactd> contacts;
+  result.getContacts(contacts);
+  ContactResult r;
+  for (const fcl::Contactd& c : contacts)
+    r.contacts.push_back({c.pos, -c.normal, c.penetration_depth, ""});
+  return r;
+}
+
+TEST(FclSettingsMeasured, ContactCountCapsBoxBoxAtItsOwnFour) {
+  // num_max_contacts caps how many of a pair's contacts collide() keeps (the deepest first,
+  // shape_collision_traversal_node-inl.h); on two boxes boxBoxIntersect clips the face and culls
+  // to 4 points whatever the request (FCL 0.7 passes maxc = 4 to boxBox2, box_box-inl.h). So:
+  // at 1, one point; at 4 and above, the square's four corners, and four of the octagon's eight
+  // (a corner of it uncovered). The backend asks for more than 4 (reference/fcl.cpp's
+  // kMaxContacts): every point FCL makes, its own cull shown as it is.
+  const FacePatches f;
+  const Vec3 n = Vec3::UnitZ();
+  const Backend& fcl_backend = fcl_adapter().backend("fcl");
+  for (std::size_t count : {1, 4, 8, 32}) {
+    const ContactResult a = fcl_boxes(f.square, f.base, count);
+    const ContactResult b = fcl_boxes(f.turned, f.base, count);
+    const double square = farthest_corner(f.square_patch, a, n);
+    const double octagon = farthest_corner(f.octagon_patch, b, n);
+    std::printf(
+        "[measured] fcl num_max_contacts %-2zu  square: %zu points, farthest corner %.3g; "
+        "octagon: %zu points, farthest corner %.3g\n",
+        count, a.contacts.size(), square, b.contacts.size(), octagon);
+    EXPECT_EQ(a.contacts.size(), std::min<std::size_t>(count, 4));
+    EXPECT_EQ(b.contacts.size(), std::min<std::size_t>(count, 4));
+    if (count == 1) {
+      EXPECT_GT(square, 1.0);  // a corner: the opposite one a diagonal away
+      continue;
+    }
+    EXPECT_LT(square, 1e-9);
+    EXPECT_GT(octagon, 0.1);
+  }
+  // The backend's answer is the uncapped one: the same four points.
+  for (const RigidBody* body : {&f.square, &f.turned}) {
+    const ContactResult backend = fcl_backend.contact(*body, f.base);
+    ASSERT_EQ(backend.status, Status::Ok) << backend.message;
+    EXPECT_EQ(backend.contacts.size(), 4u);
+  }
 }
 
 TEST(FairReferences, NativeBoxMassRoutinesAreTheSolidBox) {
