@@ -31,7 +31,6 @@ struct Face {
   std::array<int, 3> v{};
   Vec3 n = Vec3::UnitZ();
   double dist = 0.0;
-  bool live = true;
 };
 
 // D's support point along d, each shape's climb starting from `from`'s vertices.
@@ -163,6 +162,13 @@ struct Polytope {
   std::vector<Point> points;
   std::vector<Face> faces;
   std::vector<std::array<int, 2>> horizon;
+  // The nearest triangle (least plane distance; of equals, the first in `faces`), kept by add and
+  // expand as they go, so that no iteration scans the triangles a second time for it.
+  int nearest = -1;
+
+  void consider(int g) {
+    if (nearest < 0 || faces[g].dist < faces[nearest].dist) nearest = g;
+  }
 
   // A triangle of points i, j, k (wound outward); false when the origin lies beyond its plane by
   // more than round-off. A flat triangle (the origin on its plane, to round-off: GJK's simplex on
@@ -178,6 +184,7 @@ struct Polytope {
     f.dist = f.n.dot(p);
     if (!(f.dist > -tie)) return false;
     faces.push_back(f);
+    consider(static_cast<int>(faces.size()) - 1);
     return true;
   }
   // Replaces the triangles that see point w (index `wi`) by a cone from w over their boundary.
@@ -185,14 +192,26 @@ struct Polytope {
     const Vec3& w = points[wi].w;
     horizon.clear();
     const std::size_t count = faces.size();
+    // The triangles that stay are moved down over the seen ones as the scan goes (the scans of
+    // later iterations stay short), and the nearest of them kept.
+    nearest = -1;
+    std::size_t stay = 0;
+    double least = 0.0;
     for (std::size_t g = 0; g < count; ++g) {
-      Face& f = faces[g];
+      const Face& f = faces[g];
       // Seen only from beyond the tie margin: w on the plane of coplanar triangles (points of D on
       // one face of it) would be seen from some and not others by round-off, and the fan over
       // their edge would fold inward. The nearest triangle is always seen (the loop grows it only
       // when w is beyond it by more than the margin).
-      if (!f.live || !(f.n.dot(w) - f.dist > tie)) continue;
-      f.live = false;
+      if (!(f.n.dot(w) - f.dist > tie)) {
+        if (nearest < 0 || f.dist < least) {
+          nearest = static_cast<int>(stay);
+          least = f.dist;
+        }
+        if (stay != g) faces[stay] = f;
+        ++stay;
+        continue;
+      }
       // Each directed edge of a seen triangle, unless its reverse is one too (then interior).
       for (int e = 0; e < 3; ++e) {
         const int from = f.v[e], to = f.v[(e + 1) % 3];
@@ -208,9 +227,7 @@ struct Polytope {
         }
       }
     }
-    // The seen triangles go (the scans of later iterations stay short).
-    faces.erase(std::remove_if(faces.begin(), faces.end(), [](const Face& f) { return !f.live; }),
-                faces.end());
+    faces.resize(stay);
     for (const auto& e : horizon)
       if (!add(e[0], e[1], wi, tie)) return false;
     return !horizon.empty();
@@ -234,6 +251,7 @@ bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& 
   Polytope& poly = scratch.polytope->poly;
   poly.points.assign(s.begin(), s.end());
   poly.faces.clear();
+  poly.nearest = -1;
   // The tetrahedron, each face wound away from the vertex opposite it.
   for (const auto& f : {std::array<int, 4>{0, 1, 2, 3}, {0, 3, 1, 2}, {0, 2, 3, 1}, {1, 3, 2, 0}}) {
     const Vec3 m = (s[f[1]].w - s[f[0]].w).cross(s[f[2]].w - s[f[0]].w);
@@ -244,10 +262,8 @@ bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& 
   Vec3 upper_dir = Vec3::UnitZ();
   Point upper_at;
   for (int it = 0; it < kEpaIterations; ++it) {
-    // The nearest live triangle: its plane distance is a lower bound on the answer.
-    const Face* near = nullptr;
-    for (const Face& f : poly.faces)
-      if (f.live && (!near || f.dist < near->dist)) near = &f;
+    // The nearest triangle: its plane distance is a lower bound on the answer.
+    const Face* near = &poly.faces[poly.nearest];
     const Vec3 n = near->n;
     const double lower = near->dist;
     // The climbs start from the triangle's corner furthest along its normal (nearest the answer).
@@ -285,7 +301,7 @@ bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& 
   const double limit = upper + 8.0 * tie;
   Vec3 axis = Vec3::Zero();
   for (const Face& f : poly.faces) {
-    if (!f.live || f.dist > limit) continue;
+    if (f.dist > limit) continue;
     if (!(f.dist > tie)) return false;  // still flat at the cap: no proof
     axis += f.n;
   }
@@ -299,7 +315,7 @@ bool inner_polytope_bound(const Side& a, const Side& b, double tie, Candidates& 
   axis.normalize();
   double angle = 0.0;
   for (const Face& f : poly.faces)
-    if (f.live && f.dist <= limit)
+    if (f.dist <= limit)
       angle = std::max(angle, std::acos(std::clamp(f.n.dot(axis), -1.0, 1.0)) +
                                   std::acos(std::clamp(f.dist / limit, -1.0, 1.0)));
   // Round-off of the angles themselves (acos near 1 loses half the digits: ~1e-8 rad).

@@ -92,29 +92,35 @@ void support_corners(std::vector<ManifoldPoint>& pts, const Vec3& n, double slac
     hull.pop_back();  // each chain's last point starts the other
     std::reverse(q.begin(), q.end());
   }
-  // Corners within `slack` of the line through their neighbours, nearest first.
-  auto off_line = [&](size_t k) {
+  // Corners within `slack` of the line through their neighbours, nearest first (distances
+  // compared squared: the order is the same, without a root per corner and pass).
+  auto off_line2 = [&](size_t k) {
     const Planar &a = hull[(k + hull.size() - 1) % hull.size()], &b = hull[(k + 1) % hull.size()];
-    const double length = std::hypot(b.u - a.u, b.v - a.v);
-    if (!(length > 0.0)) return std::hypot(hull[k].u - a.u, hull[k].v - a.v);
-    return std::abs(cross(a, b, hull[k])) / length;
+    const double length2 = (b.u - a.u) * (b.u - a.u) + (b.v - a.v) * (b.v - a.v);
+    const double du = hull[k].u - a.u, dv = hull[k].v - a.v;
+    if (!(length2 > 0.0)) return du * du + dv * dv;
+    const double c = cross(a, b, hull[k]);
+    return c * c / length2;
   };
+  const double slack2 = slack * slack;
   while (hull.size() > 2) {
     size_t nearest = 0;
-    double least = off_line(0);
+    double least = off_line2(0);
     for (size_t k = 1; k < hull.size(); ++k) {
-      const double off = off_line(k);
+      const double off = off_line2(k);
       if (off < least) {
         nearest = k;
         least = off;
       }
     }
-    if (!(least <= slack)) break;
+    if (!(least <= slack2)) break;
     hull.erase(hull.begin() + static_cast<std::ptrdiff_t>(nearest));
   }
   const ManifoldPoint deepest = deepest_of(pts);
-  if (hull.size() == 1 ||
-      (hull.size() == 2 && std::hypot(hull[1].u - hull[0].u, hull[1].v - hull[0].v) <= slack)) {
+  auto apart2 = [](const Planar& x, const Planar& y) {
+    return (x.u - y.u) * (x.u - y.u) + (x.v - y.v) * (x.v - y.v);
+  };
+  if (hull.size() == 1 || (hull.size() == 2 && apart2(hull[1], hull[0]) <= slack2)) {
     // A region within `slack` of a point: its deepest point.
     pts.assign(1, deepest);
     return;
@@ -134,7 +140,8 @@ void support_corners(std::vector<ManifoldPoint>& pts, const Vec3& n, double slac
   const Vec3& pd = deepest.point;
   for (ManifoldPoint& p : pts) {
     const Vec3 d = p.point - pd;
-    if (std::hypot(d.dot(t1), d.dot(t2)) <= slack) {
+    const double du = d.dot(t1), dv = d.dot(t2);
+    if (du * du + dv * dv <= slack2) {
       p.depth = deepest.depth;
       return;
     }
@@ -156,18 +163,26 @@ std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const P
                                               const ConvexPolyhedron& b, const Pose& pb,
                                               DetectorVariant variant, double support_slack,
                                               DetectionCache& cache, ContactScratch& scratch) {
-  // 1-3. The features in contact, the chosen plane and the patch clipped on it: the query's
-  // own pipeline (engine/contact_region.h), so that `custom` answers with this manifold.
   ContactManifold m;
   m.points.reserve(8);  // a face contact's corners, and a few clipped ones, in one allocation
-  const auto contact = find_contact(a, pa, b, pb, variant, cache, scratch, &m.points);
-  if (!contact) return std::nullopt;
-  m.contact = *contact;
+  if (!build_manifold(a, pa, b, pb, variant, support_slack, cache, scratch, m)) return std::nullopt;
+  return m;
+}
+
+bool build_manifold(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                    const Pose& pb, DetectorVariant variant, double support_slack,
+                    DetectionCache& cache, ContactScratch& scratch, ContactManifold& m) {
+  // 1-3. The features in contact, the chosen plane and the patch clipped on it: the query's
+  // own pipeline (engine/contact_region.h), so that `custom` answers with this manifold.
+  auto contact = find_contact(a, pa, b, pb, variant, cache, scratch, &m.points);
+  if (!contact) return false;
   m.normal = contact->normal;
   m.depth = contact->depth;
+  m.contact = std::move(*contact);
   // Merge coincident points (a clipped corner on a corner of the reference face), the first of
   // each kept.
-  const double merge = 1e-7 * std::max(shape_size(a), shape_size(b)), merge2 = merge * merge;
+  const double size_a = shape_size(a), size_b = shape_size(b);
+  const double merge = 1e-7 * std::max(size_a, size_b), merge2 = merge * merge;
   size_t kept = 0;
   for (size_t i = 0; i < m.points.size(); ++i) {
     const Vec3& p = m.points[i].point;
@@ -180,9 +195,8 @@ std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const P
   // alone.
   plane_detail::Scratch& lists = scratch.lists();
   if (!lists.manifold) lists.manifold.reset(new plane_detail::ManifoldLists);
-  support_corners(m.points, m.normal, support_slack * std::min(shape_size(a), shape_size(b)),
-                  *lists.manifold);
-  return m;
+  support_corners(m.points, m.normal, support_slack * std::min(size_a, size_b), *lists.manifold);
+  return true;
 }
 
 }  // namespace rbx

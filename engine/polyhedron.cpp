@@ -103,6 +103,7 @@ ConvexPolyhedron ConvexPolyhedron::from_triangles(std::vector<Vec3> vertices,
     p.bounds_.min = p.bounds_.min.cwiseMin(v);
     p.bounds_.max = p.bounds_.max.cwiseMax(v);
   }
+  p.size_ = (p.bounds_.max - p.bounds_.min).norm();
   const double scale = std::max((p.bounds_.max - p.bounds_.min).maxCoeff(), 1e-300);
   // Round-off of plane offsets grows with |x| * eps; 1e-9 of the size leaves room for meshes
   // written with ~10 significant digits (OBJ files) while still catching real dents.
@@ -196,6 +197,7 @@ ConvexPolyhedron ConvexPolyhedron::translated(const Vec3& offset) const {
   for (Plane& pl : p.planes_) pl.offset += pl.normal.dot(offset);
   p.bounds_.min += offset;
   p.bounds_.max += offset;
+  p.size_ = (p.bounds_.max - p.bounds_.min).norm();
   p.build_hierarchy();
   return p;
 }
@@ -282,7 +284,5 @@ ConvexPolyhedron make_prism(double radius, double height, int sides) {
   }
   return ConvexPolyhedron::from_triangles(std::move(v), std::move(t));
 }
-
-double shape_size(const ConvexPolyhedron& s) { return (s.bounds().max - s.bounds().min).norm(); }
 
 }  // namespace rbx

@@ -92,6 +92,8 @@ class ConvexPolyhedron {
   /// The same polyhedron with every vertex moved by offset.
   ConvexPolyhedron translated(const Vec3& offset) const;
 
+  friend double shape_size(const ConvexPolyhedron& s);
+
  private:
   std::vector<Vec3> vertices_;
   std::vector<std::array<int, 3>> triangles_;
@@ -100,6 +102,7 @@ class ConvexPolyhedron {
   std::vector<Plane> planes_;
   std::vector<unsigned char> new_plane_;
   Aabb bounds_;
+  double size_ = 0.0;  // shape_size: the diagonal of bounds_, kept (every query asks for it)
   std::shared_ptr<const ShapeHierarchy> hierarchy_;  // shared by copies: the shape is immutable
   std::shared_ptr<const GaussMap> gauss_map_;        // likewise
 
@@ -113,7 +116,7 @@ class ConvexPolyhedron {
 
 /// The size of a shape: the diagonal of its bounding box (m). Every tolerance and error that is
 /// relative to a body is a fraction of it (of the smaller body's, for a pair).
-double shape_size(const ConvexPolyhedron& s);
+inline double shape_size(const ConvexPolyhedron& s) { return s.size_; }
 
 /// Box with full extents `size`, centred at the origin (12 triangles).
 ConvexPolyhedron make_box(const Vec3& size);

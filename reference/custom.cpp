@@ -1,6 +1,8 @@
 #include "reference/custom.h"
 
 #include <exception>
+#include <string>
+#include <utility>
 
 #include "engine/detect.h"
 #include "engine/manifold.h"
@@ -13,20 +15,22 @@ namespace {
 // The contact of the `custom` backend on either detector: the manifold its world steps with
 // (engine/manifold.h), its one-point contact first (the plane of least overlap and the centre of
 // the contact region for shapes proved to overlap, the detector's point for the rest), then every
-// point of the manifold, all on the manifold's normal. One detection cache and one contact
-// scratch per thread, reused by every query as a world's step reuses its own: their lists are
-// allocated once. Answers do not depend on them.
+// point of the manifold, all on the manifold's normal. One detection cache, one contact
+// scratch and one manifold per thread, reused by every query as a world's step reuses its own:
+// their lists are allocated once. Answers do not depend on them.
 ContactResult engine_contact(const RigidBody& a, const RigidBody& b, DetectorVariant variant) {
   thread_local DetectionCache cache;
   thread_local ContactScratch scratch;
+  thread_local ContactManifold m;
   ContactResult r;
-  const auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant,
-                                WorldSettings{}.position_slop, cache, scratch);
-  if (!m) return r;
-  r.contacts.reserve(1 + m->points.size());
-  r.contacts.push_back(m->contact);
-  for (const ManifoldPoint& p : m->points)
-    r.contacts.push_back({p.point, m->normal, p.depth, m->contact.feature});
+  if (!build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant,
+                      WorldSettings{}.position_slop, cache, scratch, m))
+    return r;
+  r.contacts.reserve(1 + m.points.size());  // no reallocation below: `feature` stays valid
+  r.contacts.push_back(std::move(m.contact));
+  const std::string& feature = r.contacts.front().feature;
+  for (const ManifoldPoint& p : m.points)
+    r.contacts.push_back({p.point, m.normal, p.depth, feature});
   return r;
 }
 
