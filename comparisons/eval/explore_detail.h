@@ -84,6 +84,11 @@ void draw_box(SampleRng& r, double& friction, Vec3& size, double& mass, double& 
 // "first_error" say it.
 std::string describe_outcome(const BackendOutcome& b);
 
+// The [expect] block of a shrunk contact scene (`text`, without one): the exact oracle's answer
+// at its t = 0 poses, its normal and patch left out where another axis ties (or the reversed one,
+// `either_sign`).
+std::string expect_block(const std::string& text);
+
 // One disagreement group of a campaign shrunk (explore_group_shrink.cpp): its first sample
 // simplified while `group`'s backend still shows its signature, as the JSON text rank 0 collects
 // ("ok", "text" with the scene and its [expect], "reproduced", the kind's measures).

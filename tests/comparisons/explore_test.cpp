@@ -275,6 +275,35 @@ TEST(ExploreShrink, ACoverageMissShrinksToASceneThatStatesThePatch) {
   EXPECT_TRUE(ev.json["expect"]["passed"].get<bool>()) << ev.json["expect"];
 }
 
+TEST(ExploreShrink, ATieBetweenTwoAxesStatesNeitherNormalNorPatch) {
+  // Unit cubes with B at (0.9, 0.3, 0.9) from A: the overlap is 1 - 0.9 = 0.1 along x and
+  // along z (0.7 along y), so -x and -z are both right, each with the patch on its own plane.
+  // The shrunk scene's [expect] states the depth and leaves the normal and patch to the
+  // harness's rule for ties; custom passes it in both body orders, whichever axis it takes.
+  // Moved to (0.9, 0.3, 0.8) only x is least (0.1 against 0.2): normal and patch stated.
+  auto scene = [](const std::string& b_at, bool swapped) {
+    const std::string a = "[[body]]\nname = \"A\"\n";
+    const std::string b = "[[body]]\nname = \"B\"\nposition = " + b_at + "\n";
+    return "checks = [\"contact\"]\n[sim]\nduration = 0\n" + (swapped ? b + a : a + b);
+  };
+  for (bool swapped : {false, true}) {
+    const std::string tied = scene("[0.9, 0.3, 0.9]", swapped);
+    const std::string block = explore_detail::expect_block(tied);
+    EXPECT_EQ(block.find("\nnormal ="), std::string::npos) << block;
+    EXPECT_EQ(block.find("\npatch ="), std::string::npos) << block;
+    EXPECT_NE(block.find("\ndepth = 0.09999"), std::string::npos) << block;
+    HarnessOptions opt;
+    opt.backends = "custom";
+    opt.sweep = false;
+    const SceneEvaluation ev = evaluate_scene(parse_scene(tied + block, "tied.toml"), opt);
+    EXPECT_TRUE(ev.json["expect"]["passed"].get<bool>()) << ev.json["expect"];
+
+    const std::string single = explore_detail::expect_block(scene("[0.9, 0.3, 0.8]", swapped));
+    EXPECT_NE(single.find("\nnormal = ["), std::string::npos) << single;
+    EXPECT_NE(single.find("\npatch = [["), std::string::npos) << single;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Impact kind
 
