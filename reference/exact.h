@@ -57,6 +57,18 @@ std::optional<SatPatch> sat_patch_along(const ConvexPolyhedron& a, const Pose& p
                                         const ConvexPolyhedron& b, const Pose& pb,
                                         const Vec3& normal);
 
+/// The exact separation of two placed convex polyhedra (reference/exact_distance.cpp): the
+/// distance and a closest point on each, from every vertex-triangle and edge-edge pair in closed
+/// form (docs/distance.md).
+struct ExactDistance {
+  bool overlapping = false;  // the shapes overlap by more than touching: no distance
+  double distance = 0.0;     // m; 0 when they touch
+  Vec3 point_a = Vec3::Zero(), point_b = Vec3::Zero();  // world, on A and on B
+  std::string feature_a, feature_b;  // what each point lies on: "vertex" | "edge" | "face"
+};
+ExactDistance exact_distance(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
+                             const Pose& pb);
+
 /// Backend `exact`: one contact per manifold point, each with the SAT normal and depth;
 /// the first contact is the manifold centroid.
 ContactResult exact_contact(const RigidBody& a, const RigidBody& b);
