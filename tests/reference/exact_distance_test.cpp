@@ -26,7 +26,7 @@ Quat about(double deg, const Vec3& axis) { return Quat(Eigen::AngleAxisd(deg * M
 TEST(ExactDistance, ClosedFormsWithTheirFeatures) {
   const ConvexPolyhedron cube = make_box(Vec3::Ones());
   // A's corner (0.5, 0.5, 0.5) turned onto +x reaches x = sqrt(3)/2; B's -x face is 0.25
-  // beyond it (engine/distance_test.cpp derives the same three cases).
+  // beyond it (tests/engine/distance_test.cpp derives the same three cases).
   const double tip = std::sqrt(3.0) / 2;
   const Quat corner_to_x = Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitX());
   ExactDistance d =
