@@ -69,6 +69,18 @@ struct ExactDistance {
 ExactDistance exact_distance(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                              const Pose& pb);
 
+/// The exact first contact of two convex polyhedra translating at constant velocities over
+/// [0, dt] (reference/exact_time_of_impact.cpp): the largest entering time over every separating
+/// axis (the faces' normals and the edge pairs' cross products), when no axis has closed again
+/// by then (docs/distance.md, "Time of impact").
+struct ExactImpact {
+  std::optional<double> time;   // s: the first touch in [0, dt] (0: touching at the start)
+  Vec3 normal = Vec3::UnitZ();  // unit, world, from B toward A: the axis that closed last
+};
+ExactImpact exact_translation_impact(const ConvexPolyhedron& a, const Pose& pa, const Vec3& va,
+                                     const ConvexPolyhedron& b, const Pose& pb, const Vec3& vb,
+                                     double dt);
+
 /// Backend `exact`: one contact per manifold point, each with the SAT normal and depth;
 /// the first contact is the manifold centroid.
 ContactResult exact_contact(const RigidBody& a, const RigidBody& b);
