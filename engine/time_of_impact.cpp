@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "engine/detect.h"
+#include "engine/distance.h"
 #include "engine/integrate.h"
 #include "engine/separation.h"
 
@@ -78,11 +80,61 @@ TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt,
   const double grid = std::ceil(rate * dt / (0.25 * thin));
   if (grid <= static_cast<double>(max_samples)) {
     const long n = std::max(1L, static_cast<long>(grid));
+    // Two samples apart do not prove the time between them apart: bodies skimming past each
+    // other can overlap briefly between them (a corner clipping another's). Certified from the
+    // distance (engine/distance.h): along the direction n from A's closest point to B's, the
+    // gap d between the shapes shrinks no faster than the approach along n, -(v_b - v_a) . n,
+    // plus what the turns can bring (the spin part of the travel rate), so nothing touches for
+    // d over that rate after a time the pair is apart, nor that long before (the rate of
+    // opening, backward). A touch between samples at t0 and t1 needs both spans to fit in
+    // between; where they do not, nothing touched. Else the interval is walked by those steps
+    // (conservative advancement), each at least the detector's tolerance of travel (an overlap
+    // shallower than that is touching to the detector anyway).
+    const double least_step = point_in_mesh_tolerance(*a.shape, *b.shape) / rate;
+    const auto spin_of = [&](const RigidBody& body, const PrincipalFrame* frame) {
+      return body.is_static ? 0.0 : rate_of(body, frame) - body.velocity.norm();
+    };
+    const double spin = spin_of(a, frame_a) + spin_of(b, frame_b);
+    // B's velocity seen from A (a static body does not move, whatever its velocity says).
+    const Vec3 v_rel =
+        (b.is_static ? Vec3::Zero() : b.velocity) - (a.is_static ? Vec3::Zero() : a.velocity);
+    // How long after (forward) and before (backward) time t the pair is sure to stay apart.
+    struct Room {
+      double forward = 0.0, backward = 0.0;
+    };
+    auto room = [&](double t) {
+      const Separation sep =
+          shape_distance(*a.shape, pose_at(a, t, frame_a), *b.shape, pose_at(b, t, frame_b));
+      if (sep.overlapping || !(sep.distance > 0)) return Room{};
+      const Vec3 n = (sep.point_b - sep.point_a) / sep.distance;
+      const double approach = -v_rel.dot(n);
+      auto span = [&](double closing) {
+        return closing > 0 ? sep.distance / closing : std::numeric_limits<double>::infinity();
+      };
+      return Room{span(std::max(0.0, approach) + spin), span(std::max(0.0, -approach) + spin)};
+    };
+    long walked = 0;
     double before = 0.0;
+    Room at_before = room(0.0);
     for (long k = 1; k <= n; ++k) {
       const double t = dt * static_cast<double>(k) / static_cast<double>(n);
       if (touching(t)) return first_touch(before, t);
+      const Room at_t = room(t);
+      if (!(at_before.forward + at_t.backward > t - before)) {
+        // The walk asks the distance at each step, and the detector only where the distance
+        // finds the pair touching (the cheaper query first).
+        double clear = before, span = at_before.forward;
+        for (;;) {
+          const double next = clear + std::max(span, least_step);
+          if (next >= t) break;
+          span = room(next).forward;
+          if (!(span > 0) && touching(next)) return first_touch(clear, next);
+          clear = next;
+          if (++walked >= max_samples) return {std::nullopt, false};
+        }
+      }
       before = t;
+      at_before = at_t;
     }
     return {};
   }
