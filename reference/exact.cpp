@@ -45,6 +45,8 @@
 #include <unordered_map>
 #include <utility>
 
+#include "reference/exact_geometry.h"
+
 namespace rbx {
 
 namespace {
@@ -500,26 +502,6 @@ std::vector<Vec3> clip(const std::vector<Vec3>& poly, const Vec3& s, double offs
   return out;
 }
 
-// Closest points of segments [p1, q1] and [p2, q2] (Ericson, Real-Time Collision Detection 5.1.9).
-void closest_points(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, Vec3& c1,
-                    Vec3& c2) {
-  const Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  const double c = d1.dot(r), b = d1.dot(d2);
-  const double denom = a * e - b * b;  // > 0: parallel pairs never reach here
-  double s = denom > 0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
-  double t = (b * s + f) / e;
-  if (t < 0) {
-    t = 0;
-    s = std::clamp(-c / a, 0.0, 1.0);
-  } else if (t > 1) {
-    t = 1;
-    s = std::clamp((b - c) / a, 0.0, 1.0);
-  }
-  c1 = p1 + s * d1;
-  c2 = p2 + t * d2;
-}
-
 // Face-axis manifold: reference face `face` of `ref`, incident feature of `inc`.
 std::vector<Vec3> face_manifold(const Placed& ref, int face, const Placed& inc, double tol) {
   const Vec3& n = ref.face_normals[face];
@@ -614,7 +596,7 @@ Vec3 edge_manifold(const Placed& a, int class_a, const Placed& b, int class_b, c
   const FeatureEdge ea = supporting(a, class_a, n);
   const FeatureEdge eb = supporting(b, class_b, -n);
   Vec3 ca, cb;
-  closest_points(a.x[ea.a], a.x[ea.b], b.x[eb.a], b.x[eb.b], ca, cb);
+  exact_detail::closest_of_segments(a.x[ea.a], a.x[ea.b], b.x[eb.a], b.x[eb.b], ca, cb);
   return 0.5 * (ca + cb);
 }
 

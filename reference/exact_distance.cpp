@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "reference/exact.h"
+#include "reference/exact_geometry.h"
 
 namespace rbx {
 
@@ -51,48 +52,6 @@ Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3
     return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
   const double denom = 1.0 / (va + vb + vc);
   return a + ab * (vb * denom) + ac * (vc * denom);
-}
-
-// The closest points of segments p1q1 and p2q2 (Ericson 5.1.9), into c1 and c2.
-void closest_of_segments(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2, Vec3& c1,
-                         Vec3& c2) {
-  const Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  double s = 0.0, t = 0.0;
-  if (a <= 0 && e <= 0) {
-    // both points
-  } else if (a <= 0) {
-    t = std::clamp(f / e, 0.0, 1.0);
-  } else {
-    const double c = d1.dot(r);
-    if (e <= 0) {
-      s = std::clamp(-c / a, 0.0, 1.0);
-    } else {
-      const double b = d1.dot(d2), denom = a * e - b * b;
-      // Parallel segments (denom 0): any s; the start of the first, then clamped.
-      s = denom > 0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
-      t = (b * s + f) / e;
-      if (t < 0) {
-        t = 0;
-        s = std::clamp(-c / a, 0.0, 1.0);
-      } else if (t > 1) {
-        t = 1;
-        s = std::clamp((b - c) / a, 0.0, 1.0);
-      }
-    }
-  }
-  c1 = p1 + d1 * s;
-  c2 = p2 + d2 * t;
-}
-
-// A shape's vertices placed in the world, relative to `origin`.
-std::vector<Vec3> placed(const ConvexPolyhedron& s, const Pose& p, const Vec3& origin) {
-  std::vector<Vec3> out;
-  out.reserve(s.vertices().size());
-  const Mat3 r = p.rotation();
-  const Vec3 t = p.position - origin;
-  for (const Vec3& v : s.vertices()) out.push_back(r * v + t);
-  return out;
 }
 
 // The kind of feature of `s` (placed as `v`, its planes turned by `r`) that point x lies on:
@@ -122,7 +81,8 @@ ExactDistance exact_distance(const ConvexPolyhedron& a, const Pose& pa, const Co
     return out;
   }
   const Vec3 origin = 0.5 * (pa.position + pb.position);
-  const std::vector<Vec3> va = placed(a, pa, origin), vb = placed(b, pb, origin);
+  const std::vector<Vec3> va = exact_detail::placed_vertices(a, pa, origin),
+                          vb = exact_detail::placed_vertices(b, pb, origin);
   double best = std::numeric_limits<double>::infinity();
   Vec3 wa = Vec3::Zero(), wb = Vec3::Zero();
   auto take = [&](const Vec3& on_a, const Vec3& on_b) {
@@ -142,7 +102,7 @@ ExactDistance exact_distance(const ConvexPolyhedron& a, const Pose& pa, const Co
   for (const Edge& ea : a.edges())
     for (const Edge& eb : b.edges()) {
       Vec3 ca, cb;
-      closest_of_segments(va[ea.a], va[ea.b], vb[eb.a], vb[eb.b], ca, cb);
+      exact_detail::closest_of_segments(va[ea.a], va[ea.b], vb[eb.a], vb[eb.b], ca, cb);
       take(ca, cb);
     }
   out.distance = std::sqrt(best);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "reference/exact.h"
+#include "reference/exact_geometry.h"
 
 namespace rbx {
 
@@ -38,20 +39,14 @@ Interval project(const std::vector<Vec3>& v, const Vec3& axis) {
   return out;
 }
 
-std::vector<Vec3> placed(const ConvexPolyhedron& s, const Pose& p, const Vec3& origin) {
-  std::vector<Vec3> out;
-  const Mat3 r = p.rotation();
-  for (const Vec3& v : s.vertices()) out.push_back(r * v + (p.position - origin));
-  return out;
-}
-
 }  // namespace
 
 ExactImpact exact_translation_impact(const ConvexPolyhedron& a, const Pose& pa, const Vec3& va,
                                      const ConvexPolyhedron& b, const Pose& pb, const Vec3& vb,
                                      double dt) {
   const Vec3 origin = 0.5 * (pa.position + pb.position);
-  const std::vector<Vec3> xa = placed(a, pa, origin), xb = placed(b, pb, origin);
+  const std::vector<Vec3> xa = exact_detail::placed_vertices(a, pa, origin),
+                          xb = exact_detail::placed_vertices(b, pb, origin);
   const Mat3 ra = pa.rotation(), rb = pb.rotation();
   std::vector<Vec3> axes;
   for (const Plane& p : a.planes()) axes.push_back(ra * p.normal);
