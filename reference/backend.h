@@ -86,6 +86,19 @@ inline bool is_native_box(const RigidBody& body) {
          off_diagonal <= 1e-12 * std::abs(inertia.trace());
 }
 
+/// A distance query's answer at given poses (docs/distance.md): how far apart A and B are and a
+/// closest point on each, world frame, SI. `overlapping`: the library says the pair overlaps or
+/// touches, and gives no separation (the contact query answers there); `distance` and the points
+/// are then unspecified.
+struct DistanceResult {
+  Status status = Status::Ok;
+  std::string message;  // why, when not ok; or what the library's answer is (a margin contact)
+  bool overlapping = false;
+  double distance = 0.0;        // m
+  Vec3 point_a = Vec3::Zero();  // m, world: A's point nearest B
+  Vec3 point_b = Vec3::Zero();  // m, world: B's point nearest A
+};
+
 /// Final state of one body after a dynamics run.
 struct BodyFinal {
   std::string name;
@@ -200,6 +213,8 @@ using ContactFn = std::function<ContactResult(const RigidBody& a, const RigidBod
 /// Dynamics run of a whole scene.
 using DynamicsFn =
     std::function<DynamicsResult(const WorldDefinition& scene, const DynamicsOptions& opt)>;
+/// Distance query: bodies carry their poses. A and B in that order.
+using DistanceFn = std::function<DistanceResult(const RigidBody& a, const RigidBody& b)>;
 /// The library's own mass properties of a body's hull for the body's mass.
 using MassFn = std::function<MassResult(const RigidBody& body)>;
 
@@ -241,23 +256,30 @@ struct BenchSizes {
 };
 
 struct Backend {
-  std::string name;          // as in JSON and reports
-  std::string description;   // one line: library, algorithm
-  ContactFn contact;         // empty: no contact queries
-  DynamicsFn dynamics;       // empty: no dynamics
-  MassFn mass = nullptr;     // empty: the library computes no mass properties of a hull
-  bool library = true;       // an outside library's code: isolated with a deadline per call
-  bool friction = true;      // its dynamics apply Coulomb friction (false: mu is ignored)
-  bool user = false;         // registered at run time (register_backend): never cached
-  SolverBudget budget = {};  // the solver's iteration budget, when it has one
-  SoftContact soft = {};     // its contact softness, when it has some to tune
-  BackendStyle style = {};   // its colour and marker
-  BenchSizes bench = {};     // the hulls `rbx bench` times its contact query on
+  std::string name;               // as in JSON and reports
+  std::string description;        // one line: library, algorithm
+  ContactFn contact;              // empty: no contact queries
+  DynamicsFn dynamics;            // empty: no dynamics
+  MassFn mass = nullptr;          // empty: the library computes no mass properties of a hull
+  bool library = true;            // an outside library's code: isolated with a deadline per call
+  bool friction = true;           // its dynamics apply Coulomb friction (false: mu is ignored)
+  bool user = false;              // registered at run time (register_backend): never cached
+  SolverBudget budget = {};       // the solver's iteration budget, when it has one
+  SoftContact soft = {};          // its contact softness, when it has some to tune
+  BackendStyle style = {};        // its colour and marker
+  BenchSizes bench = {};          // the hulls `rbx bench` times its contact query on
+  DistanceFn distance = nullptr;  // empty: no distance query (`unsupported`)
 
   /// This row drawn in `colour` with `marker`.
   Backend drawn(std::string colour, std::string marker) const {
     Backend b = *this;
     b.style = {std::move(colour), std::move(marker)};
+    return b;
+  }
+  /// This row with the library's distance query.
+  Backend measuring(DistanceFn fn) const {
+    Backend b = *this;
+    b.distance = std::move(fn);
     return b;
   }
   /// This row's contact query timed by `rbx bench` on hulls up to `full` (`quick`) vertices.
@@ -339,6 +361,9 @@ struct AtSettings {
   std::function<DynamicsResult(const WorldDefinition& scene, const DynamicsOptions& opt,
                                const Settings& settings)>
       dynamics;
+  /// Empty where the library has no distance query.
+  std::function<DistanceResult(const RigidBody& a, const RigidBody& b, const Settings& settings)>
+      distance = nullptr;
 };
 
 /// Every query variant, one line each (reference/registry.cpp).

@@ -29,6 +29,10 @@
 // m_positionWorldOnA = m_positionWorldOnB + m_normalWorldOnB * distance on object 0.
 #include "reference/bullet.h"
 
+#include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
+#include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
+#include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
 #include <btBulletCollisionCommon.h>
 #include <btBulletDynamicsCommon.h>
 
@@ -206,6 +210,53 @@ ContactResult pair_query(const RigidBody& a, const RigidBody& b, const BulletSet
   } catch (const std::exception& e) {
     return {Status::Error, e.what(), {}};
   }
+}
+
+/// Bullet's closest points of two convex shapes, as its own distance demos and tests ask for
+/// them: btGjkPairDetector (GJK with a Voronoi simplex solver; EPA when they overlap) on the
+/// set-up's shapes, at the bodies' poses, into a btPointCollector. Its convention
+/// (btGjkPairDetector::getClosestPointsNonVirtual): m_pointInWorld lies on B, m_normalOnBInWorld
+/// points from B toward A, and A's point is m_pointInWorld + m_normalOnBInWorld * m_distance; a
+/// negative distance is an overlap. Margins are the set-up's: a btBoxShape's lies inside the box
+/// and GJK adds it back as a rounding of radius margin at its edges and corners (measured in
+/// BulletSettingsMeasured.BoxMarginRoundsTheDistanceAtCorners), a hull's is zero.
+DistanceResult pair_distance(const RigidBody& a, const RigidBody& b,
+                             const BulletSettings& settings) {
+  DistanceResult r;
+  try {
+    const Mat3 identity = Mat3::Identity();
+    const std::unique_ptr<btConvexShape> shape_a = make_shape(a, identity, settings);
+    const std::unique_ptr<btConvexShape> shape_b = make_shape(b, identity, settings);
+    btVoronoiSimplexSolver simplex;
+    btGjkEpaPenetrationDepthSolver epa;
+    btGjkPairDetector gjk(shape_a.get(), shape_b.get(), &simplex, &epa);
+    btGjkPairDetector::ClosestPointInput input;
+    input.m_transformA = body_transform(a, identity);
+    input.m_transformB = body_transform(b, identity);
+    btPointCollector collector;
+    gjk.getClosestPoints(input, collector, nullptr);
+    if (!collector.m_hasResult) {
+      r.status = Status::Error;
+      r.message = "btGjkPairDetector::getClosestPoints returned no result";
+      return r;
+    }
+    if (collector.m_distance < 0) {
+      r.overlapping = true;
+      return r;
+    }
+    r.distance = collector.m_distance;
+    for (const auto* shape : {shape_a.get(), shape_b.get()})
+      if (shape->getShapeType() == BOX_SHAPE_PROXYTYPE && shape->getMargin() > 0)
+        r.message = "btBoxShape with Bullet's margin (" + std::to_string(shape->getMargin()) +
+                    " m) inside it: GJK sees the box rounded by the margin at its edges and "
+                    "corners";
+    r.point_b = from_bt(collector.m_pointInWorld);
+    r.point_a = r.point_b + from_bt(collector.m_normalOnBInWorld) * collector.m_distance;
+  } catch (const std::exception& e) {
+    r.status = Status::Error;
+    r.message = e.what();
+  }
+  return r;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -514,7 +565,7 @@ const AtSettings<BulletSettings>& bullet_at_settings() {
       [](const RigidBody& a, const RigidBody& b, const BulletSettings& settings) {
         return pair_query(a, b, settings);
       },
-      run_bullet_world};
+      run_bullet_world, pair_distance};
   return entries;
 }
 
@@ -533,6 +584,10 @@ BulletSettings bullet_sat_settings() {
 template <BulletSettings (*Settings)()>
 ContactResult query(const RigidBody& a, const RigidBody& b) {
   return pair_query(a, b, Settings());
+}
+template <BulletSettings (*Settings)()>
+DistanceResult distance_query(const RigidBody& a, const RigidBody& b) {
+  return pair_distance(a, b, Settings());
 }
 template <BulletSettings (*Settings)()>
 ContactResult prebuilt_query(const RigidBody& a, const RigidBody& b) {
@@ -598,6 +653,7 @@ const Adapter& bullet_adapter() {
               {"bullet", "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
                query<bullet_native_settings>, dynamics_run<bullet_native_settings>, bullet_mass},
               bullet_budget())
+              .measuring(distance_query<bullet_native_settings>)
               .drawn("#009E73", "o")
               .timed(2048, 2048),
           // Every body a zero-margin btConvexHullShape through GJK + EPA (one point).
@@ -605,6 +661,7 @@ const Adapter& bullet_adapter() {
               {"bullet-hull", "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",
                query<bullet_hull_settings>, dynamics_run<bullet_hull_settings>, bullet_hull_mass},
               bullet_budget())
+              .measuring(distance_query<bullet_hull_settings>)
               .drawn("#00543D", "s"),
           // Every body a polyhedral hull (boxes too), SAT + clipping; contact queries only.
           Backend{"bullet-sat", "Bullet 3.24 double: polyhedral hull SAT + clipping, boxes too",

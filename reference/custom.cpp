@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "engine/detect.h"
+#include "engine/distance.h"
 #include "engine/manifold.h"
 #include "reference/dynamics_recorder.h"
 
@@ -103,6 +104,17 @@ DynamicsResult custom_seed_dynamics(const WorldDefinition& scene, const Dynamics
   return run_dynamics(scene, opt, ContactModel::Seed);
 }
 
+// `custom`'s distance query: the engine's GJK (engine/distance.h), as it is.
+DistanceResult custom_distance(const RigidBody& a, const RigidBody& b) {
+  const Separation s = shape_distance(*a.shape, a.pose(), *b.shape, b.pose());
+  DistanceResult r;
+  r.overlapping = s.overlapping;
+  r.distance = s.distance;
+  r.point_a = s.point_a;
+  r.point_b = s.point_b;
+  return r;
+}
+
 }  // namespace
 
 DynamicsResult custom_seed_dynamics_with(const WorldDefinition& scene, const DynamicsOptions& opt,
@@ -133,6 +145,7 @@ const Adapter& custom_adapter() {
                "every new contact",
                custom_contact, custom_dynamics, nullptr, false},
               custom_budget())
+              .measuring(custom_distance)
               .drawn("#0072B2", "o")
               .timed(8192, 2048),
           Backend{"custom-seed",

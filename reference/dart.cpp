@@ -22,6 +22,8 @@
 #include <cmath>
 #include <dart/collision/CollisionGroup.hpp>
 #include <dart/collision/CollisionObject.hpp>
+#include <dart/collision/DistanceOption.hpp>
+#include <dart/collision/DistanceResult.hpp>
 #include <dart/collision/dart/DARTCollisionDetector.hpp>
 #include <dart/collision/fcl/FCLCollisionDetector.hpp>
 #include <dart/constraint/BoxedLcpConstraintSolver.hpp>
@@ -197,6 +199,38 @@ ContactResult query(QueryPair& q, const RigidBody& a, const RigidBody& b) {
 ContactResult contact_query(const RigidBody& a, const RigidBody& b, const DartSettings& s) {
   auto q = make_query_pair(a, b, s);
   return query(*q, a, b);
+}
+// DART's distance query: CollisionDetector::distance with nearest points, on its FCL detector
+// whatever the pair (DART's own detector computes no distance: DARTCollisionDetector::distance
+// warns and returns 0), with the set-up's shapes (BoxShape or MeshShape). The nearest points are
+// in the world frame, nearestPoint1 on shapeFrame1, which need not be A's. DART clamps the
+// distance at the option's lower bound (0): an overlapping pair reads 0, and a mesh inside
+// another reads the distance between their surfaces; neither is told apart from a touch.
+DistanceResult distance_query(const RigidBody& a, const RigidBody& b, const DartSettings& s) {
+  DistanceResult r;
+  try {
+    PlacedShape pa = place_shape(a, s.native_boxes), pb = place_shape(b, s.native_boxes);
+    pa.frame->setRelativeTransform(transform_of(a));
+    pb.frame->setRelativeTransform(transform_of(b));
+    auto detector = make_detector(DartDetector::Fcl, s.fcl_primitives);
+    auto group_a = detector->createCollisionGroup(pa.frame.get());
+    auto group_b = detector->createCollisionGroup(pb.frame.get());
+    dc::DistanceResult result;
+    detector->distance(group_a.get(), group_b.get(), dc::DistanceOption(true), &result);
+    if (!result.found()) {
+      r.status = Status::Error;
+      r.message = "DART distance found no shape pair";
+      return r;
+    }
+    const bool a_first = result.shapeFrame1 == pa.frame.get();
+    r.distance = result.minDistance;
+    r.point_a = a_first ? result.nearestPoint1 : result.nearestPoint2;
+    r.point_b = a_first ? result.nearestPoint2 : result.nearestPoint1;
+  } catch (const std::exception& e) {
+    r.status = Status::Error;
+    r.message = std::string("DART distance: ") + e.what();
+  }
+  return r;
 }
 
 }  // namespace
@@ -523,6 +557,9 @@ const Adapter& dart_adapter() {
                            [](const RigidBody& b) { return mass_of(b, true); }},
                           dart_budget()),
               dart_soft(DartSettings{}))
+              .measuring([](const RigidBody& a, const RigidBody& b) {
+                return distance_query(a, b, DartSettings{});
+              })
               .drawn("#999933", "o")
               .timed(2048, 512),
           with_soft(with_budget(
@@ -531,6 +568,9 @@ const Adapter& dart_adapter() {
                          [](const RigidBody& b) { return mass_of(b, false); }},
                         dart_budget()),
                     dart_soft(dart_hull_settings()))
+              .measuring([](const RigidBody& a, const RigidBody& b) {
+                return distance_query(a, b, dart_hull_settings());
+              })
               .drawn("#5C5C1F", "s"),
       },
       {

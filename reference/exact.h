@@ -69,6 +69,10 @@ struct ExactDistance {
 ExactDistance exact_distance(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                              const Pose& pb);
 
+/// How far the world point `x` is from shape `s` at pose `p` (0 inside or on it), in closed form
+/// over its triangles: what a distance query's witness point is checked with.
+double exact_point_distance(const ConvexPolyhedron& s, const Pose& p, const Vec3& x);
+
 /// The exact first contact of two convex polyhedra translating at constant velocities over
 /// [0, dt] (reference/exact_time_of_impact.cpp): the largest entering time over every separating
 /// axis (the faces' normals and the edge pairs' cross products), when no axis has closed again

@@ -119,4 +119,19 @@ ExactDistance exact_distance(const ConvexPolyhedron& a, const Pose& pa, const Co
   return out;
 }
 
+double exact_point_distance(const ConvexPolyhedron& s, const Pose& p, const Vec3& x) {
+  // In the body frame, where the hull's own coordinates are exact.
+  const Vec3 local = p.rotation().transpose() * (x - p.position);
+  const auto& tris = s.triangles();
+  const auto& v = s.vertices();
+  bool inside = true;
+  for (size_t i = 0; i < tris.size() && inside; ++i)
+    inside = s.planes()[i].normal.dot(local - v[tris[i][0]]) <= 0.0;
+  if (inside) return 0.0;
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& t : tris)
+    best = std::min(best, (local - closest_on_triangle(local, v[t[0]], v[t[1]], v[t[2]])).norm());
+  return best;
+}
+
 }  // namespace rbx

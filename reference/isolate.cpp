@@ -43,6 +43,10 @@ std::string encode(const TimedDynamics& t) { return encode_result(t.result, t.ru
 bool decode(const std::string& bytes, TimedDynamics& t) {
   return decode_result(bytes, t.result, t.runtime_s);
 }
+std::string encode(const TimedDistance& t) { return encode_result(t.result, t.runtime_s); }
+bool decode(const std::string& bytes, TimedDistance& t) {
+  return decode_result(bytes, t.result, t.runtime_s);
+}
 std::string encode(const MassResult& m) { return encode_result(m, 0.0); }
 bool decode(const std::string& bytes, MassResult& m) {
   double no_runtime;
@@ -463,6 +467,12 @@ struct RecordAccess<TimedDynamics> {
   static void set_runtime(TimedDynamics& t, double s) { t.runtime_s = s; }
 };
 template <>
+struct RecordAccess<TimedDistance> {
+  static Status& status(TimedDistance& t) { return t.result.status; }
+  static std::string& message(TimedDistance& t) { return t.result.message; }
+  static void set_runtime(TimedDistance& t, double s) { t.runtime_s = s; }
+};
+template <>
 struct RecordAccess<MassResult> {
   static Status& status(MassResult& m) { return m.status; }
   static std::string& message(MassResult& m) { return m.message; }
@@ -509,6 +519,11 @@ TimedContact isolated_contact(const std::string& backend, double deadline_s,
 
 TimedDynamics isolated_dynamics(const std::string& backend, double deadline_s,
                                 const std::function<TimedDynamics()>& call) {
+  return isolated_call(backend, deadline_s, call);
+}
+
+TimedDistance isolated_distance(const std::string& backend, double deadline_s,
+                                const std::function<TimedDistance()>& call) {
   return isolated_call(backend, deadline_s, call);
 }
 

@@ -27,7 +27,7 @@ namespace rbx {
 /// call (a contact query of two 8,192-vertex hulls takes milliseconds, the longest dynamics run
 /// of the scene library seconds), with room for the sanitizer build's slowdown.
 struct CallDeadlines {
-  double contact_s = 30.0;    // one contact query, its timing repeats included
+  double contact_s = 30.0;    // one contact or distance query, its timing repeats included
   double dynamics_s = 600.0;  // one dynamics run of a whole scene
   double mass_s = 30.0;       // one library's mass properties of one hull
 };
@@ -77,6 +77,14 @@ TimedContact isolated_contact(const std::string& backend, double deadline_s,
 /// Likewise for a whole dynamics run.
 TimedDynamics isolated_dynamics(const std::string& backend, double deadline_s,
                                 const std::function<TimedDynamics()>& call);
+/// A distance query and its run time (s).
+struct TimedDistance {
+  DistanceResult result;
+  double runtime_s = 0.0;
+};
+/// Likewise for a distance query.
+TimedDistance isolated_distance(const std::string& backend, double deadline_s,
+                                const std::function<TimedDistance()>& call);
 /// Likewise for a library's mass properties.
 MassResult isolated_mass(const std::string& backend, double deadline_s,
                          const std::function<MassResult()>& call);

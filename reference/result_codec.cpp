@@ -51,6 +51,11 @@ void result_fields(Io& io, R& m, Is<R, MassResult> = 0) {
   io.io(m.status, m.message, m.mass, m.volume, m.center_of_mass, m.inertia);
 }
 
+template <class Io, class R>
+void result_fields(Io& io, R& d, Is<R, DistanceResult> = 0) {
+  io.io(d.status, d.message, d.overlapping, d.distance, d.point_a, d.point_b);
+}
+
 template <class R>
 std::string encode(const R& r, double runtime_s) {
   ByteWriter w;
@@ -78,6 +83,12 @@ std::string encode_result(const DynamicsResult& r, double runtime_s) {
   return encode(r, runtime_s);
 }
 std::string encode_result(const MassResult& r, double runtime_s) { return encode(r, runtime_s); }
+std::string encode_result(const DistanceResult& r, double runtime_s) {
+  return encode(r, runtime_s);
+}
+bool decode_result(const std::string& bytes, DistanceResult& r, double& runtime_s) {
+  return decode(bytes, r, runtime_s);
+}
 bool decode_result(const std::string& bytes, ContactResult& r, double& runtime_s) {
   return decode(bytes, r, runtime_s);
 }

@@ -26,7 +26,7 @@ void scene_options(CLI::App* cmd, rbx::SceneCommandOptions& o, bool many, bool b
 
 // Every command's options, filled by the parser.
 struct Options {
-  rbx::SceneCommandOptions run, contacts, compare;
+  rbx::SceneCommandOptions run, contacts, distance, compare;
   rbx::ReportOptions report, check;
   std::vector<std::string> scenes_inputs;
   rbx::BenchOptions bench;
@@ -52,7 +52,7 @@ const CLI::Validator kAtLeastOne(
     },
     "N >= 1");
 
-// run, contacts, compare: the commands on scene files.
+// run, contacts, distance, compare: the commands on scene files.
 void add_scene_commands(CLI::App& app, Options& o) {
   CLI::App* run = app.add_subcommand("run", "custom engine only: collision events and final state");
   scene_options(run, o.run, false, true);
@@ -67,6 +67,8 @@ void add_scene_commands(CLI::App& app, Options& o) {
                    "first-contact: query at the first step where a pair touches (the custom "
                    "engine's motion, the exact oracle's test)")
       ->check(CLI::IsMember({"first-contact"}));
+  scene_options(app.add_subcommand("distance", "distance query at the t=0 poses, every backend"),
+                o.distance, false, true);
   scene_options(app.add_subcommand("compare", "the scenes' checks, side by side"), o.compare, true,
                 true);
 }
@@ -209,6 +211,7 @@ int dispatch(CLI::App& app, const Options& o) {
   try {
     if (app.got_subcommand("run")) return rbx::run_command(o.run);
     if (app.got_subcommand("contacts")) return rbx::contacts_command(o.contacts);
+    if (app.got_subcommand("distance")) return rbx::distance_command(o.distance);
     if (app.got_subcommand("compare")) return rbx::compare_command(o.compare);
     if (app.got_subcommand("report")) return rbx::report_command(o.report);
     if (app.got_subcommand("check")) return rbx::check_command(o.check);

@@ -35,6 +35,8 @@ Scene load_scene_for_command(const std::string& path, const SceneCommandOptions&
 int run_command(const SceneCommandOptions& opt);
 /// `rbx contacts SCENE`: contact queries at the t = 0 poses, every backend, side by side.
 int contacts_command(const SceneCommandOptions& opt);
+/// `rbx distance SCENE`: distance queries at the t = 0 poses, every backend, side by side.
+int distance_command(const SceneCommandOptions& opt);
 
 }  // namespace rbx
 

@@ -10,7 +10,15 @@ namespace rbx {
 namespace {
 
 bool serves(const Backend& b, Capability cap) {
-  return cap == Capability::Contact ? static_cast<bool>(b.contact) : static_cast<bool>(b.dynamics);
+  switch (cap) {
+    case Capability::Contact:
+      return static_cast<bool>(b.contact);
+    case Capability::Dynamics:
+      return static_cast<bool>(b.dynamics);
+    case Capability::Distance:
+      return static_cast<bool>(b.distance);
+  }
+  return false;
 }
 
 }  // namespace

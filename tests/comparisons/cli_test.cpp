@@ -313,6 +313,43 @@ TEST(Cli, ContactsRunsEveryBackendInTheContractConvention) {
   fs::remove_all(dir);
 }
 
+TEST(Cli, DistanceRunsEveryBackendWithTheWitnessPointsOnTheirBodies) {
+  // Two unit cubes 0.25 apart across parallel faces, B above A: every backend with a distance
+  // query gives 0.25, A's point on A's top face (z = 0.5) and B's on B's bottom (z = 0.75),
+  // within FCL's default distance tolerance (1e-6 m, the loosest any of them states); a backend
+  // named without one says unsupported. Run from another folder, as a user would.
+  const fs::path dir = temp_dir("distance");
+  std::ofstream(dir / "pair.toml") << "[sim]\nduration = 0\n[[body]]\nname = \"A\"\n"
+                                      "[[body]]\nname = \"B\"\nposition = [0.2, 0.1, 1.25]\n";
+  const CmdResult r = rbx_in(dir.string(), "distance pair.toml --json -");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["pairs"].size(), 1u);
+  const auto& pair = j["pairs"][0];
+  EXPECT_EQ(pair["bodies"], nlohmann::json::array({"A", "B"}));
+  EXPECT_DOUBLE_EQ(pair["exact"]["distance"].get<double>(), 0.25);
+  int answered = 0;
+  for (const auto& [name, b] : pair["backends"].items()) {
+    ASSERT_EQ(b["status"], "ok") << name << ": " << b["message"];
+    EXPECT_NEAR(b["distance"].get<double>(), 0.25, 1e-6) << name;
+    EXPECT_NEAR(b["point_a"][2].get<double>(), 0.5, 1e-6) << name;
+    EXPECT_NEAR(b["point_b"][2].get<double>(), 0.75, 1e-6) << name;
+    EXPECT_EQ(b["mark"], "") << name;
+    ++answered;
+  }
+  EXPECT_GE(answered, 10);  // custom, exact, four FCL rows, two Bullet, two DART
+  EXPECT_NE(r.err.find("witness err"), std::string::npos);  // the readable table
+  const CmdResult named = rbx_in(dir.string(), "distance pair.toml --backends ode --json -");
+  ASSERT_EQ(named.code, 0) << named.err;
+  EXPECT_EQ(nlohmann::json::parse(named.out)["pairs"][0]["backends"]["ode"]["status"],
+            "unsupported");
+  // A scene that does not exist: exit 2, one line.
+  const CmdResult missing = rbx_in(dir.string(), "distance nowhere.toml");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
+  fs::remove_all(dir);
+}
+
 TEST(Cli, CompareExitsOneOnAWrongExpectation) {
   // Two unit cubes overlapping by 0.1 along x; the exact depth is 0.1, the scene claims 0.2.
   const fs::path dir = temp_dir("expect");

@@ -13,6 +13,7 @@
 // fcl-indep's negative depth and unrotated normal); such a result is held to the rest.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "reference/backend.h"
+#include "reference/exact.h"
 #include "reference/isolate.h"
 #include "tests/common/fixtures.h"
 
@@ -211,6 +213,98 @@ TEST_P(DynamicsConformance, ANonFiniteStartIsTheBackendsErrorNeverOkNorACrash) {
 
 INSTANTIATE_TEST_SUITE_P(EveryDynamicsBackend, DynamicsConformance,
                          ::testing::ValuesIn(names_with(false)), test_name);
+
+// Distance: two bodies apart across parallel faces are at the gap, with A's point on A's face
+// and B's on B's, straight across; the other body order swaps the points; the same query twice
+// gives the same answer, bit for bit; an overlapping pair is never given a positive distance.
+// Conventions, not accuracy: the tolerance is 1e-6 m, FCL's default distance_tolerance and the
+// loosest any registered library states for its distance; a library's rounding of a shape
+// (Bullet's box margin, pinned in fair_settings_test) is the report's business, so only poses
+// where it cannot show are used here.
+std::vector<std::string> names_with_distance() {
+  std::vector<std::string> names;
+  for (const Backend& b : backends())
+    if (b.distance) names.push_back(b.name);
+  return names;
+}
+
+class DistanceConformance : public ::testing::TestWithParam<std::string> {
+ protected:
+  const Backend& backend() const { return *find_backend(GetParam()); }
+};
+
+constexpr double kDistanceConventionTol = 1e-6;
+
+TEST_P(DistanceConformance, APairApartAcrossParallelFacesIsAtTheGap) {
+  for (const double gap : {0.5, 0.01}) {
+    const auto [a, b] = stacked(gap);
+    const DistanceResult r = backend().distance(a, b);
+    ASSERT_EQ(r.status, Status::Ok) << r.message;
+    ASSERT_FALSE(r.overlapping) << "gap " << gap;
+    EXPECT_NEAR(r.distance, gap, kDistanceConventionTol);
+    // A's point on A's bottom face, B's on B's top face, straight across.
+    EXPECT_NEAR(r.point_a.z(), 0.5 + gap, kDistanceConventionTol);
+    EXPECT_NEAR(r.point_b.z(), 0.5, kDistanceConventionTol);
+    EXPECT_LE(exact_point_distance(*a.shape, a.pose(), r.point_a), kDistanceConventionTol);
+    EXPECT_LE(exact_point_distance(*b.shape, b.pose(), r.point_b), kDistanceConventionTol);
+    EXPECT_NEAR((r.point_a - r.point_b).head<2>().norm(), 0.0, kDistanceConventionTol);
+  }
+}
+
+// A above B turned by `turn`, its lowest point `gap` above B's top face at (0.2, 0.1): a pose
+// whose closest pair is unique when a corner points down.
+std::pair<RigidBody, RigidBody> hanging(const Quat& turn, double gap) {
+  RigidBody a = test::unit_cube("A", Vec3::Zero(), turn);
+  double lowest = 0.0;
+  for (const Vec3& v : a.shape->vertices()) lowest = std::min(lowest, (turn * v).z());
+  a = test::unit_cube("A", Vec3(0.2, 0.1, 0.5 + gap - lowest), turn);
+  return {a, test::unit_cube("B", Vec3::Zero())};
+}
+
+TEST_P(DistanceConformance, TheOtherBodyOrderSwapsTheWitnessPoints) {
+  // A corner of A straight down (its body diagonal turned onto z, then 20 degrees about z):
+  // one closest pair, the corner and the point of B's face below it. The points of both orders
+  // agree to the library's accuracy; each lies on (or in) its own body.
+  const Quat turn = Quat(Eigen::AngleAxisd(0.35, Vec3::UnitZ())) *
+                    Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitZ());
+  const auto [a, b] = hanging(turn, 0.1);
+  const DistanceResult ab = backend().distance(a, b), ba = backend().distance(b, a);
+  ASSERT_EQ(ab.status, Status::Ok) << ab.message;
+  ASSERT_EQ(ba.status, Status::Ok) << ba.message;
+  ASSERT_FALSE(ab.overlapping);
+  ASSERT_FALSE(ba.overlapping);
+  EXPECT_NEAR(ab.distance, ba.distance, kDistanceConventionTol);
+  EXPECT_LE((ab.point_a - ba.point_b).norm(), kDistanceConventionTol);
+  EXPECT_LE((ab.point_b - ba.point_a).norm(), kDistanceConventionTol);
+  // Which body a point belongs to: A's point is on A, 0.1 clear of B (not the other way round).
+  EXPECT_LE(exact_point_distance(*a.shape, a.pose(), ab.point_a), kDistanceConventionTol);
+  EXPECT_GT(exact_point_distance(*b.shape, b.pose(), ab.point_a), 0.05);
+  EXPECT_LE(exact_point_distance(*b.shape, b.pose(), ab.point_b), kDistanceConventionTol);
+  EXPECT_GT(exact_point_distance(*a.shape, a.pose(), ab.point_b), 0.05);
+}
+
+TEST_P(DistanceConformance, TheSameQueryTwiceGivesTheSameAnswer) {
+  const auto [a, b] = stacked(0.01);
+  const DistanceResult first = backend().distance(a, b), second = backend().distance(a, b);
+  ASSERT_EQ(first.status, Status::Ok) << first.message;
+  EXPECT_EQ(first.status, second.status);
+  EXPECT_EQ(first.overlapping, second.overlapping);
+  EXPECT_EQ(first.distance, second.distance);
+  EXPECT_TRUE(first.point_a == second.point_a);
+  EXPECT_TRUE(first.point_b == second.point_b);
+}
+
+TEST_P(DistanceConformance, AnOverlappingPairIsNeverGivenAPositiveDistance) {
+  const auto [a, b] = stacked(-0.1);
+  const DistanceResult r = backend().distance(a, b);
+  ASSERT_EQ(r.status, Status::Ok) << r.message;
+  // Either the library says it overlaps, or (DART, which clamps at its lower bound of 0) it gives
+  // zero; never a gap.
+  EXPECT_TRUE(r.overlapping || r.distance <= 0.0) << r.distance;
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryDistanceBackend, DistanceConformance,
+                         ::testing::ValuesIn(names_with_distance()), test_name);
 
 TEST(Registry, EveryBackendIsNamedInTheContractAndInTheBackendsTable) {
   // docs/contract.md names every backend and docs/backends.md gives each a row: a backend added

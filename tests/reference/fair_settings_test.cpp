@@ -30,6 +30,7 @@
 #include "reference/fcl.h"
 #include "reference/mujoco.h"
 #include "reference/ode.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {
@@ -245,6 +246,36 @@ TEST(BulletSettingsMeasured, BoxMarginZeroOrDefaultMakesNoDifference) {
     EXPECT_LT(measured("bullet box margin default", c, with_default), kExact) << c.name;
     EXPECT_LT(measured("bullet box margin 0", c, with_zero), kExact) << c.name;
   }
+}
+
+TEST(BulletSettingsMeasured, BoxMarginRoundsTheDistanceAtCorners) {
+  // Bullet's distance query (btGjkPairDetector) adds a btBoxShape's margin back around the box
+  // shrunk by it: the box is seen rounded with radius m at its edges and corners. A unit cube
+  // hung corner down 0.1 above another (the corner's diagonal vertical) is then farther by
+  // m (sqrt(3) - 1), 0.0293 m at Bullet's default 0.04 m; margin 0 gives the box itself. The
+  // `bullet` row keeps the margin its contacts and dynamics run with (the default, harmless
+  // there: BoxMarginZeroOrDefaultMakesNoDifference); `bullet-hull`'s zero-margin hull is
+  // Bullet's exact distance, so the report shows both.
+  const RigidBody floor = test::unit_cube("B", Vec3::Zero());
+  // The body diagonal (1, 1, 1) turned onto +z, so the vertex -(1, 1, 1)/2 points straight down.
+  const Quat turn = Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3::UnitZ());
+  const RigidBody cube = test::unit_cube("A", Vec3(0.1, 0.1, 0.6 + std::sqrt(3.0) / 2), turn);
+  const DistanceResult with_default =
+      bullet_at_settings().distance(cube, floor, bullet_native_settings());
+  const DistanceResult with_zero = bullet_at_settings().distance(
+      cube, floor, bullet_with([](BulletSettings& s) { s.box_margin = 0.0; }));
+  ASSERT_EQ(with_default.status, Status::Ok) << with_default.message;
+  ASSERT_EQ(with_zero.status, Status::Ok) << with_zero.message;
+  Case c;
+  c.name = "cube corner 0.1 above a face";
+  const double default_err =
+      measured("bullet box margin default: distance - 0.1", c, with_default.distance - 0.1);
+  const double zero_err =
+      measured("bullet box margin 0: distance - 0.1", c, with_zero.distance - 0.1);
+  // The rounding in closed form, to the GJK's own tolerance (1e-6 m, as the conformance tests).
+  EXPECT_NEAR(default_err, 0.04 * (std::sqrt(3.0) - 1.0), 1e-6);
+  EXPECT_NEAR(zero_err, 0.0, 1e-6);
+  EXPECT_NE(with_default.message.find("rounded"), std::string::npos) << with_default.message;
 }
 
 TEST(BulletSettingsMeasured, PolyhedralHullsClippedAboutTheGjkAxisNotSat) {

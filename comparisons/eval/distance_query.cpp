@@ -1,0 +1,161 @@
+#include "comparisons/eval/distance_query.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+
+#include "comparisons/eval/measures.h"
+#include "engine/format.h"
+#include "reference/exact.h"
+#include "reference/isolate.h"
+
+namespace rbx {
+
+namespace {
+
+// One backend's answer, its first call timed alone; a library's call runs isolated.
+DistanceRow answer_of(const Backend* be, const std::string& name, const RigidBody& a,
+                      const RigidBody& b) {
+  DistanceRow row;
+  row.backend = name;
+  if (!be || !be->distance) {
+    row.result.status = Status::Unsupported;
+    row.result.message = name + " has no distance query";
+    return row;
+  }
+  auto call = [&] {
+    TimedDistance t;
+    Stopwatch clock;
+    try {
+      t.result = be->distance(a, b);
+    } catch (const std::exception& e) {
+      t.result = DistanceResult{};
+      t.result.status = Status::Error;
+      t.result.message = e.what();
+    }
+    t.runtime_s = clock.seconds();
+    return t;
+  };
+  const TimedDistance t =
+      be->library ? isolated_distance(name, CallDeadlines{}.contact_s, call) : call();
+  row.result = t.result;
+  row.timing.cold_s = t.runtime_s;
+  return row;
+}
+
+// Times every row that answered, interleaved as the contact queries are (docs/bench.md).
+void time_rows(std::vector<DistanceRow>& rows, const RigidBody& a, const RigidBody& b,
+               double budget_s) {
+  if (budget_s <= 0) return;
+  std::vector<TimedSubject> subjects;
+  std::vector<DistanceRow*> timed;
+  for (DistanceRow& r : rows) {
+    const Backend* be = find_backend(r.backend);
+    if (!be || !be->distance || r.result.status != Status::Ok) continue;
+    subjects.push_back(
+        {be->name, be->library, [be, &a, &b] { be->distance(a, b); }, CallDeadlines{}.contact_s});
+    timed.push_back(&r);
+  }
+  TimingPlan plan;
+  plan.min_time_s = budget_s;
+  const std::vector<Timing> t = time_interleaved(subjects, plan);
+  for (size_t i = 0; i < timed.size(); ++i) {
+    const double cold = timed[i]->timing.cold_s;
+    timed[i]->timing = t[i];
+    timed[i]->timing.cold_s = cold;
+  }
+}
+
+Json result_json(const DistanceResult& r) {
+  Json j = {{"status", to_string(r.status)}, {"message", r.message}};
+  if (r.status != Status::Ok) return j;
+  j["overlapping"] = r.overlapping;
+  if (r.overlapping) return j;
+  j["distance"] = r.distance;
+  j["point_a"] = to_json(r.point_a);
+  j["point_b"] = to_json(r.point_b);
+  return j;
+}
+
+}  // namespace
+
+DistanceVerdict judge_distance(const DistanceResult& answer, const DistanceResult& truth,
+                               const RigidBody& a, const RigidBody& b) {
+  DistanceVerdict v;
+  const double size = std::min(body_size(a), body_size(b));
+  v.scale = std::max(truth.distance, kDistanceFloorRel * size);
+  if (answer.status != Status::Ok || truth.status != Status::Ok) return v;
+  // Touching to round-off: "overlapping" and a zero distance are both right.
+  const bool touching = !truth.overlapping && truth.distance <= kDistanceFloorRel * size;
+  if (answer.overlapping != truth.overlapping) {
+    if (touching) return v;
+    v.mark = "disagrees";
+    v.why = answer.overlapping
+                ? "says the pair overlaps; it is " + fmt_num(truth.distance, 6) + " m apart"
+                : "gives a distance (" + fmt_num(answer.distance, 6) + " m) to an overlapping pair";
+    return v;
+  }
+  if (truth.overlapping) return v;
+  v.comparable = true;
+  v.distance_err = std::abs(answer.distance - truth.distance) / v.scale;
+  const double off_a = exact_point_distance(*a.shape, a.pose(), answer.point_a);
+  const double off_b = exact_point_distance(*b.shape, b.pose(), answer.point_b);
+  const double gap = std::abs((answer.point_a - answer.point_b).norm() - truth.distance);
+  v.witness_err = std::max({off_a, off_b, gap}) / v.scale;
+  const double worst = std::max(v.distance_err, v.witness_err);
+  if (!std::isfinite(worst) || worst > kDistanceDisagreeRel)
+    v.mark = "disagrees";
+  else if (worst > kDistanceDeviateRel)
+    v.mark = "deviates";
+  if (!v.mark.empty())
+    v.why = "distance off by " + fmt_num(v.distance_err, 3) + ", witness points off by " +
+            fmt_num(v.witness_err, 3) + " of the distance";
+  return v;
+}
+
+DistanceComparison compare_distances(const Scene& scene, const std::vector<std::string>& names,
+                                     double budget_s) {
+  DistanceComparison c;
+  c.scene = scene.name;
+  c.file = scene.file;
+  const std::vector<RigidBody> bodies = make_bodies(scene);
+  for (size_t i = 0; i < bodies.size(); ++i)
+    for (size_t j = i + 1; j < bodies.size(); ++j) {
+      const RigidBody &a = bodies[i], &b = bodies[j];
+      if (a.is_static && b.is_static) continue;
+      DistancePair p;
+      p.a = a.name;
+      p.b = b.name;
+      p.truth = answer_of(find_backend("exact"), "exact", a, b).result;
+      for (const std::string& name : names)
+        p.rows.push_back(answer_of(find_backend(name), name, a, b));
+      time_rows(p.rows, a, b, budget_s);
+      for (DistanceRow& r : p.rows) r.verdict = judge_distance(r.result, p.truth, a, b);
+      c.pairs.push_back(std::move(p));
+    }
+  return c;
+}
+
+Json distance_json(const DistanceComparison& c) {
+  Json j = {{"scene", c.scene}, {"file", c.file}, {"query", "distance"}};
+  j["pairs"] = Json::array();
+  for (const DistancePair& p : c.pairs) {
+    Json pj = {{"bodies", {p.a, p.b}}, {"exact", result_json(p.truth)}};
+    pj["backends"] = Json::object();
+    for (const DistanceRow& r : p.rows) {
+      Json rj = result_json(r.result);
+      if (r.verdict.comparable) {
+        rj["distance_err_rel"] = r.verdict.distance_err;
+        rj["witness_err_rel"] = r.verdict.witness_err;
+      }
+      rj["mark"] = r.verdict.mark;
+      if (!r.verdict.why.empty()) rj["why"] = r.verdict.why;
+      put_timing(r.timing, rj);
+      pj["backends"][r.backend] = rj;
+    }
+    j["pairs"].push_back(pj);
+  }
+  return j;
+}
+
+}  // namespace rbx

@@ -1,0 +1,61 @@
+#include "comparisons/output/distance_table.h"
+
+#include "comparisons/output/table.h"
+#include "engine/format.h"
+
+namespace rbx {
+
+namespace {
+
+std::string answer(const DistanceResult& r) {
+  if (r.status != Status::Ok) return "-";
+  return r.overlapping ? "overlapping" : fmt_num(r.distance, 10);
+}
+
+}  // namespace
+
+void print_distances(std::ostream& out, const DistanceComparison& c) {
+  for (const DistancePair& p : c.pairs) {
+    out << "\npair " << p.a << "-" << p.b << "; exact: " << answer(p.truth);
+    if (!p.truth.overlapping && p.truth.status == Status::Ok) out << " (" << p.truth.message << ")";
+    out << "\n";
+    Table table({"backend", "status", "distance", "point on " + p.a, "point on " + p.b,
+                 "distance err", "witness err", "mark", "time (µs)", "25-75 %", "cold call (µs)"});
+    for (const DistanceRow& r : p.rows) {
+      const bool points = r.result.status == Status::Ok && !r.result.overlapping;
+      const bool timed = r.timing.rounds > 0;
+      table.add(
+          {r.backend, to_string(r.result.status), answer(r.result),
+           points ? fmt_vec(r.result.point_a) : "-", points ? fmt_vec(r.result.point_b) : "-",
+           r.verdict.comparable ? fmt_num(r.verdict.distance_err, 3) : "-",
+           r.verdict.comparable ? fmt_num(r.verdict.witness_err, 3) : "-",
+           r.verdict.mark == "disagrees"  ? "✗"
+           : r.verdict.mark == "deviates" ? "~"
+                                          : "",
+           timed ? fmt_num(r.timing.median_s * 1e6, 3) : "-",
+           timed ? fmt_num(r.timing.q25_s * 1e6, 3) + "-" + fmt_num(r.timing.q75_s * 1e6, 3) : "-",
+           r.result.status == Status::Unsupported ? "-" : fmt_num(r.timing.cold_s * 1e6, 3)});
+    }
+    table.print(out);
+    for (const DistanceRow& r : p.rows)
+      if (!r.result.message.empty() && r.result.status != Status::Unsupported &&
+          r.backend != "exact")
+        out << "  " << r.backend << ": " << r.result.message << "\n";
+    for (const DistanceRow& r : p.rows)
+      if (!r.verdict.mark.empty())
+        out << "  " << r.verdict.mark << ": " << r.backend << " on " << p.a << "-" << p.b << ": "
+            << r.verdict.why << "\n";
+  }
+  if (c.pairs.empty()) {
+    out << "no pair of bodies to measure (every body is static, or there is only one)\n";
+    return;
+  }
+  out << "\nerrors: relative to the true distance (at least 1e-12 of the smaller body's size); "
+         "witness err: how far the two points are from a closest pair (off their bodies, or "
+         "apart by other than the distance); ✗ over 1e-6, ~ over 1e-9 (docs/distance.md)\n";
+  out << "time: per query, the median over rounds of repeated calls (warmed up, backends "
+         "interleaved; docs/bench.md) with its 25-75 % range; the cold call is the first, which "
+         "gave the answer, timed alone\n";
+}
+
+}  // namespace rbx
