@@ -72,7 +72,9 @@ constexpr std::size_t kMaxContacts = 32;
 constexpr double kClosingSpeed = 1e-6;
 
 // An assimp scene of one triangle mesh: the hull's vertices and outward triangles, as DART
-// reads a mesh file. MeshShape owns it (aiReleaseImport deletes a scene no importer made).
+// reads a mesh file. Debian's assimp is built without ASSIMP_DOUBLE_PRECISION, so its ai_real is
+// float: a MeshShape's vertices are the hull's rounded to float (6e-8 relative), whatever feeds
+// DART a mesh. MeshShape owns it (aiReleaseImport deletes a scene no importer made).
 const aiScene* hull_scene(const ConvexPolyhedron& hull) {
   auto* mesh = new aiMesh();
   const auto& v = hull.vertices();
@@ -223,6 +225,8 @@ DistanceResult distance_query(const RigidBody& a, const RigidBody& b, const Dart
       return r;
     }
     const bool a_first = result.shapeFrame1 == pa.frame.get();
+    if (pa.shape->is<dd::MeshShape>() || pb.shape->is<dd::MeshShape>())
+      r.message = "MeshShape vertices rounded to float (assimp's ai_real)";
     r.distance = result.minDistance;
     r.point_a = a_first ? result.nearestPoint1 : result.nearestPoint2;
     r.point_b = a_first ? result.nearestPoint2 : result.nearestPoint1;

@@ -105,7 +105,7 @@ DistanceVerdict judge_distance(const DistanceResult& answer, const DistanceResul
   const double worst = std::max(v.distance_err, v.witness_err);
   if (!std::isfinite(worst) || worst > kDistanceDisagreeRel)
     v.mark = "disagrees";
-  else if (worst > kDistanceDeviateRel)
+  else if (worst > std::max(kDistanceDeviateRel, kDistanceRoundOffRel * size / v.scale))
     v.mark = "deviates";
   if (!v.mark.empty())
     v.why = "distance off by " + fmt_num(v.distance_err, 3) + ", witness points off by " +

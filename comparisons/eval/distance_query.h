@@ -12,13 +12,17 @@
 
 namespace rbx {
 
-/// A distance answer's error against the oracle's, relative to the true distance (floored at
-/// kDistanceFloorRel of the smaller body's size, where round-off of the coordinates lies). Over
-/// kDistanceDisagreeRel the answer disagrees: the threshold rbx explore marks distance samples by.
-/// Over kDistanceDeviateRel it deviates: beyond what round-off of a closed-form answer gives.
+/// A distance answer's errors against the oracle's are relative to the true distance, floored at
+/// kDistanceFloorRel of the smaller body's size: every answer, the oracle's own included, carries
+/// round-off of the coordinates (measured up to a few 1e-16 of the size, more for bodies far
+/// from their midpoint), which over a gap of 1e-8 of the size is 1e-7 relative, a tenth of the
+/// disagreement threshold. Over kDistanceDisagreeRel the answer disagrees: the threshold rbx
+/// explore marks distance samples by. Over kDistanceDeviateRel, and beyond kDistanceRoundOffRel
+/// of the size in absolute terms (ten times the round-off measured), it deviates.
 constexpr double kDistanceDisagreeRel = 1e-6;
 constexpr double kDistanceDeviateRel = 1e-9;
-constexpr double kDistanceFloorRel = 1e-12;
+constexpr double kDistanceFloorRel = 1e-8;
+constexpr double kDistanceRoundOffRel = 1e-14;
 
 /// How one backend's answer on one pair stands against the oracle's.
 struct DistanceVerdict {

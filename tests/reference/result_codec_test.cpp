@@ -115,6 +115,27 @@ TEST(ResultCodec, MassResultComesBackBitForBit) {
   EXPECT_EQ(back.inertia, m.inertia);
 }
 
+TEST(ResultCodec, DistanceResultComesBackBitForBit) {
+  DistanceResult d;
+  d.message = "btBoxShape with Bullet's margin";
+  d.distance = 0.1 + 1e-17;
+  d.point_a = Vec3(0.1, -0.2, 0.3 + 1e-16);
+  d.point_b = Vec3(-0.0, 1e-300, 0.5);
+  DistanceResult back;
+  back.overlapping = true;
+  double runtime = -1;
+  ASSERT_TRUE(decode_result(encode_result(d, 2.5e-6), back, runtime));
+  EXPECT_EQ(runtime, 2.5e-6);
+  EXPECT_EQ(back.status, Status::Ok);
+  EXPECT_EQ(back.message, d.message);
+  EXPECT_FALSE(back.overlapping);
+  EXPECT_EQ(back.distance, d.distance);
+  EXPECT_TRUE(same_bits(back.point_a, d.point_a));
+  EXPECT_TRUE(same_bits(back.point_b, d.point_b));
+  // One encoding of another kind is not a distance.
+  EXPECT_FALSE(decode_result(encode_result(MassResult{}, 0.0), back, runtime));
+}
+
 TEST(ResultCodec, TruncatedExtendedOrForeignBytesAreRefused) {
   ContactResult r;
   r.contacts.resize(3);
