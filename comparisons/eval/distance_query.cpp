@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "comparisons/eval/measures.h"
+#include "engine/bounding.h"
 #include "engine/format.h"
 #include "reference/exact.h"
 #include "reference/isolate.h"
@@ -13,33 +14,17 @@ namespace rbx {
 
 namespace {
 
-// One backend's answer, its first call timed alone; a library's call runs isolated.
+// One backend's answer, its first call timed alone.
 DistanceRow answer_of(const Backend* be, const std::string& name, const RigidBody& a,
                       const RigidBody& b) {
   DistanceRow row;
   row.backend = name;
-  if (!be || !be->distance) {
+  if (!be) {
     row.result.status = Status::Unsupported;
     row.result.message = name + " has no distance query";
     return row;
   }
-  auto call = [&] {
-    TimedDistance t;
-    Stopwatch clock;
-    try {
-      t.result = be->distance(a, b);
-    } catch (const std::exception& e) {
-      t.result = DistanceResult{};
-      t.result.status = Status::Error;
-      t.result.message = e.what();
-    }
-    t.runtime_s = clock.seconds();
-    return t;
-  };
-  const TimedDistance t =
-      be->library ? isolated_distance(name, CallDeadlines{}.contact_s, call) : call();
-  row.result = t.result;
-  row.timing.cold_s = t.runtime_s;
+  row.result = run_distance(*be, a, b, &row.timing.cold_s);
   return row;
 }
 
@@ -66,6 +51,13 @@ void time_rows(std::vector<DistanceRow>& rows, const RigidBody& a, const RigidBo
   }
 }
 
+// How far the pair's farthest vertex can be from the world origin (m): the magnitude of the
+// coordinates every answer is computed in.
+double extent(const RigidBody& a, const RigidBody& b) {
+  const BoundingSphere sa = bounding_sphere(a), sb = bounding_sphere(b);
+  return std::max(sa.center.norm() + sa.radius, sb.center.norm() + sb.radius);
+}
+
 Json result_json(const DistanceResult& r) {
   Json j = {{"status", to_string(r.status)}, {"message", r.message}};
   if (r.status != Status::Ok) return j;
@@ -79,10 +71,37 @@ Json result_json(const DistanceResult& r) {
 
 }  // namespace
 
+DistanceResult run_distance(const Backend& be, const RigidBody& a, const RigidBody& b,
+                            double* cold_s) {
+  if (!be.distance) {
+    DistanceResult r;
+    r.status = Status::Unsupported;
+    r.message = be.name + " has no distance query";
+    return r;
+  }
+  auto call = [&] {
+    TimedDistance t;
+    Stopwatch clock;
+    try {
+      t.result = be.distance(a, b);
+    } catch (const std::exception& e) {
+      t.result = DistanceResult{};
+      t.result.status = Status::Error;
+      t.result.message = e.what();
+    }
+    t.runtime_s = clock.seconds();
+    return t;
+  };
+  const TimedDistance t =
+      be.library ? isolated_distance(be.name, CallDeadlines{}.contact_s, call) : call();
+  if (cold_s) *cold_s = t.runtime_s;
+  return t.result;
+}
+
 DistanceVerdict judge_distance(const DistanceResult& answer, const DistanceResult& truth,
                                const RigidBody& a, const RigidBody& b) {
   DistanceVerdict v;
-  const double size = std::min(body_size(a), body_size(b));
+  const double size = extent(a, b);
   v.scale = std::max(truth.distance, kDistanceFloorRel * size);
   if (answer.status != Status::Ok || truth.status != Status::Ok) return v;
   // Touching to round-off: "overlapping" and a zero distance are both right.

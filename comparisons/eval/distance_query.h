@@ -13,12 +13,14 @@
 namespace rbx {
 
 /// A distance answer's errors against the oracle's are relative to the true distance, floored at
-/// kDistanceFloorRel of the smaller body's size: every answer, the oracle's own included, carries
-/// round-off of the coordinates (measured up to a few 1e-16 of the size, more for bodies far
-/// from their midpoint), which over a gap of 1e-8 of the size is 1e-7 relative, a tenth of the
-/// disagreement threshold. Over kDistanceDisagreeRel the answer disagrees: the threshold rbx
-/// explore marks distance samples by. Over kDistanceDeviateRel, and beyond kDistanceRoundOffRel
-/// of the size in absolute terms (ten times the round-off measured), it deviates.
+/// kDistanceFloorRel of the pair's extent (how far its farthest vertex is from the world origin):
+/// every answer, the oracle's own included, carries round-off of the world coordinates, a few
+/// 1e-16 of their magnitude, which over a gap of 1e-8 of it is 1e-7 relative, a tenth of the
+/// disagreement threshold. (Of the smaller body's size it is not: a body a thousandth the size of
+/// its neighbour, a metre from the origin, carries the round-off of metres.) Over
+/// kDistanceDisagreeRel the answer disagrees: the threshold rbx explore marks distance samples
+/// by. Over kDistanceDeviateRel, and beyond kDistanceRoundOffRel of the extent in absolute terms
+/// (ten times the round-off measured), it deviates.
 constexpr double kDistanceDisagreeRel = 1e-6;
 constexpr double kDistanceDeviateRel = 1e-9;
 constexpr double kDistanceFloorRel = 1e-8;
@@ -33,10 +35,15 @@ struct DistanceVerdict {
   /// points need not be unique (parallel faces): any pair on the bodies at the true distance is
   /// right, so they are checked against the bodies, not against the oracle's pair.
   double witness_err = 0.0;
-  double scale = 0.0;  // m: max(d*, kDistanceFloorRel x the smaller body's size)
+  double scale = 0.0;  // m: max(d*, kDistanceFloorRel x the pair's extent)
   std::string mark;    // "" | "deviates" | "disagrees"
   std::string why;     // the mark's reason, one line
 };
+
+/// Backend `b`'s distance query on (a, bb): `unsupported` without one; a library's call runs
+/// isolated under its deadline (reference/isolate.h). `cold_s`, when given, gets its run time.
+DistanceResult run_distance(const Backend& b, const RigidBody& a, const RigidBody& bb,
+                            double* cold_s = nullptr);
 
 /// The verdict on `answer` for the pair (a, b) whose exact answer is `truth`.
 DistanceVerdict judge_distance(const DistanceResult& answer, const DistanceResult& truth,

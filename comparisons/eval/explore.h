@@ -98,6 +98,10 @@ struct BackendOutcome {
   // Contact kind (measured): how far the points fall short of the exact patch / size
   // (patch_cover.h); counted, not yet a disagreement (docs/explore.md).
   double coverage_err_rel = 0.0;
+  // Distance kind (measured): the errors of rbx distance's verdict (distance_query.h), relative
+  // to the true distance.
+  double distance_err_rel = 0.0;
+  double witness_err_rel = 0.0;
 };
 
 /// Everything measured on one sample.
@@ -424,5 +428,28 @@ struct TunnelShrinkResult {
 };
 TunnelShrinkResult shrink_tunnel(const TunnelSample& s, const std::string& backend,
                                  const std::string& sig, int max_evaluations = 120);
+
+// ---------------------------------------------------------------------------------------------
+// Distance kind: the contact kind's shapes (boxes, hulls of 4 to 2,000 points, slivers; sizes
+// up to 1e3 apart) in its poses (touching, parallel faces, around a corner, crossed edges, ...)
+// moved apart along the exact closest pair's direction until the gap is g, drawn log-uniformly
+// from 1e-9 to 10 times the smaller body's size. Moving B along that direction by t changes the
+// distance by exactly t (the pair stays closest, and the plane between them still separates), so
+// the gap is g to round-off; the truth is the oracle's distance on the written scene.
+
+/// "hair" (g below 1e-4 of the smaller size), "near" (below 0.1) or "far": a sample's gap class.
+std::string gap_class(double gap_rel);
+
+/// Sample `index` of `seed` (distance kind): a pure function of the two; its pose_class is its
+/// gap class.
+ContactSample make_distance_sample(uint64_t seed, uint64_t index);
+
+/// Runs the sample's scene (sample_scene_text) through the exact oracle and each named backend's
+/// distance query (those without one left out) and classifies each answer by rbx distance's
+/// verdict (judge_distance): status error, then overlap (says the pair overlaps), then distance
+/// (off by more than kDistanceDisagreeRel), then witness (the points are not a closest pair).
+SampleOutcome evaluate_distance_sample(const ContactSample& s,
+                                       const std::vector<std::string>& names,
+                                       const std::vector<Backend>* table = nullptr);
 
 }  // namespace rbx

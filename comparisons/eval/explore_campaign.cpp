@@ -27,7 +27,8 @@ namespace {
 
 const char* const kMetrics[] = {"normal_err_deg",   "depth_err_rel",   "point_err_rel",
                                 "coverage_err_rel", "velocity_err_ke", "momentum_err_ke",
-                                "position_err_m",   "turn_rad",        "rest_time_err_s"};
+                                "position_err_m",   "turn_rad",        "rest_time_err_s",
+                                "distance_err_rel", "witness_err_rel"};
 
 // The metrics of one kind of sample.
 std::vector<std::string> metrics_of(const std::string& kind) {
@@ -35,6 +36,7 @@ std::vector<std::string> metrics_of(const std::string& kind) {
   if (kind == "landing" || kind == "slide")
     return {"position_err_m", "turn_rad", "velocity_err_ke", "rest_time_err_s"};
   if (kind == "tunnel") return {"velocity_err_ke", "position_err_m"};
+  if (kind == "distance") return {"distance_err_rel", "witness_err_rel"};
   return {"normal_err_deg", "depth_err_rel", "point_err_rel", "coverage_err_rel"};
 }
 
@@ -48,18 +50,22 @@ double metric_value(const BackendOutcome& b, const std::string& m) {
   if (m == "momentum_err_ke") return b.momentum_err_ke;
   if (m == "position_err_m") return b.position_err_m;
   if (m == "turn_rad") return b.turn_rad;
+  if (m == "distance_err_rel") return b.distance_err_rel;
+  if (m == "witness_err_rel") return b.witness_err_rel;
   return b.rest_time_err_s;
 }
 
 std::vector<std::string> subject_backends(const std::string& list, const std::string& kind) {
   std::vector<std::string> names;
   if (list.empty() || list == "all") {
-    // Every backend with a contact query (contact kind) or a dynamics run (impact, landing);
-    // `exact` is the truth, not a subject.
-    for (const Backend& b : backends())
-      if ((kind != "contact" ? static_cast<bool>(b.dynamics) : static_cast<bool>(b.contact)) &&
-          b.name != "exact")
-        names.push_back(b.name);
+    // Every backend with a contact query (contact kind), a distance query (distance kind) or a
+    // dynamics run (the others); `exact` is the truth, not a subject.
+    for (const Backend& b : backends()) {
+      const bool serves = kind == "contact"    ? static_cast<bool>(b.contact)
+                          : kind == "distance" ? static_cast<bool>(b.distance)
+                                               : static_cast<bool>(b.dynamics);
+      if (serves && b.name != "exact") names.push_back(b.name);
+    }
     return names;
   }
   names = parse_backend_list(list);
@@ -98,6 +104,8 @@ std::vector<std::string> sample_all(const ExploreSettings& set,
         return encode(evaluate_slide_sample(make_slide_sample(set.seed, i), names));
       if (set.kind == "tunnel")
         return encode(evaluate_tunnel_sample(make_tunnel_sample(set.seed, i), names));
+      if (set.kind == "distance")
+        return encode(evaluate_distance_sample(make_distance_sample(set.seed, i), names));
       const ContactSample s = make_contact_sample(set.seed, i);
       if (bench && (s.a.points.size() >= 100 || s.b.points.size() >= 100)) return "";
       if (!set.shapes.empty() && !keeps_shapes(set.shapes, s.a.shape_class, s.b.shape_class))
@@ -249,6 +257,9 @@ Json group_json(const std::string& sig, long count, const BackendTally& t, const
     g["shrunk_error"] = {{"velocity_err_ke", r["velocity_err_ke"]},
                          {"position_err_m", r["position_err_m"]},
                          {"phase", r["phase"]}};
+  } else if (kind == "distance") {
+    g["shrunk_error"] = {{"distance_err_rel", r["distance_err_rel"]},
+                         {"witness_err_rel", r["witness_err_rel"]}};
   } else if (kind == "slide") {
     g["shrunk_error"] = {{"position_err_m", r["position_err_m"]},
                          {"turn_rad", r["turn_rad"]},

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "comparisons/eval/contact_eval.h"
+#include "comparisons/eval/distance_query.h"
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/explore_detail.h"
 #include "comparisons/eval/json_io.h"
@@ -107,6 +108,11 @@ std::string describe_outcome(const BackendOutcome& b) {
     return "status " + b.error + ": " + m;
   }
   if (b.error == "misses") return "misses a contact";
+  if (b.error == "overlap") return "says the pair overlaps; it is apart";
+  if (b.error == "false_distance") return "gives a distance to an overlapping pair";
+  if (b.error == "distance" || b.error == "witness")
+    return "distance off by " + fmt_num(b.distance_err_rel, 3) + ", witness points off by " +
+           fmt_num(b.witness_err_rel, 3) + " of the true distance";
   if (b.error == "coverage")
     return "its points fall short of the exact contact patch by " + fmt_num(b.coverage_err_rel, 3) +
            " of the smaller body";
@@ -301,6 +307,35 @@ std::string shrink_tunnel_group(const Json& g, uint64_t seed, long count, int bu
       });
 }
 
+// One distance group: its first sample's scene as drawn (distance samples are not shrunk yet),
+// reproduced when `rbx distance`'s comparison of the written scene marks the backend.
+std::string distance_group(const Json& g, uint64_t seed, long count) {
+  const ContactSample start = make_distance_sample(seed, g["first_sample"].get<uint64_t>());
+  const std::string backend = g["backend"], sig = g["signature"];
+  const SampleOutcome o = evaluate_distance_sample(start, {backend});
+  const BackendOutcome found = outcome_of(o, backend);
+  if (found.error.empty()) return Json{{"ok", false}}.dump();
+  std::ostringstream h;
+  h << "# Found by `rbx explore --kind distance --seed " << seed << " --count " << count
+    << "`: sample " << start.index << " (" << start.pose_class << " gap), group '" << sig
+    << "',\n# " << g["count"].get<long>() << " samples. " << backend
+    << " against the exact oracle: " << describe_outcome(found)
+    << ".\n# Not shrunk: the sample as drawn.\n# Reproduce: rbx distance THIS_FILE --backends "
+    << backend << "\n";
+  const std::string text = sample_scene_text(start, h.str());
+  const DistanceComparison c = compare_distances(parse_scene(text, "explore.toml"), {backend}, 0.0);
+  const DistanceRow& row = c.pairs.at(0).rows.at(0);
+  Json fields = {{"ok", true},
+                 {"text", text},
+                 {"reproduced", row.verdict.mark == "disagrees"},
+                 {"harness", "rbx distance: " + (row.verdict.why.empty() ? std::string("no mark")
+                                                                         : row.verdict.why)},
+                 {"message", found.message},
+                 {"distance_err_rel", found.distance_err_rel},
+                 {"witness_err_rel", found.witness_err_rel}};
+  return fields.dump();
+}
+
 }  // namespace
 
 std::string shrink_group(const Json& group, const ExploreSettings& set) {
@@ -313,6 +348,7 @@ std::string shrink_group(const Json& group, const ExploreSettings& set) {
       return shrink_slide_group(group, set.seed, set.count, std::min(set.shrink_budget, 60));
     if (set.kind == "tunnel")
       return shrink_tunnel_group(group, set.seed, set.count, std::min(set.shrink_budget, 60));
+    if (set.kind == "distance") return distance_group(group, set.seed, set.count);
     return shrink_contact_group(group, set.seed, set.count, set.shrink_budget);
   } catch (const std::exception& e) {
     return Json{{"ok", false}, {"message", e.what()}}.dump();

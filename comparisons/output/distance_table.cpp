@@ -50,10 +50,10 @@ void print_distances(std::ostream& out, const DistanceComparison& c) {
     out << "no pair of bodies to measure (every body is static, or there is only one)\n";
     return;
   }
-  out << "\nerrors: relative to the true distance (at least 1e-8 of the smaller body's size); "
-         "witness err: how far the two points are from a closest pair (off their bodies, or "
-         "apart by other than the distance); ✗ over 1e-6, ~ over 1e-9 and beyond round-off "
-         "(docs/distance.md)\n";
+  out << "\nerrors: relative to the true distance, at least 1e-8 of the pair's extent from the "
+         "origin (round-off of the coordinates); witness err: how far the two points are from a "
+         "closest pair (off their bodies, or apart by other than the distance), on the same scale; "
+         "✗ over 1e-6, ~ over 1e-9 and beyond round-off (docs/distance.md)\n";
   out << "time: per query, the median over rounds of repeated calls (warmed up, backends "
          "interleaved; docs/bench.md) with its 25-75 % range; the cold call is the first, which "
          "gave the answer, timed alone\n";

@@ -66,9 +66,9 @@ TEST(JudgeDistance, AWrongDistanceOrAPointOffItsBodyDisagrees) {
   // 1e-8 of the distance off: beyond round-off, within the disagreement threshold.
   v = judge_distance(apart(0.25 * (1 + 1e-8), Vec3(0, 0, 0.75), Vec3(0, 0, 0.5)), truth, p.a, p.b);
   EXPECT_EQ(v.mark, "deviates");
-  // Cubes 1e-10 apart (below the floor, 1e-8 of the size 1.73): round-off of the coordinates
-  // (3e-16 here) is no mark, the oracle's own answers carry that much; 1e-13 off is beyond it
-  // and, over the floor, beyond 1e-6 as well: it disagrees.
+  // Cubes 1e-10 apart (below the floor, 1e-8 of the pair's extent 1.9): round-off of the
+  // coordinates (3e-16 here) is no mark, the oracle's own answers carry that much; 1e-13 off is
+  // beyond it and, over the floor, beyond 1e-6 as well: it disagrees.
   const RigidBody a = test::unit_cube("A", Vec3(0.2, 0.1, 1.0 + 1e-10)), b = p.b;
   const double gap = (a.position.z() - 0.5) - 0.5;
   const DistanceResult hair = apart(gap, Vec3(0, 0, 0.5 + gap), Vec3(0, 0, 0.5));
