@@ -63,8 +63,8 @@ TEST(ExactDistance, ClosedFormsWithTheirFeatures) {
 // A tetrahedron's outward triangles from its four corners.
 ConvexPolyhedron tetrahedron(const std::vector<Vec3>& v) {
   std::vector<std::array<int, 3>> tris;
-  for (const auto& t : std::vector<std::array<int, 4>>{{0, 1, 2, 3}, {0, 1, 3, 2}, {0, 2, 3, 1},
-                                                       {1, 2, 3, 0}}) {
+  for (const auto& t :
+       std::vector<std::array<int, 4>>{{0, 1, 2, 3}, {0, 1, 3, 2}, {0, 2, 3, 1}, {1, 2, 3, 0}}) {
     const Vec3 n = (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]);
     if (n.dot(v[t[3]] - v[t[0]]) < 0)
       tris.push_back({t[0], t[1], t[2]});
