@@ -32,6 +32,8 @@ void tally(const std::string& scene, const std::vector<std::string>& encoded,
       values[b.backend]["position_err_m"].push_back(b.position_err_m);
       values[b.backend]["turn_rad"].push_back(b.turn_rad);
       values[b.backend]["rest_time_err_s"].push_back(b.rest_time_err_s);
+      values[b.backend]["distance_err_rel"].push_back(b.distance_err_rel);
+      values[b.backend]["witness_err_rel"].push_back(b.witness_err_rel);
     }
   }
   for (const auto& [backend, n] : samples) {
@@ -68,6 +70,19 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
                                                           contact_backends, table, cache));
                   }),
           {"normal_err_deg", "depth_err_rel", "coverage_err_rel"}, "exact", out);
+  // The distance kind's subjects: the contact backends that have a distance query.
+  std::vector<std::string> distance_backends;
+  for (const std::string& name : contact_backends)
+    if (const Backend* b = find_backend(name, table); b && b->distance)
+      distance_backends.push_back(name);
+  if (!distance_backends.empty() && set.distance > 0)
+    tally("explore/distance",
+          run.map(static_cast<size_t>(set.distance),
+                  [&](size_t i) {
+                    return encode(evaluate_distance_sample(make_distance_sample(set.seed, i),
+                                                           distance_backends, table));
+                  }),
+          {"distance_err_rel", "witness_err_rel"}, "exact", out);
   if (!impact_backends.empty() && set.impact > 0)
     tally("explore/impact",
           run.map(static_cast<size_t>(set.impact),

@@ -13,27 +13,29 @@
 
 namespace rbx {
 
-/// Which samples: explore's own families (contact, impact, landing, slide and tunnel kinds),
-/// from one seed.
+/// Which samples: explore's own families (contact, distance, impact, landing, slide and tunnel
+/// kinds), from one seed.
 struct ExploreCheckSet {
   uint64_t seed = 1;
-  int contact = 2000;  // contact-kind samples
-  int impact = 300;    // impact-kind samples
-  int landing = 300;   // landing-kind samples
-  int slide = 200;     // slide-kind samples
-  int tunnel = 200;    // tunnel-kind samples
+  int contact = 2000;   // contact-kind samples
+  int distance = 1000;  // distance-kind samples
+  int impact = 300;     // impact-kind samples
+  int landing = 300;    // landing-kind samples
+  int slide = 200;      // slide-kind samples
+  int tunnel = 200;     // tunnel-kind samples
 };
 
 /// One metric of the sample set, under a pseudo-scene name ("explore/contact",
-/// "explore/impact", "explore/landing", "explore/slide", "explore/tunnel") so that it takes its
-/// place beside the scenes' metrics.
+/// "explore/distance", "explore/impact", "explore/landing", "explore/slide", "explore/tunnel") so
+/// that it takes its place beside the scenes' metrics.
 struct ExploreCheckMetric {
   std::string scene;
   Metric metric;
 };
 
 /// Per backend: the disagreement rate and the median and 90th percentile of its errors (contact:
-/// normal_err_deg, depth_err_rel; impact: velocity_err_ke; landing: position_err_m, turn_rad;
+/// normal_err_deg, depth_err_rel; distance, for the contact backends with a distance query:
+/// distance_err_rel, witness_err_rel; impact: velocity_err_ke; landing: position_err_m, turn_rad;
 /// slide: those and rest_time_err_s; tunnel: velocity_err_ke), over the samples, exactly as
 /// `rbx explore` classifies them. Impacts, landings, slides and tunnels run the
 /// dynamics backends. Backends are looked up in `table` (null: the registry). The samples

@@ -58,6 +58,10 @@ const std::vector<ExploreFamily>& explore_families() {
        "contact pairs",
        {{"normal_err_deg", "normal error (deg) p50 / p90"},
         {"depth_err_rel", "depth error / smaller size p50 / p90"}}},
+      {"explore/distance",
+       "separated pairs (distance)",
+       {{"distance_err_rel", "distance error / true distance p50 / p90"},
+        {"witness_err_rel", "witness points' error / true distance p50 / p90"}}},
       {"explore/impact", "impacts", {{"velocity_err_ke", "velocity error (KE norm) p50 / p90"}}},
       {"explore/landing",
        "landings with friction",
@@ -88,8 +92,10 @@ std::string explore_intro(const ExploreCheckSet& set) {
   std::ostringstream md;
   md << "What no scene of the library shows: `rbx explore`'s fixed samples (seed " << set.seed
      << "; the ones `rbx check` compares), " << set.contact
-     << " random convex pairs against the `exact` oracle, " << set.impact
-     << " random vertex-on-face impacts at a random phase, " << set.landing
+     << " random convex pairs against the `exact` oracle, " << set.distance
+     << " random separated pairs (gaps of 1e-9 to 10 sizes) whose distance and closest points "
+        "each distance query gives against the oracle's, "
+     << set.impact << " random vertex-on-face impacts at a random phase, " << set.landing
      << " random landings of a box sliding on a floor with friction (any direction, speed, mu "
         "and yaw), "
      << set.slide
@@ -99,7 +105,8 @@ std::string explore_intro(const ExploreCheckSet& set) {
      << " random fast projectiles at thin walls (up to 20 times the wall per step), against "
         "their closed forms. "
         "*Disagreement*: a sample a backend answers clearly wrong (normal > 1°, depth > 1 % of "
-        "the smaller body, velocity error > 0.1 %, a landing or slide at rest more than 1 mm "
+        "the smaller body, a distance or its points off by more than 1e-6 of the true distance "
+        "(docs/distance.md), velocity error > 0.1 %, a landing or slide at rest more than 1 mm "
         "from where Coulomb's law puts it or turned by more than 1e-3 rad, a slide coming to rest "
         "more than 3 ms off its time, a projectile through or into its wall, a missed or false "
         "contact, an error). Errors are the median and 90th percentile over the samples where "

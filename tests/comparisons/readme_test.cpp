@@ -92,6 +92,7 @@ TEST(Readme, ItsCountsAreTheSceneTablesAndTheReportsExploreSamples) {
   // The report's random samples are the check's (comparisons/eval/explore_check.h).
   const rbx::ExploreCheckSet report_samples;
   EXPECT_EQ(number_before(readme, "random convex pairs"), report_samples.contact);
+  EXPECT_EQ(number_before(readme, "random separated pairs"), report_samples.distance);
   EXPECT_EQ(number_before(readme, "random impacts"), report_samples.impact);
   EXPECT_EQ(number_before(readme, "random landings"), report_samples.landing);
   EXPECT_EQ(number_before(readme, "random slides"), report_samples.slide);
