@@ -326,8 +326,9 @@ struct QueryVariant {
   std::string variant;      // e.g. "prebuilt"
   std::string description;  // one line: what differs
   ContactFn contact;
-  BenchSizes bench = {};    // the hulls `rbx bench` times it on (0: not timed)
-  bool boxes_only = false;  // timed on the box pair only (a path a library takes for boxes)
+  BenchSizes bench = {};          // the hulls `rbx bench` times it on (0: not timed)
+  bool boxes_only = false;        // timed on the box pair only (a path a library takes for boxes)
+  DistanceFn distance = nullptr;  // the same set-up's distance query (empty: none)
 };
 
 /// One library adapter as a table: the backends it provides and their query variants, each row

@@ -350,6 +350,21 @@ DistanceResult fcl_distance_indep(const RigidBody& a, const RigidBody& b) {
                       fcl::GST_INDEP, false, "fcl::distance (GST_INDEP)");
 }
 
+// `fcl`'s distance with each shape's geometry built once per thread (fcl_contact_prebuilt).
+DistanceResult fcl_distance_prebuilt(const RigidBody& a, const RigidBody& b) {
+  thread_local PrebuiltCache<std::shared_ptr<fcl::CollisionGeometryd>> box_cache, convex_cache;
+  auto cache_of = [&](const RigidBody& body) -> auto& {
+    return is_native_box(body) ? box_cache : convex_cache;
+  };
+  fcl::Transform3d tf_a, tf_b;
+  auto geom_a = cache_of(a).get(a.shape, nullptr, [&] { return native_geometry(a, tf_a); });
+  auto geom_b = cache_of(b).get(b.shape, nullptr, [&] { return native_geometry(b, tf_b); });
+  native_placement(a, tf_a);
+  native_placement(b, tf_b);
+  return fcl_distance(geom_a, tf_a, geom_b, tf_b, fcl::GST_LIBCCD, false,
+                      "fcl::distance (GST_LIBCCD)");
+}
+
 MassResult fcl_hull_mass(const RigidBody& body);
 
 // `fcl` mass: fcl::Box's volume and inertia for box bodies (unit density, scaled by mass /
@@ -419,7 +434,9 @@ const Adapter& fcl_adapter() {
            "prebuilt",
            "each fcl::Box or Convex built once and kept, as a user holding FCL objects",
            fcl_contact_prebuilt,
-           {8192, 2048}},
+           {8192, 2048},
+           false,
+           fcl_distance_prebuilt},
           // `fcl` on two box bodies runs fcl::Box (boxBoxIntersect): timed apart on the boxes.
           {"fcl",
            "boxes",

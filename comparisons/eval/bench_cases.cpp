@@ -1,6 +1,6 @@
 // `rbx bench`: the performance comparison of the contact query, the broad phase and the whole step.
 //
-// Four families of cases (the table kFamilies below), each built as groups of cases that are
+// Five families of cases (the table kFamilies below), each built as groups of cases that are
 // timed together (comparisons/eval/timing.h: rounds in turns, the first case rotating, until each
 // has its minimum time and count of rounds):
 //   - narrowphase: every contact backend through the registry's ContactFn, on the same convex
@@ -8,6 +8,8 @@
 //     poses (touching, deep, separated); a group is one shape size and pose kind. One call is
 //     one query at each of the next poses of the cycle; ns_per_query is the time per call over
 //     the number of poses.
+//   - distance: every distance query (distance_backends()) on the narrow phase's shapes, B 1 %
+//     and 20 % of the size beyond touching; a group is one shape size and gap.
 //   - broadphase: the engine's broad-phase methods finding the pairs of a crowd of cubes (a
 //     fixed density, so the pairs per body stay constant), after a small motion of every body
 //     per step (the motion is not timed); a group is one crowd size.
@@ -98,6 +100,18 @@ std::vector<NarrowBackend> narrow_backends() {
   return rows;
 }
 
+std::vector<DistanceBackend> distance_backends() {
+  std::vector<DistanceBackend> rows;
+  for (const Backend& b : backends()) {
+    if (b.distance && b.bench.full > 0 && b.name != "exact")
+      rows.push_back({b.name, "default", b.distance, b.bench.full, b.bench.quick});
+    for (const QueryVariant& v : query_variants())
+      if (v.backend == b.name && v.distance && v.bench.full > 0)
+        rows.push_back({b.name, v.variant, v.distance, v.bench.full, v.bench.quick});
+  }
+  return rows;
+}
+
 namespace {
 
 // ---------------------------------------------------------------------------------------------
@@ -129,11 +143,27 @@ struct CaseSet {
 // ---------------------------------------------------------------------------------------------
 // Narrow phase: every backend of narrow_backends() on every shape size and pose kind.
 
-CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
+// One query of a timed row on a pair at its pose: "" when the answer is ok, else its status and
+// message.
+using PairQuery = std::function<std::string(const RigidBody& a, const RigidBody& b)>;
+
+// A row of a query family: what is timed and up to which size.
+struct QueryRow {
+  std::string backend, variant;
+  PairQuery query;
+  int max_full = 0, max_quick = 0;
+  bool boxes_only = false;
+};
+
+// A query family's groups: every row on every shape size and pose kind of `kinds` (one group
+// each, named "<family>/<size>/<kind>"), the rows going to `into` (ns per query).
+CaseSet query_cases(const BenchPlan& plan, const std::string& family,
+                    const std::vector<QueryRow>& rows, const std::vector<PoseKind>& kinds,
+                    std::vector<NarrowRow> BenchResults::*into) {
   struct State {
     NarrowRow row;
     std::shared_ptr<PosedPair> pair;
-    ContactFn contact;
+    PairQuery query;
     std::string name;
     std::string status = "ok";
     std::size_t next = 0;  // the pose the next query takes (modulo the cycle)
@@ -142,8 +172,7 @@ CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
   std::vector<std::shared_ptr<State>> states;
   std::vector<int> sizes = {8};
   sizes.insert(sizes.end(), plan.hull_sizes.begin(), plan.hull_sizes.end());
-  const std::vector<NarrowBackend> nb = narrow_backends();
-  std::cerr << "bench: building shapes and poses\n";
+  std::cerr << "bench: building shapes and poses (" << family << ")\n";
   for (int n : sizes) {
     const bool box = n == 8;
     // One generator per shape and per pose kind, seeded by them: the quick run times the first
@@ -151,26 +180,29 @@ CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
     std::mt19937_64 shape_rng(1000003ull * static_cast<unsigned>(n));
     const ConvexPolyhedron shape =
         box ? make_box(Vec3::Constant(kBenchShapeSize)) : sphere_hull(n, shape_rng);
-    for (const PoseKind& kind : kPoseKinds) {
+    for (const PoseKind& kind : kinds) {
+      // The seed of the narrow phase's pose kind at the same place in kPoseKinds; a gap kind,
+      // past them, its own.
       std::mt19937_64 pose_rng(1000003ull * static_cast<unsigned>(n) +
-                               static_cast<unsigned>(&kind - kPoseKinds) + 1);
+                               static_cast<unsigned>(&kind - kinds.data()) + 1 +
+                               (family == "narrowphase" ? 0u : 100u));
       auto pair = std::make_shared<PosedPair>(make_poses(shape, box, kind, plan.poses, pose_rng));
       BenchGroup group;
-      group.name = "narrowphase/" + std::to_string(n) + "/" + kind.name;
+      group.name = family + "/" + std::to_string(n) + "/" + kind.name;
       group.plan.min_time_s = plan.min_time;
-      for (const NarrowBackend& b : nb) {
+      for (const QueryRow& b : rows) {
         if (b.boxes_only && !box) continue;
-        if (n > (plan.quick ? b.max_vertices_quick : b.max_vertices_full)) continue;
+        if (n > (plan.quick ? b.max_quick : b.max_full)) continue;
         auto c = std::make_shared<State>();
         c->row.backend = b.backend;
         c->row.variant = b.variant;
         c->row.pose = kind.name;
         c->row.vertices = n;
         c->row.hull_vertices = static_cast<int>(shape.vertices().size());
-        c->name = "narrowphase/" + b.backend + "/" + b.variant + "/" + std::to_string(n) + "/" +
-                  kind.name;
+        c->name =
+            family + "/" + b.backend + "/" + b.variant + "/" + std::to_string(n) + "/" + kind.name;
         c->pair = pair;
-        c->contact = b.contact;
+        c->query = b.query;
         states.push_back(c);
         // One query at pose k of the pair.
         auto query = [c](std::size_t k) {
@@ -180,7 +212,7 @@ CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
           p.a.orientation = p.poses_a[k].orientation;
           p.b.position = p.poses_b[k].position;
           p.b.orientation = p.poses_b[k].orientation;
-          return c->contact(p.a, p.b);
+          return c->query(p.a, p.b);
         };
         BenchCase bc;
         bc.name = c->name;
@@ -194,9 +226,8 @@ CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
         // status that is not ok is kept.
         bc.body = [c, query, per_iteration] {
           for (std::size_t k = 0; k < per_iteration; ++k) {
-            const ContactResult r = query(c->next++);
-            if (r.status != Status::Ok)
-              c->status = std::string(to_string(r.status)) + ": " + r.message;
+            const std::string status = query(c->next++);
+            if (!status.empty()) c->status = status;
           }
         };
         group.cases.push_back(bc);
@@ -204,18 +235,56 @@ CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
       set.groups.push_back(std::move(group));
     }
   }
-  set.collect = [states, poses = plan.poses_per_iteration](const CaseTimes& times,
-                                                           BenchResults& out) {
+  set.collect = [states, poses = plan.poses_per_iteration, into](const CaseTimes& times,
+                                                                 BenchResults& out) {
     for (const auto& c : states) {
       NarrowRow r = c->row;
       r.status = c->status;
       // A call queries `poses` poses: the row's unit is ns per query.
       r.ns_per_query = times.time(c->name, 1e9 / static_cast<double>(poses));
       if (times.errors.count(c->name)) r.status = "error: " + times.errors.at(c->name);
-      out.narrow.push_back(r);
+      (out.*into).push_back(r);
     }
   };
   return set;
+}
+
+// Narrow phase: every backend of narrow_backends() on every shape size and pose kind.
+CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64&) {
+  std::vector<QueryRow> rows;
+  for (const NarrowBackend& b : narrow_backends()) {
+    const ContactFn contact = b.contact;
+    rows.push_back({b.backend, b.variant,
+                    [contact](const RigidBody& a, const RigidBody& bb) {
+                      const ContactResult r = contact(a, bb);
+                      return r.status == Status::Ok
+                                 ? std::string()
+                                 : std::string(to_string(r.status)) + ": " + r.message;
+                    },
+                    b.max_vertices_full, b.max_vertices_quick, b.boxes_only});
+  }
+  return query_cases(plan, "narrowphase", rows,
+                     std::vector<PoseKind>(std::begin(kPoseKinds), std::end(kPoseKinds)),
+                     &BenchResults::narrow);
+}
+
+// Distance: every query of distance_backends() on every shape size, 1 % and 20 % apart.
+CaseSet distance_cases(const BenchPlan& plan, std::mt19937_64&) {
+  std::vector<QueryRow> rows;
+  for (const DistanceBackend& b : distance_backends()) {
+    const DistanceFn distance = b.distance;
+    rows.push_back({b.backend, b.variant,
+                    [distance](const RigidBody& a, const RigidBody& bb) {
+                      const DistanceResult r = distance(a, bb);
+                      if (r.status != Status::Ok)
+                        return std::string(to_string(r.status)) + ": " + r.message;
+                      return r.overlapping ? std::string("said overlapping") : std::string();
+                    },
+                    b.max_vertices_full, b.max_vertices_quick});
+  }
+  return query_cases(plan, "distance", rows,
+                     std::vector<PoseKind>(std::begin(kGapKinds), std::end(kGapKinds)),
+                     &BenchResults::distance);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -466,9 +535,8 @@ struct Family {
   CaseSet (*build)(const BenchPlan& plan, std::mt19937_64& rng);
 };
 const Family kFamilies[] = {
-    {"narrowphase", narrowphase_cases},
-    {"broadphase", broadphase_cases},
-    {"step", step_cases},
+    {"narrowphase", narrowphase_cases}, {"distance", distance_cases},
+    {"broadphase", broadphase_cases},   {"step", step_cases},
     {"explore", explore_cases},
 };
 

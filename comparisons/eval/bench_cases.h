@@ -73,6 +73,23 @@ struct NarrowBackend {
 /// Every contact backend with the sizes it is timed at.
 std::vector<NarrowBackend> narrow_backends();
 
+/// The gaps the distance queries are timed at, as fractions of the shape size (the pose kinds'
+/// convention: B placed that far beyond touching along the placement direction).
+inline constexpr PoseKind kGapKinds[] = {{"gap 1%", 0.01}, {"gap 20%", 0.2}};
+
+/// One distance query as benchmarked: a row of the distance table.
+struct DistanceBackend {
+  std::string backend;  // registry name
+  std::string variant;  // "default", or the query variant's ("prebuilt" for fcl)
+  DistanceFn distance;
+  int max_vertices_full;   // largest hull size timed in the full run
+  int max_vertices_quick;  // in the quick run
+};
+/// Every distance query timed: the registry backends with one whose contact query is timed
+/// (`exact` left out: its distance is a check over every feature pair, not a query), and the
+/// query variants with one, at their contact rows' sizes.
+std::vector<DistanceBackend> distance_backends();
+
 // ---- Scene builders ------------------------------------------------------------------------
 
 /// The hull of n random points on the sphere of radius 0.5 (all of them are hull vertices).
@@ -171,6 +188,7 @@ struct BenchResults {
   double mhz = 0.0;
   std::size_t cases = 0;
   std::vector<NarrowRow> narrow;
+  std::vector<NarrowRow> distance;  // the distance queries, `pose` naming the gap kind
   std::vector<BroadRow> broad;
   std::vector<StepRow> step;
   std::vector<ExploreRow> explore;

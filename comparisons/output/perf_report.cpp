@@ -93,6 +93,17 @@ Json perf_json(const BenchPlan& plan, const BenchResults& results,
     put_time(row, "ns_per_query", r.ns_per_query);
     j["rows"].push_back(row);
   }
+  for (const NarrowRow& r : results.distance) {
+    Json row = {{"kind", "distance"},
+                {"backend", r.backend},
+                {"variant", r.variant},
+                {"vertices", r.vertices},
+                {"hull_vertices", r.hull_vertices},
+                {"gap", r.pose},
+                {"status", r.status}};
+    put_time(row, "ns_per_query", r.ns_per_query);
+    j["rows"].push_back(row);
+  }
   for (const BroadRow& r : results.broad) {
     Json row = {{"kind", "broadphase"},
                 {"method", r.method},
@@ -146,6 +157,9 @@ std::string perf_csv(const BenchResults& results) {
          "unit\n";
   for (const NarrowRow& r : results.narrow)
     csv << "narrowphase," << r.backend << "," << r.variant << ",,," << r.vertices << "," << r.pose
+        << ",," << figures(r.ns_per_query) << ",ns_per_query\n";
+  for (const NarrowRow& r : results.distance)
+    csv << "distance," << r.backend << "," << r.variant << ",,," << r.vertices << "," << r.pose
         << ",," << figures(r.ns_per_query) << ",ns_per_query\n";
   for (const BroadRow& r : results.broad)
     csv << "broadphase,,," << r.method << ",,,," << r.bodies << "," << figures(r.ns_per_step)
@@ -257,6 +271,66 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
   return md.str();
 }
 
+// The distance queries: every one per gap and size, and custom's time over FCL's prebuilt one,
+// round by round.
+std::string distance_markdown(const BenchPlan& plan, const BenchResults& results) {
+  const std::vector<DistanceBackend> db = distance_backends();
+  if (results.distance.empty()) return "";
+  std::vector<int> sizes = {8};
+  sizes.insert(sizes.end(), plan.hull_sizes.begin(), plan.hull_sizes.end());
+  std::ostringstream md;
+  md << "\n## Distance query\n\n"
+     << "Every distance query (`rbx distance`, docs/distance.md) on the narrow phase's shapes, "
+        "placed as its poses are but with B beyond touching by ";
+  for (size_t k = 0; k < std::size(kGapKinds); ++k)
+    md << (k ? " or " : "") << kGapKinds[k].offset * 100 << "% of the size";
+  md << " along the placement direction (*" << kGapKinds[0].name << "*, *" << kGapKinds[1].name
+     << "*); timed as the narrow phase is, each adapter doing what it does per call (`fcl "
+        "(prebuilt)` with each fcl::Box or Convex built once, the fair comparison for custom). "
+        "The last row of each table is custom's time over FCL's prebuilt one, the median of the "
+        "ratios round by round, ± half their 25-75 % range.\n\n";
+  auto find = [&](const std::string& backend, const std::string& variant, const char* gap,
+                  int n) -> const NarrowRow* {
+    for (const NarrowRow& r : results.distance)
+      if (r.backend == backend && r.variant == variant && r.pose == gap && r.vertices == n)
+        return &r;
+    return nullptr;
+  };
+  for (const PoseKind& k : kGapKinds) {
+    md << "### " << k.name << "\n\n| backend | variant |";
+    for (int n : sizes) md << (n == 8 ? " box" : " N = " + std::to_string(n)) << " |";
+    md << "\n|---|---|";
+    for (std::size_t i = 0; i < sizes.size(); ++i) md << "---:|";
+    md << "\n";
+    for (const DistanceBackend& b : db) {
+      md << "| " << b.backend << " | " << b.variant << " |";
+      for (int n : sizes) {
+        const NarrowRow* r = find(b.backend, b.variant, k.name, n);
+        std::string note;
+        if (r && r->status != "ok") note = " (" + r->status.substr(0, r->status.find(':')) + ")";
+        md << " " << (r ? time_cell(r->ns_per_query, true) : std::string("—")) << note << " |";
+      }
+      md << "\n";
+    }
+    md << "| **custom / fcl (prebuilt)** | |";
+    for (int n : sizes) {
+      const NarrowRow* c = find("custom", "default", k.name, n);
+      const NarrowRow* f = find("fcl", "prebuilt", k.name, n);
+      if (!c || !f) {
+        md << " — |";
+        continue;
+      }
+      const RatioSpread q = bench_ratio(c->ns_per_query, f->ns_per_query);
+      md << " " << bench_num(q.median, 3);
+      if (q.rounds > 1 && q.median > 0)
+        md << " ±" << bench_num(50.0 * (q.q75 - q.q25) / q.median, 2) << "%";
+      md << " |";
+    }
+    md << "\n\n";
+  }
+  return md.str();
+}
+
 // The broad phase: every method per crowd size.
 std::string broad_markdown(const BenchPlan& plan, const BenchResults& results) {
   std::ostringstream md;
@@ -328,7 +402,7 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
   csv << perf_csv(results);
   std::ostringstream md;
   md << goals_markdown(plan, results, goals, timing_s) << narrow_markdown(plan, results)
-     << broad_markdown(plan, results) << step_markdown(results);
+     << distance_markdown(plan, results) << broad_markdown(plan, results) << step_markdown(results);
   // Everything is built in a temporary folder, figures drawn there, then each file moved into
   // the output folder (other files there, such as `rbx report`'s, are kept).
   const fs::path target(out);
