@@ -126,6 +126,7 @@ struct ModelOptions {
   bool elliptic_cone = false;
   double impratio = 1.0;
   int noslip_iterations = 0;
+  double margin = 0.0;  // m, every geom's contact margin (distance queries: a contact within it)
 };
 
 // Prints a double so that it reads back exactly (17 significant digits).
@@ -207,7 +208,9 @@ std::string build_mjcf(const std::vector<RigidBody>& bodies, bool all_free,
   if (!opt.box_geoms)
     for (size_t i = 0; i < n; ++i) s << mesh_element("hull" + std::to_string(i), *bodies[i].shape);
   s << "</asset>\n<worldbody>\n";
-  const std::string contact = geom_contact_attributes(opt.contact);
+  const std::string contact =
+      geom_contact_attributes(opt.contact) +
+      (opt.margin > 0 ? " margin=\"" + num(opt.margin) + "\"" : std::string());
   for (size_t i = 0; i < n; ++i) {
     const RigidBody& b = bodies[i];
     const std::string shape = shape_attributes(b, i, opt.box_geoms);
@@ -541,6 +544,59 @@ ContactResult query_model(QueryModel& q, const RigidBody& a, const RigidBody& b)
   return r;
 }
 
+/// MuJoCo 2.2.2 has no distance query (mj_geomDistance came later); a contact within the
+/// geoms' margin carries a distance instead (mjContact::dist > 0, at pos, the midpoint, along
+/// frame's normal from geom1 toward geom2), from the same colliders as its contacts: MPR on the
+/// shapes grown by the margin for meshes, mjc_BoxBox for boxes. The margin is set just past the
+/// farthest the pair can be apart (its centres' distance), so a contact is always reported; the
+/// nearest is the answer, its points half the distance either side of pos.
+DistanceResult distance_of(const RigidBody& a, const RigidBody& b, const MujocoSettings& settings) {
+  DistanceResult r;
+  QueryModel q;
+  const std::vector<RigidBody> bodies{a, b};
+  q.opt.box_geoms = use_box_geoms(bodies, settings);
+  q.opt.multiccd = settings.multiccd;
+  // The centres of mass lie inside the bodies, so the pair is no farther apart than they are.
+  q.opt.margin = 1.01 * (a.position - b.position).norm() + 1e-9;
+  std::tie(q.m, q.d) = make_simulation(bodies, /*all_free=*/true, q.opt, &q.error);
+  if (!q.m) {
+    r.status = Status::Error;
+    r.message = q.error;
+    return r;
+  }
+  set_state(q.m.get(), q.d.get(), bodies);
+  const mjModel* mc = q.m.get();
+  mjData* dd = q.d.get();
+  t_trap.clear_warning();
+  if (!guarded([&] { mj_forward(mc, dd); })) {
+    r.status = Status::Error;
+    r.message = std::string("MuJoCo mj_forward: ") + t_trap.error;
+    return r;
+  }
+  const int body_a = mc->geom_bodyid[geom_of(mc, 0)];
+  const mjContact* nearest = nullptr;
+  for (int i = 0; i < dd->ncon; ++i)
+    if (!nearest || dd->contact[i].dist < nearest->dist) nearest = &dd->contact[i];
+  if (!nearest) {
+    r.status = Status::Error;
+    r.message = "MuJoCo reported no contact within a margin past the pair's farthest points";
+    return r;
+  }
+  if (nearest->dist < 0) {
+    r.overlapping = true;
+    return r;
+  }
+  // frame[0..2] points from geom1 toward geom2.
+  const Vec3 n(nearest->frame[0], nearest->frame[1], nearest->frame[2]);
+  const Vec3 toward_b = mc->geom_bodyid[nearest->geom1] == body_a ? n : Vec3(-n);
+  const Vec3 pos(nearest->pos[0], nearest->pos[1], nearest->pos[2]);
+  r.distance = nearest->dist;
+  r.point_a = pos - 0.5 * nearest->dist * toward_b;
+  r.point_b = pos + 0.5 * nearest->dist * toward_b;
+  r.message = "a contact within the margin: its distance along the collider's normal";
+  return r;
+}
+
 /// The contact query with the pair's model compiled once per thread (variant "prebuilt").
 ContactResult prebuilt_query(const RigidBody& a, const RigidBody& b, const MujocoSettings& settings,
                              PrebuiltCache<QueryModel>& cache) {
@@ -840,6 +896,9 @@ const Adapter& mujoco_adapter() {
                                  mujoco_contact, mujoco_dynamics, mujoco_mass},
                                 mujoco_budget()),
                     mujoco_soft(MujocoSettings{}))
+              .measuring([](const RigidBody& a, const RigidBody& b) {
+                return distance_of(a, b, MujocoSettings{});
+              })
               .drawn("#D55E00", "o")
               .timed(8192, 512),
           with_soft(with_budget({"mujoco-hull",
@@ -848,6 +907,9 @@ const Adapter& mujoco_adapter() {
                                  mujoco_hull_contact, mujoco_hull_dynamics, mujoco_hull_mass},
                                 mujoco_budget()),
                     mujoco_soft(mujoco_hull_settings()))
+              .measuring([](const RigidBody& a, const RigidBody& b) {
+                return distance_of(a, b, mujoco_hull_settings());
+              })
               .drawn("#7A2E00", "s"),
       },
       {

@@ -86,8 +86,9 @@ struct DistanceBackend {
   int max_vertices_quick;  // in the quick run
 };
 /// Every distance query timed: the registry backends with one whose contact query is timed
-/// (`exact` left out: its distance is a check over every feature pair, not a query), and the
-/// query variants with one, at their contact rows' sizes.
+/// (`exact` left out: its distance is a check over every feature pair, not a query; a library's
+/// plain row, which builds its shapes on every call, up to N = 2,048), and the query variants
+/// with one, at their contact rows' sizes.
 std::vector<DistanceBackend> distance_backends();
 
 // ---- Scene builders ------------------------------------------------------------------------
