@@ -508,18 +508,21 @@ struct QueryModel {
   std::string error;
 };
 
-QueryModel make_query_model(const RigidBody& a, const RigidBody& b,
-                            const MujocoSettings& settings) {
+QueryModel make_query_model(const RigidBody& a, const RigidBody& b, const MujocoSettings& settings,
+                            double margin = 0.0) {
   QueryModel q;
   const std::vector<RigidBody> bodies{a, b};
   q.opt.box_geoms = use_box_geoms(bodies, settings);
   q.opt.multiccd = settings.multiccd;
+  q.opt.margin = margin;
   std::tie(q.m, q.d) = make_simulation(bodies, /*all_free=*/true, q.opt, &q.error);
   return q;
 }
 
-/// mj_forward on the model at the bodies' poses; every contact, converted.
-ContactResult query_model(QueryModel& q, const RigidBody& a, const RigidBody& b) {
+/// mj_forward on the model at the bodies' poses; every contact, converted (with `margin`, those
+/// within the geoms' margin too, at negative depth).
+ContactResult query_model(QueryModel& q, const RigidBody& a, const RigidBody& b,
+                          bool margin = false) {
   if (!q.m) return {Status::Error, q.error, {}};
   ContactResult r;
   set_state(q.m.get(), q.d.get(), {a, b});
@@ -533,7 +536,7 @@ ContactResult query_model(QueryModel& q, const RigidBody& a, const RigidBody& b)
   const int body_a = mc->geom_bodyid[geom_of(mc, 0)];
   for (int i = 0; i < dd->ncon; ++i) {
     const mjContact& c = dd->contact[i];
-    if (c.dist > 0.0) continue;  // inside the margin only (margin is 0: does not happen)
+    if (c.dist > 0.0 && !margin) continue;  // within a margin only (contact queries have none)
     r.contacts.push_back(convert_contact(c, mc->geom_bodyid[c.geom1] == body_a));
     r.contacts.back().feature = q.opt.box_geoms ? "box-box" : "mesh";
   }
@@ -544,55 +547,28 @@ ContactResult query_model(QueryModel& q, const RigidBody& a, const RigidBody& b)
   return r;
 }
 
-/// MuJoCo 2.2.2 has no distance query (mj_geomDistance came later); a contact within the
-/// geoms' margin carries a distance instead (mjContact::dist > 0, at pos, the midpoint, along
-/// frame's normal from geom1 toward geom2), from the same colliders as its contacts: MPR on the
-/// shapes grown by the margin for meshes, mjc_BoxBox for boxes. The margin is set just past the
-/// farthest the pair can be apart (its centres' distance), so a contact is always reported; the
-/// nearest is the answer, its points half the distance either side of pos.
+/// 2.2.2 has no distance query: the nearest contact within a margin just past the centres'
+/// distance (they lie inside the bodies, so one is always found) answers (docs/distance.md).
 DistanceResult distance_of(const RigidBody& a, const RigidBody& b, const MujocoSettings& settings) {
+  QueryModel q = make_query_model(a, b, settings, 1.01 * (a.position - b.position).norm() + 1e-9);
+  const ContactResult c = query_model(q, a, b, /*margin=*/true);
   DistanceResult r;
-  QueryModel q;
-  const std::vector<RigidBody> bodies{a, b};
-  q.opt.box_geoms = use_box_geoms(bodies, settings);
-  q.opt.multiccd = settings.multiccd;
-  // The centres of mass lie inside the bodies, so the pair is no farther apart than they are.
-  q.opt.margin = 1.01 * (a.position - b.position).norm() + 1e-9;
-  std::tie(q.m, q.d) = make_simulation(bodies, /*all_free=*/true, q.opt, &q.error);
-  if (!q.m) {
+  r.status = c.status;
+  r.message = c.message;
+  const ContactPoint* nearest = nullptr;
+  for (const ContactPoint& p : c.contacts)
+    if (!nearest || p.depth > nearest->depth) nearest = &p;
+  if (c.status == Status::Ok && !nearest) {
     r.status = Status::Error;
-    r.message = q.error;
-    return r;
+    r.message = "MuJoCo reported no contact within a margin past the pair's centres";
   }
-  set_state(q.m.get(), q.d.get(), bodies);
-  const mjModel* mc = q.m.get();
-  mjData* dd = q.d.get();
-  t_trap.clear_warning();
-  if (!guarded([&] { mj_forward(mc, dd); })) {
-    r.status = Status::Error;
-    r.message = std::string("MuJoCo mj_forward: ") + t_trap.error;
-    return r;
-  }
-  const int body_a = mc->geom_bodyid[geom_of(mc, 0)];
-  const mjContact* nearest = nullptr;
-  for (int i = 0; i < dd->ncon; ++i)
-    if (!nearest || dd->contact[i].dist < nearest->dist) nearest = &dd->contact[i];
-  if (!nearest) {
-    r.status = Status::Error;
-    r.message = "MuJoCo reported no contact within a margin past the pair's farthest points";
-    return r;
-  }
-  if (nearest->dist < 0) {
-    r.overlapping = true;
-    return r;
-  }
-  // frame[0..2] points from geom1 toward geom2.
-  const Vec3 n(nearest->frame[0], nearest->frame[1], nearest->frame[2]);
-  const Vec3 toward_b = mc->geom_bodyid[nearest->geom1] == body_a ? n : Vec3(-n);
-  const Vec3 pos(nearest->pos[0], nearest->pos[1], nearest->pos[2]);
-  r.distance = nearest->dist;
-  r.point_a = pos - 0.5 * nearest->dist * toward_b;
-  r.point_b = pos + 0.5 * nearest->dist * toward_b;
+  if (r.status != Status::Ok) return r;
+  r.overlapping = nearest->depth > 0;
+  if (r.overlapping) return r;
+  // The normal points from B toward A; the position is the midpoint.
+  r.distance = -nearest->depth;
+  r.point_a = nearest->point + 0.5 * r.distance * nearest->normal;
+  r.point_b = nearest->point - 0.5 * r.distance * nearest->normal;
   r.message = "a contact within the margin: its distance along the collider's normal";
   return r;
 }
