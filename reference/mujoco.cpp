@@ -554,7 +554,7 @@ DistanceResult distance_of(const RigidBody& a, const RigidBody& b, const MujocoS
   const ContactResult c = query_model(q, a, b, /*margin=*/true);
   DistanceResult r;
   r.status = c.status;
-  r.message = c.message;
+  r.message = c.status == Status::Ok ? "" : c.message;  // not its contacts' depth label
   const ContactPoint* nearest = nullptr;
   for (const ContactPoint& p : c.contacts)
     if (!nearest || p.depth > nearest->depth) nearest = &p;
