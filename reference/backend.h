@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -98,6 +99,41 @@ struct DistanceResult {
   Vec3 point_a = Vec3::Zero();  // m, world: A's point nearest B
   Vec3 point_b = Vec3::Zero();  // m, world: B's point nearest A
 };
+
+/// A time-of-impact query's answer (docs/time_of_impact.md): the first time within an interval
+/// at which A and B, separated or touching at its start, touch. Each body moves by the stated
+/// motion: its centre of mass at its constant velocity, its orientation at its constant angular
+/// velocity (world frame) about the centre of mass, over [0, dt]. `fraction` is the time as a
+/// fraction of dt; `point` and `normal` are where and how they touch then, when `located`.
+struct ToiResult {
+  Status status = Status::Ok;
+  std::string message;          // why, when not ok; or how the library's answer was read
+  bool hit = false;             // the pair touches within the interval
+  double fraction = 1.0;        // first touch, in [0, 1] of the interval (1 when no hit)
+  bool located = false;         // `point` and `normal` are given
+  Vec3 point = Vec3::Zero();    // m, world: the contact at the touch
+  Vec3 normal = Vec3::UnitZ();  // unit, world, from B toward A at the touch
+};
+
+/// Turn (rad) over the interval from which a body's two end poses no longer name its motion: the
+/// libraries that take a start and an end pose (FCL's InterpMotion, Bullet's
+/// btTransformUtil::calculateVelocity) turn the short way between them, by less than half a turn.
+constexpr double kMaxToiTurn = 3.0;
+
+/// The body at the end of a time-of-impact interval of `dt` (s) under the stated motion
+/// (ToiResult); nothing when it turns by kMaxToiTurn or more, where its end poses name another
+/// motion. The adapters that take end poses get them here.
+inline std::optional<RigidBody> body_at_end(const RigidBody& body, double dt) {
+  const Vec3 turn = body.angular_velocity * dt;
+  const double angle = turn.norm();
+  if (!(angle < kMaxToiTurn)) return std::nullopt;
+  RigidBody end = body;
+  end.position = body.position + body.velocity * dt;
+  if (angle > 0)
+    end.orientation =
+        (Quat(Eigen::AngleAxisd(angle, turn / angle)) * body.orientation).normalized();
+  return end;
+}
 
 /// Final state of one body after a dynamics run.
 struct BodyFinal {
@@ -215,6 +251,9 @@ using DynamicsFn =
     std::function<DynamicsResult(const WorldDefinition& scene, const DynamicsOptions& opt)>;
 /// Distance query: bodies carry their poses. A and B in that order.
 using DistanceFn = std::function<DistanceResult(const RigidBody& a, const RigidBody& b)>;
+/// Time-of-impact query: bodies carry their poses at the interval's start and their velocities;
+/// `dt` (s) is the interval. A and B in that order.
+using ToiFn = std::function<ToiResult(const RigidBody& a, const RigidBody& b, double dt)>;
 /// The library's own mass properties of a body's hull for the body's mass.
 using MassFn = std::function<MassResult(const RigidBody& body)>;
 
@@ -269,6 +308,7 @@ struct Backend {
   BackendStyle style = {};        // its colour and marker
   BenchSizes bench = {};          // the hulls `rbx bench` times its contact query on
   DistanceFn distance = nullptr;  // empty: no distance query (`unsupported`)
+  ToiFn toi = nullptr;            // empty: no time-of-impact query (`unsupported`)
 
   /// This row drawn in `colour` with `marker`.
   Backend drawn(std::string colour, std::string marker) const {
@@ -280,6 +320,12 @@ struct Backend {
   Backend measuring(DistanceFn fn) const {
     Backend b = *this;
     b.distance = std::move(fn);
+    return b;
+  }
+  /// This row with the library's time-of-impact query.
+  Backend sweeping(ToiFn fn) const {
+    Backend b = *this;
+    b.toi = std::move(fn);
     return b;
   }
   /// This row's contact query timed by `rbx bench` on hulls up to `full` (`quick`) vertices.
@@ -329,6 +375,7 @@ struct QueryVariant {
   BenchSizes bench = {};          // the hulls `rbx bench` times it on (0: not timed)
   bool boxes_only = false;        // timed on the box pair only (a path a library takes for boxes)
   DistanceFn distance = nullptr;  // the same set-up's distance query (empty: none)
+  ToiFn toi = nullptr;            // a time-of-impact call of its own (empty: none)
 };
 
 /// One library adapter as a table: the backends it provides and their query variants, each row
@@ -365,6 +412,10 @@ struct AtSettings {
   /// Empty where the library has no distance query.
   std::function<DistanceResult(const RigidBody& a, const RigidBody& b, const Settings& settings)>
       distance = nullptr;
+  /// Empty where the library has no time-of-impact query.
+  std::function<ToiResult(const RigidBody& a, const RigidBody& b, double dt,
+                          const Settings& settings)>
+      toi = nullptr;
 };
 
 /// Every query variant, one line each (reference/registry.cpp).

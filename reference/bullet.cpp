@@ -29,9 +29,12 @@
 // m_positionWorldOnA = m_positionWorldOnB + m_normalWorldOnB * distance on object 0.
 #include "reference/bullet.h"
 
+#include <BulletCollision/NarrowPhaseCollision/btContinuousConvexCollision.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkConvexCast.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
 #include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
+#include <BulletCollision/NarrowPhaseCollision/btSubSimplexConvexCast.h>
 #include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
 #include <btBulletCollisionCommon.h>
 #include <btBulletDynamicsCommon.h>
@@ -41,6 +44,7 @@
 #include <cmath>
 #include <exception>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -252,6 +256,64 @@ DistanceResult pair_distance(const RigidBody& a, const RigidBody& b,
                     "corners";
     r.point_b = from_bt(collector.m_pointInWorld);
     r.point_a = r.point_b + from_bt(collector.m_normalOnBInWorld) * collector.m_distance;
+  } catch (const std::exception& e) {
+    r.status = Status::Error;
+    r.message = e.what();
+  }
+  return r;
+}
+
+/// Bullet's casts (btConvexCast::calcTimeOfImpact), as its convex sweep tests call them, on the
+/// set-up's shapes between the bodies' start and end poses. Read from the 3.24 sources:
+/// - btContinuousConvexCollision takes each body's linear and angular velocity from its two poses
+///   (btTransformUtil::calculateVelocity: the short way round) and advances conservatively on
+///   btGjkPairDetector's distance, as the stated motion does; btGjkConvexCast and
+///   btSubsimplexConvexCast move the origins only, keeping the start orientations.
+/// - all three stop once the pair is within 1 mm (a fixed radius in each) and report that time as
+///   m_fraction, with m_normal from B toward A and m_hitPoint on B (btGjkPairDetector's
+///   m_pointInWorld), world frame; m_allowedPenetration stays at its 0.
+enum class BulletCast { Continuous, Gjk, Subsimplex };
+
+ToiResult pair_toi(const RigidBody& a, const RigidBody& b, double dt,
+                   const BulletSettings& settings, BulletCast cast) {
+  ToiResult r;
+  try {
+    const std::optional<RigidBody> end_a = body_at_end(a, dt), end_b = body_at_end(b, dt);
+    const bool rotating = !a.angular_velocity.isZero(0) || !b.angular_velocity.isZero(0);
+    if (!end_a || !end_b || (cast != BulletCast::Continuous && rotating)) {
+      r.status = Status::Unsupported;
+      r.message = !end_a || !end_b ? "a body turns too far for its end poses to name its motion"
+                                   : "this cast moves the bodies without turning them";
+      return r;
+    }
+    const Mat3 identity = Mat3::Identity();
+    const std::unique_ptr<btConvexShape> shape_a = make_shape(a, identity, settings);
+    const std::unique_ptr<btConvexShape> shape_b = make_shape(b, identity, settings);
+    btVoronoiSimplexSolver simplex;
+    btGjkEpaPenetrationDepthSolver epa;
+    btConvexCast::CastResult result;
+    const btTransform from_a = body_transform(a, identity), to_a = body_transform(*end_a, identity);
+    const btTransform from_b = body_transform(b, identity), to_b = body_transform(*end_b, identity);
+    bool hit = false;
+    if (cast == BulletCast::Continuous) {
+      btContinuousConvexCollision caster(shape_a.get(), shape_b.get(), &simplex, &epa);
+      hit = caster.calcTimeOfImpact(from_a, to_a, from_b, to_b, result);
+    } else if (cast == BulletCast::Gjk) {
+      btGjkConvexCast caster(shape_a.get(), shape_b.get(), &simplex);
+      hit = caster.calcTimeOfImpact(from_a, to_a, from_b, to_b, result);
+    } else {
+      btSubsimplexConvexCast caster(shape_a.get(), shape_b.get(), &simplex);
+      hit = caster.calcTimeOfImpact(from_a, to_a, from_b, to_b, result);
+    }
+    if (!hit) return r;
+    r.hit = true;
+    r.fraction = result.m_fraction;
+    const Vec3 normal = from_bt(result.m_normal);
+    if (normal.norm() > 0.5) {
+      r.located = true;
+      r.point = from_bt(result.m_hitPoint);
+      r.normal = normal.normalized();
+    }
   } catch (const std::exception& e) {
     r.status = Status::Error;
     r.message = e.what();
@@ -589,6 +651,10 @@ template <BulletSettings (*Settings)()>
 DistanceResult distance_query(const RigidBody& a, const RigidBody& b) {
   return pair_distance(a, b, Settings());
 }
+template <BulletSettings (*Settings)(), BulletCast Cast>
+ToiResult toi_query(const RigidBody& a, const RigidBody& b, double dt) {
+  return pair_toi(a, b, dt, Settings(), Cast);
+}
 template <BulletSettings (*Settings)()>
 ContactResult prebuilt_query(const RigidBody& a, const RigidBody& b) {
   thread_local ShapeCache cache;
@@ -654,6 +720,7 @@ const Adapter& bullet_adapter() {
                query<bullet_native_settings>, dynamics_run<bullet_native_settings>, bullet_mass},
               bullet_budget())
               .measuring(distance_query<bullet_native_settings>)
+              .sweeping(toi_query<bullet_native_settings, BulletCast::Continuous>)
               .drawn("#009E73", "o")
               .timed(2048, 2048),
           // Every body a zero-margin btConvexHullShape through GJK + EPA (one point).
@@ -662,6 +729,7 @@ const Adapter& bullet_adapter() {
                query<bullet_hull_settings>, dynamics_run<bullet_hull_settings>, bullet_hull_mass},
               bullet_budget())
               .measuring(distance_query<bullet_hull_settings>)
+              .sweeping(toi_query<bullet_hull_settings, BulletCast::Continuous>)
               .drawn("#00543D", "s"),
           // Every body a polyhedral hull (boxes too), SAT + clipping; contact queries only.
           Backend{"bullet-sat", "Bullet 3.24 double: polyhedral hull SAT + clipping, boxes too",
@@ -674,6 +742,22 @@ const Adapter& bullet_adapter() {
            prebuilt_query<bullet_native_settings>},
           {"bullet-hull", "prebuilt", "each btConvexHullShape built once and kept",
            prebuilt_query<bullet_hull_settings>},
+          {"bullet-hull",
+           "gjk-cast",
+           "btGjkConvexCast on the zero-margin hulls: translation only",
+           nullptr,
+           {},
+           false,
+           nullptr,
+           toi_query<bullet_hull_settings, BulletCast::Gjk>},
+          {"bullet-hull",
+           "subsimplex-cast",
+           "btSubsimplexConvexCast on the zero-margin hulls: translation only",
+           nullptr,
+           {},
+           false,
+           nullptr,
+           toi_query<bullet_hull_settings, BulletCast::Subsimplex>},
           {"bullet-sat", "prebuilt", "each polyhedral hull built once and kept",
            prebuilt_query<bullet_sat_settings>},
       }};

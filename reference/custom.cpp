@@ -7,6 +7,7 @@
 #include "engine/detect.h"
 #include "engine/distance.h"
 #include "engine/manifold.h"
+#include "engine/sweep.h"
 #include "reference/dynamics_recorder.h"
 
 namespace rbx {
@@ -115,6 +116,25 @@ DistanceResult custom_distance(const RigidBody& a, const RigidBody& b) {
   return r;
 }
 
+// `custom`'s time of impact: conservative advancement on its GJK (engine/sweep.h), as it is.
+ToiResult custom_toi(const RigidBody& a, const RigidBody& b, double dt) {
+  const SweepImpact s =
+      sweep_time_of_impact(*a.shape, {a.pose(), a.velocity, a.angular_velocity}, *b.shape,
+                           {b.pose(), b.velocity, b.angular_velocity}, dt);
+  ToiResult r;
+  if (!s.certified) {
+    r.status = Status::Error;
+    r.message = "conservative advancement reached its step limit before a touch or the end";
+    return r;
+  }
+  r.hit = s.hit;
+  r.fraction = s.hit ? s.time / dt : 1.0;
+  r.located = s.located;
+  r.point = s.point;
+  r.normal = s.normal;
+  return r;
+}
+
 }  // namespace
 
 DynamicsResult custom_seed_dynamics_with(const WorldDefinition& scene, const DynamicsOptions& opt,
@@ -146,6 +166,7 @@ const Adapter& custom_adapter() {
                custom_contact, custom_dynamics, nullptr, false},
               custom_budget())
               .measuring(custom_distance)
+              .sweeping(custom_toi)
               .drawn("#0072B2", "o")
               .timed(8192, 2048),
           Backend{"custom-seed",

@@ -780,6 +780,9 @@ const Adapter& exact_adapter() {
                "rbx oracle: separating-axis test over faces and edge pairs, clipped manifold",
                exact_contact, nullptr, nullptr, false}
            .measuring(exact_distance_query)
+           .sweeping([](const RigidBody& a, const RigidBody& b, double dt) {
+             return exact_toi(a, b, dt);
+           })
            .drawn("#000000", "*")
            .timed(2048, 512)},
       {}};

@@ -85,6 +85,14 @@ ExactImpact exact_translation_impact(const ConvexPolyhedron& a, const Pose& pa, 
                                      const ConvexPolyhedron& b, const Pose& pb, const Vec3& vb,
                                      double dt);
 
+/// The oracle's time of impact of two bodies under the stated motion (reference/backend.h,
+/// ToiResult): in pure translation exact_translation_impact's time, in closed form; with rotation
+/// conservative advancement on exact_distance, each step certified by a bound on the motion,
+/// until the pair is within kExactToiTouchRel of its size (docs/time_of_impact.md). An error
+/// result when that takes more than `max_steps` steps.
+constexpr double kExactToiTouchRel = 1e-12;
+ToiResult exact_toi(const RigidBody& a, const RigidBody& b, double dt, long max_steps = 200000);
+
 /// Backend `exact`: one contact per manifold point, each with the SAT normal and depth;
 /// the first contact is the manifold centroid.
 ContactResult exact_contact(const RigidBody& a, const RigidBody& b);

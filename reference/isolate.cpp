@@ -47,6 +47,10 @@ std::string encode(const TimedDistance& t) { return encode_result(t.result, t.ru
 bool decode(const std::string& bytes, TimedDistance& t) {
   return decode_result(bytes, t.result, t.runtime_s);
 }
+std::string encode(const TimedToi& t) { return encode_result(t.result, t.runtime_s); }
+bool decode(const std::string& bytes, TimedToi& t) {
+  return decode_result(bytes, t.result, t.runtime_s);
+}
 std::string encode(const MassResult& m) { return encode_result(m, 0.0); }
 bool decode(const std::string& bytes, MassResult& m) {
   double no_runtime;
@@ -473,6 +477,12 @@ struct RecordAccess<TimedDistance> {
   static void set_runtime(TimedDistance& t, double s) { t.runtime_s = s; }
 };
 template <>
+struct RecordAccess<TimedToi> {
+  static Status& status(TimedToi& t) { return t.result.status; }
+  static std::string& message(TimedToi& t) { return t.result.message; }
+  static void set_runtime(TimedToi& t, double s) { t.runtime_s = s; }
+};
+template <>
 struct RecordAccess<MassResult> {
   static Status& status(MassResult& m) { return m.status; }
   static std::string& message(MassResult& m) { return m.message; }
@@ -524,6 +534,11 @@ TimedDynamics isolated_dynamics(const std::string& backend, double deadline_s,
 
 TimedDistance isolated_distance(const std::string& backend, double deadline_s,
                                 const std::function<TimedDistance()>& call) {
+  return isolated_call(backend, deadline_s, call);
+}
+
+TimedToi isolated_toi(const std::string& backend, double deadline_s,
+                      const std::function<TimedToi()>& call) {
   return isolated_call(backend, deadline_s, call);
 }
 

@@ -85,6 +85,14 @@ struct TimedDistance {
 /// Likewise for a distance query.
 TimedDistance isolated_distance(const std::string& backend, double deadline_s,
                                 const std::function<TimedDistance()>& call);
+/// A time-of-impact query and its run time (s).
+struct TimedToi {
+  ToiResult result;
+  double runtime_s = 0.0;
+};
+/// Likewise for a time-of-impact query.
+TimedToi isolated_toi(const std::string& backend, double deadline_s,
+                      const std::function<TimedToi()>& call);
 /// Likewise for a library's mass properties.
 MassResult isolated_mass(const std::string& backend, double deadline_s,
                          const std::function<MassResult()>& call);

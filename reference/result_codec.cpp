@@ -56,6 +56,11 @@ void result_fields(Io& io, R& d, Is<R, DistanceResult> = 0) {
   io.io(d.status, d.message, d.overlapping, d.distance, d.point_a, d.point_b);
 }
 
+template <class Io, class R>
+void result_fields(Io& io, R& t, Is<R, ToiResult> = 0) {
+  io.io(t.status, t.message, t.hit, t.fraction, t.located, t.point, t.normal);
+}
+
 template <class R>
 std::string encode(const R& r, double runtime_s) {
   ByteWriter w;
@@ -87,6 +92,10 @@ std::string encode_result(const DistanceResult& r, double runtime_s) {
   return encode(r, runtime_s);
 }
 bool decode_result(const std::string& bytes, DistanceResult& r, double& runtime_s) {
+  return decode(bytes, r, runtime_s);
+}
+std::string encode_result(const ToiResult& r, double runtime_s) { return encode(r, runtime_s); }
+bool decode_result(const std::string& bytes, ToiResult& r, double& runtime_s) {
   return decode(bytes, r, runtime_s);
 }
 bool decode_result(const std::string& bytes, ContactResult& r, double& runtime_s) {

@@ -148,11 +148,13 @@ std::string encode_result(const ContactResult& r, double runtime_s);
 std::string encode_result(const DynamicsResult& r, double runtime_s);
 std::string encode_result(const MassResult& r, double runtime_s);
 std::string encode_result(const DistanceResult& r, double runtime_s);
+std::string encode_result(const ToiResult& r, double runtime_s);
 /// The result and run time encode_result wrote; false (outputs unspecified) when `bytes` is not
 /// exactly one such encoding.
 bool decode_result(const std::string& bytes, ContactResult& r, double& runtime_s);
 bool decode_result(const std::string& bytes, DynamicsResult& r, double& runtime_s);
 bool decode_result(const std::string& bytes, MassResult& r, double& runtime_s);
 bool decode_result(const std::string& bytes, DistanceResult& r, double& runtime_s);
+bool decode_result(const std::string& bytes, ToiResult& r, double& runtime_s);
 
 }  // namespace rbx

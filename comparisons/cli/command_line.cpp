@@ -2,6 +2,7 @@
 // codes (0 success, 1 a check failed, 2 bad input or usage, with one line on stderr). The `rbx`
 // executable (main.cpp) and the Python module (python/rbx_module.cpp) both run it.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <exception>
 #include <filesystem>
 #include <iostream>
@@ -26,7 +27,7 @@ void scene_options(CLI::App* cmd, rbx::SceneCommandOptions& o, bool many, bool b
 
 // Every command's options, filled by the parser.
 struct Options {
-  rbx::SceneCommandOptions run, contacts, distance, compare;
+  rbx::SceneCommandOptions run, contacts, distance, toi, compare;
   rbx::ReportOptions report, check;
   std::vector<std::string> scenes_inputs;
   rbx::BenchOptions bench;
@@ -52,7 +53,22 @@ const CLI::Validator kAtLeastOne(
     },
     "N >= 1");
 
-// run, contacts, distance, compare: the commands on scene files.
+// A positive, finite number of seconds.
+const CLI::Validator kPositiveSeconds(
+    [](std::string& text) -> std::string {
+      size_t used = 0;
+      double value = 0;
+      try {
+        value = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == text.size() && std::isfinite(value) && value > 0) return "";
+      return "must be a positive number of seconds, got '" + text + "'";
+    },
+    "S > 0");
+
+// run, contacts, distance, toi, compare: the commands on scene files.
 void add_scene_commands(CLI::App& app, Options& o) {
   CLI::App* run = app.add_subcommand("run", "custom engine only: collision events and final state");
   scene_options(run, o.run, false, true);
@@ -69,6 +85,11 @@ void add_scene_commands(CLI::App& app, Options& o) {
       ->check(CLI::IsMember({"first-contact"}));
   scene_options(app.add_subcommand("distance", "distance query at the t=0 poses, every backend"),
                 o.distance, false, true);
+  CLI::App* toi = app.add_subcommand(
+      "toi", "time of impact: each body at its velocities from its t=0 pose, every backend");
+  scene_options(toi, o.toi, false, true);
+  toi->add_option("--interval", o.toi.interval, "the interval in seconds (default: the scene's dt)")
+      ->check(kPositiveSeconds);
   scene_options(app.add_subcommand("compare", "the scenes' checks, side by side"), o.compare, true,
                 true);
 }
@@ -213,6 +234,7 @@ int dispatch(CLI::App& app, const Options& o) {
     if (app.got_subcommand("run")) return rbx::run_command(o.run);
     if (app.got_subcommand("contacts")) return rbx::contacts_command(o.contacts);
     if (app.got_subcommand("distance")) return rbx::distance_command(o.distance);
+    if (app.got_subcommand("toi")) return rbx::toi_command(o.toi);
     if (app.got_subcommand("compare")) return rbx::compare_command(o.compare);
     if (app.got_subcommand("report")) return rbx::report_command(o.report);
     if (app.got_subcommand("check")) return rbx::check_command(o.check);

@@ -26,6 +26,7 @@ struct SceneCommandOptions {
   bool force = false;               // --force: accept absurd step counts
   std::string at;                   // contacts --at: "" (t = 0) | "first-contact"
   long sample_every = 0;            // run --sample-every N: the trajectory, every N steps
+  double interval = 0.0;            // toi --interval S: the query's interval (0: the scene's dt)
 };
 
 /// Loads a scene applying --set and --force (InputError on bad input).
@@ -37,6 +38,8 @@ int run_command(const SceneCommandOptions& opt);
 int contacts_command(const SceneCommandOptions& opt);
 /// `rbx distance SCENE`: distance queries at the t = 0 poses, every backend, side by side.
 int distance_command(const SceneCommandOptions& opt);
+/// `rbx toi SCENE`: time-of-impact queries over an interval, every backend, side by side.
+int toi_command(const SceneCommandOptions& opt);
 
 }  // namespace rbx
 

@@ -46,20 +46,15 @@ bool timeable(const ContactRun& run) {
 void time_contacts(const std::vector<const Backend*>& backends, std::vector<ContactRun*> runs,
                    const RigidBody& a, const RigidBody& b, const TimingPlan& plan) {
   std::vector<TimedSubject> subjects;
-  std::vector<ContactRun*> timed;
+  std::vector<Timing*> timed;
   for (size_t i = 0; i < backends.size() && i < runs.size(); ++i) {
     const Backend& be = *backends[i];
     if (runs[i]->cached || !timeable(*runs[i]) || !be.contact) continue;
     subjects.push_back(
         {be.name, be.library, [&be, &a, &b] { be.contact(a, b); }, CallDeadlines{}.contact_s});
-    timed.push_back(runs[i]);
+    timed.push_back(&runs[i]->timing);
   }
-  const std::vector<Timing> t = time_interleaved(subjects, plan);
-  for (size_t i = 0; i < timed.size(); ++i) {
-    const double cold = timed[i]->timing.cold_s;
-    timed[i]->timing = t[i];
-    timed[i]->timing.cold_s = cold;
-  }
+  time_into(subjects, timed, plan);
 }
 
 TimedDynamics run_dynamics_isolated(const Backend& b, const WorldDefinition& scene,

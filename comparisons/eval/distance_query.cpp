@@ -33,22 +33,17 @@ void time_rows(std::vector<DistanceRow>& rows, const RigidBody& a, const RigidBo
                double budget_s) {
   if (budget_s <= 0) return;
   std::vector<TimedSubject> subjects;
-  std::vector<DistanceRow*> timed;
+  std::vector<Timing*> timed;
   for (DistanceRow& r : rows) {
     const Backend* be = find_backend(r.backend);
     if (!be || !be->distance || r.result.status != Status::Ok) continue;
     subjects.push_back(
         {be->name, be->library, [be, &a, &b] { be->distance(a, b); }, CallDeadlines{}.contact_s});
-    timed.push_back(&r);
+    timed.push_back(&r.timing);
   }
   TimingPlan plan;
   plan.min_time_s = budget_s;
-  const std::vector<Timing> t = time_interleaved(subjects, plan);
-  for (size_t i = 0; i < timed.size(); ++i) {
-    const double cold = timed[i]->timing.cold_s;
-    timed[i]->timing = t[i];
-    timed[i]->timing.cold_s = cold;
-  }
+  time_into(subjects, timed, plan);
 }
 
 // How far the pair's farthest vertex can be from the world origin (m): the magnitude of the

@@ -17,6 +17,8 @@ bool serves(const Backend& b, Capability cap) {
       return static_cast<bool>(b.dynamics);
     case Capability::Distance:
       return static_cast<bool>(b.distance);
+    case Capability::Toi:
+      return static_cast<bool>(b.toi);
   }
   return false;
 }

@@ -11,7 +11,7 @@
 namespace rbx {
 
 /// What a backend is asked for.
-enum class Capability { Contact, Dynamics, Distance };
+enum class Capability { Contact, Dynamics, Distance, Toi };
 
 /// The names of a comma-separated --backends LIST, in order, empty items dropped.
 std::vector<std::string> split_list(const std::string& list);

@@ -165,4 +165,14 @@ std::vector<Timing> time_interleaved(const std::vector<TimedSubject>& subjects,
   return out;
 }
 
+void time_into(const std::vector<TimedSubject>& subjects, const std::vector<Timing*>& into,
+               const TimingPlan& plan) {
+  const std::vector<Timing> t = time_interleaved(subjects, plan);
+  for (size_t i = 0; i < into.size() && i < t.size(); ++i) {
+    const double cold = into[i]->cold_s;
+    *into[i] = t[i];
+    into[i]->cold_s = cold;
+  }
+}
+
 }  // namespace rbx

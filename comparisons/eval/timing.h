@@ -91,4 +91,9 @@ std::vector<Rounds> time_rounds(const std::vector<TimedSubject>& subjects,
 std::vector<Timing> time_interleaved(const std::vector<TimedSubject>& subjects,
                                      const TimingPlan& plan = {});
 
+/// time_interleaved's Timing of each subject written to `into` (one per subject, in order), each
+/// keeping the cold_s it holds: the answering call's, which the caller timed.
+void time_into(const std::vector<TimedSubject>& subjects, const std::vector<Timing*>& into,
+               const TimingPlan& plan = {});
+
 }  // namespace rbx

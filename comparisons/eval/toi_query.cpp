@@ -1,0 +1,178 @@
+#include "comparisons/eval/toi_query.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+
+#include "comparisons/eval/measures.h"
+#include "engine/bounding.h"
+#include "engine/format.h"
+#include "reference/exact.h"
+#include "reference/isolate.h"
+
+namespace rbx {
+
+namespace {
+
+ToiRow answer_of(const ToiSubject& s, const RigidBody& a, const RigidBody& b, double dt) {
+  ToiRow row;
+  row.backend = s.name;
+  row.result = run_toi(s, a, b, dt, &row.timing.cold_s);
+  return row;
+}
+
+// Times every row that answered, interleaved as the contact queries are (docs/bench.md).
+void time_rows(std::vector<ToiRow>& rows, const std::vector<ToiSubject>& subjects,
+               const RigidBody& a, const RigidBody& b, double dt, double budget_s) {
+  if (budget_s <= 0) return;
+  std::vector<TimedSubject> timed_subjects;
+  std::vector<Timing*> timed;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const ToiSubject& s = subjects[i];
+    if (!s.fn || rows[i].result.status != Status::Ok) continue;
+    timed_subjects.push_back(
+        {s.name, s.library, [&s, &a, &b, dt] { s.fn(a, b, dt); }, CallDeadlines{}.contact_s});
+    timed.push_back(&rows[i].timing);
+  }
+  TimingPlan plan;
+  plan.min_time_s = budget_s;
+  time_into(timed_subjects, timed, plan);
+}
+
+Json result_json(const ToiResult& r) {
+  Json j = {{"status", to_string(r.status)}, {"message", r.message}};
+  if (r.status != Status::Ok) return j;
+  j["hit"] = r.hit;
+  if (!r.hit) return j;
+  j["fraction"] = r.fraction;
+  if (r.located) {
+    j["point"] = to_json(r.point);
+    j["normal"] = to_json(r.normal);
+  }
+  return j;
+}
+
+}  // namespace
+
+std::vector<ToiSubject> toi_subjects(const std::vector<std::string>& names) {
+  std::vector<ToiSubject> out;
+  for (const std::string& name : names) {
+    const Backend* be = find_backend(name);
+    out.push_back({name, be ? be->toi : nullptr, be ? be->library : false});
+    for (const QueryVariant& v : query_variants())
+      if (v.backend == name && v.toi) out.push_back({name + "/" + v.variant, v.toi, true});
+  }
+  return out;
+}
+
+ToiResult run_toi(const ToiSubject& s, const RigidBody& a, const RigidBody& b, double dt,
+                  double* cold_s) {
+  if (!s.fn) {
+    ToiResult r;
+    r.status = Status::Unsupported;
+    r.message = s.name + " has no time-of-impact query";
+    if (cold_s) *cold_s = 0;
+    return r;
+  }
+  auto call = [&] {
+    TimedToi t;
+    Stopwatch clock;
+    try {
+      t.result = s.fn(a, b, dt);
+    } catch (const std::exception& e) {
+      t.result = ToiResult{};
+      t.result.status = Status::Error;
+      t.result.message = e.what();
+    }
+    t.runtime_s = clock.seconds();
+    return t;
+  };
+  const TimedToi t = s.library ? isolated_toi(s.name, CallDeadlines{}.contact_s, call) : call();
+  if (cold_s) *cold_s = t.runtime_s;
+  return t.result;
+}
+
+ToiVerdict judge_toi(const ToiResult& answer, const ToiResult& truth, const RigidBody& a,
+                     const RigidBody& b, double dt) {
+  ToiVerdict v;
+  if (answer.status != Status::Ok || truth.status != Status::Ok) return v;
+  if (answer.hit != truth.hit) {
+    v.mark = "disagrees";
+    v.why = answer.hit ? "reports a touch at " + fmt_num(answer.fraction, 9) +
+                             " of the interval; the pair does not touch within it"
+                       : "misses the touch at " + fmt_num(truth.fraction, 9) + " of the interval";
+    return v;
+  }
+  if (!truth.hit) return v;
+  v.comparable = true;
+  v.time_err = std::abs(answer.fraction - truth.fraction);
+  if (!std::isfinite(v.time_err) || v.time_err > kToiDisagree)
+    v.mark = "disagrees";
+  else if (v.time_err > kToiDeviate)
+    v.mark = "deviates";
+  if (!v.mark.empty())
+    v.why = "touches at " + fmt_num(answer.fraction, 9) + " of the interval; exact " +
+            fmt_num(truth.fraction, 9) + " (off by " + fmt_num(v.time_err, 3) + ")";
+  const std::optional<RigidBody> at_a = body_at_end(a, truth.fraction * dt),
+                                 at_b = body_at_end(b, truth.fraction * dt);
+  if (answer.located && truth.located && at_a && at_b) {
+    v.located = true;
+    const double c = std::clamp(answer.normal.normalized().dot(truth.normal), -1.0, 1.0);
+    v.normal_err_deg = std::acos(c) * 180.0 / M_PI;
+    const double size = bounding_sphere(a).radius + bounding_sphere(b).radius;
+    v.point_err_rel = std::max(exact_point_distance(*a.shape, at_a->pose(), answer.point),
+                               exact_point_distance(*b.shape, at_b->pose(), answer.point)) /
+                      size;
+  }
+  return v;
+}
+
+ToiComparison compare_tois(const Scene& scene, const std::vector<std::string>& names,
+                           double interval, double budget_s) {
+  ToiComparison c;
+  c.scene = scene.name;
+  c.file = scene.file;
+  c.interval = interval;
+  const std::vector<RigidBody> bodies = make_bodies(scene);
+  const std::vector<ToiSubject> subjects = toi_subjects(names);
+  const std::vector<ToiSubject> oracle = toi_subjects({"exact"});
+  for (size_t i = 0; i < bodies.size(); ++i)
+    for (size_t j = i + 1; j < bodies.size(); ++j) {
+      const RigidBody &a = bodies[i], &b = bodies[j];
+      if (a.is_static && b.is_static) continue;
+      ToiPair p;
+      p.a = a.name;
+      p.b = b.name;
+      p.truth = answer_of(oracle.at(0), a, b, interval).result;
+      for (const ToiSubject& s : subjects) p.rows.push_back(answer_of(s, a, b, interval));
+      time_rows(p.rows, subjects, a, b, interval, budget_s);
+      for (ToiRow& r : p.rows) r.verdict = judge_toi(r.result, p.truth, a, b, interval);
+      c.pairs.push_back(std::move(p));
+    }
+  return c;
+}
+
+Json toi_json(const ToiComparison& c) {
+  Json j = {{"scene", c.scene}, {"file", c.file}, {"query", "toi"}, {"interval", c.interval}};
+  j["pairs"] = Json::array();
+  for (const ToiPair& p : c.pairs) {
+    Json pj = {{"bodies", {p.a, p.b}}, {"exact", result_json(p.truth)}};
+    pj["backends"] = Json::object();
+    for (const ToiRow& r : p.rows) {
+      Json rj = result_json(r.result);
+      if (r.verdict.comparable) rj["time_err"] = r.verdict.time_err;
+      if (r.verdict.located) {
+        rj["normal_err_deg"] = r.verdict.normal_err_deg;
+        rj["point_err_rel"] = r.verdict.point_err_rel;
+      }
+      rj["mark"] = r.verdict.mark;
+      if (!r.verdict.why.empty()) rj["why"] = r.verdict.why;
+      put_timing(r.timing, rj);
+      pj["backends"][r.backend] = rj;
+    }
+    j["pairs"].push_back(pj);
+  }
+  return j;
+}
+
+}  // namespace rbx
