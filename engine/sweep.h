@@ -39,8 +39,11 @@ struct SweepImpact {
 constexpr double kSweepTouchRel = 1e-11;
 
 /// The first time in [0, dt] at which shape A moving by `sa` and shape B moving by `sb` come
-/// within kSweepTouchRel of their size: each step advances by the distance over a bound on how
-/// fast the gap along the closest direction can close, so no touch is stepped over. At most
+/// within kSweepTouchRel of their size: each step advances by the gap along a separating plane
+/// over a bound on how fast it can close, so no touch is stepped over. The plane is the closest
+/// points' own, or where round-off has tilted it at a tiny gap, one the touching features name (a
+/// face, or the two nearest edges' cross product); the distance over the fastest any point moves
+/// is always safe too. The longest safe step is taken. At most
 /// `max_steps` steps (a grazing pass converges slowly); past it the answer is not certified.
 SweepImpact sweep_time_of_impact(const ConvexPolyhedron& a, const Sweep& sa,
                                  const ConvexPolyhedron& b, const Sweep& sb, double dt,

@@ -154,7 +154,7 @@ void add_study_commands(CLI::App& app, Options& o) {
   explore->add_option("--count", o.explore.count, "number of samples (default 20000)");
   explore->add_option("--seed", o.explore.seed, "seed (default 1)");
   explore->add_option("--kind", o.explore.kind,
-                      "contact | distance | impact | landing | slide | tunnel");
+                      "contact | distance | impact | landing | slide | tunnel | toi");
   explore->add_option("--backends", o.explore.backends, "comma-separated backend names");
   explore->add_option("--shapes", o.explore.shapes,
                       "contact kind: only these shape-class pairs, e.g. box-box,box-hull (classes "

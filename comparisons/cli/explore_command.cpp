@@ -51,11 +51,12 @@ int explore_command(const ExploreOptions& opt) {
   ParallelRun par(opt.threads);
   if (opt.count <= 0)
     throw InputError("rbx explore: --count: must be > 0, got " + std::to_string(opt.count));
-  const std::set<std::string> kinds = {"contact", "distance", "impact",
-                                       "landing", "slide",    "tunnel"};
+  const std::set<std::string> kinds = {"contact", "distance", "impact", "landing",
+                                       "slide",   "tunnel",   "toi"};
   if (!kinds.count(opt.kind))
     throw InputError(
-        "rbx explore: --kind: must be contact, distance, impact, landing, slide or tunnel, got '" +
+        "rbx explore: --kind: must be contact, distance, impact, landing, slide, tunnel or toi, "
+        "got '" +
         opt.kind + "'");
   ExploreSettings set;
   set.kind = opt.kind;

@@ -102,6 +102,8 @@ struct BackendOutcome {
   // to the true distance.
   double distance_err_rel = 0.0;
   double witness_err_rel = 0.0;
+  // Toi kind (measured: both touch): |first touch - exact's|, of the interval.
+  double time_err = 0.0;
 };
 
 /// Everything measured on one sample.
@@ -444,6 +446,9 @@ std::string gap_class(double gap_rel);
 /// gap class.
 ContactSample make_distance_sample(uint64_t seed, uint64_t index);
 
+/// `s` with B moved apart from A to a gap drawn from (seed, index) as make_distance_sample does.
+ContactSample moved_apart(ContactSample s, uint64_t seed, uint64_t index);
+
 /// Runs the sample's scene (sample_scene_text) through the exact oracle and each named backend's
 /// distance query (those without one left out) and classifies each answer by rbx distance's
 /// verdict (judge_distance): status error, then overlap (says the pair overlaps), then distance
@@ -451,5 +456,38 @@ ContactSample make_distance_sample(uint64_t seed, uint64_t index);
 SampleOutcome evaluate_distance_sample(const ContactSample& s,
                                        const std::vector<std::string>& names,
                                        const std::vector<Backend>* table = nullptr);
+
+// ---------------------------------------------------------------------------------------------
+// Toi kind: the distance kind's separated pairs (gaps 1e-9 to 10 sizes), hulls cut to their
+// first kToiMaxPoints points (the oracle's closed form weighs every edge pair against every
+// vertex: a 2,000-point pair costs minutes), set moving over an interval of 1 s, in one of five
+// motions: head-on (along the closest pair's direction, the touch
+// at a drawn fraction f of the interval, exact: the gap closes at the approach speed), oblique
+// (head-on plus a sideways drift), spinning (plus a turn of up to 2 rad for each body), hair-miss
+// (head-on, ending short of the touch by 1e-9 to 1e-4 of the smaller size) and graze (sideways
+// only). The truth is the oracle's time (exact_toi) on the written scene.
+
+constexpr size_t kToiMaxPoints = 64;
+
+/// A toi sample: the pair and each body's velocity and angular velocity over `interval`.
+struct ToiSample {
+  ContactSample pair;  // pose_class: the motion
+  Vec3 velocity_a = Vec3::Zero(), angular_velocity_a = Vec3::Zero();
+  Vec3 velocity_b = Vec3::Zero(), angular_velocity_b = Vec3::Zero();
+  double interval = 1.0;  // s
+};
+
+/// Sample `index` of `seed` (toi kind): a pure function of the two.
+ToiSample make_toi_sample(uint64_t seed, uint64_t index);
+
+/// The sample as a scene file: the pair's scene with the velocities and `dt` = the interval, so
+/// that `rbx toi` on it asks the same question.
+std::string toi_scene_text(const ToiSample& s, const std::string& header = "");
+
+/// Runs the sample through the oracle (exact_toi) and each named backend's time-of-impact query
+/// and its variants' (rows without one left out); classifies each answer by rbx toi's verdict
+/// (judge_toi): status error, then misses (no touch where the oracle has one), then
+/// false_contact (a touch where it has none), then time (over kToiDisagree of the interval).
+SampleOutcome evaluate_toi_sample(const ToiSample& s, const std::vector<std::string>& names);
 
 }  // namespace rbx

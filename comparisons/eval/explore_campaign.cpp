@@ -13,6 +13,7 @@
 #include "comparisons/eval/explore_detail.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/select_backends.h"
+#include "comparisons/eval/toi_query.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/bounding.h"
 #include "engine/format.h"
@@ -28,7 +29,7 @@ namespace {
 const char* const kMetrics[] = {"normal_err_deg",   "depth_err_rel",   "point_err_rel",
                                 "coverage_err_rel", "velocity_err_ke", "momentum_err_ke",
                                 "position_err_m",   "turn_rad",        "rest_time_err_s",
-                                "distance_err_rel", "witness_err_rel"};
+                                "distance_err_rel", "witness_err_rel", "time_err"};
 
 // The metrics of one kind of sample.
 std::vector<std::string> metrics_of(const std::string& kind) {
@@ -37,6 +38,7 @@ std::vector<std::string> metrics_of(const std::string& kind) {
     return {"position_err_m", "turn_rad", "velocity_err_ke", "rest_time_err_s"};
   if (kind == "tunnel") return {"velocity_err_ke", "position_err_m"};
   if (kind == "distance") return {"distance_err_rel", "witness_err_rel"};
+  if (kind == "toi") return {"time_err"};
   return {"normal_err_deg", "depth_err_rel", "point_err_rel", "coverage_err_rel"};
 }
 
@@ -52,17 +54,20 @@ double metric_value(const BackendOutcome& b, const std::string& m) {
   if (m == "turn_rad") return b.turn_rad;
   if (m == "distance_err_rel") return b.distance_err_rel;
   if (m == "witness_err_rel") return b.witness_err_rel;
+  if (m == "time_err") return b.time_err;
   return b.rest_time_err_s;
 }
 
 std::vector<std::string> subject_backends(const std::string& list, const std::string& kind) {
   std::vector<std::string> names;
   if (list.empty() || list == "all") {
-    // Every backend with a contact query (contact kind), a distance query (distance kind) or a
+    // Every backend with a contact query (contact kind), a distance query (distance kind), a
+    // time-of-impact query (toi kind: its variants' rows come with it) or a
     // dynamics run (the others); `exact` is the truth, not a subject.
     for (const Backend& b : backends()) {
       const bool serves = kind == "contact"    ? static_cast<bool>(b.contact)
                           : kind == "distance" ? static_cast<bool>(b.distance)
+                          : kind == "toi"      ? static_cast<bool>(b.toi)
                                                : static_cast<bool>(b.dynamics);
       if (serves && b.name != "exact") names.push_back(b.name);
     }
@@ -106,6 +111,8 @@ std::vector<std::string> sample_all(const ExploreSettings& set,
         return encode(evaluate_tunnel_sample(make_tunnel_sample(set.seed, i), names));
       if (set.kind == "distance")
         return encode(evaluate_distance_sample(make_distance_sample(set.seed, i), names));
+      if (set.kind == "toi")
+        return encode(evaluate_toi_sample(make_toi_sample(set.seed, i), names));
       const ContactSample s = make_contact_sample(set.seed, i);
       if (bench && (s.a.points.size() >= 100 || s.b.points.size() >= 100)) return "";
       if (!set.shapes.empty() && !keeps_shapes(set.shapes, s.a.shape_class, s.b.shape_class))
@@ -260,6 +267,8 @@ Json group_json(const std::string& sig, long count, const BackendTally& t, const
   } else if (kind == "distance") {
     g["shrunk_error"] = {{"distance_err_rel", r["distance_err_rel"]},
                          {"witness_err_rel", r["witness_err_rel"]}};
+  } else if (kind == "toi") {
+    g["shrunk_error"] = {{"time_err", r["time_err"]}};
   } else if (kind == "slide") {
     g["shrunk_error"] = {{"position_err_m", r["position_err_m"]},
                          {"turn_rad", r["turn_rad"]},
@@ -322,11 +331,19 @@ ExploreCampaign run_explore(const ExploreSettings& set, const ParallelRun& par) 
   Stopwatch clock;
   const std::vector<std::string> raw = sample_all(set, names, par, false);
   c.sampling_s = clock.seconds();
+  // The toi kind's rows: each backend's query, then its variants' ("bullet-hull/gjk-cast").
+  std::vector<std::string> rows;
+  if (set.kind == "toi") {
+    for (const ToiSubject& s : toi_subjects(names))
+      if (s.fn) rows.push_back(s.name);
+  } else {
+    rows = names;
+  }
   Tallies t;
   Json groups = Json::array();
   if (par.root()) {
-    t = tally_samples(raw, names, set.kind);
-    groups = disagreement_groups(t, names);
+    t = tally_samples(raw, rows, set.kind);
+    groups = disagreement_groups(t, rows);
   }
   clock = Stopwatch();
   const Json all_groups = Json::parse(par.broadcast(groups.dump()));
@@ -349,7 +366,7 @@ ExploreCampaign run_explore(const ExploreSettings& set, const ParallelRun& par) 
   j["invalid_samples"] = t.invalid;
   j["pose_classes"] = t.pose_classes;
   j["backends"] = Json::object();
-  for (const std::string& n : names)
+  for (const std::string& n : rows)
     j["backends"][n] = backend_json(t.backend[n], set.kind, all_groups, shrunk, c);
   const double cores = static_cast<double>(par.ranks()) * par.threads();
   j["timing"] = {{"runtime_s", c.sampling_s + c.shrinking_s},

@@ -34,6 +34,7 @@ void tally(const std::string& scene, const std::vector<std::string>& encoded,
       values[b.backend]["rest_time_err_s"].push_back(b.rest_time_err_s);
       values[b.backend]["distance_err_rel"].push_back(b.distance_err_rel);
       values[b.backend]["witness_err_rel"].push_back(b.witness_err_rel);
+      values[b.backend]["time_err"].push_back(b.time_err);
     }
   }
   for (const auto& [backend, n] : samples) {
@@ -83,6 +84,19 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
                                                            distance_backends, table));
                   }),
           {"distance_err_rel", "witness_err_rel"}, "exact", out);
+  // The toi kind's subjects: the contact backends that have a time-of-impact query (their
+  // variants' rows come with them).
+  std::vector<std::string> toi_backends;
+  for (const std::string& name : contact_backends)
+    if (const Backend* b = find_backend(name, table); b && b->toi && name != "exact")
+      toi_backends.push_back(name);
+  if (!toi_backends.empty() && set.toi > 0)
+    tally("explore/toi",
+          run.map(static_cast<size_t>(set.toi),
+                  [&](size_t i) {
+                    return encode(evaluate_toi_sample(make_toi_sample(set.seed, i), toi_backends));
+                  }),
+          {"time_err"}, "exact", out);
   if (!impact_backends.empty() && set.impact > 0)
     tally("explore/impact",
           run.map(static_cast<size_t>(set.impact),

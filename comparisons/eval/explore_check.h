@@ -23,6 +23,7 @@ struct ExploreCheckSet {
   int landing = 300;    // landing-kind samples
   int slide = 200;      // slide-kind samples
   int tunnel = 200;     // tunnel-kind samples
+  int toi = 300;        // toi-kind samples
 };
 
 /// One metric of the sample set, under a pseudo-scene name ("explore/contact",

@@ -94,6 +94,9 @@ std::string expect_block(const std::string& text);
 // ("ok", "text" with the scene and its [expect], "reproduced", the kind's measures).
 std::string shrink_group(const Json& group, const ExploreSettings& set);
 
+// One toi group (explore_toi.cpp): its first sample's scene as drawn, as shrink_group's JSON.
+std::string toi_group(const Json& g, uint64_t seed, long count);
+
 // The first of up to `attempts` draws from the sample's own stream that `draw` realizes (draw
 // fills the sample and says whether it is valid); throws when none is.
 template <class Sample, class Draw>

@@ -30,7 +30,10 @@ std::string gap_class(double gap_rel) {
 }
 
 ContactSample make_distance_sample(uint64_t seed, uint64_t index) {
-  ContactSample s = make_contact_sample(seed, index);
+  return moved_apart(make_contact_sample(seed, index), seed, index);
+}
+
+ContactSample moved_apart(ContactSample s, uint64_t seed, uint64_t index) {
   SampleRng r(seed ^ kGapStream, index);
   const auto shape_a = build_shape(s.a), shape_b = build_shape(s.b);
   const double small = std::min(shape_size(*shape_a), shape_size(*shape_b));

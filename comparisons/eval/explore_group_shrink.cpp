@@ -113,6 +113,7 @@ std::string describe_outcome(const BackendOutcome& b) {
   if (b.error == "distance" || b.error == "witness")
     return "distance off by " + fmt_num(b.distance_err_rel, 3) + ", witness points off by " +
            fmt_num(b.witness_err_rel, 3) + " of the true distance";
+  if (b.error == "time") return "first touch off by " + fmt_num(b.time_err, 3) + " of the interval";
   if (b.error == "coverage")
     return "its points fall short of the exact contact patch by " + fmt_num(b.coverage_err_rel, 3) +
            " of the smaller body";
@@ -349,6 +350,7 @@ std::string shrink_group(const Json& group, const ExploreSettings& set) {
     if (set.kind == "tunnel")
       return shrink_tunnel_group(group, set.seed, set.count, std::min(set.shrink_budget, 60));
     if (set.kind == "distance") return distance_group(group, set.seed, set.count);
+    if (set.kind == "toi") return toi_group(group, set.seed, set.count);
     return shrink_contact_group(group, set.seed, set.count, set.shrink_budget);
   } catch (const std::exception& e) {
     return Json{{"ok", false}, {"message", e.what()}}.dump();

@@ -19,6 +19,13 @@ namespace rbx {
 /// rotation (reference/exact.h), both far below.
 constexpr double kToiDisagree = 1e-6;
 constexpr double kToiDeviate = 1e-9;
+/// A time is also right, whatever its distance from the oracle's, where the pair at that time is
+/// within kToiTouchBand of the pair's size (the sum of the bodies' bounding radii) of touching:
+/// apart by at most that, or overlapping by at most that. A grazing touch closes so slowly that
+/// a distance of round-off spans a long time (a touch within 3e-11 m at 4e-6 m/s is 7.6e-6 of the
+/// interval early); which instant is "the" touch is then the stopping tolerance's choice, not an
+/// error. 1e-9 is the band the contact kind takes as touching (explore.h).
+constexpr double kToiTouchBand = 1e-9;
 
 /// How one backend's answer on one pair stands against the oracle's.
 struct ToiVerdict {

@@ -226,10 +226,40 @@ std::string markdown_distance(const Json& j) {
   return o.str();
 }
 
+std::string markdown_toi(const Json& j) {
+  std::ostringstream o;
+  o << "# rbx explore: " << j["count"] << " random moving pairs, seed " << j["seed"] << "\n\n"
+    << "Every sample is a separated pair of the distance kind's (hulls cut to 64 points) moving "
+       "over an interval of 1 s: head-on (the touch at a drawn fraction of the interval), "
+       "oblique (with a sideways drift), spinning (each body turning up to 2 rad), hair-miss "
+       "(ending 1e-9 to 1e-4 of the smaller size short of a touch) or graze (sideways only). "
+       "Each backend's time-of-impact query, and its variants', is checked against the exact "
+       "oracle as `rbx toi` checks it. A disagreement is a status error, a missed touch "
+       "(misses), a touch where there is none (false_contact), or a first touch more than 1e-6 "
+       "of the interval from the oracle's (time; docs/time_of_impact.md).\n\n";
+  o << "## Backends\n\n";
+  Table t(
+      {"backend", "samples", "disagreements", "rate", "time err p50/p90/p99", "worst time err"});
+  for (const auto& [name, b] : j["backends"].items()) {
+    const Json& e = b["errors"];
+    t.add({name, std::to_string(b["samples"].get<long>()),
+           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
+           three(e, "time_err"), fmt_num(e["time_err"]["max"], 2)});
+  }
+  o << t.markdown();
+  o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B, whether the "
+       "oracle has a touch (touch, no_touch), the kind of error. Each group's first sample is "
+       "written as drawn (toi samples are not shrunk); `reproduced` says whether `rbx toi` marks "
+       "it on the scene.\n\n";
+  o << groups_table(j);
+  return o.str();
+}
+
 }  // namespace
 
 std::string explore_markdown(const Json& j, bool have_figure) {
   if (j["kind"] == "distance") return markdown_distance(j);
+  if (j["kind"] == "toi") return markdown_toi(j);
   if (j["kind"] == "tunnel") return markdown_tunnel(j);
   if (j["kind"] == "impact") return markdown_impact(j);
   if (j["kind"] == "landing") return markdown_landing(j);

@@ -62,6 +62,9 @@ const std::vector<ExploreFamily>& explore_families() {
        "separated pairs (distance)",
        {{"distance_err_rel", "distance error / true distance p50 / p90"},
         {"witness_err_rel", "witness points' error / true distance p50 / p90"}}},
+      {"explore/toi",
+       "moving pairs (time of impact)",
+       {{"time_err", "first touch's error / interval p50 / p90"}}},
       {"explore/impact", "impacts", {{"velocity_err_ke", "velocity error (KE norm) p50 / p90"}}},
       {"explore/landing",
        "landings with friction",
@@ -95,6 +98,10 @@ std::string explore_intro(const ExploreCheckSet& set) {
      << " random convex pairs against the `exact` oracle, " << set.distance
      << " random separated pairs (gaps of 1e-9 to 10 sizes) whose distance and closest points "
         "each distance query gives against the oracle's, "
+     << set.toi
+     << " random separated pairs set moving over an interval (head-on, oblique, spinning, "
+        "missing by a hair, grazing) whose first touch each time-of-impact query gives against "
+        "the oracle's (docs/time_of_impact.md), "
      << set.impact << " random vertex-on-face impacts at a random phase, " << set.landing
      << " random landings of a box sliding on a floor with friction (any direction, speed, mu "
         "and yaw), "
@@ -106,7 +113,8 @@ std::string explore_intro(const ExploreCheckSet& set) {
         "their closed forms. "
         "*Disagreement*: a sample a backend answers clearly wrong (normal > 1°, depth > 1 % of "
         "the smaller body, a distance or its points off by more than 1e-6 of the true distance "
-        "(docs/distance.md), velocity error > 0.1 %, a landing or slide at rest more than 1 mm "
+        "(docs/distance.md), a first touch more than 1e-6 of the interval off, velocity error > "
+        "0.1 %, a landing or slide at rest more than 1 mm "
         "from where Coulomb's law puts it or turned by more than 1e-3 rad, a slide coming to rest "
         "more than 3 ms off its time, a projectile through or into its wall, a missed or false "
         "contact, an error). Errors are the median and 90th percentile over the samples where "

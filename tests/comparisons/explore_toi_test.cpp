@@ -1,0 +1,102 @@
+// rbx explore --kind toi: its samples ask what their motion class says (head-on ones touch,
+// hair-misses do not), the written scene asks the same question, custom agrees with the oracle on
+// them (the samples it once missed included), and rbx toi's verdict excuses only what is decided
+// at the nanometre.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "comparisons/eval/explore.h"
+#include "comparisons/eval/toi_query.h"
+#include "comparisons/scene/scene_file.h"
+#include "reference/exact.h"
+#include "tests/common/fixtures.h"
+
+namespace rbx {
+namespace {
+
+TEST(ExploreToi, HeadOnSamplesTouchAndHairMissesDoNot) {
+  std::map<std::string, int> classes;
+  for (uint64_t i = 0; i < 150; ++i) {
+    const ToiSample s = make_toi_sample(3, i);
+    ++classes[s.pair.pose_class];
+    if (s.pair.pose_class != "head-on" && s.pair.pose_class != "hair-miss") continue;
+    const Scene scene = parse_scene(toi_scene_text(s), "explore.toml");
+    const std::vector<RigidBody> bodies = make_bodies(scene);
+    const ToiResult truth = exact_toi(bodies[0], bodies[1], scene.sim.dt);
+    ASSERT_EQ(truth.status, Status::Ok) << i;
+    // Head-on: the gap closes within the interval, at a drawn 0.05 to 0.95 of it. Hair-miss: it
+    // ends short by at least 1e-9 of the smaller size, far above the positions' round-off.
+    if (s.pair.pose_class == "head-on") {
+      EXPECT_TRUE(truth.hit) << i;
+      EXPECT_GT(truth.fraction, 0.05 - 1e-9) << i;
+      EXPECT_LT(truth.fraction, 0.95 + 1e-9) << i;
+    } else {
+      EXPECT_FALSE(truth.hit) << i << " at " << truth.fraction;
+    }
+  }
+  EXPECT_EQ(classes.size(), 5u);  // every motion drawn
+  for (const auto& [name, n] : classes) EXPECT_GT(n, 15) << name;
+}
+
+TEST(ExploreToi, TheWrittenSceneAsksTheSameQuestion) {
+  for (uint64_t i = 0; i < 20; ++i) {
+    const ToiSample s = make_toi_sample(5, i);
+    const SampleOutcome o = evaluate_toi_sample(s, {"custom"});
+    const Scene scene = parse_scene(toi_scene_text(s), "explore.toml");
+    const ToiComparison c = compare_tois(scene, {"custom"}, scene.sim.dt, 0.0);
+    ASSERT_EQ(c.pairs.size(), 1u);
+    EXPECT_EQ(c.pairs[0].truth.hit, o.touching) << i;
+    EXPECT_EQ(make_toi_sample(5, i).velocity_b, s.velocity_b) << i;  // a pure function
+  }
+}
+
+TEST(ExploreToi, CustomAgreesWithTheOracleOnRandomSamples) {
+  // Seed 11 (not used while developing), 300 samples; and three of seed 1 that custom missed or
+  // put late before its steps took the touching features' own axes (a drift carrying two edges
+  // a nanometre apart past each other: the closest points' direction, tilted by round-off, had
+  // called the pair apart for good).
+  std::vector<std::pair<uint64_t, uint64_t>> samples = {{1, 242}, {1, 805}, {1, 287}};
+  for (uint64_t i = 0; i < 300; ++i) samples.push_back({11, i});
+  for (const auto& [seed, index] : samples) {
+    const SampleOutcome o = evaluate_toi_sample(make_toi_sample(seed, index), {"custom"});
+    if (o.feature == "unresolved") continue;  // the oracle's own limit, counted nowhere
+    ASSERT_EQ(o.backends.size(), 1u) << seed << " " << index;
+    const BackendOutcome& b = o.backends[0];
+    EXPECT_EQ(b.error, "") << "seed " << seed << " sample " << index << " (" << o.pose_class << ", "
+                           << o.shapes << ", " << o.feature << "): " << b.message;
+  }
+}
+
+// rbx toi's verdict on closed forms: a time 1e-3 of the interval early on a head-on landing
+// disagrees; a touch reported on a pass that ends 1e-12 of the size short of touching is excused
+// (the band), one that ends 1e-3 short is not.
+TEST(ToiVerdict, OnlyWhatIsDecidedAtTheNanometreIsExcused) {
+  RigidBody a = test::unit_cube("A", Vec3(0.2, 0.1, 1.3));
+  const RigidBody b = test::unit_cube("B", Vec3::Zero());
+  a.velocity = Vec3(0, 0, -0.6);  // touches at 0.5 of the interval of 1 s
+  const ToiResult truth = exact_toi(a, b, 1.0);
+  ASSERT_TRUE(truth.hit);
+  ToiResult early = truth;
+  early.fraction -= 1e-3;
+  early.located = false;
+  EXPECT_EQ(judge_toi(early, truth, a, b, 1.0).mark, "disagrees");
+  early.fraction = truth.fraction - 1e-8;
+  EXPECT_EQ(judge_toi(early, truth, a, b, 1.0).mark, "deviates");
+  // The pass that ends just short: A falls 0.3 m less a hair.
+  for (const double hair : {1e-12, 1e-3}) {
+    RigidBody short_of = a;
+    short_of.velocity = Vec3(0, 0, -(0.3 - hair));
+    const ToiResult none = exact_toi(short_of, b, 1.0);
+    ASSERT_FALSE(none.hit) << hair;
+    ToiResult claimed;
+    claimed.hit = true;
+    claimed.fraction = 1.0;
+    EXPECT_EQ(judge_toi(claimed, none, short_of, b, 1.0).mark, hair < 1e-9 ? "" : "disagrees")
+        << hair;
+  }
+}
+
+}  // namespace
+}  // namespace rbx
