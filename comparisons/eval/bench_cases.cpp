@@ -89,6 +89,7 @@ using bench_detail::CaseSet;
 using bench_detail::CaseTimes;
 using bench_detail::distance_cases;
 using bench_detail::narrowphase_cases;
+using bench_detail::toi_cases;
 
 // ---------------------------------------------------------------------------------------------
 // Broad phase: every method of kBenchBroadPhaseMethods on crowds of growing size.
@@ -338,9 +339,8 @@ struct Family {
   CaseSet (*build)(const BenchPlan& plan, std::mt19937_64& rng);
 };
 const Family kFamilies[] = {
-    {"narrowphase", narrowphase_cases}, {"distance", distance_cases},
-    {"broadphase", broadphase_cases},   {"step", step_cases},
-    {"explore", explore_cases},
+    {"narrowphase", narrowphase_cases}, {"distance", distance_cases}, {"toi", toi_cases},
+    {"broadphase", broadphase_cases},   {"step", step_cases},         {"explore", explore_cases},
 };
 
 }  // namespace

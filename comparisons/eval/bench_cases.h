@@ -91,6 +91,20 @@ struct DistanceBackend {
 /// with one, at their contact rows' sizes.
 std::vector<DistanceBackend> distance_backends();
 
+/// One time-of-impact query as benchmarked: a row of the time-of-impact table.
+struct ToiBackend {
+  std::string backend;  // registry name
+  std::string variant;  // "default", or the query variant's ("gjk-cast")
+  ToiFn toi;
+  int max_vertices_full;   // largest hull size timed in the full run
+  int max_vertices_quick;  // in the quick run
+};
+/// Every time-of-impact query timed, on the distance queries' poses with B moving onto A (its
+/// velocity the centres' offset, over an interval of 1 s): custom at its contact rows' sizes,
+/// the libraries' rows and variants (which build their shapes on every call) up to N = 2,048
+/// (512 quick); `exact` left out (a check, not a query).
+std::vector<ToiBackend> toi_backends();
+
 // ---- Scene builders ------------------------------------------------------------------------
 
 /// The hull of n random points on the sphere of radius 0.5 (all of them are hull vertices).
@@ -190,6 +204,7 @@ struct BenchResults {
   std::size_t cases = 0;
   std::vector<NarrowRow> narrow;
   std::vector<NarrowRow> distance;  // the distance queries, `pose` naming the gap kind
+  std::vector<NarrowRow> toi;       // the time-of-impact queries, likewise
   std::vector<BroadRow> broad;
   std::vector<StepRow> step;
   std::vector<ExploreRow> explore;

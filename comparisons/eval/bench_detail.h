@@ -42,5 +42,7 @@ struct CaseSet {
 CaseSet narrowphase_cases(const BenchPlan& plan, std::mt19937_64& rng);
 /// Distance: every query of distance_backends() on every shape size, 1 % and 20 % apart.
 CaseSet distance_cases(const BenchPlan& plan, std::mt19937_64& rng);
+/// Time of impact: every query of toi_backends() on the distance queries' poses, B moving onto A.
+CaseSet toi_cases(const BenchPlan& plan, std::mt19937_64& rng);
 
 }  // namespace rbx::bench_detail

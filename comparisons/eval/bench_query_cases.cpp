@@ -45,6 +45,21 @@ std::vector<DistanceBackend> distance_backends() {
   return rows;
 }
 
+std::vector<ToiBackend> toi_backends() {
+  constexpr int kLibraryFull = 2048, kLibraryQuick = 512;
+  std::vector<ToiBackend> rows;
+  for (const Backend& b : backends()) {
+    if (b.name == "exact") continue;
+    if (b.toi)
+      rows.push_back({b.name, "default", b.toi, b.library ? kLibraryFull : b.bench.full,
+                      b.library ? kLibraryQuick : b.bench.quick});
+    for (const QueryVariant& v : query_variants())
+      if (v.backend == b.name && v.toi)
+        rows.push_back({b.name, v.variant, v.toi, kLibraryFull, kLibraryQuick});
+  }
+  return rows;
+}
+
 namespace bench_detail {
 
 namespace {
@@ -193,6 +208,30 @@ CaseSet distance_cases(const BenchPlan& plan, std::mt19937_64&) {
   return query_cases(plan, "distance", rows,
                      std::vector<PoseKind>(std::begin(kGapKinds), std::end(kGapKinds)),
                      &BenchResults::distance);
+}
+
+// Time of impact: every query of toi_backends() on the distance poses, B moving onto A at the
+// centres' offset per second over 1 s (pure translation, so every row, the translation-only
+// casts too, answers the same question); the moving copy of B is made on every call, by every
+// row alike.
+CaseSet toi_cases(const BenchPlan& plan, std::mt19937_64&) {
+  std::vector<QueryRow> rows;
+  for (const ToiBackend& b : toi_backends()) {
+    const ToiFn toi = b.toi;
+    rows.push_back({b.backend, b.variant,
+                    [toi](const RigidBody& a, const RigidBody& bb) {
+                      RigidBody moving = bb;
+                      moving.velocity = a.position - bb.position;
+                      const ToiResult r = toi(a, moving, 1.0);
+                      if (r.status != Status::Ok)
+                        return std::string(to_string(r.status)) + ": " + r.message;
+                      return r.hit ? std::string() : std::string("no touch");
+                    },
+                    b.max_vertices_full, b.max_vertices_quick});
+  }
+  return query_cases(plan, "toi", rows,
+                     std::vector<PoseKind>(std::begin(kGapKinds), std::end(kGapKinds)),
+                     &BenchResults::toi);
 }
 
 }  // namespace bench_detail

@@ -102,12 +102,10 @@ std::string toi_scene_text(const ToiSample& s, const std::string& header) {
   dt.precision(17);
   dt << "dt = " << s.interval << "\n";
   insert_after("duration = 0\n", dt.str());
-  insert_after("name = \"A\"\n", "velocity = " + vec_text(s.velocity_a) +
-                                     "\nangular_velocity = " + vec_text(s.angular_velocity_a) +
-                                     "\n");
-  insert_after("name = \"B\"\n", "velocity = " + vec_text(s.velocity_b) +
-                                     "\nangular_velocity = " + vec_text(s.angular_velocity_b) +
-                                     "\n");
+  insert_after("name = \"A\"\n", "velocity = " + vec_text(s.velocity_a) + "\nangular_velocity = " +
+                                     vec_text(s.angular_velocity_a) + "\n");
+  insert_after("name = \"B\"\n", "velocity = " + vec_text(s.velocity_b) + "\nangular_velocity = " +
+                                     vec_text(s.angular_velocity_b) + "\n");
   return text;
 }
 
@@ -160,9 +158,9 @@ std::string toi_group(const Json& g, uint64_t seed, long count) {
     if (b.backend == row) found = b;
   if (found.error.empty()) return Json{{"ok", false}}.dump();
   std::ostringstream h;
-  h << "# Found by `rbx explore --kind toi --seed " << seed << " --count " << count
-    << "`: sample " << start.pair.index << " (" << start.pair.pose_class << "), group '" << sig
-    << "',\n# " << g["count"].get<long>() << " samples. " << row
+  h << "# Found by `rbx explore --kind toi --seed " << seed << " --count " << count << "`: sample "
+    << start.pair.index << " (" << start.pair.pose_class << "), group '" << sig << "',\n# "
+    << g["count"].get<long>() << " samples. " << row
     << " against the exact oracle: " << describe_outcome(found)
     << ".\n# Not shrunk: the sample as drawn.\n# Reproduce: rbx toi THIS_FILE --backends "
     << backend << "\n";

@@ -93,17 +93,20 @@ Json perf_json(const BenchPlan& plan, const BenchResults& results,
     put_time(row, "ns_per_query", r.ns_per_query);
     j["rows"].push_back(row);
   }
-  for (const NarrowRow& r : results.distance) {
-    Json row = {{"kind", "distance"},
-                {"backend", r.backend},
-                {"variant", r.variant},
-                {"vertices", r.vertices},
-                {"hull_vertices", r.hull_vertices},
-                {"gap", r.pose},
-                {"status", r.status}};
-    put_time(row, "ns_per_query", r.ns_per_query);
-    j["rows"].push_back(row);
-  }
+  for (const auto& [kind, family] :
+       {std::pair<const char*, const std::vector<NarrowRow>*>{"distance", &results.distance},
+        {"toi", &results.toi}})
+    for (const NarrowRow& r : *family) {
+      Json row = {{"kind", kind},
+                  {"backend", r.backend},
+                  {"variant", r.variant},
+                  {"vertices", r.vertices},
+                  {"hull_vertices", r.hull_vertices},
+                  {"gap", r.pose},
+                  {"status", r.status}};
+      put_time(row, "ns_per_query", r.ns_per_query);
+      j["rows"].push_back(row);
+    }
   for (const BroadRow& r : results.broad) {
     Json row = {{"kind", "broadphase"},
                 {"method", r.method},
@@ -161,6 +164,9 @@ std::string perf_csv(const BenchResults& results) {
   for (const NarrowRow& r : results.distance)
     csv << "distance," << r.backend << "," << r.variant << ",,," << r.vertices << "," << r.pose
         << ",," << figures(r.ns_per_query) << ",ns_per_query\n";
+  for (const NarrowRow& r : results.toi)
+    csv << "toi," << r.backend << "," << r.variant << ",,," << r.vertices << "," << r.pose << ",,"
+        << figures(r.ns_per_query) << ",ns_per_query\n";
   for (const BroadRow& r : results.broad)
     csv << "broadphase,,," << r.method << ",,,," << r.bodies << "," << figures(r.ns_per_step)
         << ",ns_per_step\n";
@@ -271,27 +277,19 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
   return md.str();
 }
 
-// The distance queries: every one per gap and size, and custom's time over FCL's prebuilt one,
-// round by round.
-std::string distance_markdown(const BenchPlan& plan, const BenchResults& results) {
-  const std::vector<DistanceBackend> db = distance_backends();
-  if (results.distance.empty()) return "";
+// A query family's tables, one per gap kind: every row per size, then `ratio`'s row (custom's
+// time over another row's, the median of the ratios round by round, ± half their 25-75 % range)
+// when it names one.
+std::string gap_tables(const BenchPlan& plan,
+                       const std::vector<std::pair<std::string, std::string>>& rows,
+                       const std::vector<NarrowRow>& results,
+                       const std::pair<std::string, std::string>& ratio_to) {
   std::vector<int> sizes = {8};
   sizes.insert(sizes.end(), plan.hull_sizes.begin(), plan.hull_sizes.end());
   std::ostringstream md;
-  md << "\n## Distance query\n\n"
-     << "Every distance query (`rbx distance`, docs/distance.md) on the narrow phase's shapes, "
-        "placed as its poses are but with B beyond touching by ";
-  for (size_t k = 0; k < std::size(kGapKinds); ++k)
-    md << (k ? " or " : "") << kGapKinds[k].offset * 100 << "% of the size";
-  md << " along the placement direction (*" << kGapKinds[0].name << "*, *" << kGapKinds[1].name
-     << "*); timed as the narrow phase is, each adapter doing what it does per call (`fcl "
-        "(prebuilt)` with each fcl::Box or Convex built once, the fair comparison for custom). "
-        "The last row of each table is custom's time over FCL's prebuilt one, the median of the "
-        "ratios round by round, ± half their 25-75 % range.\n\n";
   auto find = [&](const std::string& backend, const std::string& variant, const char* gap,
                   int n) -> const NarrowRow* {
-    for (const NarrowRow& r : results.distance)
+    for (const NarrowRow& r : results)
       if (r.backend == backend && r.variant == variant && r.pose == gap && r.vertices == n)
         return &r;
     return nullptr;
@@ -302,32 +300,81 @@ std::string distance_markdown(const BenchPlan& plan, const BenchResults& results
     md << "\n|---|---|";
     for (std::size_t i = 0; i < sizes.size(); ++i) md << "---:|";
     md << "\n";
-    for (const DistanceBackend& b : db) {
-      md << "| " << b.backend << " | " << b.variant << " |";
+    for (const auto& [backend, variant] : rows) {
+      md << "| " << backend << " | " << variant << " |";
       for (int n : sizes) {
-        const NarrowRow* r = find(b.backend, b.variant, k.name, n);
+        const NarrowRow* r = find(backend, variant, k.name, n);
         std::string note;
         if (r && r->status != "ok") note = " (" + r->status.substr(0, r->status.find(':')) + ")";
         md << " " << (r ? time_cell(r->ns_per_query, true) : std::string("—")) << note << " |";
       }
       md << "\n";
     }
-    md << "| **custom / fcl (prebuilt)** | |";
-    for (int n : sizes) {
-      const NarrowRow* c = find("custom", "default", k.name, n);
-      const NarrowRow* f = find("fcl", "prebuilt", k.name, n);
-      if (!c || !f) {
-        md << " — |";
-        continue;
+    if (!ratio_to.first.empty()) {
+      md << "| **custom / " << ratio_to.first << " (" << ratio_to.second << ")** | |";
+      for (int n : sizes) {
+        const NarrowRow* c = find("custom", "default", k.name, n);
+        const NarrowRow* f = find(ratio_to.first, ratio_to.second, k.name, n);
+        if (!c || !f) {
+          md << " — |";
+          continue;
+        }
+        const RatioSpread q = bench_ratio(c->ns_per_query, f->ns_per_query);
+        md << " " << bench_num(q.median, 3);
+        if (q.rounds > 1 && q.median > 0)
+          md << " ±" << bench_num(50.0 * (q.q75 - q.q25) / q.median, 2) << "%";
+        md << " |";
       }
-      const RatioSpread q = bench_ratio(c->ns_per_query, f->ns_per_query);
-      md << " " << bench_num(q.median, 3);
-      if (q.rounds > 1 && q.median > 0)
-        md << " ±" << bench_num(50.0 * (q.q75 - q.q25) / q.median, 2) << "%";
-      md << " |";
+      md << "\n";
     }
-    md << "\n\n";
+    md << "\n";
   }
+  return md.str();
+}
+
+// The gaps of kGapKinds, as prose: "1% or 20% of the size".
+std::string gap_prose() {
+  std::ostringstream md;
+  for (size_t k = 0; k < std::size(kGapKinds); ++k)
+    md << (k ? " or " : "") << kGapKinds[k].offset * 100 << "% of the size";
+  return md.str();
+}
+
+// The distance queries: every one per gap and size, and custom's time over FCL's prebuilt one.
+std::string distance_markdown(const BenchPlan& plan, const BenchResults& results) {
+  if (results.distance.empty()) return "";
+  std::vector<std::pair<std::string, std::string>> rows;
+  for (const DistanceBackend& b : distance_backends()) rows.push_back({b.backend, b.variant});
+  std::ostringstream md;
+  md << "\n## Distance query\n\n"
+     << "Every distance query (`rbx distance`, docs/distance.md) on the narrow phase's shapes, "
+        "placed as its poses are but with B beyond touching by "
+     << gap_prose() << " along the placement direction (*" << kGapKinds[0].name << "*, *"
+     << kGapKinds[1].name
+     << "*); timed as the narrow phase is, each adapter doing what it does per call (`fcl "
+        "(prebuilt)` with each fcl::Box or Convex built once, the fair comparison for custom). "
+        "The last row of each table is custom's time over FCL's prebuilt one, the median of the "
+        "ratios round by round, ± half their 25-75 % range.\n\n";
+  md << gap_tables(plan, rows, results.distance, {"fcl", "prebuilt"});
+  return md.str();
+}
+
+// The time-of-impact queries: every one per gap and size, and custom's time over FCL's.
+std::string toi_markdown(const BenchPlan& plan, const BenchResults& results) {
+  if (results.toi.empty()) return "";
+  std::vector<std::pair<std::string, std::string>> rows;
+  for (const ToiBackend& b : toi_backends()) rows.push_back({b.backend, b.variant});
+  std::ostringstream md;
+  md << "\n## Time-of-impact query\n\n"
+     << "Every time-of-impact query (`rbx toi`, docs/time_of_impact.md) on the distance "
+        "queries' poses (B beyond touching by "
+     << gap_prose()
+     << "), B moving onto A by the centres' offset over an interval of 1 s, in pure translation "
+        "(so that the translation-only casts answer the same question); each adapter builds its "
+        "shapes on every call, as the plain distance rows do. A row that does not answer ok is "
+        "noted (Bullet's btGjkConvexCast misses exact landings: docs/time_of_impact.md). The "
+        "last row of each table is custom's time over FCL's.\n\n";
+  md << gap_tables(plan, rows, results.toi, {"fcl", "default"});
   return md.str();
 }
 
@@ -402,7 +449,8 @@ void write_perf_pages(const BenchPlan& plan, const BenchResults& results,
   csv << perf_csv(results);
   std::ostringstream md;
   md << goals_markdown(plan, results, goals, timing_s) << narrow_markdown(plan, results)
-     << distance_markdown(plan, results) << broad_markdown(plan, results) << step_markdown(results);
+     << distance_markdown(plan, results) << toi_markdown(plan, results)
+     << broad_markdown(plan, results) << step_markdown(results);
   // Everything is built in a temporary folder, figures drawn there, then each file moved into
   // the output folder (other files there, such as `rbx report`'s, are kept).
   const fs::path target(out);
