@@ -83,6 +83,8 @@ py::list backend_rows() {
     d["description"] = b.description;
     d["contact"] = static_cast<bool>(b.contact);
     d["dynamics"] = static_cast<bool>(b.dynamics);
+    d["distance"] = static_cast<bool>(b.distance);
+    d["toi"] = static_cast<bool>(b.toi);
     d["mass"] = static_cast<bool>(b.mass);
     d["library"] = b.library;
     d["friction"] = b.friction;

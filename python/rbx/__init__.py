@@ -176,12 +176,13 @@ def _with_json(args, show_progress=False):
 # -- the commands ----------------------------------------------------------------------------
 
 def backends():
-    """Every backend: name, description, kind (a list of "contact", "dynamics"), whether it is
+    """Every backend: name, description, kind (a list of "contact", "dynamics", "distance",
+    "toi": the queries it answers), whether it is
     an outside library's, applies friction, or was registered from Python (user), and its colour
     and marker in every figure ("" where it has none)."""
     rows = []
     for b in _rbx.backends():
-        kind = [k for k in ("contact", "dynamics") if b[k]]
+        kind = [k for k in ("contact", "dynamics", "distance", "toi") if b[k]]
         rows.append({"name": b["name"], "description": b["description"], "kind": kind,
                      "mass": b["mass"], "library": b["library"], "friction": b["friction"],
                      "user": b["user"], "colour": b["colour"], "marker": b["marker"]})
@@ -228,6 +229,27 @@ def contacts(scene, backends=None, sets=None, at=None):
     with _SceneFiles(scene) as paths:
         return _with_json(["contacts", *paths[:1], *_names(backends), *_sets(sets)] +
                           (["--at", at] if at else []))
+
+
+def distance(scene, backends=None, sets=None):
+    """`rbx distance SCENE --json`: every backend's distance and closest points of every pair at
+    t = 0, each against the exact oracle (docs/distance.md)."""
+    with _SceneFiles(scene) as paths:
+        return _with_json(["distance", *paths[:1], *_names(backends), *_sets(sets)])
+
+
+def toi(scene, interval=None, backends=None, sets=None):
+    """`rbx toi SCENE --json`: every backend's first touch of every pair, each body moving at its
+    velocity and angular velocity over `interval` seconds (None: the scene's dt), each against
+    the exact oracle (docs/time_of_impact.md)."""
+    extra = []
+    if interval is not None:
+        if isinstance(interval, bool) or not isinstance(interval, (int, float)) or \
+                not math.isfinite(interval) or interval <= 0:
+            raise ValueError("interval: a positive number of seconds")
+        extra = ["--interval", repr(float(interval))]
+    with _SceneFiles(scene) as paths:
+        return _with_json(["toi", *paths[:1], *_names(backends), *_sets(sets)] + extra)
 
 
 def _body_toml(name, body):

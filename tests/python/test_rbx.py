@@ -99,6 +99,28 @@ def test_contacts_is_the_command_lines_document_and_a_dict_scene_is_a_file():
     assert np.allclose(c["normal"], [0, 0, 1]) and abs(c["depth"] - 0.5 ** 0.5) < 1e-12
 
 
+def test_distance_and_toi_are_the_command_lines_documents():
+    # B 0.25 above A, falling at 2 m/s: 0.25 apart now, touching at 0.25 of an interval of 0.5 s.
+    scene = {"name": "fall", "description": "a cube falls onto another", "checks": ["contact"],
+             "sim": {"duration": 0},
+             "body": [{"name": "A"},
+                      {"name": "B", "position": [0.2, 0.1, 1.25], "velocity": [0, 0, -2]}]}
+    d = rbx.distance(scene, backends=["custom"])
+    assert abs(d["pairs"][0]["exact"]["distance"] - 0.25) < 1e-15
+    assert abs(d["pairs"][0]["backends"]["custom"]["distance"] - 0.25) < 1e-12
+    t = rbx.toi(scene, interval=0.5, backends=["custom", "fcl"])
+    assert t["interval"] == 0.5 and abs(t["pairs"][0]["exact"]["fraction"] - 0.25) < 1e-15
+    # The same question twice, the same answers (a dict scene is a new temporary file each time).
+    assert without_timings(t["pairs"]) == without_timings(
+        rbx.toi(scene, interval=0.5, backends=["custom", "fcl"])["pairs"])
+    path = os.path.join(ROOT, "scenes", "analytic", "corner_drop_e05.toml")
+    assert without_timings(cli_json("toi", path, "--interval", "0.1")) == without_timings(
+        rbx.toi(path, interval=0.1))
+    for bad in (0, -1.0, float("nan"), "soon", True):
+        with pytest.raises(ValueError, match="interval"):
+            rbx.toi(scene, interval=bad)
+
+
 def test_ensemble_is_the_command_lines_document():
     path = os.path.join(ROOT, "scenes", "seed", "edge_drop.toml")
     args = ["--count", "6", "--perturb", "orientation=1e-05", "--backends", "custom,ode"]
@@ -114,9 +136,10 @@ def test_tosses_is_the_command_lines_document():
 
 def test_backends_lists_every_registry_row_with_its_kind():
     rows = {b["name"]: b for b in rbx.backends()}
-    assert rows["exact"]["kind"] == ["contact"]
     assert rows["custom-seed"]["kind"] == ["dynamics"]
-    assert rows["bullet"]["kind"] == ["contact", "dynamics"]
+    assert rows["bullet"]["kind"] == ["contact", "dynamics", "distance", "toi"]
+    assert rows["ode"]["kind"] == ["contact", "dynamics"]
+    assert rows["exact"]["kind"] == ["contact", "distance", "toi"]
     assert all(b["description"] for b in rows.values())
 
 
