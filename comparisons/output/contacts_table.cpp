@@ -1,5 +1,6 @@
 #include "comparisons/output/contacts_table.h"
 
+#include "comparisons/output/query_cells.h"
 #include "comparisons/output/table.h"
 #include "engine/format.h"
 
@@ -20,19 +21,18 @@ void print_contacts(std::ostream& out, const Scene& scene, const ContactsCompari
                  "depth - exact", "coverage", "mark", "time (µs)", "25-75 %", "cold call (µs)"});
     for (const ContactsRow& r : p.rows) {
       const ContactPoint* q = deepest(r.run.result);
-      const bool timed = r.run.timing.rounds > 0;
-      table.add(
-          {r.backend, to_string(r.run.result.status), std::to_string(r.run.result.contacts.size()),
-           q ? fmt_vec(q->normal) : "-", q ? fmt_num(q->depth, 5) : "-",
-           q ? fmt_vec(q->point) : "-", r.angle, r.depth_diff,
-           r.cover ? fmt_num(r.cover->coverage_err / r.size, 3) : "-",
-           r.mark == "disagrees"  ? "✗"
-           : r.mark == "deviates" ? "~"
-                                  : "",
-           timed ? fmt_num(r.run.timing.median_s * 1e6, 3) : "-",
-           timed ? fmt_num(r.run.timing.q25_s * 1e6, 3) + "-" + fmt_num(r.run.timing.q75_s * 1e6, 3)
-                 : "-",
-           fmt_num(r.run.timing.cold_s * 1e6, 3)});
+      std::vector<std::string> cells = {r.backend,
+                                        to_string(r.run.result.status),
+                                        std::to_string(r.run.result.contacts.size()),
+                                        q ? fmt_vec(q->normal) : "-",
+                                        q ? fmt_num(q->depth, 5) : "-",
+                                        q ? fmt_vec(q->point) : "-",
+                                        r.angle,
+                                        r.depth_diff,
+                                        r.cover ? fmt_num(r.cover->coverage_err / r.size, 3) : "-",
+                                        mark_cell(r.mark)};
+      for (std::string& c : timing_cells(r.run.timing)) cells.push_back(std::move(c));
+      table.add(std::move(cells));
     }
     table.print(out);
     for (const ContactsRow& r : p.rows)
@@ -44,9 +44,7 @@ void print_contacts(std::ostream& out, const Scene& scene, const ContactsCompari
     out << "\ncoverage: how far the points fall short of the exact contact patch, the largest "
            "distance from a corner of the patch to the hull of the points across the normal, "
            "relative to the smaller body (0: they span it; docs/contact_manifold.md)\n";
-    out << "time: per query, the median over rounds of repeated calls (warmed up, backends "
-           "interleaved; docs/bench.md) with its 25-75 % range; the cold call is the first, "
-           "which gave the answer, timed alone\n";
+    out << kQueryTimingNote;
     return;
   }
   if (!c.at_first)

@@ -1,5 +1,6 @@
 #include "comparisons/output/distance_table.h"
 
+#include "comparisons/output/query_cells.h"
 #include "comparisons/output/table.h"
 #include "engine/format.h"
 
@@ -23,18 +24,18 @@ void print_distances(std::ostream& out, const DistanceComparison& c) {
                  "distance err", "witness err", "mark", "time (µs)", "25-75 %", "cold call (µs)"});
     for (const DistanceRow& r : p.rows) {
       const bool points = r.result.status == Status::Ok && !r.result.overlapping;
-      const bool timed = r.timing.rounds > 0;
-      table.add(
-          {r.backend, to_string(r.result.status), answer(r.result),
-           points ? fmt_vec(r.result.point_a) : "-", points ? fmt_vec(r.result.point_b) : "-",
-           r.verdict.comparable ? fmt_num(r.verdict.distance_err, 3) : "-",
-           r.verdict.comparable ? fmt_num(r.verdict.witness_err, 3) : "-",
-           r.verdict.mark == "disagrees"  ? "✗"
-           : r.verdict.mark == "deviates" ? "~"
-                                          : "",
-           timed ? fmt_num(r.timing.median_s * 1e6, 3) : "-",
-           timed ? fmt_num(r.timing.q25_s * 1e6, 3) + "-" + fmt_num(r.timing.q75_s * 1e6, 3) : "-",
-           r.result.status == Status::Unsupported ? "-" : fmt_num(r.timing.cold_s * 1e6, 3)});
+      std::vector<std::string> cells = {
+          r.backend,
+          to_string(r.result.status),
+          answer(r.result),
+          points ? fmt_vec(r.result.point_a) : "-",
+          points ? fmt_vec(r.result.point_b) : "-",
+          r.verdict.comparable ? fmt_num(r.verdict.distance_err, 3) : "-",
+          r.verdict.comparable ? fmt_num(r.verdict.witness_err, 3) : "-",
+          mark_cell(r.verdict.mark)};
+      for (std::string& c : timing_cells(r.timing, r.result.status != Status::Unsupported))
+        cells.push_back(std::move(c));
+      table.add(std::move(cells));
     }
     table.print(out);
     for (const DistanceRow& r : p.rows)
@@ -54,9 +55,7 @@ void print_distances(std::ostream& out, const DistanceComparison& c) {
          "origin (round-off of the coordinates); witness err: how far the two points are from a "
          "closest pair (off their bodies, or apart by other than the distance), on the same scale; "
          "✗ over 1e-6, ~ over 1e-9 and beyond round-off (docs/distance.md)\n";
-  out << "time: per query, the median over rounds of repeated calls (warmed up, backends "
-         "interleaved; docs/bench.md) with its 25-75 % range; the cold call is the first, which "
-         "gave the answer, timed alone\n";
+  out << kQueryTimingNote;
 }
 
 }  // namespace rbx

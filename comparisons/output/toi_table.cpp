@@ -1,5 +1,6 @@
 #include "comparisons/output/toi_table.h"
 
+#include "comparisons/output/query_cells.h"
 #include "comparisons/output/table.h"
 #include "engine/format.h"
 
@@ -26,19 +27,19 @@ void print_tois(std::ostream& out, const ToiComparison& c) {
                  "point err", "mark", "time (µs)", "25-75 %", "cold call (µs)"});
     for (const ToiRow& r : p.rows) {
       const bool located = r.result.status == Status::Ok && r.result.hit && r.result.located;
-      const bool timed = r.timing.rounds > 0;
-      table.add(
-          {r.backend, to_string(r.result.status), answer(r.result),
-           located ? fmt_vec(r.result.point) : "-", located ? fmt_vec(r.result.normal) : "-",
-           r.verdict.comparable ? fmt_num(r.verdict.time_err, 3) : "-",
-           r.verdict.located ? fmt_num(r.verdict.normal_err_deg, 3) : "-",
-           r.verdict.located ? fmt_num(r.verdict.point_err_rel, 3) : "-",
-           r.verdict.mark == "disagrees"  ? "✗"
-           : r.verdict.mark == "deviates" ? "~"
-                                          : "",
-           timed ? fmt_num(r.timing.median_s * 1e6, 3) : "-",
-           timed ? fmt_num(r.timing.q25_s * 1e6, 3) + "-" + fmt_num(r.timing.q75_s * 1e6, 3) : "-",
-           r.result.status == Status::Unsupported ? "-" : fmt_num(r.timing.cold_s * 1e6, 3)});
+      std::vector<std::string> cells = {
+          r.backend,
+          to_string(r.result.status),
+          answer(r.result),
+          located ? fmt_vec(r.result.point) : "-",
+          located ? fmt_vec(r.result.normal) : "-",
+          r.verdict.comparable ? fmt_num(r.verdict.time_err, 3) : "-",
+          r.verdict.located ? fmt_num(r.verdict.normal_err_deg, 3) : "-",
+          r.verdict.located ? fmt_num(r.verdict.point_err_rel, 3) : "-",
+          mark_cell(r.verdict.mark)};
+      for (std::string& c : timing_cells(r.timing, r.result.status != Status::Unsupported))
+        cells.push_back(std::move(c));
+      table.add(std::move(cells));
     }
     table.print(out);
     for (const ToiRow& r : p.rows)
@@ -57,9 +58,7 @@ void print_tois(std::ostream& out, const ToiComparison& c) {
          "the oracle's; ✗ over 1e-6, ~ over 1e-9 (docs/time_of_impact.md). normal err: the angle "
          "to the oracle's normal (at an edge or a corner many are right); point err: how far the "
          "point is from either body at the oracle's time, over the pair's size\n";
-  out << "time: per query, the median over rounds of repeated calls (warmed up, backends "
-         "interleaved; docs/bench.md) with its 25-75 % range; the cold call is the first, which "
-         "gave the answer, timed alone\n";
+  out << kQueryTimingNote;
 }
 
 }  // namespace rbx
