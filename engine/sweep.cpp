@@ -94,14 +94,6 @@ SweepImpact sweep_time_of_impact(const ConvexPolyhedron& a, const Sweep& sa,
       return out;
     }
     const Vec3 n = (s.point_a - s.point_b) / s.distance;
-    if (s.distance <= touch) {
-      out.hit = true;
-      out.time = t;
-      out.point = 0.5 * (s.point_a + s.point_b);
-      out.normal = n;
-      out.located = true;
-      return out;
-    }
     // A plane with unit normal u across a gap g along it (gap_along: the shapes' own supports)
     // separates the shapes while A's points, moving along u no slower than va.u - |wa| ra, and
     // B's, no faster than vb.u + |wb| rb, have not closed it: the bound holds at every time, so a
@@ -109,21 +101,43 @@ SweepImpact sweep_time_of_impact(const ConvexPolyhedron& a, const Sweep& sa,
     // closest points' direction gives the distance's own plane; where round-off has tilted it
     // (a gap along it under half the distance), the axes the touching features name, and the
     // distance over the fastest any point moves, are tried too: the longest safe step is taken.
-    // Each stops half the touching distance short, so that it ends apart (located).
     std::vector<Vec3> axes = {n};
     const double gap_n = gap_along(a, pa, b, pb, n);
     if (gap_n < 0.5 * s.distance) {
       const std::vector<Vec3> more = feature_axes(a, pa, b, pb, s, n);
       axes.insert(axes.end(), more.begin(), more.end());
     }
-    double step = (s.distance - 0.5 * touch) / ((sb.velocity - sa.velocity).norm() + spin);
-    for (const Vec3& u : axes) {
-      const double gap = u == n ? gap_n : gap_along(a, pa, b, pb, u);
-      if (gap <= 0.5 * touch) continue;
-      const double closing = (sb.velocity - sa.velocity).dot(u) + spin;
-      if (closing <= 0) return out;  // this plane separates them for good
-      step = std::max(step, (gap - 0.5 * touch) / closing);
+    // The longest safe step that stops `short_by` short of closing the gap (infinite: a plane
+    // the bound never closes).
+    auto safe_step = [&](double short_by) {
+      double step = (s.distance - short_by) / ((sb.velocity - sa.velocity).norm() + spin);
+      for (const Vec3& u : axes) {
+        const double gap = u == n ? gap_n : gap_along(a, pa, b, pb, u);
+        if (gap <= short_by) continue;
+        const double closing = (sb.velocity - sa.velocity).dot(u) + spin;
+        if (closing <= 0) return std::numeric_limits<double>::infinity();
+        step = std::max(step, (gap - short_by) / closing);
+      }
+      return step;
+    };
+    if (s.distance <= touch) {
+      // Within the touching distance: located here, apart, where the closest points still give
+      // the normal. The time takes one more safe step, to the touch itself, so that it is not
+      // early by the tolerance over a slow approach (a touch 1e-11 of the size short, closing at
+      // 1e-9 of the size per second, is 0.01 s early); a step no point can cross the touching
+      // distance in, so that a pair that only grazes (its plane closing slowly while its
+      // features slide apart) is still within it, and never past the interval.
+      const double reach = touch / ((sb.velocity - sa.velocity).norm() + spin);
+      out.hit = true;
+      out.time = t + std::clamp(std::min(safe_step(0.0), reach), 0.0, dt - t);
+      out.point = 0.5 * (s.point_a + s.point_b);
+      out.normal = n;
+      out.located = true;
+      return out;
     }
+    // Each step stops half the touching distance short, so that the sweep ends apart (located).
+    const double step = safe_step(0.5 * touch);
+    if (!std::isfinite(step)) return out;  // a plane that separates them for good
     t += step;
     if (t > dt) return out;
   }

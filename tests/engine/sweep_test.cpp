@@ -1,5 +1,6 @@
 // `custom`'s time of impact under the stated motion (engine/sweep.h) on closed forms: a cube
-// falling flat, and a rod turning about its centre until its corner meets a face.
+// falling flat, fast or a hair a second, and a rod turning about its centre until its corner
+// meets a face.
 #include "engine/sweep.h"
 
 #include <gtest/gtest.h>
@@ -25,16 +26,34 @@ TEST(SweepTimeOfImpact, AFallingCubeTouchesWhenTheGapCloses) {
   const SweepImpact hit = sweep_time_of_impact(cube, a, cube, b, 0.5);
   ASSERT_TRUE(hit.hit);
   ASSERT_TRUE(hit.located);
-  // It stops short by at most the touching distance (kSweepTouchRel of the size, here 1.73)
-  // over the closing speed.
-  EXPECT_LE(hit.time, 0.15 + 1e-15);
-  EXPECT_GE(hit.time, 0.15 - kSweepTouchRel * 1.8 / 2);
+  // Its last safe step lands on the touch: round-off of the coordinates over the speed.
+  EXPECT_NEAR(hit.time, 0.15, 1e-15);
   EXPECT_GT(hit.normal.z(), 1 - 1e-12);
   EXPECT_NEAR(hit.point.z(), 0.5, 1e-9);
   // Too short an interval, or moving away: no touch.
   EXPECT_FALSE(sweep_time_of_impact(cube, a, cube, b, 0.1).hit);
   const Sweep away{a.start, Vec3(0, 0, 2), Vec3::Zero()};
   EXPECT_FALSE(sweep_time_of_impact(cube, away, cube, b, 10.0).hit);
+}
+
+// A slow approach: the same cubes 1e-8 m apart closing at 1e-8 m/s touch at 1 s. Stopping at
+// the touching distance (kSweepTouchRel of the size, 1.7e-11 m) would be 1.7e-3 s early; the
+// last safe step lands on the touch. What is left is round-off: the coordinates' (1e-16 m) over
+// the closing speed is 1e-8 s.
+TEST(SweepTimeOfImpact, ASlowApproachTouchesOnTimeNotATolerancesWorthEarly) {
+  const ConvexPolyhedron cube = make_box(Vec3::Ones());
+  const Sweep a{{Vec3(0.2, 0.1, 1.0 + 1e-8), Quat::Identity()}, Vec3(0, 0, -1e-8), Vec3::Zero()};
+  const Sweep b{{Vec3::Zero(), Quat::Identity()}, Vec3::Zero(), Vec3::Zero()};
+  const SweepImpact hit = sweep_time_of_impact(cube, a, cube, b, 2.0);
+  ASSERT_TRUE(hit.hit);
+  ASSERT_TRUE(hit.located);
+  EXPECT_NEAR(hit.time, 1.0, 1e-7);
+  EXPECT_GT(hit.normal.z(), 1 - 1e-6);
+  // The same approach turning slowly about z: still never late, and now within the spin's bound.
+  const Sweep turning{a.start, a.velocity, Vec3(0, 0, 1e-9)};
+  const SweepImpact spun = sweep_time_of_impact(cube, turning, cube, b, 2.0);
+  ASSERT_TRUE(spun.hit);
+  EXPECT_LE(spun.time, 1.0 + 1e-7);
 }
 
 // A rod (half-length L = 1, half-thickness h = 0.05) along x turns about z at w; a unit cube's
