@@ -15,6 +15,7 @@
 #include "comparisons/eval/regression_check.h"
 #include "comparisons/eval/scene_batch.h"
 #include "comparisons/eval/tosses.h"
+#include "comparisons/output/query_report.h"
 #include "comparisons/output/report_pages.h"
 #include "comparisons/output/report_writer.h"
 #include "comparisons/output/tosses_report.h"
@@ -153,7 +154,8 @@ int report_command(const ReportOptions& opt) {
       if (b.dynamics) impact.push_back(b.name);
     }
     const ResultCache fill(hopt.cache_dir, ResultCache::code_fingerprint(), false);
-    in.explore = explore_check_metrics(contact, impact, in.explore_set, nullptr, &par, &fill);
+    in.explore =
+        explore_check_metrics(contact, impact, in.explore_set, nullptr, &par, &fill, &in.queries);
     parts.end("explore");
   }
   if (!par.root()) return 0;  // rank 0 writes everything
@@ -169,6 +171,9 @@ int report_command(const ReportOptions& opt) {
   fs::create_directories(tmp / "figures");
   try {
     write_report_tables(tmp.string(), scenes, evs);
+    if (!in.queries.empty())  // the distance and toi sections' figures are drawn from it
+      write_text((tmp / "queries.json").string(),
+                 query_families_json(in.queries, in.explore_set).dump(1) + "\n");
     parts.end("tables");
     std::string figures_msg;
     const bool figures_ok = draw_report_figures(tmp.string(), par.threads(), figures_msg);

@@ -432,7 +432,8 @@ std::string encode(const SampleOutcome& s) {
     j["b"].push_back({b.backend, b.error, b.measured, b.normal_err_deg, b.depth_err_rel,
                       b.point_err_rel, b.message, b.velocity_err_ke, b.momentum_err_ke,
                       b.position_err_m, b.turn_rad, b.rest_time_err_s, b.reported_depth_m, b.rise_m,
-                      b.coverage_err_rel, b.distance_err_rel, b.witness_err_rel, b.time_err});
+                      b.coverage_err_rel, b.distance_err_rel, b.witness_err_rel, b.time_err,
+                      b.separation_m});
   if (s.phase >= 0) j["ph"] = s.phase;
   return j.dump();
 }
@@ -448,7 +449,7 @@ SampleOutcome decode(const std::string& text) {
   s.depth_rel = j["d"];
   for (const Json& b : j["b"])
     s.backends.push_back({b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11],
-                          b[12], b[13], b[14], b[15], b[16], b[17]});
+                          b[12], b[13], b[14], b[15], b[16], b[17], b[18]});
   s.phase = j.value("ph", -1.0);
   return s;
 }

@@ -75,7 +75,7 @@ std::string sample_scene_text(const ContactSample& s, const std::string& header 
                               const std::string& expect = "");
 
 /// What went wrong for one backend on one sample ("" : agrees with the truth).
-/// error | misses | false_contact | normal | depth | point
+/// error | misses | false_contact | normal | depth | point (the other kinds name theirs)
 struct BackendOutcome {
   std::string backend;
   std::string error;            // "" when it agrees, else the kind above
@@ -102,8 +102,10 @@ struct BackendOutcome {
   // to the true distance.
   double distance_err_rel = 0.0;
   double witness_err_rel = 0.0;
-  // Toi kind (measured: both touch): |first touch - exact's|, of the interval.
+  // Toi kind (measured: both touch): |first touch - exact's|, of the interval; where that is
+  // a disagreement (early, late), the pair's separation at the row's time (ToiVerdict).
   double time_err = 0.0;
+  double separation_m = 0.0;
 };
 
 /// Everything measured on one sample.

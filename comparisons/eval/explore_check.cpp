@@ -8,6 +8,7 @@
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/explore_campaign.h"
 #include "comparisons/eval/parallel.h"
+#include "comparisons/eval/toi_query.h"
 
 namespace rbx {
 
@@ -55,10 +56,73 @@ void tally(const std::string& scene, const std::vector<std::string>& encoded,
 
 }  // namespace
 
+QueryFamily query_family(const std::string& scene, const std::string& error,
+                         const std::vector<std::string>& encoded) {
+  QueryFamily f{scene, error, static_cast<long>(encoded.size()), {}};
+  std::map<std::string, QueryFamilyRow> rows;
+  std::map<std::string, std::vector<double>> main, witness;
+  std::map<std::string, std::map<std::string, std::vector<double>>> separations;
+  for (const std::string& text : encoded) {
+    const SampleOutcome o = decode(text);
+    for (const BackendOutcome& b : o.backends) {
+      QueryFamilyRow& r = rows[b.backend];
+      r.backend = b.backend;
+      ++r.samples;
+      if (!b.error.empty()) {
+        ++r.disagreements;
+        auto k = std::find_if(r.kinds.begin(), r.kinds.end(),
+                              [&](const QueryFamilyRow::Kind& x) { return x.name == b.error; });
+        if (k == r.kinds.end())
+          k = r.kinds.insert(r.kinds.end(), QueryFamilyRow::Kind{b.error, 0, o.index, 0.0, 0.0});
+        ++k->count;
+        if (b.error == "early" || b.error == "late")
+          separations[b.backend][b.error].push_back(std::abs(b.separation_m));
+      }
+      if (!b.measured) continue;
+      ++r.measured;
+      if (error == "time_err" && b.error.empty() && b.time_err > kToiDisagree) ++r.grazing;
+      main[b.backend].push_back(error == "time_err" ? b.time_err : b.distance_err_rel);
+      witness[b.backend].push_back(b.witness_err_rel);
+    }
+  }
+  for (auto& [name, r] : rows) {
+    std::vector<double>& v = main[name];
+    std::sort(v.begin(), v.end());
+    for (int p = 0; p <= 100; p += 5) r.quantiles.push_back(nearest_rank_percentile(v, p));
+    r.p50 = nearest_rank_percentile(v, 50);
+    r.p90 = nearest_rank_percentile(v, 90);
+    r.p99 = nearest_rank_percentile(v, 99);
+    std::vector<double>& w = witness[name];
+    std::sort(w.begin(), w.end());
+    r.witness_p50 = nearest_rank_percentile(w, 50);
+    r.witness_p90 = nearest_rank_percentile(w, 90);
+    for (QueryFamilyRow::Kind& k : r.kinds) {
+      std::vector<double>& sep = separations[name][k.name];
+      if (sep.empty()) continue;
+      std::sort(sep.begin(), sep.end());
+      k.separation_p50 = nearest_rank_percentile(sep, 50);
+      k.separation_max = sep.back();
+    }
+    std::stable_sort(r.kinds.begin(), r.kinds.end(),
+                     [](const auto& x, const auto& y) { return x.count > y.count; });
+    f.rows.push_back(r);
+  }
+  auto rate = [](const QueryFamilyRow& r) {
+    return r.samples ? static_cast<double>(r.disagreements) / static_cast<double>(r.samples) : 1.0;
+  };
+  // Rows arrive in name order, which breaks the remaining ties.
+  std::stable_sort(f.rows.begin(), f.rows.end(), [&](const auto& x, const auto& y) {
+    if (rate(x) != rate(y)) return rate(x) < rate(y);
+    return x.p50 < y.p50;
+  });
+  return f;
+}
+
 std::vector<ExploreCheckMetric> explore_check_metrics(
     const std::vector<std::string>& contact_backends,
     const std::vector<std::string>& impact_backends, const ExploreCheckSet& set,
-    const std::vector<Backend>* table, const ParallelRun* given, const ResultCache* cache) {
+    const std::vector<Backend>* table, const ParallelRun* given, const ResultCache* cache,
+    std::vector<QueryFamily>* queries) {
   std::vector<ExploreCheckMetric> out;
   std::optional<ParallelRun> own;
   if (!given) own.emplace();
@@ -76,27 +140,29 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
   for (const std::string& name : contact_backends)
     if (const Backend* b = find_backend(name, table); b && b->distance)
       distance_backends.push_back(name);
-  if (!distance_backends.empty() && set.distance > 0)
-    tally("explore/distance",
-          run.map(static_cast<size_t>(set.distance),
-                  [&](size_t i) {
-                    return encode(evaluate_distance_sample(make_distance_sample(set.seed, i),
-                                                           distance_backends, table));
-                  }),
-          {"distance_err_rel", "witness_err_rel"}, "exact", out);
+  if (!distance_backends.empty() && set.distance > 0) {
+    const std::vector<std::string> encoded =
+        run.map(static_cast<size_t>(set.distance), [&](size_t i) {
+          return encode(evaluate_distance_sample(make_distance_sample(set.seed, i),
+                                                 distance_backends, table));
+        });
+    tally("explore/distance", encoded, {"distance_err_rel", "witness_err_rel"}, "exact", out);
+    if (queries && run.root())
+      queries->push_back(query_family("explore/distance", "distance_err_rel", encoded));
+  }
   // The toi kind's subjects: the contact backends that have a time-of-impact query (their
   // variants' rows come with them).
   std::vector<std::string> toi_backends;
   for (const std::string& name : contact_backends)
     if (const Backend* b = find_backend(name, table); b && b->toi && name != "exact")
       toi_backends.push_back(name);
-  if (!toi_backends.empty() && set.toi > 0)
-    tally("explore/toi",
-          run.map(static_cast<size_t>(set.toi),
-                  [&](size_t i) {
-                    return encode(evaluate_toi_sample(make_toi_sample(set.seed, i), toi_backends));
-                  }),
-          {"time_err"}, "exact", out);
+  if (!toi_backends.empty() && set.toi > 0) {
+    const std::vector<std::string> encoded = run.map(static_cast<size_t>(set.toi), [&](size_t i) {
+      return encode(evaluate_toi_sample(make_toi_sample(set.seed, i), toi_backends));
+    });
+    tally("explore/toi", encoded, {"time_err"}, "exact", out);
+    if (queries && run.root()) queries->push_back(query_family("explore/toi", "time_err", encoded));
+  }
   if (!impact_backends.empty() && set.impact > 0)
     tally("explore/impact",
           run.map(static_cast<size_t>(set.impact),

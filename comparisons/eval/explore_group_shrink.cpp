@@ -113,7 +113,11 @@ std::string describe_outcome(const BackendOutcome& b) {
   if (b.error == "distance" || b.error == "witness")
     return "distance off by " + fmt_num(b.distance_err_rel, 3) + ", witness points off by " +
            fmt_num(b.witness_err_rel, 3) + " of the true distance";
-  if (b.error == "time") return "first touch off by " + fmt_num(b.time_err, 3) + " of the interval";
+  if (b.error == "early" || b.error == "late")
+    return "first touch " + fmt_num(b.time_err, 3) + " of the interval " + b.error + ", the pair " +
+           (b.separation_m >= 0 ? fmt_num(b.separation_m, 3) + " m apart"
+                                : "overlapping by " + fmt_num(-b.separation_m, 3) + " m") +
+           " then";
   if (b.error == "coverage")
     return "its points fall short of the exact contact patch by " + fmt_num(b.coverage_err_rel, 3) +
            " of the smaller body";

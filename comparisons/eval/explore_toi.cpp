@@ -136,7 +136,10 @@ SampleOutcome evaluate_toi_sample(const ToiSample& s, const std::vector<std::str
     o.time_err = v.time_err;
     o.normal_err_deg = v.normal_err_deg;
     if (v.mark == "disagrees") {
-      o.error = r.hit == truth.hit ? "time" : r.hit ? "false_contact" : "misses";
+      o.error = r.hit != truth.hit            ? (r.hit ? "false_contact" : "misses")
+                : r.fraction < truth.fraction ? "early"
+                                              : "late";
+      o.separation_m = v.separation_m;
       o.message = v.why;
     }
     out.backends.push_back(o);

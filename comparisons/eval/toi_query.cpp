@@ -94,19 +94,25 @@ ToiResult run_toi(const ToiSubject& s, const RigidBody& a, const RigidBody& b, d
 
 namespace {
 
-// Whether the pair at `fraction` of the interval is within kToiTouchBand of touching (exactly,
-// by the oracle): apart by at most the band, or overlapping by at most it.
-bool touching_at(const RigidBody& a, const RigidBody& b, double dt, double fraction) {
+// The pair's exact separation at `fraction` of the interval: the distance where apart, minus the
+// deepest exact depth where overlapping; NaN where the motion has no pose there.
+double separation_at(const RigidBody& a, const RigidBody& b, double dt, double fraction) {
   const std::optional<RigidBody> at_a = body_at_end(a, fraction * dt),
                                  at_b = body_at_end(b, fraction * dt);
-  if (!at_a || !at_b) return false;
-  const double band = kToiTouchBand * (bounding_sphere(a).radius + bounding_sphere(b).radius);
+  if (!at_a || !at_b) return std::nan("");
   const ExactDistance e = exact_distance(*a.shape, at_a->pose(), *b.shape, at_b->pose());
-  if (!e.overlapping) return e.distance <= band;
+  if (!e.overlapping) return e.distance;
   double depth = 0;
   for (const ContactPoint& c : exact_contact(*at_a, *at_b).contacts)
     depth = std::max(depth, c.depth);
-  return depth <= band;
+  return -depth;
+}
+
+// Whether the pair at `fraction` of the interval is within kToiTouchBand of touching (exactly,
+// by the oracle): apart by at most the band, or overlapping by at most it.
+bool touching_at(const RigidBody& a, const RigidBody& b, double dt, double fraction) {
+  const double band = kToiTouchBand * (bounding_sphere(a).radius + bounding_sphere(b).radius);
+  return std::abs(separation_at(a, b, dt, fraction)) <= band;  // false for NaN
 }
 
 // Whether a touch the oracle finds at `fraction` is a hair-deep pass: at 17 instants from it to
@@ -145,9 +151,11 @@ ToiVerdict judge_toi(const ToiResult& answer, const ToiResult& truth, const Rigi
   v.comparable = true;
   v.time_err = std::abs(answer.fraction - truth.fraction);
   const bool grazing = v.time_err > kToiDeviate && touching_at(a, b, dt, answer.fraction);
-  if (!std::isfinite(v.time_err) || (v.time_err > kToiDisagree && !grazing))
+  if (!std::isfinite(v.time_err) || (v.time_err > kToiDisagree && !grazing)) {
     v.mark = "disagrees";
-  else if (v.time_err > kToiDeviate && !grazing)
+    if (const double s = separation_at(a, b, dt, answer.fraction); std::isfinite(s))
+      v.separation_m = s;
+  } else if (v.time_err > kToiDeviate && !grazing)
     v.mark = "deviates";
   if (!v.mark.empty())
     v.why = "touches at " + fmt_num(answer.fraction, 9) + " of the interval; exact " +
@@ -200,6 +208,8 @@ Json toi_json(const ToiComparison& c) {
     for (const ToiRow& r : p.rows) {
       Json rj = result_json(r.result);
       if (r.verdict.comparable) rj["time_err"] = r.verdict.time_err;
+      if (r.verdict.comparable && r.verdict.mark == "disagrees")
+        rj["separation_m"] = r.verdict.separation_m;
       if (r.verdict.located) {
         rj["normal_err_deg"] = r.verdict.normal_err_deg;
         rj["point_err_rel"] = r.verdict.point_err_rel;

@@ -37,6 +37,10 @@ struct ToiVerdict {
   bool located = false;
   double normal_err_deg = 0.0;
   double point_err_rel = 0.0;
+  /// Where the time disagrees: how the pair stands at the answer's instant, exactly (m): apart
+  /// by this much (positive: the answer stops short of the touch) or overlapping by minus this
+  /// (negative: it passes the touch). What a reader checks a library's stopping rule against.
+  double separation_m = 0.0;
   std::string mark;  // "" | "deviates" | "disagrees"
   std::string why;   // the mark's reason, one line
 };

@@ -236,7 +236,7 @@ std::string markdown_toi(const Json& j) {
        "Each backend's time-of-impact query, and its variants', is checked against the exact "
        "oracle as `rbx toi` checks it. A disagreement is a status error, a missed touch "
        "(misses), a touch where there is none (false_contact), or a first touch more than 1e-6 "
-       "of the interval from the oracle's (time; docs/time_of_impact.md).\n\n";
+       "of the interval before or after the oracle's (early, late; docs/time_of_impact.md).\n\n";
   o << "## Backends\n\n";
   Table t(
       {"backend", "samples", "disagreements", "rate", "time err p50/p90/p99", "worst time err"});

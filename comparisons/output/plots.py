@@ -1,11 +1,11 @@
 #!/usr/bin/python3
 """Figures of an rbx report: error against run time per family, the contact-law residuals per
-family (law_plots.py), per-scene velocity bars, a 3-D picture of each contact scene with
-every backend's contact point and normal, and each ensemble's final positions
-(ensemble_plots.py).
+family (law_plots.py), the distance and time-of-impact queries' errors (query_plots.py),
+per-scene velocity bars, a 3-D picture of each contact scene with every backend's contact point
+and normal, and each ensemble's final positions (ensemble_plots.py).
 
-Usage: plots.py REPORT_DIR [JOBS]  (reads results.json, sweep.csv and laws.csv, writes
-figures/*.png and *.svg; JOBS processes share the figures, default 1)
+Usage: plots.py REPORT_DIR [JOBS]  (reads results.json, sweep.csv, laws.csv and queries.json,
+writes figures/*.png and *.svg; JOBS processes share the figures, default 1)
 """
 import csv
 import json
@@ -33,6 +33,7 @@ def layer(backend):
     return {"custom": 6, "custom-seed": 5}.get(backend, 3)
 from ensemble_plots import scatter as ensemble_scatter  # noqa: E402
 from law_plots import contact_laws  # noqa: E402
+from query_plots import kinds as query_kinds, query_errors  # noqa: E402
 
 
 # Errors below ROUNDOFF are round-off (a few ulps of double precision on unit-sized numbers) and
@@ -391,6 +392,7 @@ def figures(report, out):
     figures (the longest) first."""
     results = json.load(open(os.path.join(report, "results.json")))
     todo = [(error_vs_runtime, (report, out)), (contact_laws, (report, out))]
+    todo += [(query_errors, (report, out, kind)) for kind in query_kinds(report)]
     for scene in results["scenes"]:
         if "contact" in scene["checks"]:
             todo.append((contact_picture, (scene, out)))

@@ -9,6 +9,7 @@
 #include "comparisons/output/law_report.h"
 #include "comparisons/output/markdown_html.h"
 #include "comparisons/output/predictability_report.h"
+#include "comparisons/output/query_report.h"
 #include "comparisons/output/report_writer.h"
 #include "comparisons/output/scorecard.h"
 #include "comparisons/output/table.h"
@@ -131,10 +132,13 @@ std::string explore_markdown(const std::vector<ExploreCheckMetric>& metrics,
   md << "## Random poses and impacts\n\n"
      << explore_intro(set)
      << "Each cell: the share of the family's samples the backend disagrees on; the median and "
-        "90th percentile of each error are in details.md.\n\n";
+        "90th percentile of each error are in details.md. The separated and the moving pairs "
+        "have sections of their own (below: distance, time of impact).\n\n";
   std::vector<std::string> header = {"backend"}, order;
   std::map<std::string, std::map<std::string, double>> rate;  // backend -> family -> rate
   for (const ExploreFamily& f : explore_families()) {
+    if (f.scene == std::string("explore/distance") || f.scene == std::string("explore/toi"))
+      continue;  // their own sections (query_report.h)
     const auto by = family_metrics(metrics, f.scene);
     if (by.empty()) continue;
     header.push_back(f.title);
@@ -294,6 +298,7 @@ std::string report_summary_markdown(const std::vector<Scene>& scenes,
   md << contact_laws_markdown(scenes, evs, cols, in.report_dir, in.figures_ok);
   md << predictability_summary_markdown(scenes, evs, in.report_dir, in.figures_ok);
   md << explore_markdown(in.explore, in.explore_set);
+  md << query_sections_markdown(in.queries, in.explore_set, in.report_dir, in.figures_ok);
   md << in.tosses;
   md << backends_markdown(cols);
   return md.str();

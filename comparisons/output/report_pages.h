@@ -25,6 +25,8 @@ struct SummaryInputs {
   /// Explore's fixed random samples (explore_check_metrics), empty when not run.
   std::vector<ExploreCheckMetric> explore;
   ExploreCheckSet explore_set;  // the sample set they come from
+  /// Their distance and time-of-impact queries' sections (report.md's own sections).
+  std::vector<QueryFamily> queries;
 };
 
 /// details.md's random poses and impacts: per explore family one table, backends by their
@@ -39,7 +41,8 @@ std::string glance_markdown(const std::vector<ScoreRow>& rows);
 
 /// report.md: at a glance (glance_markdown), the ranked scorecard, the measured causes
 /// of failures (one scene each), error against run time, random poses and impacts (explore's
-/// fixed samples, when run), the real tosses, and links to the full tables.
+/// fixed samples, when run), the distance and time-of-impact queries, the real tosses, and
+/// links to the full tables.
 std::string report_summary_markdown(const std::vector<Scene>& scenes,
                                     const std::vector<SceneEvaluation>& evs,
                                     const SummaryInputs& in);

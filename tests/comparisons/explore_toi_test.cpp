@@ -1,13 +1,14 @@
 // rbx explore --kind toi: its samples ask what their motion class says (head-on ones touch,
 // hair-misses do not), the written scene asks the same question, custom agrees with the oracle on
-// them (the samples it once missed included), and rbx toi's verdict excuses only what is decided
-// at the nanometre.
+// them (the samples it once missed included), rbx toi's verdict excuses only what is decided
+// at the nanometre, and the report's section counts what each row got wrong.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
 
 #include "comparisons/eval/explore.h"
+#include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/toi_query.h"
 #include "comparisons/scene/scene_file.h"
 #include "reference/exact.h"
@@ -70,8 +71,9 @@ TEST(ExploreToi, CustomAgreesWithTheOracleOnRandomSamples) {
 }
 
 // rbx toi's verdict on closed forms: a time 1e-3 of the interval early on a head-on landing
-// disagrees; a touch reported on a pass that ends 1e-12 of the size short of touching is excused
-// (the band), one that ends 1e-3 short is not.
+// disagrees, and says how far apart the pair is then (late: how deep); a touch reported on a pass
+// that ends 1e-12 of the size short of touching is excused (the band), one that ends 1e-3 short is
+// not.
 TEST(ToiVerdict, OnlyWhatIsDecidedAtTheNanometreIsExcused) {
   RigidBody a = test::unit_cube("A", Vec3(0.2, 0.1, 1.3));
   const RigidBody b = test::unit_cube("B", Vec3::Zero());
@@ -81,7 +83,15 @@ TEST(ToiVerdict, OnlyWhatIsDecidedAtTheNanometreIsExcused) {
   ToiResult early = truth;
   early.fraction -= 1e-3;
   early.located = false;
-  EXPECT_EQ(judge_toi(early, truth, a, b, 1.0).mark, "disagrees");
+  const ToiVerdict short_stop = judge_toi(early, truth, a, b, 1.0);
+  EXPECT_EQ(short_stop.mark, "disagrees");
+  // It stopped 1e-3 s of a 0.6 m/s fall short: the faces 6e-4 m apart, exactly (flat faces).
+  EXPECT_NEAR(short_stop.separation_m, 6e-4, 1e-12);
+  ToiResult late = truth;
+  late.fraction += 0.05;
+  late.located = false;
+  // 0.05 s past the touch the faces overlap by 0.03 m.
+  EXPECT_NEAR(judge_toi(late, truth, a, b, 1.0).separation_m, -0.03, 1e-12);
   early.fraction = truth.fraction - 1e-8;
   EXPECT_EQ(judge_toi(early, truth, a, b, 1.0).mark, "deviates");
   // The pass that ends just short: A falls 0.3 m less a hair.
@@ -96,6 +106,65 @@ TEST(ToiVerdict, OnlyWhatIsDecidedAtTheNanometreIsExcused) {
     EXPECT_EQ(judge_toi(claimed, none, short_of, b, 1.0).mark, hair < 1e-9 ? "" : "disagrees")
         << hair;
   }
+}
+
+// The report's section from outcomes made by hand: rows ranked by disagreement rate, then median
+// error; each kind of disagreement counted with its first sample; an early stop's and a late
+// pass's separations as measured.
+TEST(QueryFamily, RanksTheRowsAndCountsEachKindWithItsFirstSample) {
+  auto row = [](const std::string& name, const std::string& error, double time_err,
+                double separation) {
+    BackendOutcome o;
+    o.backend = name;
+    o.error = error;
+    o.measured = error != "misses" && error != "error";
+    o.time_err = time_err;
+    o.separation_m = separation;
+    return o;
+  };
+  std::vector<std::string> encoded;
+  for (uint64_t i = 0; i < 4; ++i) {
+    SampleOutcome s;
+    s.index = 10 + i;
+    s.backends.push_back(row("good", "", 1e-12 * static_cast<double>(i + 1), 0.0));
+    s.backends.push_back(i == 1 ? row("short", "late", 0.2, -2e-4)
+                                : row("short", "early", 0.1, 1e-3 * static_cast<double>(i + 1)));
+    // Sample 13: right, though 5e-3 of the interval off (a grazing touch the verdict excused).
+    s.backends.push_back(i == 0   ? row("lost", "misses", 0.0, 0.0)
+                         : i == 3 ? row("lost", "", 5e-3, 0.0)
+                                  : row("lost", "", 1e-9, 0.0));
+    encoded.push_back(encode(s));
+  }
+  const QueryFamily f = query_family("explore/toi", "time_err", encoded);
+  EXPECT_EQ(f.count, 4);
+  ASSERT_EQ(f.rows.size(), 3u);
+  EXPECT_EQ(f.rows[0].backend, "good");
+  EXPECT_EQ(f.rows[1].backend, "lost");
+  EXPECT_EQ(f.rows[2].backend, "short");
+  EXPECT_EQ(f.rows[0].disagreements, 0);
+  EXPECT_EQ(f.rows[0].measured, 4);
+  EXPECT_DOUBLE_EQ(f.rows[0].quantiles.front(), 1e-12);
+  EXPECT_DOUBLE_EQ(f.rows[0].quantiles.back(), 4e-12);
+  EXPECT_EQ(f.rows[0].quantiles.size(), 21u);
+  const QueryFamilyRow& lost = f.rows[1];
+  EXPECT_EQ(lost.disagreements, 1);
+  EXPECT_EQ(lost.measured, 3);
+  EXPECT_EQ(lost.grazing, 1);
+  EXPECT_EQ(f.rows[0].grazing, 0);
+  ASSERT_EQ(lost.kinds.size(), 1u);
+  EXPECT_EQ(lost.kinds[0].name, "misses");
+  EXPECT_EQ(lost.kinds[0].first, 10u);
+  const QueryFamilyRow& shorter = f.rows[2];
+  EXPECT_EQ(shorter.disagreements, 4);
+  ASSERT_EQ(shorter.kinds.size(), 2u);
+  EXPECT_EQ(shorter.kinds[0].name, "early");  // three, before the one late
+  EXPECT_EQ(shorter.kinds[0].count, 3);
+  EXPECT_EQ(shorter.kinds[0].first, 10u);
+  EXPECT_DOUBLE_EQ(shorter.kinds[0].separation_p50, 3e-3);  // of 1, 3 and 4 mm
+  EXPECT_DOUBLE_EQ(shorter.kinds[0].separation_max, 4e-3);
+  EXPECT_EQ(shorter.kinds[1].name, "late");
+  EXPECT_EQ(shorter.kinds[1].first, 11u);
+  EXPECT_DOUBLE_EQ(shorter.kinds[1].separation_p50, 2e-4);
 }
 
 }  // namespace
