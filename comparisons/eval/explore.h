@@ -156,6 +156,15 @@ struct ShrinkResult {
 ShrinkResult shrink(const ContactSample& s, const std::string& backend, const std::string& sig,
                     int max_evaluations = 400);
 
+/// Whether a candidate of shrink_with still shows the disagreement; its outcome into `out`
+/// (when given) where it does.
+using ShowsDisagreement = std::function<bool(const ContactSample&, SampleOutcome* out)>;
+
+/// shrink's simplifications, each kept while `shows` says the candidate still shows the
+/// disagreement: the distance and toi kinds judge a candidate by their own query.
+ShrinkResult shrink_with(const ContactSample& s, const ShowsDisagreement& shows,
+                         int max_evaluations);
+
 /// True when the harness (evaluate_scene, as `rbx compare` runs it) shows on the scene text
 /// the disagreement of `b`'s kind: status error, a touching mismatch, a normal off by more
 /// than kMarkAngleDeg, a depth off by more than kMarkDepthRel of the smaller body, a point

@@ -94,8 +94,17 @@ std::string expect_block(const std::string& text);
 // ("ok", "text" with the scene and its [expect], "reproduced", the kind's measures).
 std::string shrink_group(const Json& group, const ExploreSettings& set);
 
-// One toi group (explore_toi.cpp): its first sample's scene as drawn, as shrink_group's JSON.
-std::string toi_group(const Json& g, uint64_t seed, long count);
+// The outcome of `backend` on a sample (an empty error when it is not there).
+BackendOutcome outcome_of(const SampleOutcome& o, const std::string& backend);
+// Whether some backend of `o` disagrees with signature `sig` (explore.h); `o` into `out` if so.
+bool shows_signature(const SampleOutcome& o, const std::string& sig, SampleOutcome* out);
+// "from N to M points (K simplifications kept, E tried)".
+std::string points_shrunk(int before, int after, int kept, int tried);
+
+// One toi group (explore_toi.cpp): its first sample's pair shrunk (shrink_with, at most `budget`
+// tries) while the row's own query still shows the group's signature, the motion kept, as
+// shrink_group's JSON.
+std::string toi_group(const Json& g, uint64_t seed, long count, int budget);
 
 // The first of up to `attempts` draws from the sample's own stream that `draw` realizes (draw
 // fills the sample and says whether it is valid); throws when none is.

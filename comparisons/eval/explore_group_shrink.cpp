@@ -160,15 +160,28 @@ std::string describe_outcome(const BackendOutcome& b) {
   return o.str();
 }
 
-namespace {
-
-// The outcome of `backend` on a sample (an empty error when it is not there).
 BackendOutcome outcome_of(const SampleOutcome& o, const std::string& backend) {
   BackendOutcome found;
   for (const BackendOutcome& b : o.backends)
     if (b.backend == backend) found = b;
   return found;
 }
+
+bool shows_signature(const SampleOutcome& o, const std::string& sig, SampleOutcome* out) {
+  for (const BackendOutcome& b : o.backends)
+    if (!b.error.empty() && signature(o, b) == sig) {
+      if (out) *out = o;
+      return true;
+    }
+  return false;
+}
+
+std::string points_shrunk(int before, int after, int kept, int tried) {
+  return "from " + std::to_string(before) + " to " + std::to_string(after) + " points (" +
+         std::to_string(kept) + " simplifications kept, " + std::to_string(tried) + " tried)";
+}
+
+namespace {
 
 // What a group's shrink sends back to rank 0, as JSON text: the scene, whether the harness
 // shows the disagreement on it, and the kind's own `fields`.
@@ -180,12 +193,6 @@ std::string shrunk_json(const std::string& text, const BackendOutcome& found, Js
   fields["harness"] = detail;
   fields["message"] = found.message;
   return fields.dump();
-}
-
-// "from N to M points (K simplifications kept, E tried)".
-std::string points_shrunk(int before, int after, int kept, int tried) {
-  return "from " + std::to_string(before) + " to " + std::to_string(after) + " points (" +
-         std::to_string(kept) + " simplifications kept, " + std::to_string(tried) + " tried)";
 }
 
 // The leading comment of a shrunk closed-form scene (impact, landing kinds): where it was
@@ -312,22 +319,29 @@ std::string shrink_tunnel_group(const Json& g, uint64_t seed, long count, int bu
       });
 }
 
-// One distance group: its first sample's scene as drawn (distance samples are not shrunk yet),
-// reproduced when `rbx distance`'s comparison of the written scene marks the backend.
-std::string distance_group(const Json& g, uint64_t seed, long count) {
+// One distance group: its first sample shrunk (shrink_with) while the backend's own distance
+// query still shows the group's signature, reproduced when `rbx distance`'s comparison of the
+// written scene marks the backend.
+std::string distance_group(const Json& g, uint64_t seed, long count, int budget) {
   const ContactSample start = make_distance_sample(seed, g["first_sample"].get<uint64_t>());
   const std::string backend = g["backend"], sig = g["signature"];
-  const SampleOutcome o = evaluate_distance_sample(start, {backend});
-  const BackendOutcome found = outcome_of(o, backend);
+  const ShrinkResult r = shrink_with(
+      start,
+      [&](const ContactSample& c, SampleOutcome* out) {
+        return shows_signature(evaluate_distance_sample(c, {backend}), sig, out);
+      },
+      budget);
+  const BackendOutcome found = outcome_of(r.outcome, backend);
   if (found.error.empty()) return Json{{"ok", false}}.dump();
   std::ostringstream h;
   h << "# Found by `rbx explore --kind distance --seed " << seed << " --count " << count
     << "`: sample " << start.index << " (" << start.pose_class << " gap), group '" << sig
     << "',\n# " << g["count"].get<long>() << " samples. " << backend
-    << " against the exact oracle: " << describe_outcome(found)
-    << ".\n# Not shrunk: the sample as drawn.\n# Reproduce: rbx distance THIS_FILE --backends "
+    << " against the exact oracle: " << describe_outcome(found) << ".\n# Shrunk "
+    << points_shrunk(r.vertices_before, r.vertices_after, r.steps_accepted, r.evaluations)
+    << ", while the disagreement stayed.\n# Reproduce: rbx distance THIS_FILE --backends "
     << backend << "\n";
-  const std::string text = sample_scene_text(start, h.str());
+  const std::string text = sample_scene_text(r.sample, h.str());
   const DistanceComparison c = compare_distances(parse_scene(text, "explore.toml"), {backend}, 0.0);
   const DistanceRow& row = c.pairs.at(0).rows.at(0);
   Json fields = {{"ok", true},
@@ -336,6 +350,9 @@ std::string distance_group(const Json& g, uint64_t seed, long count) {
                  {"harness", "rbx distance: " + (row.verdict.why.empty() ? std::string("no mark")
                                                                          : row.verdict.why)},
                  {"message", found.message},
+                 {"points_before", r.vertices_before},
+                 {"points_after", r.vertices_after},
+                 {"evaluations", r.evaluations},
                  {"distance_err_rel", found.distance_err_rel},
                  {"witness_err_rel", found.witness_err_rel}};
   return fields.dump();
@@ -353,8 +370,11 @@ std::string shrink_group(const Json& group, const ExploreSettings& set) {
       return shrink_slide_group(group, set.seed, set.count, std::min(set.shrink_budget, 60));
     if (set.kind == "tunnel")
       return shrink_tunnel_group(group, set.seed, set.count, std::min(set.shrink_budget, 60));
-    if (set.kind == "distance") return distance_group(group, set.seed, set.count);
-    if (set.kind == "toi") return toi_group(group, set.seed, set.count);
+    // The oracle's closed form visits every feature pair: fewer tries than the contact kind's.
+    if (set.kind == "distance")
+      return distance_group(group, set.seed, set.count, std::min(set.shrink_budget, 150));
+    if (set.kind == "toi")
+      return toi_group(group, set.seed, set.count, std::min(set.shrink_budget, 100));
     return shrink_contact_group(group, set.seed, set.count, set.shrink_budget);
   } catch (const std::exception& e) {
     return Json{{"ok", false}, {"message", e.what()}}.dump();

@@ -61,22 +61,28 @@ int point_count(const ContactSample& s) {
 
 ShrinkResult shrink(const ContactSample& start, const std::string& backend, const std::string& sig,
                     int max_evaluations) {
+  const std::vector<std::string> names = {backend};
+  // A candidate shows the disagreement when its scene text, through the harness, does.
+  return shrink_with(
+      start,
+      [&](const ContactSample& c, SampleOutcome* out) {
+        return shows_signature(evaluate_scene_text(sample_scene_text(c), names, c.pose_class,
+                                                   c.a.shape_class + "-" + c.b.shape_class),
+                               sig, out);
+      },
+      max_evaluations);
+}
+
+ShrinkResult shrink_with(const ContactSample& start, const ShowsDisagreement& shows,
+                         int max_evaluations) {
   ShrinkResult r;
   r.sample = start;
   r.vertices_before = point_count(start);
-  const std::vector<std::string> names = {backend};
-  // Keeps candidate c when its scene text still shows the same signature.
   auto keeps = [&](const ContactSample& c, SampleOutcome* out = nullptr) {
     if (r.evaluations >= max_evaluations) return false;
     ++r.evaluations;
     try {
-      const SampleOutcome o = evaluate_scene_text(sample_scene_text(c), names, c.pose_class,
-                                                  c.a.shape_class + "-" + c.b.shape_class);
-      for (const BackendOutcome& b : o.backends)
-        if (!b.error.empty() && signature(o, b) == sig) {
-          if (out) *out = o;
-          return true;
-        }
+      return shows(c, out);
     } catch (const std::exception&) {
       // A candidate the loader rejects (a flat hull, say) is simply not simpler.
     }

@@ -149,39 +149,51 @@ SampleOutcome evaluate_toi_sample(const ToiSample& s, const std::vector<std::str
 
 namespace explore_detail {
 
-// One toi group: its first sample's scene as drawn (not shrunk), reproduced when `rbx toi`'s
-// comparison of the written scene marks the row.
-std::string toi_group(const Json& g, uint64_t seed, long count) {
+// One toi group: its first sample's pair shrunk while the row still shows the group's signature
+// over the same motion, reproduced when `rbx toi`'s comparison of the written scene marks the row.
+std::string toi_group(const Json& g, uint64_t seed, long count, int budget) {
   const ToiSample start = make_toi_sample(seed, g["first_sample"].get<uint64_t>());
   const std::string row = g["backend"], sig = g["signature"];
   const std::string backend = row.substr(0, row.find('/'));
-  const SampleOutcome o = evaluate_toi_sample(start, {backend});
-  BackendOutcome found;
-  for (const BackendOutcome& b : o.backends)
-    if (b.backend == row) found = b;
+  ToiSample shrunk = start;
+  const ShrinkResult r = shrink_with(
+      start.pair,
+      [&](const ContactSample& c, SampleOutcome* out) {
+        ToiSample t = start;
+        t.pair = c;
+        return shows_signature(evaluate_toi_sample(t, {backend}), sig, out);
+      },
+      budget);
+  shrunk.pair = r.sample;
+  const BackendOutcome found = outcome_of(r.outcome, row);
   if (found.error.empty()) return Json{{"ok", false}}.dump();
   std::ostringstream h;
   h << "# Found by `rbx explore --kind toi --seed " << seed << " --count " << count << "`: sample "
     << start.pair.index << " (" << start.pair.pose_class << "), group '" << sig << "',\n# "
     << g["count"].get<long>() << " samples. " << row
-    << " against the exact oracle: " << describe_outcome(found)
-    << ".\n# Not shrunk: the sample as drawn.\n# Reproduce: rbx toi THIS_FILE --backends "
+    << " against the exact oracle: " << describe_outcome(found) << ".\n# Shrunk "
+    << points_shrunk(r.vertices_before, r.vertices_after, r.steps_accepted, r.evaluations)
+    << ", the motion as drawn, while the disagreement stayed.\n# Reproduce: rbx toi THIS_FILE "
+       "--backends "
     << backend << "\n";
-  const std::string text = toi_scene_text(start, h.str());
+  const std::string text = toi_scene_text(shrunk, h.str());
   const Scene scene = parse_scene(text, "explore.toml");
   const ToiComparison c = compare_tois(scene, {backend}, scene.sim.dt, 0.0);
   std::string why = "no mark";
   bool reproduced = false;
-  for (const ToiRow& r : c.pairs.at(0).rows)
-    if (r.backend == row) {
-      reproduced = r.verdict.mark == "disagrees";
-      if (!r.verdict.why.empty()) why = r.verdict.why;
+  for (const ToiRow& x : c.pairs.at(0).rows)
+    if (x.backend == row) {
+      reproduced = x.verdict.mark == "disagrees";
+      if (!x.verdict.why.empty()) why = x.verdict.why;
     }
   return Json{{"ok", true},
               {"text", text},
               {"reproduced", reproduced},
               {"harness", "rbx toi: " + why},
               {"message", found.message},
+              {"points_before", r.vertices_before},
+              {"points_after", r.vertices_after},
+              {"evaluations", r.evaluations},
               {"time_err", found.time_err}}
       .dump();
 }

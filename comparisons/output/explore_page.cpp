@@ -219,9 +219,9 @@ std::string markdown_distance(const Json& j) {
   }
   o << t.markdown();
   o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B, the exact "
-       "closest features (of A, then of B), the kind of error. Each group's first sample is "
-       "written as drawn (distance samples are not shrunk); `reproduced` says whether "
-       "`rbx distance` marks it on the scene.\n\n";
+       "closest features (of A, then of B), the kind of error. Each group's first sample was "
+       "shrunk while the backend's distance query still showed the signature; `reproduced` "
+       "says whether `rbx distance` marks it on the scene.\n\n";
   o << groups_table(j);
   return o.str();
 }
@@ -248,9 +248,9 @@ std::string markdown_toi(const Json& j) {
   }
   o << t.markdown();
   o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B, whether the "
-       "oracle has a touch (touch, no_touch), the kind of error. Each group's first sample is "
-       "written as drawn (toi samples are not shrunk); `reproduced` says whether `rbx toi` marks "
-       "it on the scene.\n\n";
+       "oracle has a touch (touch, no_touch), the kind of error. Each group's first pair was "
+       "shrunk, the motion as drawn, while the row still showed the signature; `reproduced` "
+       "says whether `rbx toi` marks it on the scene.\n\n";
   o << groups_table(j);
   return o.str();
 }

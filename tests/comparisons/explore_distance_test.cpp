@@ -1,6 +1,7 @@
 // rbx explore --kind distance: its samples are apart by the gap drawn (to round-off), custom's
 // distance query agrees with the oracle on them, the samples custom once missed included, and a
-// backend's wrong answer is classified as rbx distance marks it.
+// backend's wrong answer is classified as rbx distance marks it, and a group is shrunk to a scene
+// that reproduces it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,6 +9,8 @@
 
 #include "comparisons/eval/distance_query.h"
 #include "comparisons/eval/explore.h"
+#include "comparisons/eval/explore_campaign.h"
+#include "comparisons/eval/explore_detail.h"
 #include "comparisons/scene/scene_file.h"
 #include "reference/exact.h"
 
@@ -101,6 +104,34 @@ TEST(ExploreDistance, ABackendsAnswerIsClassifiedAsRbxDistanceMarksIt) {
   EXPECT_NEAR(o.backends[1].distance_err_rel, 0.01, 1e-9);
   EXPECT_EQ(o.backends[2].error, "");
   EXPECT_LT(o.backends[2].distance_err_rel, 1e-15);
+}
+
+// A group's first sample is shrunk while the backend's own distance query still shows the
+// group's signature, and the written scene reproduces it through `rbx distance`. Bullet's box
+// margin (docs/distance.md) on the first box-box sample it gets wrong: the pair moved so that A
+// sits at the origin keeps the error.
+TEST(ExploreDistance, AGroupIsShrunkAndItsSceneReproducesIt) {
+  uint64_t index = 0;
+  std::string sig;
+  for (; index < 200 && sig.empty(); ++index) {
+    const ContactSample s = make_distance_sample(1, index);
+    if (s.a.shape_class != "box" || s.b.shape_class != "box") continue;
+    const SampleOutcome o = evaluate_distance_sample(s, {"bullet"});
+    if (!o.backends.empty() && !o.backends[0].error.empty()) sig = signature(o, o.backends[0]);
+  }
+  ASSERT_FALSE(sig.empty()) << "no box-box sample that bullet gets wrong";
+  ExploreSettings set;
+  set.kind = "distance";
+  set.count = 200;
+  const Json g = {
+      {"backend", "bullet"}, {"signature", sig}, {"first_sample", index - 1}, {"count", 1}};
+  const Json r = Json::parse(explore_detail::shrink_group(g, set));
+  ASSERT_TRUE(r["ok"].get<bool>()) << r.dump();
+  EXPECT_TRUE(r["reproduced"].get<bool>()) << r["harness"];
+  EXPECT_GT(r["evaluations"].get<int>(), 1);
+  const std::string text = r["text"];
+  EXPECT_NE(text.find("# Shrunk from 16 to 16 points"), std::string::npos) << text;
+  EXPECT_EQ(text.find("(0 simplifications kept"), std::string::npos) << text;
 }
 
 }  // namespace

@@ -8,7 +8,9 @@
 #include <map>
 
 #include "comparisons/eval/explore.h"
+#include "comparisons/eval/explore_campaign.h"
 #include "comparisons/eval/explore_check.h"
+#include "comparisons/eval/explore_detail.h"
 #include "comparisons/eval/toi_query.h"
 #include "comparisons/scene/scene_file.h"
 #include "reference/exact.h"
@@ -165,6 +167,35 @@ TEST(QueryFamily, RanksTheRowsAndCountsEachKindWithItsFirstSample) {
   EXPECT_EQ(shorter.kinds[1].name, "late");
   EXPECT_EQ(shorter.kinds[1].first, 11u);
   EXPECT_DOUBLE_EQ(shorter.kinds[1].separation_p50, 2e-4);
+}
+
+// A toi group's pair is shrunk over the same motion while the row still shows the group's
+// signature, and the written scene reproduces it through `rbx toi`: `bullet-hull`'s cast stops
+// within its 1 mm, early, on the first head-on sample it answers so.
+TEST(ExploreToi, AGroupIsShrunkAndItsSceneReproducesIt) {
+  uint64_t index = 0;
+  std::string sig;
+  for (; index < 100 && sig.empty(); ++index) {
+    const ToiSample s = make_toi_sample(1, index);
+    if (s.pair.pose_class != "head-on") continue;
+    const SampleOutcome o = evaluate_toi_sample(s, {"bullet-hull"});
+    for (const BackendOutcome& b : o.backends)
+      if (b.backend == "bullet-hull" && b.error == "early") sig = signature(o, b);
+  }
+  ASSERT_FALSE(sig.empty()) << "no head-on sample bullet-hull stops early on";
+  ExploreSettings set;
+  set.kind = "toi";
+  set.count = 100;
+  const Json g = {
+      {"backend", "bullet-hull"}, {"signature", sig}, {"first_sample", index - 1}, {"count", 1}};
+  const Json r = Json::parse(explore_detail::shrink_group(g, set));
+  ASSERT_TRUE(r["ok"].get<bool>()) << r.dump();
+  EXPECT_TRUE(r["reproduced"].get<bool>()) << r["harness"];
+  EXPECT_LE(r["points_after"].get<int>(), r["points_before"].get<int>());
+  EXPECT_GT(r["evaluations"].get<int>(), 1);
+  const std::string text = r["text"];
+  EXPECT_NE(text.find("the motion as drawn"), std::string::npos) << text;
+  EXPECT_EQ(text.find("(0 simplifications kept"), std::string::npos) << text;
 }
 
 }  // namespace
