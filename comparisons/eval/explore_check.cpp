@@ -5,10 +5,12 @@
 #include <map>
 #include <optional>
 
+#include "comparisons/eval/distance_query.h"
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/explore_campaign.h"
 #include "comparisons/eval/parallel.h"
 #include "comparisons/eval/toi_query.h"
+#include "comparisons/scene/scene_file.h"
 
 namespace rbx {
 
@@ -51,6 +53,41 @@ void tally(const std::string& scene, const std::vector<std::string>& encoded,
           {scene,
            {"explore", backend, "", name + "_p90", nearest_rank_percentile(v, 90), against}});
     }
+  }
+}
+
+// Each row of `f` timed on the family's first kQueryTimedSamples samples as `rbx distance` and
+// `rbx toi` time theirs (every row interleaved on one sample, then the next), on this thread
+// alone: the others have finished their samples.
+void time_query_family(QueryFamily& f, const ExploreCheckSet& set,
+                       const std::vector<std::string>& backends) {
+  std::map<std::string, std::vector<double>> times;
+  const int n = std::min<int>(kQueryTimedSamples, static_cast<int>(f.count));
+  constexpr double kBudgetS = 0.002;  // per row and sample: 40 samples of 11 rows in a second
+  for (int i = 0; i < n; ++i) {
+    const uint64_t k = static_cast<uint64_t>(i);
+    if (f.error == "time_err") {
+      const ToiSample s = make_toi_sample(set.seed, k);
+      const Scene scene = parse_scene(toi_scene_text(s), "explore.toml");
+      const ToiComparison c = compare_tois(scene, backends, s.interval, kBudgetS);
+      for (const ToiRow& r : c.pairs.at(0).rows)
+        if (r.timing.rounds > 0) times[r.backend].push_back(r.timing.median_s);
+    } else {
+      const Scene scene =
+          parse_scene(sample_scene_text(make_distance_sample(set.seed, k)), "explore.toml");
+      const DistanceComparison c = compare_distances(scene, backends, kBudgetS);
+      for (const DistanceRow& r : c.pairs.at(0).rows)
+        if (r.timing.rounds > 0) times[r.backend].push_back(r.timing.median_s);
+    }
+  }
+  for (QueryFamilyRow& r : f.rows) {
+    std::vector<double>& t = times[r.backend];
+    if (t.empty()) continue;
+    std::sort(t.begin(), t.end());
+    r.timed = static_cast<int>(t.size());
+    r.time_s = nearest_rank_percentile(t, 50);
+    r.time_q25_s = nearest_rank_percentile(t, 25);
+    r.time_q75_s = nearest_rank_percentile(t, 75);
   }
 }
 
@@ -147,8 +184,10 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
                                                  distance_backends, table));
         });
     tally("explore/distance", encoded, {"distance_err_rel", "witness_err_rel"}, "exact", out);
-    if (queries && run.root())
+    if (queries && run.root()) {
       queries->push_back(query_family("explore/distance", "distance_err_rel", encoded));
+      time_query_family(queries->back(), set, distance_backends);
+    }
   }
   // The toi kind's subjects: the contact backends that have a time-of-impact query (their
   // variants' rows come with them).
@@ -161,7 +200,10 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
       return encode(evaluate_toi_sample(make_toi_sample(set.seed, i), toi_backends));
     });
     tally("explore/toi", encoded, {"time_err"}, "exact", out);
-    if (queries && run.root()) queries->push_back(query_family("explore/toi", "time_err", encoded));
+    if (queries && run.root()) {
+      queries->push_back(query_family("explore/toi", "time_err", encoded));
+      time_query_family(queries->back(), set, toi_backends);
+    }
   }
   if (!impact_backends.empty() && set.impact > 0)
     tally("explore/impact",

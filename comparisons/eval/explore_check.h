@@ -56,7 +56,15 @@ struct QueryFamilyRow {
   std::vector<double> quantiles;  // the main error at 0, 5, ..., 100 % of the measured samples
   double p50 = 0.0, p90 = 0.0, p99 = 0.0;       // the main error
   double witness_p50 = 0.0, witness_p90 = 0.0;  // distance kind: witness_err_rel
+  /// Run time per query (s) on the family's first kQueryTimedSamples samples, each the median
+  /// over interleaved rounds (timing.h): the median over those samples and its 25-75 % range,
+  /// which spans their sizes (4 to 2,000 points), not noise. timed = 0: not timed.
+  double time_s = 0.0, time_q25_s = 0.0, time_q75_s = 0.0;
+  int timed = 0;
 };
+
+/// How many of a query family's samples its rows are timed on (QueryFamilyRow::time_s).
+constexpr int kQueryTimedSamples = 40;
 
 /// A query's section: its backends ranked by disagreement rate, then median error, then name.
 struct QueryFamily {

@@ -53,7 +53,7 @@ std::string ranked_table(const QueryFamily& f) {
       {"rank", "backend", "disagrees", "measured",
        toi ? "time err p50 / p90 / p99 (of the interval)" : "distance err p50 / p90 / p99 (rel)",
        toi ? "right, yet over 1e-6 off (grazing)" : "witness err p50 / p90 (rel)",
-       "what it got wrong: samples (the first; at its time)"});
+       "time per query (µs)", "what it got wrong: samples (the first; at its time)"});
   int rank = 0;
   for (const QueryFamilyRow& r : f.rows) {
     const auto spread = [&](std::initializer_list<double> v) {
@@ -66,6 +66,9 @@ std::string ranked_table(const QueryFamily& f) {
            percent(r.disagreements, r.samples) + " of " + std::to_string(r.samples),
            std::to_string(r.measured), spread({r.p50, r.p90, r.p99}),
            toi ? std::to_string(r.grazing) : spread({r.witness_p50, r.witness_p90}),
+           r.timed ? fmt_num(r.time_s * 1e6, 3) + " (" + fmt_num(r.time_q25_s * 1e6, 2) + "-" +
+                         fmt_num(r.time_q75_s * 1e6, 2) + ")"
+                   : "-",
            kinds_cell(r)});
   }
   return t.markdown() + "\n";
@@ -102,7 +105,10 @@ std::string section(const QueryFamily& f, const ExploreCheckSet& set, const std:
           "`error`. Errors relative to the true distance, over the samples both answer apart "
           "(`measured`).";
   }
-  md << " Ranked by disagreement rate, then median error. The command writes each group's first "
+  md << " Time per query: on the first " << kQueryTimedSamples
+     << " samples, each the median over interleaved rounds (docs/bench.md); the median over the "
+        "samples and, in brackets, their 25-75 % range, which spans their sizes, not noise."
+     << " Ranked by disagreement rate, then median error. The command writes each group's first "
         "sample as a scene (`rbx "
      << kind_of(f)
      << " SCENE` shows every row on it); what each query costs against the number of vertices: "
@@ -131,7 +137,11 @@ Json query_families_json(const std::vector<QueryFamily>& families, const Explore
                                {"samples", r.samples},
                                {"disagreements", r.disagreements},
                                {"measured", r.measured},
-                               {"quantiles_every_5", r.quantiles}});
+                               {"quantiles_every_5", r.quantiles},
+                               {"timed", r.timed},
+                               {"time_s", r.time_s},
+                               {"time_q25_s", r.time_q25_s},
+                               {"time_q75_s", r.time_q75_s}});
     j["queries"].push_back(q);
   }
   return j;

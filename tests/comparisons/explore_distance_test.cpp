@@ -10,6 +10,7 @@
 #include "comparisons/eval/distance_query.h"
 #include "comparisons/eval/explore.h"
 #include "comparisons/eval/explore_campaign.h"
+#include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/explore_detail.h"
 #include "comparisons/scene/scene_file.h"
 #include "reference/exact.h"
@@ -132,6 +133,47 @@ TEST(ExploreDistance, AGroupIsShrunkAndItsSceneReproducesIt) {
   const std::string text = r["text"];
   EXPECT_NE(text.find("# Shrunk from 16 to 16 points"), std::string::npos) << text;
   EXPECT_EQ(text.find("(0 simplifications kept"), std::string::npos) << text;
+}
+
+// The report's sections (explore_check_metrics with `queries`): one per query, every row of
+// the backends asked for (the toi kind's variants with theirs), each counted over every sample
+// and timed on the first samples, with a positive run time.
+TEST(ExploreDistance, TheReportsQuerySectionsRankEveryRowAndTimeIt) {
+  ExploreCheckSet set;
+  set.contact = set.impact = set.landing = set.slide = set.tunnel = 0;
+  set.distance = 6;
+  set.toi = 6;
+  std::vector<QueryFamily> queries;
+  explore_check_metrics({"custom", "fcl", "bullet-hull"}, {}, set, nullptr, nullptr, nullptr,
+                        &queries);
+  ASSERT_EQ(queries.size(), 2u);
+  EXPECT_EQ(queries[0].scene, "explore/distance");
+  EXPECT_EQ(queries[1].scene, "explore/toi");
+  for (const QueryFamily& f : queries) {
+    std::vector<std::string> rows;
+    for (const QueryFamilyRow& r : f.rows) {
+      rows.push_back(r.backend);
+      // A cast answers only the pairs that do not turn; every other row, every sample.
+      if (r.backend.find('/') != std::string::npos) {
+        EXPECT_GT(r.samples, 0) << r.backend;
+        EXPECT_LE(r.samples, 6) << r.backend;
+      } else {
+        EXPECT_EQ(r.samples, 6) << f.scene << " " << r.backend;
+      }
+      EXPECT_GT(r.timed, 0) << f.scene << " " << r.backend;
+      EXPECT_GT(r.time_s, 0.0) << f.scene << " " << r.backend;
+      EXPECT_LE(r.time_q25_s, r.time_s);
+      EXPECT_LE(r.time_s, r.time_q75_s);
+      EXPECT_EQ(r.quantiles.size(), 21u);
+    }
+    std::sort(rows.begin(), rows.end());
+    const std::vector<std::string> want =
+        f.scene == "explore/toi"
+            ? std::vector<std::string>{"bullet-hull", "bullet-hull/gjk-cast",
+                                       "bullet-hull/subsimplex-cast", "custom", "fcl"}
+            : std::vector<std::string>{"bullet-hull", "custom", "fcl"};
+    EXPECT_EQ(rows, want) << f.scene;
+  }
 }
 
 }  // namespace

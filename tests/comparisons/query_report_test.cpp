@@ -21,6 +21,10 @@ QueryFamily toi_family() {
   good.samples = 300;
   good.measured = 131;
   good.p50 = 3e-10;
+  good.timed = 40;
+  good.time_s = 9e-6;
+  good.time_q25_s = 1.3e-6;
+  good.time_q75_s = 1.6e-5;
   QueryFamilyRow odd;
   odd.backend = "lib|odd*name";
   odd.samples = 300;
@@ -49,7 +53,9 @@ TEST(QueryReport, RendersTheRankedRowsAndWhatEachGotWrong) {
   EXPECT_NE(md.find("| early 25 (#8, apart by 9.6e-08 m, at most 0.00039 m); misses 5 (#10) |"),
             std::string::npos)
       << md;
-  EXPECT_NE(md.find("| 131 | 3e-10 / 0 / 0 | 0 | - |"), std::string::npos) << md;
+  // Timed: the median and its range in µs; the other row untimed.
+  EXPECT_NE(md.find("| 131 | 3e-10 / 0 / 0 | 0 | 9 (1.3-16) | - |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 120 | 0 / 0 / 0 | 0 | - | early 25"), std::string::npos) << md;
   // No figure was drawn in that folder: none is linked.
   EXPECT_EQ(md.find("!["), std::string::npos);
 }
@@ -64,6 +70,8 @@ TEST(QueryReport, NothingWhenNoQueryRan) {
   EXPECT_EQ(j["queries"][0]["kind"], "toi");
   EXPECT_EQ(j["queries"][0]["backends"][0]["name"], "custom");
   EXPECT_EQ(j["queries"][0]["backends"][0]["quantiles_every_5"][1], 1.0);
+  EXPECT_EQ(j["queries"][0]["backends"][0]["timed"], 40);
+  EXPECT_EQ(j["queries"][0]["backends"][0]["time_s"], 9e-6);
 }
 
 }  // namespace
