@@ -344,17 +344,22 @@ std::string distance_group(const Json& g, uint64_t seed, long count, int budget)
   const std::string text = sample_scene_text(r.sample, h.str());
   const DistanceComparison c = compare_distances(parse_scene(text, "explore.toml"), {backend}, 0.0);
   const DistanceRow& row = c.pairs.at(0).rows.at(0);
-  Json fields = {{"ok", true},
-                 {"text", text},
-                 {"reproduced", row.verdict.mark == "disagrees"},
-                 {"harness", "rbx distance: " + (row.verdict.why.empty() ? std::string("no mark")
-                                                                         : row.verdict.why)},
-                 {"message", found.message},
-                 {"points_before", r.vertices_before},
-                 {"points_after", r.vertices_after},
-                 {"evaluations", r.evaluations},
-                 {"distance_err_rel", found.distance_err_rel},
-                 {"witness_err_rel", found.witness_err_rel}};
+  // A status error is the row's answer, not a mark: reproduced when the written scene's is one.
+  const bool failed = row.result.status != Status::Ok;
+  Json fields = {
+      {"ok", true},
+      {"text", text},
+      {"reproduced", row.verdict.mark == "disagrees" ||
+                         (failed && (found.error == "error" || found.error == "timeout"))},
+      {"harness", "rbx distance: " + (failed ? std::string("status ") + to_string(row.result.status)
+                                      : row.verdict.why.empty() ? std::string("no mark")
+                                                                : row.verdict.why)},
+      {"message", found.message},
+      {"points_before", r.vertices_before},
+      {"points_after", r.vertices_after},
+      {"evaluations", r.evaluations},
+      {"distance_err_rel", found.distance_err_rel},
+      {"witness_err_rel", found.witness_err_rel}};
   return fields.dump();
 }
 

@@ -183,8 +183,12 @@ std::string toi_group(const Json& g, uint64_t seed, long count, int budget) {
   bool reproduced = false;
   for (const ToiRow& x : c.pairs.at(0).rows)
     if (x.backend == row) {
-      reproduced = x.verdict.mark == "disagrees";
-      if (!x.verdict.why.empty()) why = x.verdict.why;
+      // A status error is the row's answer, not a mark: reproduced when the scene's is one.
+      const bool failed = x.result.status != Status::Ok;
+      reproduced = x.verdict.mark == "disagrees" ||
+                   (failed && (found.error == "error" || found.error == "timeout"));
+      if (failed) why = std::string("status ") + to_string(x.result.status);
+      if (!failed && !x.verdict.why.empty()) why = x.verdict.why;
     }
   return Json{{"ok", true},
               {"text", text},
