@@ -275,7 +275,8 @@ DistanceResult pair_distance(const RigidBody& a, const RigidBody& b,
 enum class BulletCast { Continuous, Gjk, Subsimplex };
 
 ToiResult pair_toi(const RigidBody& a, const RigidBody& b, double dt,
-                   const BulletSettings& settings, BulletCast cast) {
+                   const BulletSettings& settings, BulletCast cast,
+                   ShapeCache* prebuilt = nullptr) {
   ToiResult r;
   try {
     const std::optional<RigidBody> end_a = body_at_end(a, dt), end_b = body_at_end(b, dt);
@@ -287,8 +288,17 @@ ToiResult pair_toi(const RigidBody& a, const RigidBody& b, double dt,
       return r;
     }
     const Mat3 identity = Mat3::Identity();
-    const std::unique_ptr<btConvexShape> shape_a = make_shape(a, identity, settings);
-    const std::unique_ptr<btConvexShape> shape_b = make_shape(b, identity, settings);
+    std::unique_ptr<btConvexShape> own_a, own_b;
+    auto shape = [&](const RigidBody& body, std::unique_ptr<btConvexShape>& own) {
+      if (prebuilt)
+        return prebuilt
+            ->get(body.shape, nullptr, [&] { return make_shape(body, identity, settings); })
+            .get();
+      own = make_shape(body, identity, settings);
+      return own.get();
+    };
+    btConvexShape* const shape_a = shape(a, own_a);
+    btConvexShape* const shape_b = shape(b, own_b);
     btVoronoiSimplexSolver simplex;
     btGjkEpaPenetrationDepthSolver epa;
     btConvexCast::CastResult result;
@@ -296,13 +306,13 @@ ToiResult pair_toi(const RigidBody& a, const RigidBody& b, double dt,
     const btTransform from_b = body_transform(b, identity), to_b = body_transform(*end_b, identity);
     bool hit = false;
     if (cast == BulletCast::Continuous) {
-      btContinuousConvexCollision caster(shape_a.get(), shape_b.get(), &simplex, &epa);
+      btContinuousConvexCollision caster(shape_a, shape_b, &simplex, &epa);
       hit = caster.calcTimeOfImpact(from_a, to_a, from_b, to_b, result);
     } else if (cast == BulletCast::Gjk) {
-      btGjkConvexCast caster(shape_a.get(), shape_b.get(), &simplex);
+      btGjkConvexCast caster(shape_a, shape_b, &simplex);
       hit = caster.calcTimeOfImpact(from_a, to_a, from_b, to_b, result);
     } else {
-      btSubsimplexConvexCast caster(shape_a.get(), shape_b.get(), &simplex);
+      btSubsimplexConvexCast caster(shape_a, shape_b, &simplex);
       hit = caster.calcTimeOfImpact(from_a, to_a, from_b, to_b, result);
     }
     if (!hit) return r;
@@ -661,6 +671,11 @@ ContactResult prebuilt_query(const RigidBody& a, const RigidBody& b) {
   return pair_query(a, b, Settings(), &cache);
 }
 template <BulletSettings (*Settings)()>
+ToiResult prebuilt_toi(const RigidBody& a, const RigidBody& b, double dt) {
+  thread_local ShapeCache cache;
+  return pair_toi(a, b, dt, Settings(), BulletCast::Continuous, &cache);
+}
+template <BulletSettings (*Settings)()>
 DynamicsResult dynamics_run(const WorldDefinition& scene, const DynamicsOptions& opt) {
   return run_bullet_world(scene, opt, Settings());
 }
@@ -738,10 +753,22 @@ const Adapter& bullet_adapter() {
               .timed(512, 128),
       },
       {
-          {"bullet", "prebuilt", "each btBoxShape or polyhedral hull built once and kept",
-           prebuilt_query<bullet_native_settings>},
-          {"bullet-hull", "prebuilt", "each btConvexHullShape built once and kept",
-           prebuilt_query<bullet_hull_settings>},
+          {"bullet",
+           "prebuilt",
+           "each btBoxShape or polyhedral hull built once and kept",
+           prebuilt_query<bullet_native_settings>,
+           {},
+           false,
+           nullptr,
+           prebuilt_toi<bullet_native_settings>},
+          {"bullet-hull",
+           "prebuilt",
+           "each btConvexHullShape built once and kept",
+           prebuilt_query<bullet_hull_settings>,
+           {},
+           false,
+           nullptr,
+           prebuilt_toi<bullet_hull_settings>},
           {"bullet-hull",
            "gjk-cast",
            "btGjkConvexCast on the zero-margin hulls: translation only",

@@ -437,6 +437,30 @@ ToiResult fcl_toi_native(const RigidBody& a, const RigidBody& b, double dt) {
                  true, "fcl::continuousCollide (GST_LIBCCD)");
 }
 
+// `fcl`'s time of impact with each shape's geometry built once per thread (the "prebuilt"
+// variant: the same answers, timed as a user holding FCL objects calls it).
+ToiResult fcl_toi_prebuilt(const RigidBody& a, const RigidBody& b, double dt) {
+  thread_local PrebuiltCache<std::shared_ptr<fcl::CollisionGeometryd>> box_cache, convex_cache;
+  auto geometry = [&](const RigidBody& body) {
+    fcl::Transform3d unused;
+    return (is_native_box(body) ? box_cache : convex_cache).get(body.shape, nullptr, [&] {
+      return native_geometry(body, unused);
+    });
+  };
+  return fcl_toi(geometry(a), a, geometry(b), b, dt, fcl::GST_LIBCCD, true,
+                 "fcl::continuousCollide (GST_LIBCCD)");
+}
+
+// `fcl-hull`'s, each fcl::Convex built once per thread.
+ToiResult fcl_hull_toi_prebuilt(const RigidBody& a, const RigidBody& b, double dt) {
+  thread_local PrebuiltCache<std::shared_ptr<fcl::CollisionGeometryd>> cache;
+  auto geometry = [&](const RigidBody& body) {
+    return cache.get(body.shape, nullptr, [&] { return convex_geometry(body); });
+  };
+  return fcl_toi(geometry(a), a, geometry(b), b, dt, fcl::GST_LIBCCD, false,
+                 "fcl::continuousCollide (GST_LIBCCD)");
+}
+
 // `fcl-hull`: every body a Convex; GST_LIBCCD.
 ToiResult fcl_toi_hull(const RigidBody& a, const RigidBody& b, double dt) {
   return fcl_toi(convex_geometry(a), a, convex_geometry(b), b, dt, fcl::GST_LIBCCD, false,
@@ -523,7 +547,8 @@ const Adapter& fcl_adapter() {
            fcl_contact_prebuilt,
            {8192, 2048},
            false,
-           fcl_distance_prebuilt},
+           fcl_distance_prebuilt,
+           fcl_toi_prebuilt},
           // `fcl` on two box bodies runs fcl::Box (boxBoxIntersect): timed apart on the boxes.
           {"fcl",
            "boxes",
@@ -531,8 +556,14 @@ const Adapter& fcl_adapter() {
            fcl_contact,
            {8, 8},
            true},
-          {"fcl-hull", "prebuilt", "each fcl::Convex built once and kept",
-           fcl_hull_contact_prebuilt},
+          {"fcl-hull",
+           "prebuilt",
+           "each fcl::Convex built once and kept",
+           fcl_hull_contact_prebuilt,
+           {},
+           false,
+           nullptr,
+           fcl_hull_toi_prebuilt},
       }};
   return adapter;
 }

@@ -53,8 +53,9 @@ struct ToiSubject {
   bool library = true;
 };
 
-/// The rows `names` (registry backends) give: each backend's own query, then its variants'.
-/// A backend without one is a row that answers `unsupported`.
+/// The rows `names` (registry backends) give: each backend's own query, then its variants'
+/// (the other queries, as Bullet's casts; not a set-up variant such as "prebuilt", whose answers
+/// are the backend's). A backend without one is a row that answers `unsupported`.
 std::vector<ToiSubject> toi_subjects(const std::vector<std::string>& names);
 
 /// `s`'s query on (a, b) over `dt`; a library's call runs isolated under its deadline.

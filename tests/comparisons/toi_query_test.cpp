@@ -154,6 +154,35 @@ TEST(ToiRotating, EveryRowThatTurnsTheBodiesStopsNoLaterThanTheOracle) {
   }
 }
 
+// A set-up variant (shapes built once and kept: "prebuilt") times its backend's own query, so it
+// must answer as the backend does, bit for bit, the second call (from its kept shapes) as the
+// first: on a falling cube and on a spinning one. It is not a row of rbx toi.
+TEST(ToiPrebuilt, APrebuiltVariantAnswersAsItsBackendDoes) {
+  RigidBody spun = test::unit_cube("A", Vec3(0.1, 0.05, 1.6),
+                                   Quat(Eigen::AngleAxisd(0.4, Vec3(1, 2, 3).normalized())));
+  spun.velocity = Vec3(0.2, 0, -3);
+  spun.angular_velocity = Vec3(2, -3, 1);
+  const RigidBody slab = test::unit_cube("B", Vec3::Zero());
+  const auto [fall_a, fall_b] = falling(0.3, 2.0);
+  int variants = 0;
+  for (const QueryVariant& v : query_variants()) {
+    if (!v.toi || !v.contact) continue;
+    ++variants;
+    for (const ToiSubject& s : toi_subjects({v.backend}))
+      EXPECT_NE(s.name, v.backend + "/" + v.variant) << "a set-up variant is not a row";
+    const Backend* backend = find_backend(v.backend);
+    ASSERT_TRUE(backend && backend->toi) << v.backend;
+    for (const auto& [a, b] : {std::pair{fall_a, fall_b}, std::pair{spun, slab}})
+      for (int call = 0; call < 2; ++call) {
+        const ToiResult own = backend->toi(a, b, 0.5), kept = v.toi(a, b, 0.5);
+        ASSERT_EQ(kept.status, own.status) << v.backend << "/" << v.variant << ": " << kept.message;
+        EXPECT_EQ(kept.hit, own.hit) << v.backend << "/" << v.variant;
+        EXPECT_EQ(kept.fraction, own.fraction) << v.backend << "/" << v.variant;
+      }
+  }
+  EXPECT_GE(variants, 3);  // fcl, fcl-hull, bullet, bullet-hull
+}
+
 // Bullet's btGjkConvexCast steps by the distance over the approach speed along GJK's normal; in
 // pure translation onto a face that step lands exactly on the touch, where GJK (run without a
 // penetration solver and, on zero-margin hulls, without margins) gives no usable normal, and the
