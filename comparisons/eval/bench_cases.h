@@ -24,7 +24,8 @@ namespace rbx {
 /// deep, separated = a 5% gap.
 struct PoseKind {
   const char* name;
-  double offset;  // fraction of the size; negative: penetrating
+  double offset;      // fraction of the size; negative: penetrating
+  double turn = 0.0;  // time of impact: B's turn over the interval (rad), about a fixed axis
 };
 inline constexpr PoseKind kPoseKinds[] = {
     {"touching", -0.005}, {"deep", -0.2}, {"separated", 0.05}};
@@ -76,6 +77,10 @@ std::vector<NarrowBackend> narrow_backends();
 /// The gaps the distance queries are timed at, as fractions of the shape size (the pose kinds'
 /// convention: B placed that far beyond touching along the placement direction).
 inline constexpr PoseKind kGapKinds[] = {{"gap 1%", 0.01}, {"gap 20%", 0.2}};
+/// The time-of-impact family's: the gaps in translation, and the wider one with B turning by a
+/// radian on its way (where the translation-only casts answer `unsupported`).
+inline constexpr PoseKind kToiKinds[] = {
+    {"gap 1%", 0.01}, {"gap 20%", 0.2}, {"gap 20%, turning", 0.2, 1.0}};
 
 /// One distance query as benchmarked: a row of the distance table.
 struct DistanceBackend {

@@ -108,6 +108,9 @@ CaseSet query_cases(const BenchPlan& plan, const std::string& family,
                                static_cast<unsigned>(&kind - kinds.data()) + 1 +
                                (family == "narrowphase" ? 0u : 100u));
       auto pair = std::make_shared<PosedPair>(make_poses(shape, box, kind, plan.poses, pose_rng));
+      // A time-of-impact kind's turn: B's angular velocity, about an axis no face is square to
+      // (the queries set the poses only, so it stays).
+      pair->b.angular_velocity = kind.turn * Vec3(1, 2, 3).normalized();
       BenchGroup group;
       group.name = family + "/" + std::to_string(n) + "/" + kind.name;
       group.plan.min_time_s = plan.min_time;
@@ -211,9 +214,9 @@ CaseSet distance_cases(const BenchPlan& plan, std::mt19937_64&) {
 }
 
 // Time of impact: every query of toi_backends() on the distance poses, B moving onto A at the
-// centres' offset per second over 1 s (pure translation, so every row, the translation-only
-// casts too, answers the same question); the moving copy of B is made on every call, by every
-// row alike.
+// centres' offset per second over 1 s, in pure translation on the gaps of kGapKinds (so every
+// row, the translation-only casts too, answers the same question) and turning on the last kind
+// of kToiKinds; the moving copy of B is made on every call, by every row alike.
 CaseSet toi_cases(const BenchPlan& plan, std::mt19937_64&) {
   std::vector<QueryRow> rows;
   for (const ToiBackend& b : toi_backends()) {
@@ -230,7 +233,7 @@ CaseSet toi_cases(const BenchPlan& plan, std::mt19937_64&) {
                     b.max_vertices_full, b.max_vertices_quick});
   }
   return query_cases(plan, "toi", rows,
-                     std::vector<PoseKind>(std::begin(kGapKinds), std::end(kGapKinds)),
+                     std::vector<PoseKind>(std::begin(kToiKinds), std::end(kToiKinds)),
                      &BenchResults::toi);
 }
 

@@ -283,7 +283,8 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
 std::string gap_tables(const BenchPlan& plan,
                        const std::vector<std::pair<std::string, std::string>>& rows,
                        const std::vector<NarrowRow>& results,
-                       const std::pair<std::string, std::string>& ratio_to) {
+                       const std::pair<std::string, std::string>& ratio_to,
+                       const std::vector<PoseKind>& kinds) {
   std::vector<int> sizes = {8};
   sizes.insert(sizes.end(), plan.hull_sizes.begin(), plan.hull_sizes.end());
   std::ostringstream md;
@@ -294,7 +295,7 @@ std::string gap_tables(const BenchPlan& plan,
         return &r;
     return nullptr;
   };
-  for (const PoseKind& k : kGapKinds) {
+  for (const PoseKind& k : kinds) {
     md << "### " << k.name << "\n\n| backend | variant |";
     for (int n : sizes) md << (n == 8 ? " box" : " N = " + std::to_string(n)) << " |";
     md << "\n|---|---|";
@@ -355,7 +356,8 @@ std::string distance_markdown(const BenchPlan& plan, const BenchResults& results
         "(prebuilt)` with each fcl::Box or Convex built once, the fair comparison for custom). "
         "The last row of each table is custom's time over FCL's prebuilt one, the median of the "
         "ratios round by round, ± half their 25-75 % range.\n\n";
-  md << gap_tables(plan, rows, results.distance, {"fcl", "prebuilt"});
+  md << gap_tables(plan, rows, results.distance, {"fcl", "prebuilt"},
+                   {std::begin(kGapKinds), std::end(kGapKinds)});
   return md.str();
 }
 
@@ -371,13 +373,17 @@ std::string toi_markdown(const BenchPlan& plan, const BenchResults& results) {
         "queries' poses (B beyond touching by "
      << gap_prose()
      << "), B moving onto A by the centres' offset over an interval of 1 s, in pure translation "
-        "(so that the translation-only casts answer the same question); a library's plain row "
+        "(so that the translation-only casts answer the same question), and at the wider gap "
+        "turning by "
+     << kToiKinds[2].turn << " rad on its way as well (*" << kToiKinds[2].name
+     << "*; the casts answer only translation); a library's plain row "
         "builds its shapes on every call, as the plain distance rows do, its `prebuilt` row "
         "once (the same answers). A row that does not answer ok is noted (Bullet's "
         "btGjkConvexCast misses exact landings, FCL's libccd rows some: docs/time_of_impact.md). "
         "The last row of each table is custom's time over Bullet's prebuilt hulls' (conservative "
         "advancement too, and an answer on every pose).\n\n";
-  md << gap_tables(plan, rows, results.toi, {"bullet-hull", "prebuilt"});
+  md << gap_tables(plan, rows, results.toi, {"bullet-hull", "prebuilt"},
+                   {std::begin(kToiKinds), std::end(kToiKinds)});
   return md.str();
 }
 
