@@ -18,7 +18,8 @@ int toi_command(const SceneCommandOptions& opt) {
   const ToiComparison c = compare_tois(scene, names, interval);
   print_tois(out, c);
   if (!opt.json.empty()) write_json(opt.json, toi_json(c));
-  return 0;
+  // A scene fails, as `rbx compare` fails one, when an engine its [expect] binds misses it.
+  return c.expect.failing.empty() ? 0 : 1;
 }
 
 }  // namespace rbx

@@ -145,6 +145,20 @@ DistanceComparison compare_distances(const Scene& scene, const std::vector<std::
         p.rows.push_back(answer_of(find_backend(name), name, a, b));
       time_rows(p.rows, a, b, budget_s);
       for (DistanceRow& r : p.rows) r.verdict = judge_distance(r.result, p.truth, a, b);
+      if (c.pairs.empty() && scene.expect && scene.expect->distance) {
+        // The first pair's stated answer: the oracle's and each bound engine's against it.
+        DistanceResult stated;
+        stated.overlapping = scene.expect->distance->overlapping;
+        stated.distance = scene.expect->distance->distance;
+        c.expect.stated = stated.overlapping ? "overlapping" : fmt_num(stated.distance, 10) + " m";
+        auto disagrees = [&](const DistanceResult& r) {
+          return judge_distance(r, stated, a, b).mark == "disagrees";
+        };
+        file_stated(c.expect, *scene.expect, "exact", disagrees(p.truth));
+        for (const DistanceRow& r : p.rows)
+          if (bound_by(*scene.expect, r.backend))
+            file_stated(c.expect, *scene.expect, r.backend, disagrees(r.result));
+      }
       c.pairs.push_back(std::move(p));
     }
   return c;
@@ -169,6 +183,7 @@ Json distance_json(const DistanceComparison& c) {
     }
     j["pairs"].push_back(pj);
   }
+  if (!c.expect.stated.empty()) j["expect"] = stated_json(c.expect);
   return j;
 }
 

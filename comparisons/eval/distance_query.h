@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "comparisons/eval/json_io.h"
+#include "comparisons/eval/stated_check.h"
 #include "comparisons/eval/timing.h"
 #include "comparisons/scene/scene.h"
 #include "reference/backend.h"
@@ -68,6 +69,7 @@ struct DistancePair {
 struct DistanceComparison {
   std::string scene, file;
   std::vector<DistancePair> pairs;
+  StatedCheck expect;  // the first pair against the scene's [expect.distance]
 };
 
 /// Queries every pair of bodies (not both static) with every backend in `names` (a backend

@@ -341,7 +341,13 @@ std::string distance_group(const Json& g, uint64_t seed, long count, int budget)
     << points_shrunk(r.vertices_before, r.vertices_after, r.steps_accepted, r.evaluations)
     << ", while the disagreement stayed.\n# Reproduce: rbx distance THIS_FILE --backends "
     << backend << "\n";
-  const std::string text = sample_scene_text(r.sample, h.str());
+  // The oracle's answer on the shrunk pair, stated: rbx distance checks it, and custom by it.
+  const RigidBody sa = build_body(r.sample.a, "A"), sb = build_body(r.sample.b, "B");
+  const ExactDistance truth = exact_distance(*sa.shape, sa.pose(), *sb.shape, sb.pose());
+  const std::string text = sample_scene_text(r.sample, h.str()) +
+                           "\n[expect]\ntruth = \"exact\"\n\n[expect.distance]\n" +
+                           (truth.overlapping ? std::string("overlapping = true\n")
+                                              : "distance = " + num(truth.distance) + "\n");
   const DistanceComparison c = compare_distances(parse_scene(text, "explore.toml"), {backend}, 0.0);
   const DistanceRow& row = c.pairs.at(0).rows.at(0);
   // A status error is the row's answer, not a mark: reproduced when the written scene's is one.

@@ -176,7 +176,14 @@ std::string toi_group(const Json& g, uint64_t seed, long count, int budget) {
     << ", the motion as drawn, while the disagreement stayed.\n# Reproduce: rbx toi THIS_FILE "
        "--backends "
     << backend << "\n";
-  const std::string text = toi_scene_text(shrunk, h.str());
+  // The oracle's answer on the shrunk pair, stated: rbx toi checks it, and custom by it.
+  const auto [sa, sb] = moving_bodies(shrunk);
+  const ToiResult truth = exact_toi(sa, sb, shrunk.interval);
+  std::string text = toi_scene_text(shrunk, h.str());
+  if (truth.status == Status::Ok)
+    text += "\n[expect]\ntruth = \"exact\"\n\n[expect.toi]\n" +
+            (truth.hit ? "touch = true\nfraction = " + num(truth.fraction) + "\n"
+                       : std::string("touch = false\n"));
   const Scene scene = parse_scene(text, "explore.toml");
   const ToiComparison c = compare_tois(scene, {backend}, scene.sim.dt, 0.0);
   std::string why = "no mark";

@@ -88,7 +88,10 @@ void Evaluator::expect_binding() {
   out_.expect_checked =
       (e.contact && expect_contact_bound_) || (!e.bodies.empty() && expect_bodies_bound_);
   if (!e.contact && e.bodies.empty())
-    out_.expect_unchecked.push_back("[expect] gives nothing to check");
+    out_.expect_unchecked.push_back(
+        e.distance || e.toi ? "[expect] states a distance or a time of impact only: rbx distance "
+                              "and rbx toi check those"
+                            : "[expect] gives nothing to check");
 }
 
 }  // namespace eval_detail

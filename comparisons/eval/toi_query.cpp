@@ -197,6 +197,32 @@ ToiComparison compare_tois(const Scene& scene, const std::vector<std::string>& n
       for (const ToiSubject& s : subjects) p.rows.push_back(answer_of(s, a, b, interval));
       time_rows(p.rows, subjects, a, b, interval, budget_s);
       for (ToiRow& r : p.rows) r.verdict = judge_toi(r.result, p.truth, a, b, interval);
+      if (c.pairs.empty() && scene.expect && scene.expect->toi) {
+        // The first pair's stated answer: the oracle's and each bound engine's against it.
+        ToiResult stated;
+        stated.hit = scene.expect->toi->touch;
+        stated.fraction = scene.expect->toi->fraction;
+        c.expect.stated = stated.hit
+                              ? "a touch at " + fmt_num(stated.fraction, 10) + " of the interval"
+                              : "no touch";
+        // Held to the statement itself (judge_toi trusts a touching instant over its truth): a
+        // touch against a stated miss, or the reverse, is a miss unless the pass from the touch
+        // on is hair-deep (decided at the nanometre); a touch at another time, unless both
+        // instants are within the touching band (a grazing touch).
+        auto disagrees = [&](const ToiResult& r) {
+          if (r.status != Status::Ok) return true;
+          if (r.hit != stated.hit)
+            return !hair_deep_pass(a, b, interval, r.hit ? r.fraction : stated.fraction);
+          if (!r.hit) return false;
+          return std::abs(r.fraction - stated.fraction) > kToiDisagree &&
+                 !(touching_at(a, b, interval, r.fraction) &&
+                   touching_at(a, b, interval, stated.fraction));
+        };
+        file_stated(c.expect, *scene.expect, "exact", disagrees(p.truth));
+        for (const ToiRow& r : p.rows)
+          if (bound_by(*scene.expect, r.backend))
+            file_stated(c.expect, *scene.expect, r.backend, disagrees(r.result));
+      }
       c.pairs.push_back(std::move(p));
     }
   return c;
@@ -224,6 +250,7 @@ Json toi_json(const ToiComparison& c) {
     }
     j["pairs"].push_back(pj);
   }
+  if (!c.expect.stated.empty()) j["expect"] = stated_json(c.expect);
   return j;
 }
 

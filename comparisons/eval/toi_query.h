@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "comparisons/eval/json_io.h"
+#include "comparisons/eval/stated_check.h"
 #include "comparisons/eval/timing.h"
 #include "comparisons/scene/scene.h"
 #include "reference/backend.h"
@@ -87,6 +88,7 @@ struct ToiComparison {
   std::string scene, file;
   double interval = 0.0;  // s
   std::vector<ToiPair> pairs;
+  StatedCheck expect;  // the first pair against the scene's [expect.toi]
 };
 
 /// Queries every pair of bodies (not both static) over `interval` (s) with every row of

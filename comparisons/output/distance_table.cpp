@@ -51,6 +51,7 @@ void print_distances(std::ostream& out, const DistanceComparison& c) {
     out << "no pair of bodies to measure (every body is static, or there is only one)\n";
     return;
   }
+  print_stated(out, c.expect, "[expect.distance]");
   out << "\nerrors: relative to the true distance, at least 1e-8 of the pair's extent from the "
          "origin (round-off of the coordinates); witness err: how far the two points are from a "
          "closest pair (off their bodies, or apart by other than the distance), on the same scale; "

@@ -2,9 +2,11 @@
 // rbx toi), so the three say the same thing the same way.
 #pragma once
 
+#include <ostream>
 #include <string>
 #include <vector>
 
+#include "comparisons/eval/stated_check.h"
 #include "comparisons/eval/timing.h"
 
 namespace rbx {
@@ -16,6 +18,10 @@ std::string mark_cell(const std::string& mark);
 /// cold call (µs); "-" where it was not timed, and the cold call "-" when `answered` is false
 /// (an unsupported query made no call).
 std::vector<std::string> timing_cells(const Timing& t, bool answered = true);
+
+/// The lines on the first pair's stated answer (`block`: "[expect.distance]" or "[expect.toi]"),
+/// nothing when the scene states none: who meets it, who misses it, and whether the scene fails.
+void print_stated(std::ostream& out, const StatedCheck& c, const std::string& block);
 
 /// The note under a query table on what its times are.
 extern const char* const kQueryTimingNote;

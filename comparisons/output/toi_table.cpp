@@ -54,6 +54,7 @@ void print_tois(std::ostream& out, const ToiComparison& c) {
     out << "no pair of bodies to measure (every body is static, or there is only one)\n";
     return;
   }
+  print_stated(out, c.expect, "[expect.toi]");
   out << "\ntouch at: the first touch, as a fraction of the interval; time err: its distance from "
          "the oracle's; ✗ over 1e-6, ~ over 1e-9 (docs/time_of_impact.md). normal err: the angle "
          "to the oracle's normal (at an edge or a corner many are right); point err: how far the "

@@ -46,6 +46,19 @@ struct ExpectContact {
   std::vector<Vec3> patch;
 };
 
+/// [expect.distance]: the first two bodies' separation at t = 0, as `rbx distance` asks it.
+struct ExpectDistance {
+  bool overlapping = false;
+  double distance = 0.0;  // m, when apart
+};
+
+/// [expect.toi]: the first two bodies' first touch as they move over the interval dt, as
+/// `rbx toi` asks it.
+struct ExpectToi {
+  bool touch = false;
+  double fraction = 0.0;  // of the interval, when they touch
+};
+
 /// The [expect] block: closed-form ground truth with an absolute tolerance (SI).
 struct Expect {
   double tolerance = 1e-6;
@@ -58,6 +71,8 @@ struct Expect {
   std::string known_failure;
   std::vector<ExpectBody> bodies;
   std::optional<ExpectContact> contact;
+  std::optional<ExpectDistance> distance;
+  std::optional<ExpectToi> toi;
 };
 
 /// A scene's [ensemble] table: its nudged copies belong in the report's Predictability section

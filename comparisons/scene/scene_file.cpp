@@ -242,6 +242,69 @@ void read_sim(const Reader& r, const toml::table& sim, SimSettings& s, bool forc
       refuse(s.sweep_dt[k], "sim.sweep_dt[" + std::to_string(k) + "]", n->as_array()->get(k));
 }
 
+// The table of [expect.KIND] (node `n` of [expect] `t`), a question about the first two bodies:
+// its keys checked, and the scene must have two.
+const toml::table& pair_expectation(const Reader& r, const toml::table& t, const toml::node& n,
+                                    const std::vector<BodySpec>& bodies, const std::string& kind) {
+  const std::string p = "expect." + kind;
+  const toml::table& c = r.table(n, p);
+  r.check_keys(c, p + ".", keys_under(p + "."), false);
+  if (bodies.size() < 2)
+    r.fail(key_line(t, kind), p,
+           "it is about the first two bodies, but the scene has " + std::to_string(bodies.size()),
+           "add a second [[body]] or remove [" + p + "]");
+  return c;
+}
+
+// [expect.distance]: either overlapping = true, or the distance (m, finite, >= 0).
+ExpectDistance read_expect_distance(const Reader& r, const toml::table& t, const toml::node& n,
+                                    const std::vector<BodySpec>& bodies) {
+  const toml::table& c = pair_expectation(r, t, n, bodies, "distance");
+  ExpectDistance ed;
+  if (const toml::node* v = c.get("overlapping"))
+    ed.overlapping = r.boolean(*v, "expect.distance.overlapping", "expect.distance.overlapping");
+  const toml::node* d = c.get("distance");
+  if (ed.overlapping && d)
+    r.fail(line_of(d), "expect.distance.distance", "an overlapping pair has no distance",
+           "remove distance, or overlapping = true");
+  if (!ed.overlapping && !d)
+    r.fail(key_line(t, "distance"), "expect.distance",
+           "states neither a distance nor overlapping = true", "write e.g. distance = 0.25");
+  if (d) {
+    ed.distance = r.number(*d, "expect.distance.distance", "expect.distance.distance");
+    if (!(ed.distance >= 0) || !std::isfinite(ed.distance))
+      r.fail(line_of(d), "expect.distance.distance",
+             "must be finite and >= 0, got " + num(ed.distance),
+             "write the separation in metres, or overlapping = true");
+  }
+  return ed;
+}
+
+// [expect.toi]: touch = false, or touch = true with the fraction of the interval (in [0, 1]).
+ExpectToi read_expect_toi(const Reader& r, const toml::table& t, const toml::node& n,
+                          const std::vector<BodySpec>& bodies) {
+  const toml::table& c = pair_expectation(r, t, n, bodies, "toi");
+  ExpectToi et;
+  const toml::node* touch = c.get("touch");
+  if (!touch)
+    r.fail(key_line(t, "toi"), "expect.toi", "states no touch",
+           "write touch = true with fraction = ..., or touch = false");
+  et.touch = r.boolean(*touch, "expect.toi.touch", "expect.toi.touch");
+  const toml::node* f = c.get("fraction");
+  if (et.touch != (f != nullptr))
+    r.fail(line_of(f ? f : touch), f ? "expect.toi.fraction" : "expect.toi.touch",
+           f ? "a pair that does not touch has no time of touch" : "a touch needs its time",
+           f ? "remove fraction, or write touch = true"
+             : "write fraction = the first touch's time over the interval, in [0, 1]");
+  if (f) {
+    et.fraction = r.number(*f, "expect.toi.fraction", "expect.toi.fraction");
+    if (!(et.fraction >= 0 && et.fraction <= 1))
+      r.fail(line_of(f), "expect.toi.fraction", "must be in [0, 1], got " + num(et.fraction),
+             "write the first touch's time over the interval (dt)");
+  }
+  return et;
+}
+
 // [expect.contact] (node `n` of [expect] `t`): between the first two bodies at t = 0.
 ExpectContact read_expect_contact(const Reader& r, const toml::table& t, const toml::node& n,
                                   const std::vector<BodySpec>& bodies) {
@@ -369,6 +432,8 @@ Expect read_expect(const Reader& r, const toml::table& t, const std::vector<Body
   }
 
   if (const toml::node* n = t.get("contact")) e.contact = read_expect_contact(r, t, *n, bodies);
+  if (const toml::node* n = t.get("distance")) e.distance = read_expect_distance(r, t, *n, bodies);
+  if (const toml::node* n = t.get("toi")) e.toi = read_expect_toi(r, t, *n, bodies);
   return e;
 }
 

@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "tests/common/bad_input.h"
@@ -392,6 +393,39 @@ TEST(Cli, ToiRunsEveryRowOverTheIntervalAndRefusesABadOne) {
     EXPECT_EQ(refused.code, 2) << bad;
     EXPECT_NE(refused.err.find("--interval"), std::string::npos) << refused.err;
     EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  }
+  fs::remove_all(dir);
+}
+
+// A scene that states its distance or first touch ([expect.distance], [expect.toi]) fails, as
+// `rbx compare` fails one, when custom misses it: exit 1, the miss named; the right statement
+// passes, met by the oracle and custom. The cubes of the two tests above.
+TEST(Cli, DistanceAndToiExitOneOnAWrongStatedAnswer) {
+  const fs::path dir = temp_dir("stated");
+  const std::string pair =
+      "[sim]\nduration = 0\ndt = 0.5\n[[body]]\nname = \"A\"\n"
+      "[[body]]\nname = \"B\"\nposition = [0.2, 0.1, 1.25]\n"
+      "velocity = [0, 0, -2]\n";
+  for (const auto& [file, block, command, wrong] :
+       {std::tuple{"d.toml", "[expect.distance]\ndistance = 0.25\n", "distance", false},
+        std::tuple{"dw.toml", "[expect.distance]\ndistance = 0.26\n", "distance", true},
+        std::tuple{"dov.toml", "[expect.distance]\noverlapping = true\n", "distance", true},
+        std::tuple{"t.toml", "[expect.toi]\ntouch = true\nfraction = 0.25\n", "toi", false},
+        std::tuple{"tw.toml", "[expect.toi]\ntouch = true\nfraction = 0.3\n", "toi", true},
+        std::tuple{"tn.toml", "[expect.toi]\ntouch = false\n", "toi", true}}) {
+    std::ofstream(dir / file) << pair << block;
+    const CmdResult r =
+        rbx_in(dir.string(), std::string(command) + " " + file + " --backends custom --json -");
+    EXPECT_EQ(r.code, wrong ? 1 : 0) << file << ": " << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    const auto missed = j["expect"]["missed"].get<std::vector<std::string>>();
+    const auto failing = j["expect"]["failing"].get<std::vector<std::string>>();
+    const std::vector<std::string> none, both = {"exact", "custom"}, engine = {"custom"};
+    EXPECT_EQ(missed, wrong ? both : none) << file;
+    EXPECT_EQ(failing, wrong ? engine : none) << file;
+    EXPECT_NE(r.err.find(wrong ? "the scene fails: custom" : "met by exact, custom"),
+              std::string::npos)
+        << r.err;
   }
   fs::remove_all(dir);
 }

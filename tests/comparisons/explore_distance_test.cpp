@@ -133,6 +133,12 @@ TEST(ExploreDistance, AGroupIsShrunkAndItsSceneReproducesIt) {
   const std::string text = r["text"];
   EXPECT_NE(text.find("# Shrunk from 16 to 16 points"), std::string::npos) << text;
   EXPECT_EQ(text.find("(0 simplifications kept"), std::string::npos) << text;
+  // It states the oracle's distance, which the oracle and custom meet.
+  ASSERT_NE(text.find("[expect.distance]\ndistance = "), std::string::npos) << text;
+  const DistanceComparison c =
+      compare_distances(parse_scene(text, "shrunk.toml"), {"custom", "bullet"}, 0.0);
+  EXPECT_EQ(c.expect.met, (std::vector<std::string>{"exact", "custom"}));
+  EXPECT_TRUE(c.expect.failing.empty());
 }
 
 // The report's sections (explore_check_metrics with `queries`): one per query, every row of

@@ -196,6 +196,12 @@ TEST(ExploreToi, AGroupIsShrunkAndItsSceneReproducesIt) {
   const std::string text = r["text"];
   EXPECT_NE(text.find("the motion as drawn"), std::string::npos) << text;
   EXPECT_EQ(text.find("(0 simplifications kept"), std::string::npos) << text;
+  // It states the oracle's first touch, which the oracle and custom meet.
+  ASSERT_NE(text.find("[expect.toi]\ntouch = true\nfraction = "), std::string::npos) << text;
+  const Scene scene = parse_scene(text, "shrunk.toml");
+  const ToiComparison c = compare_tois(scene, {"custom", "bullet-hull"}, scene.sim.dt, 0.0);
+  EXPECT_EQ(c.expect.met, (std::vector<std::string>{"exact", "custom"}));
+  EXPECT_TRUE(c.expect.failing.empty());
 }
 
 }  // namespace

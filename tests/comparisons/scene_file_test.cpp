@@ -596,11 +596,40 @@ TEST(SceneFile, MissingSceneFileSaysSo) {
 
 TEST(SceneFile, KeysListEveryLevel) {
   const auto& keys = scene_keys();
-  for (const char* k :
-       {"name", "checks", "sim.dt", "sim.max_energy_ratio", "body.mass", "body.orientation",
-        "expect.tolerance", "expect.body.velocity", "expect.contact.depth", "ensemble.count",
-        "ensemble.step_test", "ensemble.duration"})
+  for (const char* k : {"name", "checks", "sim.dt", "sim.max_energy_ratio", "body.mass",
+                        "body.orientation", "expect.tolerance", "expect.body.velocity",
+                        "expect.contact.depth", "expect.distance.distance", "expect.toi.fraction",
+                        "ensemble.count", "ensemble.step_test", "ensemble.duration"})
     EXPECT_NE(std::find(keys.begin(), keys.end(), k), keys.end()) << k;
+}
+
+// [expect.distance] and [expect.toi]: the first two bodies' separation, or first touch over the
+// interval, as rbx distance and rbx toi ask it.
+TEST(SceneFile, ExpectStatesADistanceOrATimeOfImpact) {
+  const std::string two =
+      "[[body]]\nname = \"A\"\nposition = [0, 0, 2]\n\n[[body]]\nname = \"B\"\n";
+  const Scene apart = parse_scene(two + "\n[expect.distance]\ndistance = 1\n", "t.toml");
+  ASSERT_TRUE(apart.expect && apart.expect->distance);
+  EXPECT_FALSE(apart.expect->distance->overlapping);
+  EXPECT_EQ(apart.expect->distance->distance, 1.0);
+  const Scene over = parse_scene(two + "\n[expect.distance]\noverlapping = true\n", "t.toml");
+  EXPECT_TRUE(over.expect->distance->overlapping);
+  const Scene touch =
+      parse_scene(two + "\n[expect.toi]\ntouch = true\nfraction = 0.25\n", "t.toml");
+  ASSERT_TRUE(touch.expect && touch.expect->toi);
+  EXPECT_TRUE(touch.expect->toi->touch);
+  EXPECT_EQ(touch.expect->toi->fraction, 0.25);
+  const Scene miss = parse_scene(two + "\n[expect.toi]\ntouch = false\n", "t.toml");
+  EXPECT_FALSE(miss.expect->toi->touch);
+  // Neither a distance nor an overlap, and a touch without its time, are refused.
+  EXPECT_NE(input_error([&] {
+              parse_scene(two + "\n[expect.distance]\n", "t.toml");
+            }).find("expect.distance: states neither a distance nor overlapping = true"),
+            std::string::npos);
+  EXPECT_NE(input_error([&] {
+              parse_scene(two + "\n[expect.toi]\ntouch = true\n", "t.toml");
+            }).find("expect.toi.touch: a touch needs its time"),
+            std::string::npos);
 }
 
 TEST(SceneFile, EnsembleTableIsReadWithItsDefaults) {
