@@ -68,6 +68,7 @@ SceneEvaluation Evaluator::run() {
                  {"excused", out_.expect_known}};
   j["disagreements"] = out_.disagreements;
   j["deviations"] = out_.deviations;
+  read_runs(out_);
   return std::move(out_);
 }
 
@@ -96,6 +97,86 @@ void Evaluator::expect_binding() {
 
 }  // namespace eval_detail
 
+Json stability_json(const StabilityRow& r) {
+  Json s;
+  s["status"] = r.status;
+  s["dt"] = r.dt;
+  s["restitution"] = r.restitution;
+  s["nonfinite"] = r.nonfinite;
+  s["energy_growth_rel"] = r.energy_growth_rel;
+  s["energy_drift_rel"] = r.energy_drift_rel;
+  s["energy_change_rel"] = r.energy_change_rel;
+  if (r.momentum_drift_rel) s["momentum_drift_rel"] = *r.momentum_drift_rel;
+  if (r.angular_momentum_drift_rel) s["angular_momentum_drift_rel"] = *r.angular_momentum_drift_rel;
+  s["max_penetration_rel"] = r.max_penetration_rel;
+  s["rest_penetration_rel"] = r.rest_penetration_rel;
+  s["tunnelled_pairs"] = r.tunnelled_pairs;
+  if (r.jitter_rms_mps) s["jitter_rms_mps"] = *r.jitter_rms_mps;
+  s["verdict"] = r.verdict;
+  s["why"] = r.why;
+  return s;
+}
+
+namespace {
+
+StabilityRow stability_row(const std::string& backend, bool swept, const Json& s) {
+  StabilityRow r;
+  r.backend = backend;
+  r.swept = swept;
+  r.status = s.at("status");
+  r.dt = s.at("dt");
+  r.restitution = s.at("restitution");
+  r.nonfinite = s.at("nonfinite");
+  r.energy_growth_rel = s.at("energy_growth_rel");
+  r.energy_drift_rel = s.at("energy_drift_rel");
+  r.energy_change_rel = s.at("energy_change_rel");
+  if (s.contains("momentum_drift_rel")) r.momentum_drift_rel = s["momentum_drift_rel"];
+  if (s.contains("angular_momentum_drift_rel"))
+    r.angular_momentum_drift_rel = s["angular_momentum_drift_rel"];
+  r.max_penetration_rel = s.at("max_penetration_rel");
+  r.rest_penetration_rel = s.at("rest_penetration_rel");
+  r.tunnelled_pairs = s.at("tunnelled_pairs");
+  if (s.contains("jitter_rms_mps")) r.jitter_rms_mps = s["jitter_rms_mps"];
+  r.verdict = s.at("verdict");
+  r.why = s.at("why").get<std::vector<std::string>>();
+  return r;
+}
+
+}  // namespace
+
+const BackendRun* SceneEvaluation::run_of(const std::string& backend) const {
+  for (const BackendRun& r : runs)
+    if (r.backend == backend) return &r;
+  return nullptr;
+}
+
+void read_runs(SceneEvaluation& ev) {
+  ev.runs.clear();
+  ev.stability.clear();
+  if (ev.json.contains("stability"))
+    for (const auto& [name, s] : ev.json["stability"].items()) {
+      ev.stability.push_back(stability_row(name, false, s));
+      if (ev.json.contains("stability_sweep") && ev.json["stability_sweep"].contains(name))
+        for (const Json& sw : ev.json["stability_sweep"][name])
+          ev.stability.push_back(stability_row(name, true, sw));
+    }
+  if (ev.json.contains("expect")) ev.known_failure = ev.json["expect"].value("known_failure", "");
+  if (!ev.json.contains("backends")) return;
+  const Json& stability = ev.json.value("stability", Json::object());
+  for (const auto& [name, bj] : ev.json["backends"].items()) {
+    BackendRun r;
+    r.backend = name;
+    const std::string s = bj.value("status", "ok");
+    for (const Status c :
+         {Status::Ok, Status::Error, Status::Unsupported, Status::Timeout, Status::Touching})
+      if (s == to_string(c)) r.status = c;
+    r.message = bj.value("message", "");
+    if (bj.contains("runtime_s")) r.runtime_s = bj["runtime_s"].get<double>();
+    if (stability.contains(name)) r.stability = stability[name].value("verdict", "");
+    ev.runs.push_back(std::move(r));
+  }
+}
+
 SceneEvaluation evaluate_scene(const Scene& scene, const HarnessOptions& opt) {
   if (!scene.expect || scene.expect_set_aside_by.empty())
     return eval_detail::Evaluator(scene, opt).run();
@@ -112,6 +193,7 @@ SceneEvaluation evaluate_scene(const Scene& scene, const HarnessOptions& opt) {
   ev.json["expect"]["passed"] = false;
   ev.json["expect"]["unchecked"] = ev.expect_unchecked;
   ev.json["expect"]["known_failure"] = scene.expect->known_failure;
+  read_runs(ev);
   return ev;
 }
 

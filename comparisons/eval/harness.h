@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,37 @@ struct SweepPoint {
 
 struct EnsembleResult;  // comparisons/eval/ensemble.h
 
+/// One stability run of a backend: at the scene's step, or at another step of the scene's
+/// stability sweep. The scene's JSON holds it as "stability" (the scene's step) and
+/// "stability_sweep" (stability_json and read_runs convert).
+struct StabilityRow {
+  std::string backend;
+  bool swept = false;  // a step of the stability sweep, not the scene's own
+  std::string status;  // the run's status
+  double dt = 0.0, restitution = 0.0;
+  bool nonfinite = false;
+  double energy_growth_rel = 0.0, energy_drift_rel = 0.0, energy_change_rel = 0.0;
+  std::optional<double> momentum_drift_rel, angular_momentum_drift_rel;  // closed systems
+  double max_penetration_rel = 0.0, rest_penetration_rel = 0.0;
+  int tunnelled_pairs = 0;
+  std::optional<double> jitter_rms_mps;  // under gravity
+  std::string verdict;
+  std::vector<std::string> why;
+};
+
+/// The contract's JSON of one stability run (docs/contract.md).
+Json stability_json(const StabilityRow& row);
+
+/// One backend's run on a scene, as the scene's JSON records it ("backends" and "stability"):
+/// read back once (read_runs), so that what renders a scene reads no JSON.
+struct BackendRun {
+  std::string backend;
+  Status status = Status::Ok;       // the first failure of its calls, else ok (or touching)
+  std::string message;              // the first failure's message, or a note on an ok answer
+  std::optional<double> runtime_s;  // its calls' summed median time (s), where recorded
+  std::string stability;  // the stability check's verdict; "" where that check did not run
+};
+
 /// Everything the harness learned about one scene.
 struct SceneEvaluation {
   std::string family;  // folder under scenes/, or "scenes"
@@ -88,10 +120,21 @@ struct SceneEvaluation {
   std::vector<std::string> disagreements;  // clearly different from the truth (see kMark*)
   std::vector<std::string> deviations;     // beyond the scene's tolerance, yet close
   std::vector<Cause> causes;               // why each impact miss happened, measured
+  std::vector<BackendRun> runs;            // every backend that ran, by name (read_runs)
+  // Every stability run, by backend: the scene's step, then its sweep's (read_runs).
+  std::vector<StabilityRow> stability;
+  std::string known_failure;  // the scene's [expect] known_failure ("ENGINE: why"), "" if none
   // The scene's [ensemble] run (the report's, run_scene_ensembles), also in `json` as
   // "ensemble"; null when none ran.
   std::shared_ptr<const EnsembleResult> ensemble;
+
+  /// The run of `backend`; nullptr when it did not run on this scene.
+  const BackendRun* run_of(const std::string& backend) const;
 };
+
+/// Fills `ev.runs`, `ev.stability` and `ev.known_failure` from `ev.json` (the one reading of it,
+/// after an evaluation and after a transfer between processes).
+void read_runs(SceneEvaluation& ev);
 
 /// Thresholds between a deviation and a disagreement: a contact normal more than 1 degree off or
 /// a depth more than 1 % of the smaller body off; a velocity error above 0.1 % (energy norm).

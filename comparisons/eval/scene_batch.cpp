@@ -49,6 +49,7 @@ SceneEvaluation decode_evaluation(const std::string& text) {
   ev.disagreements = j["disagreements"].get<std::vector<std::string>>();
   ev.deviations = j["deviations"].get<std::vector<std::string>>();
   for (const Json& c : j["causes"]) ev.causes.push_back({c[0], c[1], c[2], c[3], c[4]});
+  read_runs(ev);
   return ev;
 }
 

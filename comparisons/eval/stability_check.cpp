@@ -10,22 +10,24 @@ void Evaluator::stability(const std::string& name, const DynRun& run, const Dyna
   const StabilityTrace tr =
       trace_stability(inputs_, run.result, sample_overlaps(run, geo), geo, inv, scene_.sim.gravity);
   const double jitter = rest_jitter(inputs_, run.result.samples, scene_.sim.gravity);
-  Json s;
-  s["status"] = to_string(run.result.status);
-  s["dt"] = run.dt;
-  s["restitution"] = scene_.sim.restitution;
-  s["nonfinite"] = tr.nonfinite;
-  s["energy_growth_rel"] = tr.growth;
-  s["energy_drift_rel"] = tr.drift_e;
-  s["energy_change_rel"] = tr.e_change;
+  StabilityRow row;
+  row.backend = name;
+  row.swept = swept;
+  row.status = to_string(run.result.status);
+  row.dt = run.dt;
+  row.restitution = scene_.sim.restitution;
+  row.nonfinite = tr.nonfinite;
+  row.energy_growth_rel = tr.growth;
+  row.energy_drift_rel = tr.drift_e;
+  row.energy_change_rel = tr.e_change;
   if (fr.closed) {
-    s["momentum_drift_rel"] = tr.drift;
-    s["angular_momentum_drift_rel"] = tr.hdrift;
+    row.momentum_drift_rel = tr.drift;
+    row.angular_momentum_drift_rel = tr.hdrift;
   }
-  s["max_penetration_rel"] = tr.pen_max;
-  s["rest_penetration_rel"] = tr.pen_rest;
-  s["tunnelled_pairs"] = tr.tunnelled;
-  if (scene_.sim.gravity.norm() > 0) s["jitter_rms_mps"] = jitter;
+  row.max_penetration_rel = tr.pen_max;
+  row.rest_penetration_rel = tr.pen_rest;
+  row.tunnelled_pairs = tr.tunnelled;
+  if (scene_.sim.gravity.norm() > 0) row.jitter_rms_mps = jitter;
   // Verdict: the rules of stability_verdict (metrics.h).
   StabilityFacts facts;
   facts.nonfinite = tr.nonfinite;
@@ -42,13 +44,13 @@ void Evaluator::stability(const std::string& name, const DynRun& run, const Dyna
   facts.friction = scene_.sim.friction;
   facts.tunnelled_pairs = tr.tunnelled;
   const StabilityVerdict verdict = stability_verdict(facts);
-  s["verdict"] = verdict.verdict;
-  s["why"] = verdict.why;
+  row.verdict = verdict.verdict;
+  row.why = verdict.why;
   if (swept) {
-    stability_sweep_json_[name].push_back(s);
+    stability_sweep_json_[name].push_back(stability_json(row));
     return;
   }
-  stability_json_[name] = s;
+  stability_json_[name] = stability_json(row);
   metric("stability", name, "", "energy_growth_err", std::max(tr.growth, 0.0), "invariant");
   metric("stability", name, "", "max_penetration_rel_err", tr.pen_max, "exact");
   metric("stability", name, "", "tunnelled_pairs_err", tr.tunnelled, "invariant");

@@ -35,13 +35,12 @@ const Metric* find_metric(const SceneEvaluation& ev, const std::string& backend,
 
 // The headline cell of a scene for one backend, and what it was measured against.
 std::string headline(const SceneEvaluation& ev, const std::string& backend, std::string& against) {
-  const Json& bj = ev.json["backends"];
-  if (!bj.contains(backend)) return "";
-  const std::string status = bj[backend]["status"];
-  if (status == "unsupported") return "n/a";
-  if (status == "error" || status == "timeout") return status;
+  const BackendRun* run = ev.run_of(backend);
+  if (!run) return "";
+  if (run->status == Status::Unsupported) return "n/a";
+  if (run->status == Status::Error || run->status == Status::Timeout) return to_string(run->status);
   std::string cell;
-  if (status == "touching") {
+  if (run->status == Status::Touching) {
     cell = "touching, no normal";
   } else if (const Metric* t = find_metric(ev, backend, "touching_err"); t && t->value > 0) {
     cell = "wrong touch";
@@ -59,8 +58,8 @@ std::string headline(const SceneEvaluation& ev, const std::string& backend, std:
       if (m.backend == backend && m.name == "inertia_err_rel") worst = std::max(worst, m.value);
     cell = "inertia " + fmt_num(worst, 2);
     against = "exact solid";
-  } else if (ev.json["stability"].contains(backend)) {
-    cell = ev.json["stability"][backend]["verdict"];
+  } else if (!run->stability.empty()) {
+    cell = run->stability;
   } else if (t) {
     cell = "0 (no contact)";
   } else {
@@ -72,8 +71,8 @@ std::string headline(const SceneEvaluation& ev, const std::string& backend, std:
     cell += " ~";
   // The engine under test on a documented limitation: marked by the same rule, and labelled.
   // The engine the known failure names ("custom" or "custom-seed", before its colon).
-  const std::string known = ev.json["expect"].value("known_failure", std::string());
-  if (ev.expect_known && backend == known.substr(0, known.find(':'))) cell += " (known failure)";
+  if (ev.expect_known && backend == ev.known_failure.substr(0, ev.known_failure.find(':')))
+    cell += " (known failure)";
   return cell;
 }
 
@@ -200,25 +199,16 @@ std::string stability_section(const std::vector<Scene>& scenes,
   for (size_t i = 0; i < evs.size(); ++i) {
     // The verdict at the scene's step, then at the other steps of its own sweep (if it names
     // one), each backend's rows together.
-    std::vector<std::pair<std::string, Json>> rows;
-    for (const auto& [name, s] : evs[i].json["stability"].items()) {
-      rows.emplace_back(name, s);
-      if (evs[i].json.contains("stability_sweep") && evs[i].json["stability_sweep"].contains(name))
-        for (const Json& sw : evs[i].json["stability_sweep"][name]) rows.emplace_back(name, sw);
-    }
-    for (const auto& [name, s] : rows) {
+    for (const StabilityRow& s : evs[i].stability) {
       any_stab = true;
       std::string why;
-      for (const auto& w : s["why"]) why += (why.empty() ? "" : "; ") + w.get<std::string>();
-      const double drift = s["energy_drift_rel"].get<double>();
-      st.add({scenes[i].name, name, fmt_num(s["dt"].get<double>(), 3),
-              fmt_num(s["restitution"].get<double>(), 3), s["verdict"],
+      for (const std::string& w : s.why) why += (why.empty() ? "" : "; ") + w;
+      const double drift = s.energy_drift_rel;
+      st.add({scenes[i].name, s.backend, fmt_num(s.dt, 3), fmt_num(s.restitution, 3), s.verdict,
               (drift > 0 ? "+" : "") + fmt_num(100 * drift, 3) + " %",
-              fmt_num(100 * s["max_penetration_rel"].get<double>(), 3) + " %",
-              fmt_num(100 * s["rest_penetration_rel"].get<double>(), 3) + " %",
-              std::to_string(s["tunnelled_pairs"].get<int>()),
-              s.contains("jitter_rms_mps") ? fmt_num(s["jitter_rms_mps"].get<double>(), 3) : "-",
-              why});
+              fmt_num(100 * s.max_penetration_rel, 3) + " %",
+              fmt_num(100 * s.rest_penetration_rel, 3) + " %", std::to_string(s.tunnelled_pairs),
+              s.jitter_rms_mps ? fmt_num(*s.jitter_rms_mps, 3) : "-", why});
     }
   }
   md << (any_stab ? st.markdown() : std::string("No scene asks for the stability check.\n"))
@@ -242,8 +232,9 @@ std::string scene_details_section(const std::vector<Scene>& scenes,
     if (views_ok) md << " — [3-D replay](" << md_url("views/" + slug + ".html") << ")";
     md << "\n\n";
     Table status({"backend", "status", "run time (s)", "message"});
-    for (const auto& [name, bj] : ev.json["backends"].items())
-      status.add({name, bj["status"], fmt_num(bj["runtime_s"].get<double>(), 3), bj["message"]});
+    for (const BackendRun& r : ev.runs)
+      status.add(
+          {r.backend, to_string(r.status), fmt_num(r.runtime_s.value_or(0.0), 3), r.message});
     md << status.markdown() << "\n";
     if (!ev.metrics.empty()) {
       Table mt({"check", "pair", "metric", "backend", "value", "against"});
@@ -268,7 +259,7 @@ std::string scene_details_section(const std::vector<Scene>& scenes,
     if (figures_ok) {
       if (scenes[i].has_check(CheckKind::Contact) && !ev.json["geometry"].empty())
         md << "\n![contacts](" << md_url("figures/contact_" + slug + ".png") << ")\n";
-      if (find_metric(ev, "custom", "velocity_err_ke") || ev.json["backends"].contains("bullet"))
+      if (find_metric(ev, "custom", "velocity_err_ke") || ev.run_of("bullet"))
         if (scenes[i].has_check(CheckKind::Impulse))
           md << "\n![velocities](" << md_url("figures/velocity_" + slug + ".png") << ")\n";
     }
@@ -283,7 +274,7 @@ std::vector<std::string> report_columns(const std::vector<SceneEvaluation>& evs)
   std::vector<std::string> cols;
   for (const Backend& b : backends())
     for (const SceneEvaluation& ev : evs)
-      if (ev.json["backends"].contains(b.name)) {
+      if (ev.run_of(b.name)) {
         cols.push_back(b.name);
         break;
       }
@@ -446,23 +437,13 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
             << fmt_num(p.timing.q25_s, 6) << "," << fmt_num(p.timing.q75_s, 6) << ","
             << p.timing.calls << "," << p.timing.rounds << "," << fmt_num(p.timing.cold_s, 6)
             << "\n";
-    std::vector<std::pair<std::string, Json>> stab_rows;  // the scene's step, then its sweep
-    for (const auto& [name, s] : evs[i].json["stability"].items()) {
-      stab_rows.emplace_back(name, s);
-      if (evs[i].json.contains("stability_sweep") && evs[i].json["stability_sweep"].contains(name))
-        for (const Json& sw : evs[i].json["stability_sweep"][name])
-          stab_rows.emplace_back(name, sw);
-    }
-    for (const auto& [name, s] : stab_rows)
-      stab << sc << "," << fam << "," << name << "," << fmt_num(s["dt"].get<double>(), 17) << ","
-           << fmt_num(s["restitution"].get<double>(), 17) << "," << s["verdict"].get<std::string>()
-           << "," << fmt_num(s["energy_growth_rel"].get<double>(), 17) << ","
-           << fmt_num(s["energy_drift_rel"].get<double>(), 17) << ","
-           << fmt_num(s["max_penetration_rel"].get<double>(), 17) << ","
-           << fmt_num(s["rest_penetration_rel"].get<double>(), 17) << ","
-           << s["tunnelled_pairs"].get<int>() << ","
-           << (s.contains("jitter_rms_mps") ? fmt_num(s["jitter_rms_mps"].get<double>(), 17) : "")
-           << "\n";
+    for (const StabilityRow& s : evs[i].stability)  // the scene's step, then its sweep
+      stab << sc << "," << fam << "," << s.backend << "," << fmt_num(s.dt, 17) << ","
+           << fmt_num(s.restitution, 17) << "," << s.verdict << ","
+           << fmt_num(s.energy_growth_rel, 17) << "," << fmt_num(s.energy_drift_rel, 17) << ","
+           << fmt_num(s.max_penetration_rel, 17) << "," << fmt_num(s.rest_penetration_rel, 17)
+           << "," << s.tunnelled_pairs << ","
+           << (s.jitter_rms_mps ? fmt_num(*s.jitter_rms_mps, 17) : "") << "\n";
   }
   write_text((tmp / "metrics.csv").string(), metrics.str());
   write_text((tmp / "sweep.csv").string(), sweep.str());

@@ -40,12 +40,12 @@ double truth_metric(const SceneEvaluation& ev, const std::string& backend,
 }
 
 // Why a backend failed a scene, measured: the status, then the first clear sign in the metrics.
-std::string cause(const SceneEvaluation& ev, const std::string& backend) {
-  const Json& bj = ev.json["backends"][backend];
-  if (bj["status"] == "error" || bj["status"] == "timeout") {
-    std::string msg = bj["message"].get<std::string>();
+std::string cause(const SceneEvaluation& ev, const BackendRun& run) {
+  const std::string& backend = run.backend;
+  if (run.status == Status::Error || run.status == Status::Timeout) {
+    std::string msg = run.message;
     if (msg.size() > 120) msg = msg.substr(0, msg.rfind(' ', 117)) + " ...";
-    return bj["status"].get<std::string>() + ": " + msg;
+    return std::string(to_string(run.status)) + ": " + msg;
   }
   // A marked contact answer: the first sign measured on it (contact_cause.h).
   for (const Cause& c : ev.causes)
@@ -67,10 +67,7 @@ std::string cause(const SceneEvaluation& ev, const std::string& backend) {
         (m.name == "inertia_err_rel" || m.name == "mass_err_rel" || m.name == "com_err_rel") &&
         m.value > 1e-6)
       return "mass properties off (relative > 1e-6)";
-  if (ev.json["stability"].contains(backend)) {
-    const std::string v = ev.json["stability"][backend]["verdict"];
-    if (v != "stable") return "stability: " + v;
-  }
+  if (!run.stability.empty() && run.stability != "stable") return "stability: " + run.stability;
   for (const std::string& d : ev.disagreements)
     if (d.rfind(backend + ":", 0) == 0) {
       if (d.find("angular_velocity") != std::string::npos)
@@ -100,7 +97,8 @@ Measure measure_of(const Scene& scene) {
 
 // Adds one scene's errors and run time to a row (the backend answered: status ok, or touching
 // with no normal, which adds its time and no error).
-void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, const Json& bj) {
+void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev,
+               const BackendRun& run) {
   const std::string& b = row.backend;
   if (row.measure == Measure::Contact) {
     if (const double a = truth_metric(ev, b, "normal_err_deg"); a >= 0) {
@@ -135,8 +133,7 @@ void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev, con
     for (const BackendEnsemble& e : ev.ensemble->backends)
       if (e.backend == b && e.runs > 0) row.amplification.push_back(e.amplification);
   const long steps = scene.sim.steps();
-  if (steps > 0 && bj.contains("runtime_s"))
-    row.time.push_back(bj["runtime_s"].get<double>() / static_cast<double>(steps));
+  if (steps > 0 && run.runtime_s) row.time.push_back(*run.runtime_s / static_cast<double>(steps));
 }
 
 // Errors below this rank as equal: round-off and the iterative methods' stopping tolerances
@@ -313,16 +310,14 @@ std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
       row.measure = measure;
       for (size_t i = 0; i < evs.size(); ++i) {
         const SceneEvaluation& ev = evs[i];
-        if (ev.family != fam || measure_of(scenes[i]) != measure ||
-            !ev.json["backends"].contains(b))
-          continue;
-        const Json& bj = ev.json["backends"][b];
-        if (bj["status"] == "unsupported") continue;
+        const BackendRun* run = ev.run_of(b);
+        if (ev.family != fam || measure_of(scenes[i]) != measure || !run) continue;
+        if (run->status == Status::Unsupported) continue;
         ++row.run;
-        const bool bad = bj["status"] == "error" || bj["status"] == "timeout" ||
+        const bool bad = run->status == Status::Error || run->status == Status::Timeout ||
                          about(ev.disagreements, b) || about(ev.deviations, b);
         if (bad) {
-          const std::string c = cause(ev, b);
+          const std::string c = cause(ev, *run);
           auto it = std::find_if(found.begin(), found.end(), [&](const FailureCause& f) {
             return f.backend == b && f.cause == c;
           });
@@ -331,9 +326,10 @@ std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
         } else {
           ++row.within;
         }
-        if (bj["status"] == "touching") ++row.touching;
+        if (run->status == Status::Touching) ++row.touching;
         // A touching answer has no normal to score, but its query time counts like any.
-        if (bj["status"] == "ok" || bj["status"] == "touching") add_scene(row, scenes[i], ev, bj);
+        if (run->status == Status::Ok || run->status == Status::Touching)
+          add_scene(row, scenes[i], ev, *run);
       }
       if (row.run > 0) group.push_back(std::move(row));
     }

@@ -35,6 +35,15 @@ std::vector<Backend> table_with_failing_backends() {
   return {thrower, *find_backend("custom"), *find_backend("exact"), failer};
 }
 
+// The scene evaluated with table_with_failing_backends(), no time-step sweep.
+SceneEvaluation evaluate_beside_failing_backends(const Scene& scene) {
+  const std::vector<Backend> table = table_with_failing_backends();
+  HarnessOptions opt;
+  opt.registry = &table;
+  opt.sweep = false;
+  return evaluate_scene(scene, opt);
+}
+
 // True when some metric of `backend` is named `name`.
 bool has_metric(const SceneEvaluation& ev, const std::string& backend, const std::string& name) {
   return std::any_of(ev.metrics.begin(), ev.metrics.end(),
@@ -47,11 +56,7 @@ TEST(Harness, AThrowingContactBackendDoesNotStopTheOthers) {
       "checks = [\"contact\"]\n[sim]\nduration = 0\n[[body]]\nname = \"A\"\n"
       "[[body]]\nname = \"B\"\nposition = [0.9, 0, 0]\n",
       "pair.toml");
-  const std::vector<Backend> table = table_with_failing_backends();
-  HarnessOptions opt;
-  opt.registry = &table;
-  opt.sweep = false;
-  const SceneEvaluation ev = evaluate_scene(scene, opt);
+  const SceneEvaluation ev = evaluate_beside_failing_backends(scene);
   const Json& b = ev.json["backends"];
   EXPECT_EQ(b["thrower"]["status"], "error");
   EXPECT_EQ(b["thrower"]["message"], "thrower: contact query failed");
@@ -72,11 +77,7 @@ TEST(Harness, AThrowingDynamicsBackendDoesNotStopTheOthers) {
       "position = [-1, 0, 0]\nvelocity = [1, 0, 0]\n[[body]]\nname = \"B\"\n"
       "position = [1, 0, 0]\nvelocity = [-1, 0, 0]\n",
       "face_face.toml");
-  const std::vector<Backend> table = table_with_failing_backends();
-  HarnessOptions opt;
-  opt.registry = &table;
-  opt.sweep = false;
-  const SceneEvaluation ev = evaluate_scene(scene, opt);
+  const SceneEvaluation ev = evaluate_beside_failing_backends(scene);
   const Json& b = ev.json["backends"];
   EXPECT_EQ(b["thrower"]["status"], "error");
   EXPECT_EQ(b["thrower"]["message"], "thrower: dynamics run failed");
@@ -86,6 +87,44 @@ TEST(Harness, AThrowingDynamicsBackendDoesNotStopTheOthers) {
   EXPECT_TRUE(has_metric(ev, "custom", "energy_err"));
   // exact has no dynamics: selected by default only where it serves, so it is not listed.
   EXPECT_FALSE(b.contains("exact"));
+}
+
+TEST(Harness, TheTypedRunsAndStabilityRowsSayWhatTheJsonSays) {
+  // A cube dropped on a static slab, checked for stability, with a throwing and a failing
+  // backend beside custom: ev.runs and ev.stability (what the pages render) carry each backend's
+  // status, message, run time and stability rows as the scene's JSON has them, and a row
+  // written back is its JSON entry, key for key.
+  const Scene scene = parse_scene(
+      "checks = [\"stability\"]\n[sim]\nduration = 0.2\ngravity = [0, 0, -9.81]\n"
+      "[[body]]\nname = \"floor\"\nstatic = true\nsize = [4, 4, 0.2]\n"
+      "position = [0, 0, -0.1]\n[[body]]\nname = \"cube\"\nposition = [0, 0, 0.6]\n",
+      "drop.toml");
+  const SceneEvaluation ev = evaluate_beside_failing_backends(scene);
+  const Json& b = ev.json["backends"];
+  ASSERT_EQ(ev.runs.size(), b.size());
+  for (const BackendRun& r : ev.runs) {
+    ASSERT_TRUE(b.contains(r.backend)) << r.backend;
+    EXPECT_EQ(to_string(r.status), b[r.backend]["status"]) << r.backend;
+    EXPECT_EQ(r.message, b[r.backend]["message"]) << r.backend;
+    ASSERT_TRUE(r.runtime_s.has_value()) << r.backend;
+    EXPECT_EQ(*r.runtime_s, b[r.backend]["runtime_s"].get<double>()) << r.backend;
+  }
+  ASSERT_NE(ev.run_of("thrower"), nullptr);
+  EXPECT_EQ(ev.run_of("thrower")->status, Status::Error);
+  EXPECT_EQ(ev.run_of("thrower")->message, "thrower: dynamics run failed");
+  EXPECT_EQ(ev.run_of("nobody"), nullptr);
+  const Json& stability = ev.json["stability"];
+  ASSERT_TRUE(stability.contains("custom"));
+  EXPECT_EQ(ev.run_of("custom")->stability, stability["custom"]["verdict"]);
+  size_t rows = 0;
+  for (const StabilityRow& row : ev.stability) {
+    ASSERT_FALSE(row.swept);  // the scene names no stability sweep
+    ASSERT_TRUE(stability.contains(row.backend)) << row.backend;
+    EXPECT_EQ(stability_json(row), stability[row.backend]) << row.backend;
+    ++rows;
+  }
+  EXPECT_EQ(rows, stability.size());
+  ASSERT_GE(rows, 1u);
 }
 
 TEST(Harness, BodiesThatStartStillAreJudgedAgainstTheMotionTheRunMade) {

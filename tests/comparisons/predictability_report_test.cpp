@@ -56,6 +56,7 @@ void add_scene(std::vector<Scene>& scenes, std::vector<SceneEvaluation>& evs,
     ensemble.backends.push_back(backend_ensemble(b, a, verdict));
   }
   if (!amplification.empty()) ev.ensemble = std::make_shared<const EnsembleResult>(ensemble);
+  read_runs(ev);
   scenes.push_back(s);
   evs.push_back(ev);
 }
@@ -118,6 +119,7 @@ TEST(Predictability, TheScorecardShowsTheMedianAmplificationOfAFamilysEnsembles)
   add_scene(scenes, evs, "friction", "c", {{"custom", 30.0}});
   add_scene(scenes, evs, "seed", "d", {});
   evs[3].json["backends"]["custom"] = {{"status", "ok"}};
+  read_runs(evs[3]);
   const std::vector<ScoreRow> rows = score_rows(scenes, evs, {"custom"});
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[0].predictability_text(), "30 (3)");
