@@ -396,6 +396,8 @@ void make_solver_fair(btDiscreteDynamicsWorld& world, const BulletSettings& sett
   // Enough Gauss-Seidel sweeps for multi-point manifolds to converge (default 10); a
   // single-point impact is exact after the first.
   info.m_numIterations = 100;
+  info.m_erp2 = settings.contact_erp;
+  info.m_globalCfm = settings.contact_cfm;
 }
 
 /// Scene body `i` as a Bullet body, in the principal frame of its inertia. Not yet in a world.
@@ -723,6 +725,30 @@ MassResult bullet_hull_mass(const RigidBody& body) {
   return r;
 }
 
+// The contact softness Bullet's users tune, from `base`'s settings: the contact error reduction
+// and constraint force mixing of btContactSolverInfo.
+SoftContact bullet_soft(const BulletSettings& base) {
+  return {{{"erp",
+            "m_erp2: the share of a penetration the split impulse's push corrects per step",
+            base.contact_erp,
+            0.0,
+            1.0,
+            {0.05, 0.1, 0.4, 0.8, 1.0}},
+           {"cfm",
+            "m_globalCfm: constraint force mixing, softening every contact",
+            base.contact_cfm,
+            0.0,
+            1.0,
+            {1e-6, 1e-5, 1e-4, 1e-3, 3e-3, 1e-2}}},
+          [base](const WorldDefinition& scene, const DynamicsOptions& opt,
+                 const std::vector<double>& v) {
+            BulletSettings s = base;
+            s.contact_erp = v.at(0);
+            s.contact_cfm = v.at(1);
+            return run_bullet_world(scene, opt, s);
+          }};
+}
+
 }  // namespace
 
 const Adapter& bullet_adapter() {
@@ -730,19 +756,24 @@ const Adapter& bullet_adapter() {
       {
           // Native boxes (btBoxShape, btBoxBoxDetector on two boxes), polyhedral hulls clipped
           // about the GJK + EPA axis otherwise, zero hull margin, the fair world.
-          with_budget(
-              {"bullet", "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
-               query<bullet_native_settings>, dynamics_run<bullet_native_settings>, bullet_mass},
-              bullet_budget())
+          with_soft(with_budget(
+                        {"bullet",
+                         "Bullet 3.24 double: btBoxShape or polyhedral hull (clipped); fair world",
+                         query<bullet_native_settings>, dynamics_run<bullet_native_settings>,
+                         bullet_mass},
+                        bullet_budget()),
+                    bullet_soft(bullet_native_settings()))
               .measuring(distance_query<bullet_native_settings>)
               .sweeping(toi_query<bullet_native_settings, BulletCast::Continuous>)
               .drawn("#009E73", "o")
               .timed(2048, 2048),
           // Every body a zero-margin btConvexHullShape through GJK + EPA (one point).
-          with_budget(
-              {"bullet-hull", "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",
-               query<bullet_hull_settings>, dynamics_run<bullet_hull_settings>, bullet_hull_mass},
-              bullet_budget())
+          with_soft(with_budget({"bullet-hull",
+                                 "Bullet 3.24 double: zero-margin hull GJK + EPA; fair world",
+                                 query<bullet_hull_settings>, dynamics_run<bullet_hull_settings>,
+                                 bullet_hull_mass},
+                                bullet_budget()),
+                    bullet_soft(bullet_hull_settings()))
               .measuring(distance_query<bullet_hull_settings>)
               .sweeping(toi_query<bullet_hull_settings, BulletCast::Continuous>)
               .drawn("#00543D", "s"),

@@ -39,6 +39,12 @@ struct BulletSettings {
   // at the first hit; 0: off (Bullet's default).
   double ccd_motion_fraction = 1.0;
   double ccd_sphere_fraction = 0.9;
+  // The contact softness Bullet's users tune (btContactSolverInfo), at Bullet's own values unless
+  // a fit sets them: the share of a penetration the split impulse's push corrects per step
+  // (m_erp2) and the constraint force mixing that softens every contact (m_globalCfm, per unit
+  // of time step as Bullet scales it).
+  double contact_erp = 0.2;
+  double contact_cfm = 0.0;
 };
 
 /// `bullet`: native boxes, polyhedral hulls (GJK + EPA axis, clipped manifold), zero hull

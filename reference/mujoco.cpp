@@ -41,6 +41,7 @@
 #include "engine/format.h"
 #include "reference/c_error_trap.h"
 #include "reference/dynamics_recorder.h"
+#include "reference/mujoco_soft.h"
 #include "reference/prebuilt_cache.h"
 
 namespace {
@@ -75,9 +76,6 @@ namespace {
 // time-discretisation error of one impact is fixed (measured at 25: 1e-4 in e at e = 1, e within
 // 0.485..0.517 for a target of 0.5 depending on the entry phase) while the penetration, about
 // v * 25 dt / pi, shrinks with dt.
-// Constant impedance d for contacts (solimp dmin = dmax): MuJoCo's largest, 1 - 1e-4. Then
-// the solver's acceleration is aref to within 1e-4, whatever its diagonal approximation.
-constexpr double kImpedance = 0.9999;
 
 // Installs our handlers (MuJoCo keeps them in two global function pointers).
 void install_handlers() {
@@ -114,6 +112,7 @@ struct ContactParams {
   double stiffness = 0.0;  // 1/s^2, per unit effective mass (solref = -stiffness)
   double damping = 0.0;    // 1/s, per unit effective mass (solref = -damping)
   double friction = 0.0;   // Coulomb mu; 0: frictionless (condim 1)
+  double impedance = MujocoSettings{}.impedance;  // solimp dmin = dmax
 };
 
 // Model-level options.
@@ -179,7 +178,7 @@ std::string geom_contact_attributes(const ContactParams& c) {
   else
     s << " condim=\"1\"";
   s << " solref=\"" << num(-c.stiffness) << " " << num(-c.damping) << "\"";
-  s << " solimp=\"" << num(kImpedance) << " " << num(kImpedance) << " 0.001 0.5 2\"";
+  s << " solimp=\"" << num(c.impedance) << " " << num(c.impedance) << " 0.001 0.5 2\"";
   return s.str();
 }
 
@@ -394,73 +393,6 @@ ContactPoint convert_contact(const mjContact& c, bool geom1_is_a) {
   return p;
 }
 
-// Stiffness (1/s^2, per unit effective mass) for a contact lasting `steps` steps when
-// undamped: half period pi / sqrt(k) = steps * dt.
-double contact_stiffness(double dt, double steps) {
-  const double w = M_PI / (steps * dt);
-  return w * w;
-}
-
-// Restitution of one soft contact as MuJoCo integrates it, in contact space and in units where
-// dt = 1 and the approach speed is 1 (the map is scale-free: see restitution_damping_ratio).
-// `entry_phase` in [0, 1] is the penetration at the first step that sees the contact, in units
-// of (approach speed * dt): contacts are detected at step starts, so the body is already that
-// deep. Semi-implicit Euler with aref explicit in x and v, as mj_step does:
-//   a = max(0, -b x' - k x),  x' += a,  x += x'   (x = dist, < 0 inside)
-// until the body is out (x >= 0); the returned separation speed is e.
-double soft_contact_restitution(double zeta, double entry_phase, double steps) {
-  const double w = M_PI / steps;  // sqrt(k0) * dt
-  const double k = w * w, b = 2.0 * zeta * w;
-  double v = -1.0, x = -entry_phase;
-  for (int it = 0; it < 1000000 && x < 0.0; ++it) {
-    v += std::max(0.0, -b * v - k * x);  // the contact pushes, never pulls
-    x += v;
-  }
-  return v;
-}
-
-// Damping ratio zeta that makes MuJoCo's soft contact return restitution e.
-//
-// Model. With a direct solref (-k0, -b0) and a constant impedance d, MuJoCo uses
-// K = k0/d^2, B = b0/d and aref = -B v - K d x (x = dist, < 0 inside, v its rate); for one
-// frictionless contact the solver's constraint acceleration is
-// a = a0 + A/(A+R) (aref - a0), R = (1-d)/d * A~ (A~ its diagonal approximation), i.e. a = aref
-// to O(1-d) = 1e-4. So the penetration delta = -x obeys delta'' = -b0 delta' - k0 delta: a
-// spring-dashpot per unit effective mass (the effective mass 1/A drops out, so the map holds
-// for any masses and lever arms). Assumptions: one contact point, normal and lever arm fixed
-// during the impact, no gravity or other force during it, d = 0.9999.
-//
-// Continuous map (the derivation). The constraint cannot pull (force >= 0), so contact ends
-// when k0 delta + b0 delta' reaches zero (delta'' = 0), before delta returns to zero; the
-// classic e = exp(-zeta pi / sqrt(1 - zeta^2)) assumes the dashpot may pull until delta = 0
-// and overestimates the dissipation (e = 0.5 needs zeta = 0.215 classic, 0.255 unilateral).
-// With zeta = b0 / (2 sqrt(k0)), delta(0) = 0, delta'(0) = v0:
-//   zeta < 1: e = exp(-zeta/sqrt(1-zeta^2) * (pi - 2 asin zeta))
-//             (delta'' = 0 at w_d t = pi - 2 asin zeta, where delta' = -v0 exp(-b0 t / 2))
-//   zeta = 1: e = exp(-2)
-//   zeta > 1: e = ((zeta - s)/(zeta + s))^(zeta/s), s = sqrt(zeta^2 - 1)
-//
-// Discrete correction (what we invert). At 25 steps per contact (`steps`) the explicit
-// damping factor (1 - b0 dt) per step, against exp(-b0 dt), lowers e by a few percent (e = 0.1
-// came out 0.072 in MuJoCo with the continuous map, exactly as the recursion predicts). So we
-// invert soft_contact_restitution() at the mean entry phase 1/2 by bisection (e decreases
-// monotonically in zeta). The entry phase itself is unknown in advance: over phases 0..1 the
-// returned e lies between 0.485 and 0.517 for a target of 0.5. zeta is capped where b0 dt = 1
-// (more explicit damping would overshoot); e below what the cap reaches is not representable
-// and gets the cap (the result's message says so).
-double restitution_damping_ratio(double e, double steps) {
-  const double zeta_max = steps / (2.0 * M_PI);  // b0 dt = 2 zeta pi / steps = 1
-  constexpr double kEntryPhase = 0.5;
-  if (e >= 1.0) return 0.0;
-  if (e <= soft_contact_restitution(zeta_max, kEntryPhase, steps)) return zeta_max;
-  double lo = 0.0, hi = zeta_max;
-  for (int it = 0; it < 100; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (soft_contact_restitution(mid, kEntryPhase, steps) > e ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
 // The library's own mass properties of a box geom (`box`) or of the hull mesh.
 MassResult mass_of_geom(const RigidBody& body, bool box) {
   MassResult r;
@@ -607,6 +539,7 @@ ModelOptions model_options(const WorldDefinition& scene, double dt,
   mo.contact.stiffness = contact_stiffness(dt, settings.contact_steps);
   mo.contact.damping = 2.0 * zeta * std::sqrt(mo.contact.stiffness);
   mo.contact.friction = scene.sim.friction;
+  mo.contact.impedance = settings.impedance;
   mo.box_geoms = use_box_geoms(bodies, settings);
   mo.multiccd = settings.multiccd;
   mo.elliptic_cone = settings.elliptic_cone;
@@ -844,9 +777,10 @@ SolverBudget mujoco_budget() {
   return {"opt.iterations (Newton solver)", {1, 3, 10, 100}, 100, 100};
 }
 
-// The contact softness MuJoCo's users tune (solref's time constant), from `base`'s settings: the
-// undamped contact's duration in steps; a fit tries from 5 (MuJoCo's documented floor for
-// solref's time constant is 2 dt) to 60 steps.
+// The contact softness MuJoCo's users tune, from `base`'s settings: solref's time constant (the
+// undamped contact's duration in steps; a fit tries from 5, MuJoCo's documented floor for it
+// being 2 dt, to 60 steps) and solimp's impedance (constant; 0.5 to 0.999, MuJoCo's default dmin
+// being 0.9).
 SoftContact mujoco_soft(const MujocoSettings& base) {
   return {{{"contact_steps",
             "undamped soft-contact duration in steps (solref's time constant over dt; the damping "
@@ -854,11 +788,19 @@ SoftContact mujoco_soft(const MujocoSettings& base) {
             base.contact_steps,
             3.0,
             1000.0,
-            {5, 10, 15, 25, 40, 60}}},
+            {5, 10, 15, 25, 40, 60}},
+           {"impedance",
+            "solimp's constant impedance d (dmin = dmax): the share of the contact's reference "
+            "acceleration the solver enforces (MuJoCo's range 1e-4 to 0.9999)",
+            base.impedance,
+            1e-4,
+            0.9999,
+            {0.5, 0.7, 0.8, 0.9, 0.95, 0.99, 0.999}}},
           [base](const WorldDefinition& scene, const DynamicsOptions& opt,
                  const std::vector<double>& v) {
             MujocoSettings s = base;
             s.contact_steps = v.at(0);
+            s.impedance = v.at(1);
             return mujoco_dynamics_with(scene, opt, s);
           }};
 }

@@ -19,6 +19,12 @@ struct MujocoSettings {
   // Soft-contact duration: an undamped contact lasts this many steps (solref's time constant,
   // as a multiple of dt; the damping then follows from the scene's restitution).
   double contact_steps = 25.0;
+  // Constant impedance d for contacts (solimp dmin = dmax): MuJoCo's largest, 1 - 1e-4, unless a
+  // fit sets it. Then the solver's acceleration is the reference acceleration to within 1e-4,
+  // whatever its diagonal approximation, which the restitution map assumes
+  // (restitution_damping_ratio); below it a share 1 - d of the unconstrained acceleration
+  // (gravity) leaks through the contact.
+  double impedance = 0.9999;
 };
 
 /// `mujoco-hull`: every body a mesh geom, single-point MPR.

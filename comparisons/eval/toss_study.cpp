@@ -220,10 +220,12 @@ Json updated_params_json(const std::string& path, const std::string& data,
       "Restitution e and Coulomb friction mu per dynamics backend, fitted on the training tosses "
       "by `rbx tosses train.csv.gz --fit` (5 x 6 grid over e in [0, 1], mu in [0, 1.5], then "
       "Nelder-Mead; objective: mean position error in cube widths); then, for a backend with a "
-      "contact softness its experts tune (soft: MuJoCo's contact duration in steps, ODE's and "
-      "DART's erp and cfm), each such parameter over its grid (soft_grid) at the fitted e and mu, "
-      "the best kept. Backends not listed run at the published e = 0.125, mu = 0.18 and their "
-      "own softness.";
+      "contact softness its experts tune (soft: MuJoCo's contact duration in steps and impedance, "
+      "ODE's and DART's erp and cfm, Bullet's contact erp and cfm), each such parameter "
+      "over its grid (soft_grid) at the fitted e and mu, the best kept (soft_scan: every value "
+      "tried and its objective), and, when the softness moved from the backend's own (soft_own), "
+      "e and mu fitted again at it (fit_stages: the objective after each stage). Backends not "
+      "listed run at the published e = 0.125, mu = 0.18 and their own softness.";
   j["model"] = model_json(CubeTossModel{});
   Json& b = j["backends"];
   if (!b.is_object()) b = Json::object();
@@ -235,6 +237,10 @@ Json updated_params_json(const std::string& path, const std::string& data,
                {"evaluations", fit.evaluations},
                {"fit_s", fit.seconds}};
     for (const auto& [p, v] : fit.params.soft) b[name]["soft"][p] = v;
+    for (const auto& [stage, v] : fit.stages)
+      b[name]["fit_stages"].push_back({{"stage", stage}, {"train_position_error", v}});
+    for (const SoftTrial& t : fit.soft_scan)
+      b[name]["soft_scan"][t.parameter].push_back({t.value, t.objective});
     if (const Backend* be = find_backend(name))
       for (const SoftParameter& p : be->soft.parameters) {
         b[name]["soft_grid"][p.name] = p.grid;

@@ -174,17 +174,29 @@ BackendTosses evaluate_backend(const Backend& backend, const std::vector<Toss>& 
 double fit_objective(const Backend& backend, const std::vector<Toss>& tosses,
                      const ContactParams& params, const CubeTossModel& model = {});
 
+/// One value of a softness parameter tried by the fit, with its objective.
+struct SoftTrial {
+  std::string parameter;
+  double value = 0.0;
+  double objective = 0.0;  // mean position error (cube widths) on the fit tosses
+};
+
 /// Outcome of fitting one backend.
 struct FitResult {
   ContactParams params;
   double objective = 0.0;  // mean position error (cube widths) on the fit tosses
   int evaluations = 0;     // objective evaluations
   double seconds = 0.0;    // wall time
+  // The objective after each stage: "e, mu"; then, with a softness, "softness" and, when the
+  // softness moved from the backend's own, "e, mu at the softness".
+  std::vector<std::pair<std::string, double>> stages;
+  std::vector<SoftTrial> soft_scan;  // every softness value tried, the backend's own included
 };
 /// Fits restitution in [0, 1] and friction in [0, 1.5]: a 5 x 6 grid, then Nelder-Mead from
-/// the best grid point (simplex of one grid spacing, parameters clamped into the box, at most
+/// the best grid point (simplex of half a grid spacing, parameters clamped into the box, at most
 /// 30 evaluations); then, for a backend with contact softness (Backend::soft), each of its
-/// parameters in turn over its grid at the fitted e and mu, the best kept (one pass).
+/// parameters in turn over its grid at the fitted e and mu, the best kept (one pass); then, if
+/// the softness moved, Nelder-Mead on e and mu again at it from the fitted point (toss_fit.cpp).
 /// Deterministic: no random numbers.
 FitResult fit_backend(const Backend& backend, const std::vector<Toss>& tosses,
                       const CubeTossModel& model = {},

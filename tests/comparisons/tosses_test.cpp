@@ -8,6 +8,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -297,7 +298,7 @@ TEST(TossesSoft, OwnValuesReproduceTheBackendAndAnotherValueMovesIt) {
       EXPECT_NE(moved.track.position, plain.track.position) << b.name << " " << p.name;
     }
   }
-  EXPECT_EQ(tuned, 6);  // mujoco, ode and dart, each with its -hull variant
+  EXPECT_EQ(tuned, 8);  // mujoco, ode, dart and bullet, each with its -hull variant
 }
 
 TEST(TossesSoft, AnUnknownOrOutOfRangeSoftParameterExitsTwoNamingFileAndKey) {
@@ -311,9 +312,13 @@ TEST(TossesSoft, AnUnknownOrOutOfRangeSoftParameterExitsTwoNamingFileAndKey) {
        "backends.ode.soft.erp: must be a number in [0, 1], got -0.5"},
       {R"("mujoco": {"restitution": 0.1, "friction": 0.2, "soft": {"timeconst": 0.02}})",
        "backends.mujoco.soft.timeconst: not a soft-contact parameter of mujoco (it has "
-       "contact_steps)"},
-      {R"("bullet": {"restitution": 0.1, "friction": 0.2, "soft": {"erp": 0.2}})",
-       "backends.bullet.soft.erp: not a soft-contact parameter of bullet (it has none)"},
+       "contact_steps, impedance)"},
+      {R"("mujoco": {"restitution": 0.1, "friction": 0.2, "soft": {"impedance": 1.0}})",
+       "backends.mujoco.soft.impedance: must be a number in [0.0001, 0.9999], got 1.0"},
+      {R"("bullet": {"restitution": 0.1, "friction": 0.2, "soft": {"erp": 1.5}})",
+       "backends.bullet.soft.erp: must be a number in [0, 1], got 1.5"},
+      {R"("custom": {"restitution": 0.1, "friction": 0.2, "soft": {"erp": 0.2}})",
+       "backends.custom.soft.erp: not a soft-contact parameter of custom (it has none)"},
       {R"("dart": {"restitution": 0.1, "friction": 0.2, "soft": {"cfm": "1e-5"}})",
        "backends.dart.soft.cfm: must be a number in [1e-09, 1]"},
   };
@@ -415,27 +420,34 @@ TEST(TossesEvaluate, ALibraryAbortingOnOneTossFailsThatTossAloneAndTheOthersAreK
   EXPECT_EQ(r.tosses[1].toss_id, 3);
 }
 
+// A tumbling, sliding toss of 90 samples "measured" by `backend` itself at `params` (its
+// softness set): a toss some parameter set reproduces exactly.
+Toss toss_measured_by(const Backend& backend, const ContactParams& params,
+                      const CubeTossModel& model) {
+  Toss toss;
+  toss.id = 0;
+  for (int i = 0; i < 90; ++i)
+    toss.samples.push_back(
+        {i / model.sample_rate, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3::Zero()});
+  toss.samples[0] = {0.0, Vec3(0, 0, 0.15),
+                     Quat(Eigen::AngleAxisd(0.4, Vec3(1, 2, 0).normalized())), Vec3(0.8, 0.1, -0.5),
+                     Vec3(3, -2, 1)};
+  const TossRun truth = simulate_toss(toss_backend(backend, params).dynamics, toss, params, model);
+  EXPECT_EQ(truth.status, Status::Ok) << truth.message;
+  for (size_t i = 0; i < toss.samples.size() && i < truth.track.position.size(); ++i) {
+    toss.samples[i].position = truth.track.position[i];
+    toss.samples[i].orientation = truth.track.orientation[i];
+  }
+  return toss;
+}
+
 TEST(TossesFit, RecoversTheParametersThatGeneratedATossOnTheGrid) {
   // A tumbling, sliding toss "measured" by ODE itself at e = 0.5, mu = 0.3 (a grid point): the
   // fit must find an objective of exactly 0 there (the runs are deterministic).
   const Backend* ode = find_backend("ode");
   ASSERT_NE(ode, nullptr);
   const CubeTossModel model;
-  Toss seed;
-  seed.id = 0;
-  for (int i = 0; i < 90; ++i)
-    seed.samples.push_back(
-        {i / model.sample_rate, Vec3::Zero(), Quat::Identity(), Vec3::Zero(), Vec3::Zero()});
-  seed.samples[0] = {0.0, Vec3(0, 0, 0.15),
-                     Quat(Eigen::AngleAxisd(0.4, Vec3(1, 2, 0).normalized())), Vec3(0.8, 0.1, -0.5),
-                     Vec3(3, -2, 1)};
-  const TossRun truth = simulate_toss(ode->dynamics, seed, {0.5, 0.3, {}}, model);
-  ASSERT_EQ(truth.status, Status::Ok) << truth.message;
-  Toss measured = seed;
-  for (size_t i = 0; i < measured.samples.size(); ++i) {
-    measured.samples[i].position = truth.track.position[i];
-    measured.samples[i].orientation = truth.track.orientation[i];
-  }
+  const Toss measured = toss_measured_by(*ode, {0.5, 0.3, {}}, model);
   // Another parameter set gives a visibly different toss (the fit has something to find).
   EXPECT_GT(fit_objective(*ode, {measured}, {0.125, 0.18, {}}, model), 1e-3);
   const FitResult fit = fit_backend(*ode, {measured}, model);
@@ -443,6 +455,94 @@ TEST(TossesFit, RecoversTheParametersThatGeneratedATossOnTheGrid) {
   EXPECT_EQ(fit.params.restitution, 0.5);
   EXPECT_EQ(fit.params.friction, 0.3);
   EXPECT_GE(fit.evaluations, 30);
+}
+
+TEST(TossesFit, ASoftnessThatMovedIsFollowedByEAndMuFittedAgainAtIt) {
+  // A toss "measured" by ODE at e = 0.5, mu = 0.3 and a softer contact than ODE's own (cfm 1e-3):
+  // the first fit, at ODE's own softness, cannot reach it, so the softness pass moves; every grid
+  // value's objective is kept beside the chosen; then e and mu are searched again at the chosen
+  // softness (every call names it), and the stored parameters reproduce the stored objective.
+  const Backend* ode = find_backend("ode");
+  ASSERT_NE(ode, nullptr);
+  const CubeTossModel model;
+  const Toss measured = toss_measured_by(*ode, {0.5, 0.3, {{"cfm", 1e-3}}}, model);
+  std::vector<std::string> calls;
+  const FitResult fit =
+      fit_backend(*ode, {measured}, model, [&](const std::string& line) { calls.push_back(line); });
+  ASSERT_EQ(fit.stages.size(), 3u);
+  EXPECT_EQ(fit.stages[0].first, "e, mu");
+  EXPECT_EQ(fit.stages[1].first, "softness");
+  EXPECT_EQ(fit.stages[2].first, "e, mu at the softness");
+  EXPECT_LT(fit.stages[1].second, fit.stages[0].second);
+  EXPECT_LE(fit.stages[2].second, fit.stages[1].second);
+  EXPECT_EQ(fit.objective, fit.stages[2].second);
+  ASSERT_EQ(fit.params.soft.size(), 2u);
+  EXPECT_EQ(fit_objective(*ode, {measured}, fit.params, model), fit.objective);
+  // The last search ran at the chosen softness: its calls name it.
+  const std::string at = " at " + soft_text({0, 0, fit.params.soft}) + " -> ";
+  ASSERT_FALSE(calls.empty());
+  EXPECT_NE(calls.back().find(at), std::string::npos) << calls.back() << " / " << at;
+  EXPECT_EQ(static_cast<int>(calls.size()), fit.evaluations);
+  // Every value of both grids, and each parameter's own, has its objective beside the chosen.
+  size_t tried = 0;
+  for (const SoftParameter& p : ode->soft.parameters) {
+    tried += p.grid.size() + 1;
+    for (const double g : p.grid) {
+      if (g == p.value) --tried;
+      EXPECT_TRUE(std::any_of(fit.soft_scan.begin(), fit.soft_scan.end(),
+                              [&](const SoftTrial& t) {
+                                return t.parameter == p.name && t.value == g &&
+                                       std::isfinite(t.objective);
+                              }))
+          << p.name << " " << g;
+    }
+  }
+  EXPECT_EQ(fit.soft_scan.size(), tried);
+}
+
+TEST(TossesFit, TheCommittedParametersCarryEverySoftnessTriedAndKeepTheBest) {
+  // scenes/real/cube_toss/params.json as `rbx tosses --fit` writes it: every backend with a
+  // softness has every value of its grid and its own in soft_scan, the chosen value is the scan's
+  // best of its parameter, and the stages never end worse than they began. A hand-edited softness
+  // or a scan left out fails here.
+  const std::string path = std::string(RBX_SOURCE_DIR) + "/scenes/real/cube_toss/params.json";
+  std::ifstream in(path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  int scanned = 0;
+  for (const Backend& b : backends()) {
+    if (b.soft.parameters.empty() || !j["backends"].contains(b.name)) continue;
+    const nlohmann::json& e = j["backends"][b.name];
+    ASSERT_TRUE(e.contains("soft_scan")) << b.name;
+    ++scanned;
+    for (const SoftParameter& p : b.soft.parameters) {
+      const nlohmann::json& scan = e["soft_scan"][p.name];
+      std::vector<double> values;
+      double best = INFINITY, best_value = NAN;
+      for (const auto& t : scan) {
+        values.push_back(t[0].get<double>());
+        // A value at which a toss failed has an infinite objective, which JSON writes as null.
+        const double v = t[1].is_null() ? INFINITY : t[1].get<double>();
+        if (v < best) best = v, best_value = t[0].get<double>();
+      }
+      std::vector<double> expected = p.grid;
+      if (std::find(expected.begin(), expected.end(), p.value) == expected.end())
+        expected.push_back(p.value);
+      std::sort(values.begin(), values.end());
+      std::sort(expected.begin(), expected.end());
+      EXPECT_EQ(values, expected) << b.name << " " << p.name;
+      EXPECT_EQ(e["soft"][p.name].get<double>(), best_value) << b.name << " " << p.name;
+    }
+    const nlohmann::json& stages = e["fit_stages"];
+    ASSERT_GE(stages.size(), 2u) << b.name;
+    for (size_t i = 1; i < stages.size(); ++i)
+      EXPECT_LE(stages[i]["train_position_error"].get<double>(),
+                stages[i - 1]["train_position_error"].get<double>())
+          << b.name;
+    EXPECT_EQ(stages.back()["train_position_error"].get<double>(),
+              e["train_position_error"].get<double>())
+        << b.name;
+  }
+  EXPECT_EQ(scanned, 8);  // mujoco, ode, dart and bullet, each with its -hull variant
 }
 
 TEST(TossesCommand, JsonIsDeterministicAndHasTheContractFields) {
