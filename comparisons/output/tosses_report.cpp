@@ -41,9 +41,12 @@ Table toss_results_table(const std::vector<BackendTosses>& rs, bool markdown) {
         b && !b->friction ? "none (frictionless)" : fmt_num(r.params.friction, 3);
     // The contact softness run: the fitted values, else the backend's own (rbx's settings).
     std::string soft = soft_text(r.params);
-    if (soft.empty() && b)
-      for (const SoftParameter& p : b->soft.parameters)
-        soft += (soft.empty() ? "own: " : ", ") + p.name + " " + fmt_num(p.value, 3);
+    if (soft.empty() && b && !b->soft.parameters.empty()) {
+      // Written as the fitted values are: three digits would show MuJoCo's 0.9999 as 1.
+      ContactParams own;
+      for (const SoftParameter& p : b->soft.parameters) own.soft.emplace_back(p.name, p.value);
+      soft = "own: " + soft_text(own);
+    }
     t.add({std::to_string(++rank), r.name, fmt_num(r.params.restitution, 3), mu,
            soft.empty() ? "-" : soft, r.params_source, std::to_string(r.tosses.size()),
            triple(spread_of(pos), 3), triple(spread_of(ang), 3), triple(spread_of(fin), 3),
