@@ -1,5 +1,7 @@
 #include "comparisons/eval/harness.h"
 
+#include <limits>
+
 #include "comparisons/eval/evaluator.h"
 
 namespace rbx {
@@ -119,24 +121,31 @@ Json stability_json(const StabilityRow& r) {
 
 namespace {
 
+// A number of a stability entry: a value that was not finite was written as null (JSON has no
+// NaN or infinity) when the evaluation crossed processes; it reads back as NaN, never throws.
+double number_at(const Json& s, const char* key) {
+  const Json& v = s.at(key);
+  return v.is_null() ? std::numeric_limits<double>::quiet_NaN() : v.get<double>();
+}
+
 StabilityRow stability_row(const std::string& backend, bool swept, const Json& s) {
   StabilityRow r;
   r.backend = backend;
   r.swept = swept;
   r.status = s.at("status");
-  r.dt = s.at("dt");
-  r.restitution = s.at("restitution");
+  r.dt = number_at(s, "dt");
+  r.restitution = number_at(s, "restitution");
   r.nonfinite = s.at("nonfinite");
-  r.energy_growth_rel = s.at("energy_growth_rel");
-  r.energy_drift_rel = s.at("energy_drift_rel");
-  r.energy_change_rel = s.at("energy_change_rel");
-  if (s.contains("momentum_drift_rel")) r.momentum_drift_rel = s["momentum_drift_rel"];
+  r.energy_growth_rel = number_at(s, "energy_growth_rel");
+  r.energy_drift_rel = number_at(s, "energy_drift_rel");
+  r.energy_change_rel = number_at(s, "energy_change_rel");
+  if (s.contains("momentum_drift_rel")) r.momentum_drift_rel = number_at(s, "momentum_drift_rel");
   if (s.contains("angular_momentum_drift_rel"))
-    r.angular_momentum_drift_rel = s["angular_momentum_drift_rel"];
-  r.max_penetration_rel = s.at("max_penetration_rel");
-  r.rest_penetration_rel = s.at("rest_penetration_rel");
+    r.angular_momentum_drift_rel = number_at(s, "angular_momentum_drift_rel");
+  r.max_penetration_rel = number_at(s, "max_penetration_rel");
+  r.rest_penetration_rel = number_at(s, "rest_penetration_rel");
   r.tunnelled_pairs = s.at("tunnelled_pairs");
-  if (s.contains("jitter_rms_mps")) r.jitter_rms_mps = s["jitter_rms_mps"];
+  if (s.contains("jitter_rms_mps")) r.jitter_rms_mps = number_at(s, "jitter_rms_mps");
   r.verdict = s.at("verdict");
   r.why = s.at("why").get<std::vector<std::string>>();
   return r;

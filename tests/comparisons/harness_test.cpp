@@ -127,6 +127,22 @@ TEST(Harness, TheTypedRunsAndStabilityRowsSayWhatTheJsonSays) {
   ASSERT_GE(rows, 1u);
 }
 
+TEST(Harness, AStabilityNumberWrittenAsNullReadsBackAsNaN) {
+  // A run whose energy overflowed has a non-finite drift, which JSON writes as null once the
+  // evaluation crosses processes: reading it back gives NaN for the pages to show, not a throw.
+  SceneEvaluation ev;
+  ev.json = Json::parse(R"({"backends": {"b": {"status": "ok", "message": "", "runtime_s": 0.5}},
+    "stability": {"b": {"status": "ok", "dt": 0.001, "restitution": 1, "nonfinite": true,
+      "energy_growth_rel": null, "energy_drift_rel": null, "energy_change_rel": null,
+      "max_penetration_rel": 0, "rest_penetration_rel": 0, "tunnelled_pairs": 0,
+      "verdict": "unstable", "why": ["non-finite state"]}}})");
+  read_runs(ev);
+  ASSERT_EQ(ev.stability.size(), 1u);
+  EXPECT_TRUE(std::isnan(ev.stability[0].energy_drift_rel));
+  EXPECT_EQ(ev.stability[0].dt, 0.001);
+  EXPECT_EQ(ev.run_of("b")->stability, "unstable");
+}
+
 TEST(Harness, BodiesThatStartStillAreJudgedAgainstTheMotionTheRunMade) {
   // Two free unit cubes (0.3 and 0.7 kg) placed at the same spot, at rest, no gravity, and a
   // backend that throws them apart with equal and opposite momenta (12 kg m/s, 1 kg m^2/s, each
