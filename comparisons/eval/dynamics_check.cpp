@@ -20,6 +20,14 @@ void Evaluator::dynamics_checks() {
     mains.emplace_back(name,
                        run_dynamics(be, scene_, scene_.sim.dt, fr.sample_every, cache_, inputs_));
   }
+  // The run times: every fresh run timed again, the backends interleaved over this scene.
+  std::vector<const Backend*> timed;
+  std::vector<DynRun*> runs;
+  for (auto& [name, run] : mains) {
+    timed.push_back(&backend(name));
+    runs.push_back(&run);
+  }
+  time_dynamics(timed, runs, scene_, fr.sample_every, opt_.timing_budget_s);
   for (const auto& [name, run] : mains)
     if (run.result.status == Status::Ok)
       for (const BodyFinal& f : run.result.finals)
@@ -85,6 +93,7 @@ void Evaluator::backend_dynamics(const std::string& name, const DynRun& main,
                                  const DynamicsFrame& fr) {
   Json& bj = backend_json(name);
   bj = dynamics_result_json(inputs_, main.result, main.runtime_s);
+  put_timing(main.timing, bj);
   if (main.cached) bj["cached"] = true;
   // The sampled trajectory, for results.json and the 3-D replay (rbx view).
   const size_t moving = static_cast<size_t>(std::count_if(

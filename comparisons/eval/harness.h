@@ -21,8 +21,8 @@ namespace rbx {
 struct HarnessOptions {
   std::string backends;           // --backends LIST ("" : the scene's, or all that serve a check)
   bool sweep = true;              // run the time-step sweep for error against run time
-  double timing_budget_s = 0.01;  // per contact query and backend: timed at least this long
-                                  // (timing.h); 0: the answers only, untimed
+  double timing_budget_s = 0.01;  // per contact query and per main dynamics run, each backend:
+                                  // timed at least this long (timing.h); 0: the answers only
   /// Backends to choose from; nullptr: the registry (reference/registry.cpp). Tests pass their
   /// own table to add a failing backend without touching the registry.
   const std::vector<Backend>* registry = nullptr;

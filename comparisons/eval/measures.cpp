@@ -27,12 +27,14 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
     if (auto hit = cache.load_dynamics(key)) {
       run.result = std::move(hit->result);
       run.runtime_s = hit->runtime_s;
+      run.timing = Timing::once(run.runtime_s);
       run.cached = true;
       return run;
     }
   const TimedDynamics t = run_dynamics_isolated(b, scene, opt);
   run.result = t.result;
   run.runtime_s = t.runtime_s;
+  run.timing = Timing::once(t.runtime_s);
   // A backend that returns fewer final states than bodies has failed in a way we must show.
   if (run.result.status == Status::Ok && run.result.finals.size() != scene.bodies.size()) {
     run.result.status = Status::Error;
@@ -41,6 +43,32 @@ DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample
   }
   if (cacheable) cache.store(key, run.result, run.runtime_s);
   return run;
+}
+
+void time_dynamics(const std::vector<const Backend*>& backends, const std::vector<DynRun*>& runs,
+                   const Scene& scene, long sample_every, double budget_s) {
+  if (budget_s <= 0) return;
+  std::vector<TimedSubject> subjects;
+  std::vector<Timing*> timed;
+  std::vector<DynRun*> fresh;
+  for (size_t i = 0; i < backends.size() && i < runs.size(); ++i) {
+    const Backend& be = *backends[i];
+    DynRun& run = *runs[i];
+    if (run.cached || run.result.status != Status::Ok || !be.dynamics) continue;
+    const DynamicsOptions opt{run.dt, sample_every};
+    subjects.push_back({be.name, be.library, [&be, &scene, opt] { be.dynamics(scene, opt); },
+                        CallDeadlines{}.dynamics_s});
+    timed.push_back(&run.timing);
+    fresh.push_back(&run);
+  }
+  TimingPlan plan;
+  plan.min_time_s = budget_s;
+  time_into(subjects, timed, plan);
+  for (DynRun* run : fresh)
+    if (run->timing.rounds > 0)
+      run->runtime_s = run->timing.median_s;
+    else
+      run->timing = Timing::once(run->runtime_s);
 }
 
 ContactRun answer_contact(const Backend& be, const RigidBody& a, const RigidBody& b,

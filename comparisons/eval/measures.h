@@ -22,7 +22,8 @@ namespace rbx {
 /// A dynamics run with its wall-clock time; library exceptions become status Error.
 struct DynRun {
   DynamicsResult result;
-  double runtime_s = 0.0;
+  double runtime_s = 0.0;  // the answering run's time, or the median of its timed repeats
+  Timing timing;           // cold_s: the answering run; the rest once timed (time_dynamics)
   double dt = 0.0;
   bool cached = false;    // from the reference-result cache
   std::string cache_key;  // the run's cache key ("" : not cacheable)
@@ -34,6 +35,13 @@ struct DynRun {
 /// settings, dt, sampling and budget); otherwise it runs and is stored.
 DynRun run_dynamics(const Backend& b, const Scene& scene, double dt, long sample_every,
                     const ResultCache& cache, const std::vector<RigidBody>& bodies, int budget = 0);
+
+/// Times the fresh, answered runs of one scene together, interleaved (timing.h: warmed up,
+/// repeated to at least `budget_s` each, the median with its spread), each as its answering call
+/// was made (step `dt`, sampling every `sample_every`); each run's runtime_s becomes the median.
+/// A run that fails while being timed keeps its answering call's time, counted as one round.
+void time_dynamics(const std::vector<const Backend*>& backends, const std::vector<DynRun*>& runs,
+                   const Scene& scene, long sample_every, double budget_s);
 
 /// A contact query's answer: the cached run of the same query (a reference backend's, see
 /// result_cache.h, with the timing stored with it), or one fresh call, not yet timed.

@@ -65,6 +65,7 @@ TEST(BudgetSweep, RunsEveryBudgetOfEveryBackendAtTheScenesStep) {
   HarnessOptions opt;
   opt.backends = "bullet,ode,custom,custom-seed";
   opt.phases = false;
+  opt.timing_budget_s = 0.0;  // the verdicts only: no run is timed again
   const SceneEvaluation ev = evaluate_scene(scene, opt);
   std::map<std::string, std::vector<std::pair<int, double>>> points;
   for (const SweepPoint& p : ev.sweep)

@@ -205,6 +205,44 @@ TEST(Harness, ATouchingAnswerIsTimedLikeAnyOther) {
   EXPECT_EQ(points, 1);
 }
 
+TEST(Harness, ADynamicsRunIsTimedAgainWarmAndItsAnsweringRunReportedApart) {
+  // The face-face pair, shortened, run by the engine (in process) and by ODE (isolated).
+  const Scene scene = parse_scene(
+      "checks = [\"impulse\"]\n[sim]\nduration = 0.2\n[[body]]\nname = \"A\"\n"
+      "position = [-1, 0, 0]\nvelocity = [1, 0, 0]\n[[body]]\nname = \"B\"\n"
+      "position = [1, 0, 0]\nvelocity = [-1, 0, 0]\n",
+      "face_face.toml");
+  for (const double budget : {0.0, 0.002}) {
+    HarnessOptions opt;
+    opt.backends = "custom,ode";
+    opt.sweep = false;
+    opt.timing_budget_s = budget;
+    const SceneEvaluation ev = evaluate_scene(scene, opt);
+    for (const char* name : {"custom", "ode"}) {
+      const Json& b = ev.json["backends"][name];
+      ASSERT_EQ(b["status"], "ok") << name << ": " << b["message"];
+      ASSERT_TRUE(b.contains("timing")) << name;
+      const Json& t = b["timing"];
+      const double median = b["runtime_s"].get<double>();
+      EXPECT_GT(t["cold_s"].get<double>(), 0.0) << name;
+      if (budget == 0.0) {
+        // Untimed (rbx check): the answering run is the one run, and says so.
+        EXPECT_EQ(t["rounds"], 1) << name;
+        EXPECT_EQ(t["calls"], 1) << name;
+        EXPECT_EQ(median, t["cold_s"].get<double>()) << name;
+        continue;
+      }
+      // Timed: at least the plan's rounds for a slow call, the median inside its quartiles.
+      EXPECT_GE(t["rounds"].get<int>(), TimingPlan{}.min_rounds_slow) << name;
+      EXPECT_GE(t["calls"].get<long>(), t["rounds"].get<long>()) << name;
+      EXPECT_LE(t["q25_s"].get<double>(), median) << name;
+      EXPECT_LE(median, t["q75_s"].get<double>()) << name;
+      const std::optional<double> typed =
+          ev.run_of(name) ? ev.run_of(name)->runtime_s : std::nullopt;
+      EXPECT_EQ(typed, median) << name << ": the typed run reads the median";
+    }
+  }
+}
 TEST(Harness, BodiesOverlappingAtRestThroughEveryBackendAreJudgedInFiniteNumbers) {
   // Two free cubes (0.3 and 0.7 kg) overlapping by 80 % at rest, no gravity: nothing in the scene
   // has energy. Every backend's conservation metrics are finite and small where momentum is kept

@@ -172,6 +172,7 @@ nlohmann::json data_of(const std::string& file) {
   const Scene scene = load_scene(std::string(RBX_SOURCE_DIR) + "/" + file);
   HarnessOptions opt;
   opt.sweep = false;
+  opt.timing_budget_s = 0.0;  // the replay only: no run is timed again
   return view_data(scene, evaluate_scene(scene, opt).json);
 }
 
@@ -190,6 +191,7 @@ TEST(ViewPage, SceneTextIsEscapedInHtmlAndJsonAndMarkdown) {
   ASSERT_EQ(scene.name, evil);
   HarnessOptions opt;
   opt.sweep = false;
+  opt.timing_budget_s = 0.0;  // the replay only: no run is timed again
   const std::string page =
       view_page(view_data(scene, evaluate_scene(scene, opt).json), "/*three*/");
   // The only </script> closings are the page's own script elements.
@@ -275,6 +277,7 @@ TEST_F(ViewBrowser, TheCameraFramesTheMovingBodiesNotTheFloor) {
   const Scene scene = load_scene((dir / "drop.toml").string());
   HarnessOptions opt;
   opt.sweep = false;
+  opt.timing_budget_s = 0.0;  // the replay only: no run is timed again
   std::ofstream(dir / "drop.html")
       << view_page(view_data(scene, evaluate_scene(scene, opt).json), three_js());
   const nlohmann::json st = page_state(dir / "drop.html", "", 2000);
