@@ -43,8 +43,10 @@ CheckDiff print_check(const Json& base, const CheckRun& run, const CheckSettings
   const double base_rt = base.value("runtime_s", 0.0);
   std::cout << "check: " << run.now.size() << " metrics over " << scenes
             << " scenes: " << d.worse + d.missing << " worse, " << d.better << " better, "
-            << d.added << " new; run time " << fmt_num(run.runtime_s, 3) << " s (baseline "
-            << fmt_num(base_rt, 3) << " s; timings never fail the check";
+            << d.added << " new; run time " << fmt_num(run.runtime_s, 3) << " s (scenes "
+            << fmt_num(run.scenes_s, 3) << " s, explore " << fmt_num(run.explore_s, 3)
+            << " s, tosses " << fmt_num(run.tosses_s, 3) << " s; baseline " << fmt_num(base_rt, 3)
+            << " s; timings never fail the check";
   if (!run.cache_dir.empty() && run.cacheable > 0)
     std::cout << "; " << run.cached << " of " << run.cacheable << " reference runs from the cache, "
               << run.cache_dir;

@@ -194,14 +194,19 @@ SinglePointImpulse single_point_impulse(const RigidBody& A, const RigidBody& B, 
 bool free_flight(double flight, const std::vector<RigidBody>& after, const RigidBody& A,
                  const RigidBody& B, const SinglePointImpulse& imp, double size, Quat& qa,
                  Quat& qb) {
+  // The rotation is carried from one check to the next (the flight is autonomous: L is
+  // constant), not integrated again from the start for each of the 20 checks.
+  Quat ra = A.orientation, rb = B.orientation;
   for (int step = 1; step <= 20; ++step) {
     const double t = flight * step / 20.0;
     RigidBody a2 = after[0], b2 = after[1];
     a2.position += imp.va * t;
-    a2.orientation = free_rotation(A.inverse_inertia_body, A.orientation, imp.La, t);
+    ra = free_rotation(A.inverse_inertia_body, ra, imp.La, flight / 20.0);
+    a2.orientation = ra;
     if (!B.is_static) {
       b2.position += imp.vb * t;
-      b2.orientation = free_rotation(B.inverse_inertia_body, B.orientation, imp.Lb, t);
+      rb = free_rotation(B.inverse_inertia_body, rb, imp.Lb, flight / 20.0);
+      b2.orientation = rb;
     }
     const SatResult r = sat_query(*a2.shape, a2.pose(), *b2.shape, b2.pose());
     if (r.touching || r.depth > -1e-6 * size) return false;

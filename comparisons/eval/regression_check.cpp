@@ -131,39 +131,49 @@ void add_toss_metrics(const CheckSettings& set, CheckRun& run) {
     std::ostringstream bytes;
     bytes << data.rdbuf();
     const std::string data_id = std::to_string(std::hash<std::string>{}(bytes.str()));
+    // Each backend's errors per toss: position errors, then angle errors; empty when it failed.
+    struct Job {
+      const Backend* backend;
+      ContactParams params;
+      std::string key;
+      std::vector<double> both;
+    };
+    std::vector<Job> jobs;
     for (const Backend& b : table) {
       if (!b.dynamics || !set.selected(b.name)) continue;
-      const ContactParams params = stored_params(stored, b.name);
+      Job job{&b, stored_params(stored, b.name), "", {}};
       // A library's errors per toss come from the cache (keyed by its code, the data's bytes
       // and the parameters; the toss code is in the derived hash); an engine's always run.
-      std::string key;
       if (cache.enabled() && ResultCache::caches(b.name)) {
         std::ostringstream k;
         k << std::setprecision(17) << ResultCache::code_fingerprint() << "; tosses " << b.name
-          << " " << data_id << " e " << params.restitution << " mu " << params.friction;
-        for (const auto& [name, value] : params.soft) k << " " << name << " " << value;
-        key = k.str();
+          << " " << data_id << " e " << job.params.restitution << " mu " << job.params.friction;
+        for (const auto& [name, value] : job.params.soft) k << " " << name << " " << value;
+        job.key = k.str();
       }
-      std::vector<double> position, angle;
-      if (auto hit = key.empty() ? std::nullopt : cache.load_derived(key, "toss errors")) {
-        position.assign(hit->begin(), hit->begin() + static_cast<long>(hit->size() / 2));
-        angle.assign(hit->begin() + static_cast<long>(hit->size() / 2), hit->end());
-      } else {
-        const BackendTosses r = evaluate_backend(b, tosses, params);
-        if (r.status != Status::Ok) continue;  // a failed toss: its metrics go missing (worse)
-        for (const TossErrors& e : r.tosses) {
-          position.push_back(e.position);
-          angle.push_back(e.orientation_deg);
-        }
-        std::vector<double> both = position;
-        both.insert(both.end(), angle.begin(), angle.end());
-        if (!key.empty()) cache.store_derived(key, "toss errors", both);
+      jobs.push_back(std::move(job));
+    }
+    // The backends that run (the engines, a library not cached) run side by side.
+    run_jobs(jobs.size(), set.threads, [&](size_t i) {
+      Job& job = jobs[i];
+      if (auto hit = job.key.empty() ? std::nullopt : cache.load_derived(job.key, "toss errors")) {
+        job.both = *hit;
+        return;
       }
-      const Spread p = spread_of(position), a = spread_of(angle);
+      const BackendTosses r = evaluate_backend(*job.backend, tosses, job.params);
+      if (r.status != Status::Ok) return;  // a failed toss: its metrics go missing (worse)
+      for (const TossErrors& e : r.tosses) job.both.push_back(e.position);
+      for (const TossErrors& e : r.tosses) job.both.push_back(e.orientation_deg);
+      if (!job.key.empty()) cache.store_derived(job.key, "toss errors", job.both);
+    });
+    for (const Job& job : jobs) {
+      if (job.both.empty()) continue;
+      const auto half = job.both.begin() + static_cast<long>(job.both.size() / 2);
+      const Spread p = spread_of({job.both.begin(), half}), a = spread_of({half, job.both.end()});
       for (const auto& [name, value] :
            {std::pair{"position_err_p50", p.median}, std::pair{"position_err_p90", p.p90},
             std::pair{"angle_err_deg_p50", a.median}})
-        run.now[key_of(scene, {"tosses", b.name, "", name, value, "measured"})] = value;
+        run.now[key_of(scene, {"tosses", job.backend->name, "", name, value, "measured"})] = value;
     }
   }
 }
@@ -219,9 +229,12 @@ CheckRun measure_check(const std::vector<Scene>& scenes, const CheckSettings& se
   ParallelRun par(set.threads);
   const std::vector<SceneEvaluation> evs = evaluate_scenes(par, scenes, hopt, [](size_t) {});
   add_scene_metrics(scenes, evs, set, run);
+  run.scenes_s = clock.seconds();
   if (set.explore) measure_explore(set, par, run);
+  run.explore_s = clock.seconds() - run.scenes_s;
   if (set.tosses) add_toss_metrics(set, run);
   run.runtime_s = clock.seconds();
+  run.tosses_s = run.runtime_s - run.scenes_s - run.explore_s;
   return run;
 }
 

@@ -41,6 +41,7 @@ struct CheckRun {
   int cached = 0, cacheable = 0;  // reference runs read from the cache, of those cacheable
   std::string cache_dir;          // "" : no cache
   double runtime_s = 0.0;
+  double scenes_s = 0.0, explore_s = 0.0, tosses_s = 0.0;  // the parts of runtime_s
 };
 
 /// Runs every scene (and, with `set.explore`, explore's fixed samples; with `set.tosses`, the
