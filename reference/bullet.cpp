@@ -584,7 +584,7 @@ DynamicsResult run_bullet_world(const WorldDefinition& scene, const DynamicsOpti
       for (size_t i = 0; i < bodies.size(); ++i) states.push_back(final_state(names[i], bodies[i]));
       return states;
     });
-    recorder.measure_contact_laws(scene.sim);
+    recorder.measure_contact_laws(scene);
     recorder.start();
     for (long k = 0; k < steps; ++k) {
       recorder.before_step(result.events);

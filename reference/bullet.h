@@ -21,8 +21,9 @@ struct BulletSettings {
   double split_impulse_threshold = 1e30;  // m; Bullet splits where distance < this (BT_LARGE_FLOAT)
   // The share of the push's rotation applied with its translation (Bullet's default 0.1): the
   // split impulse solves each point's push for the whole rigid motion, and applying only a tenth
-  // of its turn leaves the corners of a resting face corrected unequally, which tilts and turns
-  // a sliding box; 1 applies the push as solved (`bullet`). < 0: Bullet's own (`bullet-hull`).
+  // of its turn leaves the corners of a resting face corrected unequally, which tilts a sliding
+  // box and delays its rest; 1 applies the push as solved (`bullet`). < 0: Bullet's own
+  // (`bullet-hull`).
   double split_turn_erp = 1.0;
   double restitution_threshold = 0.0;  // m/s; no bounce below this approach speed
   // A manifold point is solved once its distance is at most this fraction of the body's

@@ -33,11 +33,27 @@ struct LawResidual {
   double median = 0.0;  // the histogram's (LawTally): within 1.2 % of the true median
 };
 
+/// Friction a body received beyond the Coulomb cone (the cone residual's part of each friction
+/// impulse; in Bullet nearly all of it at points left with no normal impulse), and what it did
+/// to a body sliding on one surface: the turn about the contact normal and the push along the
+/// slide. The turn integrates the yaw rate that friction gives, damped as Coulomb friction damps
+/// a sliding box's spin (the loaded points' mu j_n (r . v_hat)^2 / |v| against the inertia about
+/// the normal), and held at zero while the body is at rest; the push is the impulse along the
+/// slide times the speed over the mass, which moves the stop by push / deceleration
+/// (docs/contact_laws.md).
+struct ConeExcess {
+  int body = 0;            // scene index
+  long points = 0;         // contact points with friction beyond the cone, over every step
+  double turn_rad = 0.0;   // signed, about the contact normal (out of the surface)
+  double push_m2s2 = 0.0;  // signed, along the slide: the stop moves by push / deceleration
+};
+
 /// A run's contact-law residuals.
 struct ContactLaws {
   bool measured = false;  // the backend reported its contact impulses (false: no residuals)
   long contacts = 0;      // contact points scored, over every step
   std::array<LawResidual, kLaws> residuals{};  // by Law
+  std::vector<ConeExcess> cone_excess;         // bodies that received any, in scene order
 };
 
 /// What one contact point is scored on. Velocities are of A's material point at the contact

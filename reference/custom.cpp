@@ -69,7 +69,7 @@ DynamicsResult run_dynamics(const WorldDefinition& scene, const DynamicsOptions&
       for (const RigidBody& b : world.bodies()) states.push_back(final_of(b));
       return states;
     });
-    recorder.measure_contact_laws(sim);
+    recorder.measure_contact_laws(scene);
     recorder.start();
     while (world.steps_taken() < steps) {
       recorder.before_step(world.events());

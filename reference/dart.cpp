@@ -424,7 +424,7 @@ DynamicsResult dart_dynamics_with(const WorldDefinition& scene, const DynamicsOp
       return states;
     };
     DynamicsRecorder recorder(r, opt, read_states);
-    recorder.measure_contact_laws(scene.sim);
+    recorder.measure_contact_laws(scene);
     recorder.start();
     for (long step = 0; step < steps; ++step) {
       recorder.before_step(r.events);

@@ -23,10 +23,79 @@ void DynamicsRecorder::start() {
   if (sample_every_ > 0) sample(0.0);
 }
 
-void DynamicsRecorder::measure_contact_laws(const SimSettings& sim) {
+void DynamicsRecorder::measure_contact_laws(const WorldDefinition& scene) {
   measuring_ = true;
-  restitution_ = sim.restitution;
-  friction_ = sim.friction;
+  restitution_ = scene.sim.restitution;
+  friction_ = scene.sim.friction;
+  for (const RigidBody& b : make_bodies(scene)) {
+    mass_.push_back(b.is_static ? 0.0 : b.mass);
+    inertia_body_.push_back(b.inertia_body);
+  }
+  cone_excess_.assign(mass_.size(), ConeExcess{});
+  excess_spin_.assign(mass_.size(), 0.0);
+}
+
+void DynamicsRecorder::follow_cone_excess(double dt) {
+  // Below this speed (m/s) a body counts as at rest, its spin held by static friction.
+  constexpr double kRestSpeed = 1e-3;
+  // A library's friction directions are perpendicular to the normal to round-off only, so a
+  // point left at exactly no normal impulse reads +-1e-21 N s or so: the load and the excess
+  // are judged against the step's largest normal impulse.
+  double largest = 0.0;
+  for (const SolvedContact& c : step_contacts_)
+    largest = std::max(largest, std::abs(c.impulse.dot(c.normal)));
+  const size_t n = mass_.size();
+  std::vector<double> torque(n, 0.0), damping(n, 0.0), push(n, 0.0);
+  std::vector<long> points(n, 0);
+  std::vector<bool> touched(n, false);
+  for (const SolvedContact& c : step_contacts_) {
+    const double jn = c.impulse.dot(c.normal);
+    for (const int side : {c.a, c.b}) {
+      const size_t i = static_cast<size_t>(side);
+      if (i >= n || mass_[i] <= 0.0) continue;
+      // The body's view: the normal out of the other body into it, the impulse it received.
+      const double sign = side == c.a ? 1.0 : -1.0;
+      const Vec3 normal = sign * c.normal, impulse = sign * c.impulse;
+      const Vec3 r = c.point - (side == c.a ? c.centre_a : c.centre_b);
+      const Vec3 v = before_[i].velocity - before_[i].velocity.dot(normal) * normal;
+      const double speed = v.norm();
+      touched[i] = true;
+      if (jn > 1e-9 * largest && speed > kRestSpeed) {
+        const double lever = r.dot(v / speed);
+        damping[i] += friction_ * jn * lever * lever / speed;
+      }
+      const Vec3 jt = impulse - impulse.dot(normal) * normal;
+      const double excess = jt.norm() - friction_ * std::max(jn, 0.0);
+      if (!(excess > 1e-6 * friction_ * largest) || jt.norm() == 0.0) continue;
+      const Vec3 beyond = jt * (excess / jt.norm());
+      ++points[i];
+      torque[i] += r.cross(beyond).dot(normal);
+      if (speed > kRestSpeed) push[i] += beyond.dot(v / speed) * speed / mass_[i];
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    if (!touched[i]) continue;
+    const Vec3 v = before_[i].velocity;
+    // The axis: the first contact's normal into this body (a box on one surface has one).
+    Vec3 axis = Vec3::Zero();
+    for (const SolvedContact& c : step_contacts_)
+      if (static_cast<size_t>(c.a) == i || static_cast<size_t>(c.b) == i) {
+        axis = static_cast<size_t>(c.a) == i ? c.normal : Vec3(-c.normal);
+        break;
+      }
+    const Mat3 rot = before_[i].orientation.toRotationMatrix();
+    const double inertia = axis.dot(rot * inertia_body_[i] * rot.transpose() * axis);
+    const double speed = (v - v.dot(axis) * axis).norm();
+    double& spin = excess_spin_[i];
+    spin = speed <= kRestSpeed || !(inertia > 0.0)
+               ? 0.0
+               : (spin + torque[i] / inertia) / (1.0 + damping[i] / inertia);
+    ConeExcess& u = cone_excess_[i];
+    u.body = static_cast<int>(i);
+    u.points += points[i];
+    u.turn_rad += spin * dt;
+    u.push_m2s2 += push[i];
+  }
 }
 
 void DynamicsRecorder::contact(const SolvedContact& c) {
@@ -49,8 +118,9 @@ void DynamicsRecorder::before_step(const std::vector<CollisionEvent>& events) {
   before_known_ = false;
 }
 
-void DynamicsRecorder::score_step() {
+void DynamicsRecorder::score_step(double dt) {
   if (step_contacts_.empty()) return;
+  follow_cone_excess(dt);
   std::vector<BodyFinal> after = read_states_();
   for (const SolvedContact& c : step_contacts_) {
     // The relative velocity of A's material point at the contact to B's.
@@ -86,7 +156,10 @@ void DynamicsRecorder::first_impulse_from_event(const CollisionEvent& first, dou
 }
 
 void DynamicsRecorder::finish_laws() {
-  if (measuring_) result_.laws = tally_.summary();
+  if (!measuring_) return;
+  result_.laws = tally_.summary();
+  for (const ConeExcess& u : cone_excess_)
+    if (u.points > 0) result_.laws.cone_excess.push_back(u);
 }
 
 void DynamicsRecorder::finish(const std::string& library) {
@@ -101,7 +174,8 @@ void DynamicsRecorder::finish(const std::string& library) {
 }
 
 void DynamicsRecorder::after_step(long steps_taken, double time) {
-  if (measuring_) score_step();
+  if (measuring_) score_step(time - last_time_);
+  last_time_ = time;
   if (sample_every_ > 0 && steps_taken % sample_every_ == 0) sample(time);
 }
 

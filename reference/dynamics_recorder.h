@@ -38,9 +38,10 @@ class DynamicsRecorder {
   /// never), reading the bodies with `read_states`.
   DynamicsRecorder(DynamicsResult& result, const DynamicsOptions& opt, ReadStates read_states);
 
-  /// Scores every contact point given by contact() against the laws of `sim` (its restitution
-  /// and friction) after each step; the result's `laws` are filled from then on.
-  void measure_contact_laws(const SimSettings& sim);
+  /// Scores every contact point given by contact() against the laws of the scene's `sim` (its
+  /// restitution and friction) after each step, and follows the friction its bodies receive
+  /// beyond the cone (ConeExcess); the result's `laws` are filled from then on.
+  void measure_contact_laws(const WorldDefinition& scene);
   /// One contact point the step solved, its impulse as the library reports it and the bodies'
   /// centres of mass at its detection (the velocities' lever arms).
   void contact(const SolvedContact& c);
@@ -72,7 +73,9 @@ class DynamicsRecorder {
  private:
   void sample(double time);
   // Scores the step's contacts against the states after it.
-  void score_step();
+  void score_step(double dt);
+  // Follows the friction beyond the cone of the step's contacts (ConeExcess).
+  void follow_cone_excess(double dt);
 
   DynamicsResult& result_;
   long sample_every_;
@@ -84,6 +87,13 @@ class DynamicsRecorder {
   double restitution_ = 0.0, friction_ = 0.0;  // the scene's laws
   std::vector<SolvedContact> step_contacts_;   // the step's scored points
   LawTally tally_;
+  double last_time_ = 0.0;  // simulated time at the last step's end
+  // Per body: its mass and body-frame inertia (static: mass 0), and the friction beyond the cone
+  // followed so far with the spin it gave (rad/s).
+  std::vector<double> mass_;
+  std::vector<Mat3> inertia_body_;
+  std::vector<ConeExcess> cone_excess_;
+  std::vector<double> excess_spin_;
 };
 
 /// One contact point a library solved in a step, for events merged per pair (libraries that

@@ -683,7 +683,7 @@ DynamicsResult mujoco_dynamics_with(const WorldDefinition& scene, const Dynamics
   });
   Episodes episodes;
   t_trap.clear_warning();
-  recorder.measure_contact_laws(scene.sim);
+  recorder.measure_contact_laws(scene);
   recorder.start();
   for (long step = 0; step < steps; ++step) {
     recorder.before_step(r.events);

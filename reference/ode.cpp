@@ -570,7 +570,7 @@ DynamicsResult ode_dynamics_with(const WorldDefinition& scene, const DynamicsOpt
   t_trap.clear_warning();
   t_trap.warning_count = 0;
   long first_message_step = -1;
-  recorder.measure_contact_laws(scene.sim);
+  recorder.measure_contact_laws(scene);
   recorder.start();
   for (long step = 0; step < steps; ++step) {
     recorder.before_step(r.events);

@@ -44,6 +44,8 @@ void result_fields(Io& io, R& d, Is<R, DynamicsResult> = 0) {
         fi.impulse, fi.approach_speed, fi.entry_phase);
   io.io(d.laws.measured, d.laws.contacts);
   for (auto& r : d.laws.residuals) io.io(r.worst, r.median);
+  io.io_list(d.laws.cone_excess,
+             [](Io& i, auto& u) { i.io(u.body, u.points, u.turn_rad, u.push_m2s2); });
 }
 
 template <class Io, class R>

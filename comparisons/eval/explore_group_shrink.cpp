@@ -141,6 +141,12 @@ std::string describe_outcome(const BackendOutcome& b) {
     return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
            fmt_num(b.turn_rad, 3) + " rad, after its collider reported a contact " +
            fmt_num(b.reported_depth_m, 3) + " m deep (no landing or resting box is)";
+  if (b.error == "cone_excess")
+    return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
+           fmt_num(b.turn_rad, 3) +
+           " rad, by friction beyond the Coulomb cone (measured on the library's own impulses: "
+           "friction at contact points that carry no normal impulse; the closed form's friction "
+           "is bounded by mu times the push)";
   if (b.error == "lift_off")
     return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
            fmt_num(b.turn_rad, 3) + " rad, its time to rest off by " +

@@ -119,6 +119,17 @@ Json contact_laws_json(const DynamicsResult& r) {
     const LawResidual& r = laws.residuals[static_cast<int>(law)];
     j[to_string(law)] = {{"worst", r.worst}, {"median", r.median}};
   }
+  if (!laws.cone_excess.empty()) {
+    Json u = Json::array();
+    for (const ConeExcess& f : laws.cone_excess)
+      u.push_back({{"body", static_cast<size_t>(f.body) < r.finals.size()
+                                ? r.finals[static_cast<size_t>(f.body)].name
+                                : std::to_string(f.body)},
+                   {"points", f.points},
+                   {"turn_rad", f.turn_rad},
+                   {"push_m2s2", f.push_m2s2}});
+    j["cone_excess"] = u;
+  }
   return j;
 }
 

@@ -128,7 +128,8 @@ std::string markdown_slide(const Json& j) {
   o << "# rbx explore: " << j["count"] << " random slides with friction, seed " << j["seed"]
     << "\n\n"
     << "Every sample is a box (sides 0.2 to 2 m, mass 0.1 to 10 kg, any yaw) resting on a static "
-       "floor (2 samples in 5) or incline (any heading, up to where mu cos(theta) - sin(theta) = "
+       "floor (2 samples in 5, 1 µm into it: zero depth rounds to some corners off) or incline "
+       "(any heading, up to where mu cos(theta) - sin(theta) = "
        "0.1), e = 0, mu in [0.1, 1], launched along the surface at 0.05 to 1.5 m/s (on an "
        "incline down or up its fall line) or left at rest on the incline; its height is drawn so "
        "that it cannot tip (mu sz <= 0.8 min(sx, sy)). The closed form (deceleration mu g on a "
@@ -142,7 +143,10 @@ std::string markdown_slide(const Json& j) {
        "contact deeper than a tenth of the box's smallest side (its collider's answer: no "
        "resting box goes so deep), else lift_off where the box's centre rose more than 0.1 mm "
        "off its surface on the way (the closed form's box never leaves it; docs/references.md says "
-       "whose model does this). Velocity error: "
+       "whose model does this), and a turn or position miss is named cone_excess where the "
+       "friction the library applied beyond the Coulomb cone (measured on its own impulses, "
+       "docs/contact_laws.md; Bullet leaves it at points with no normal impulse) gave at least "
+       "half the turn, or moved the stop by what puts it past the mark. Velocity error: "
        "the final velocities in the energy norm against the launch's kinetic energy (a 1 m/s "
        "slide's for a box left at rest).\n\n## Backends\n\n";
   Table t({"backend", "samples", "disagreements", "rate", "position err p50/p90/p99 (m)",

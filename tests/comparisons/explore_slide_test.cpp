@@ -40,7 +40,7 @@ TEST(ExploreSlide, ClosedFormMatchesTheHandDerivedSlides) {
   EXPECT_NEAR(s.stop_distance, 1.0 / (2 * 0.5 * kG), 1e-15);
   EXPECT_NEAR(s.rest_time, 1.0 / (0.5 * kG), 1e-15);
   EXPECT_NEAR(s.expect_position.x(), 1.0 / (2 * 0.5 * kG), 1e-15);
-  EXPECT_DOUBLE_EQ(s.expect_position.z(), 0.5);
+  EXPECT_DOUBLE_EQ(s.expect_position.z(), 0.5 - 1e-6);  // a micrometre into the floor
   // The scene as written gives the same time (its surface, launch, gravity and friction).
   EXPECT_NEAR(slide_rest_time(parse_scene(s.text, "slide.toml")), s.rest_time, 1e-12);
   EXPECT_NEAR(s.duration / s.dt, std::round(s.duration / s.dt), 1e-9);
@@ -165,6 +165,55 @@ TEST(ExploreSlide, AContactReportedMetresDeepNamesTheDisagreement) {
   EXPECT_LT(o.backends[1].reported_depth_m, 1e-3);
 }
 
+TEST(ExploreSlide, TheBoxStartsAMicrometreIntoItsSurfaceEveryCornerOfItsBaseIn) {
+  // At exactly zero depth the written pose's rounding left some corners of the base on an
+  // incline about 1e-16 m above the surface: ODE's and DART's first step found one or two
+  // corners, whose friction turned the box (ODE, seed 8086 samples 84, 147, 520, 581 and 682)
+  // or pushed it aside (DART, 283, 872 and 877). Every corner of the base now starts in.
+  for (uint64_t i : {84, 283, 682, 872, 877}) {
+    const SlideSample s = make_slide_sample(8086, i);
+    const Scene scene = parse_scene(s.text, "slide.toml");
+    const std::vector<RigidBody> bodies = make_bodies(scene);
+    const Vec3 n = bodies[1].orientation * Vec3::UnitZ();
+    const Vec3 top = bodies[1].position + 0.5 * n;  // the slab is 1 m thick
+    int below = 0;
+    for (const Vec3& v : bodies[0].shape->vertices()) {
+      const double height = (bodies[0].position + bodies[0].orientation * v - top).dot(n);
+      // The base's corners sit 1 µm in, to the rounding of the written pose (1e-15 m here).
+      if (height < 0.0) {
+        EXPECT_NEAR(height, -1e-6, 1e-12) << "sample " << i;
+        ++below;
+      }
+    }
+    EXPECT_EQ(below, 4) << "sample " << i;
+  }
+  // The misses they were, now within the closed form: ODE's largest turn, DART's largest shift.
+  for (const auto& [i, name] : {std::pair<uint64_t, std::string>{682, "ode"}, {877, "dart"}}) {
+    const SampleOutcome o = evaluate_slide_sample(make_slide_sample(8086, i), {name});
+    ASSERT_EQ(o.backends.size(), 1u);
+    EXPECT_EQ(o.backends[0].error, "")
+        << name << " on sample " << i << ": turned " << o.backends[0].turn_rad << " rad, rests "
+        << o.backends[0].position_err_m << " m off";
+  }
+}
+
+TEST(ExploreSlide, FrictionBeyondTheConeNamesBulletsTurn) {
+  // Seed 8086, sample 416: a box sliding on a floor that Bullet turns by 0.011 rad. Its solver
+  // bounds a point's friction by mu times its normal impulse only while that impulse is
+  // positive, so a corner whose normal impulse fell to zero keeps an earlier sweep's friction
+  // (docs/contact_laws.md). The run's own impulses measure the turn that friction gives, and
+  // name the miss; the written scene shows it again. Custom leaves no friction at a point
+  // without load.
+  const SlideSample s = make_slide_sample(8086, 416);
+  const SampleOutcome o = evaluate_slide_sample(s, {"bullet", "custom"});
+  ASSERT_EQ(o.backends.size(), 2u);
+  EXPECT_EQ(o.backends[0].error, "cone_excess");
+  EXPECT_GT(o.backends[0].turn_rad, kLandingTurnMark);
+  std::string detail;
+  EXPECT_TRUE(harness_reproduces(s.text, "slide.toml", o.backends[0], &detail)) << detail;
+  EXPECT_EQ(o.backends[1].error, "");
+}
+
 TEST(ExploreSlide, TheRiseIsTheCentresHighestOffTheSurfaceAlongItsNormal) {
   // On a 30 deg incline: a centre that moves along the surface never rises; one lifted 2 mm
   // along the normal at one sample rises 2 mm; one sinking into the surface rises 0.
@@ -235,8 +284,10 @@ TEST(ExploreSlide, BulletSettingsMeasuredOnTheFamily) {
   // not used while choosing them, each alternative beside the chosen pair: the processing
   // threshold at 0 drops a point the split push lifted past zero, and the box hops and creeps
   // (time to rest); Bullet's default solves points before they touch; the push's turn at
-  // Bullet's 0.1 tilts and turns sliding boxes. Judged on the errors' 90th percentiles, which
-  // 200 slides fix far better than the few disagreements they hold.
+  // Bullet's 0.1 tilts sliding boxes and delays their rest. Judged on the errors' 90th and 99th
+  // percentiles, which 200 slides fix far better than the few disagreements they hold. (With the
+  // box started at zero depth, the 0.1 turn also turned the boxes, p90 3x; from a micrometre in
+  // both turn by round-off only.)
   const auto bullet_at = [](const std::string& name, void (*change)(BulletSettings&)) {
     Backend b = *find_backend("bullet");
     b.name = name;
@@ -285,7 +336,6 @@ TEST(ExploreSlide, BulletSettingsMeasuredOnTheFamily) {
   // per cent at 200 samples).
   EXPECT_GT(p90(turn["threshold 0"]), 5 * p90(turn[chosen]));
   EXPECT_GT(p99(rest["threshold 0"]), 2 * p99(rest[chosen]));
-  EXPECT_GT(p90(turn["turn erp 0.1"]), 3 * p90(turn[chosen]));
   EXPECT_GT(p99(rest["turn erp 0.1"]), 2 * p99(rest[chosen]));
   // Bullet's default threshold slides about as well, but it solves a projectile's contact
   // before it reaches the wall and sends it back early, at the wrong speed.

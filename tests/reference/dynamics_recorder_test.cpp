@@ -8,6 +8,8 @@
 #include <limits>
 #include <vector>
 
+#include "tests/common/fixtures.h"
+
 namespace rbx {
 namespace {
 
@@ -145,10 +147,13 @@ TEST(DynamicsRecorder, ScoresTheContactLawsOnTheVelocitiesAroundEachStep) {
   DynamicsResult result;
   FakeRun run;
   DynamicsRecorder recorder(result, {}, [&] { return run.states(); });
-  SimSettings sim;
-  sim.restitution = 0.0;
-  sim.friction = 0.5;
-  recorder.measure_contact_laws(sim);
+  WorldDefinition scene;
+  scene.sim.restitution = 0.0;
+  scene.sim.friction = 0.5;
+  scene.bodies = {test::box_spec("a", Vec3::Ones(), Vec3(0.0, 1.0, 0.0)),
+                  test::box_spec("floor", Vec3::Ones(), Vec3::Zero())};
+  scene.bodies[1].is_static = true;
+  recorder.measure_contact_laws(scene);
   recorder.start();
   for (long k = 0; k < 3; ++k) {
     recorder.before_step(run.events);
@@ -172,6 +177,85 @@ TEST(DynamicsRecorder, ScoresTheContactLawsOnTheVelocitiesAroundEachStep) {
     EXPECT_DOUBLE_EQ(result.laws.residuals[static_cast<int>(law)].worst,
                      law == Law::Complementarity ? 1.0 : 0.0)
         << to_string(law);
+}
+
+TEST(DynamicsRecorder, FollowsTheFrictionBeyondTheConeAtPointsThatCarryNoNormalImpulse) {
+  // A unit cube (1 kg, inertia 1/6 about z) sliding at 1 m/s along x on a static floor, two
+  // steps of 0.01 s. Each step one corner pushes (0.5 N s up, at y = +0.5) and one carries no
+  // normal impulse yet a friction impulse of 0.01 N s against the slide (at y = -0.5): all of
+  // it beyond the cone.
+  DynamicsResult result;
+  auto states = [] {
+    BodyFinal a;
+    a.name = "a";
+    a.position = Vec3(0.0, 0.0, 0.5);
+    a.velocity = Vec3(1.0, 0.0, 0.0);
+    BodyFinal floor;
+    floor.name = "floor";
+    return std::vector<BodyFinal>{a, floor};
+  };
+  DynamicsRecorder recorder(result, {}, states);
+  WorldDefinition scene;
+  scene.sim.friction = 0.5;
+  scene.bodies = {test::box_spec("a", Vec3::Ones(), Vec3(0.0, 0.0, 0.5)),
+                  test::box_spec("floor", Vec3(4.0, 4.0, 1.0), Vec3(0.0, 0.0, -0.5))};
+  scene.bodies[1].is_static = true;
+  recorder.measure_contact_laws(scene);
+  recorder.start();
+  std::vector<CollisionEvent> events;
+  for (long k = 0; k < 2; ++k) {
+    recorder.before_step(events);
+    SolvedContact loaded;
+    loaded.a = 0;
+    loaded.b = 1;
+    loaded.point = Vec3(0.5, 0.5, 0.0);
+    loaded.normal = Vec3::UnitZ();
+    loaded.impulse = Vec3(0.0, 0.0, 0.5);
+    SolvedContact unloaded = loaded;
+    unloaded.point = Vec3(0.5, -0.5, 0.0);
+    // Its normal impulse is round-off (a library's friction direction off the plane by 1e-17):
+    // no load, judged against the step's largest normal impulse.
+    unloaded.impulse = Vec3(-0.01, 0.0, 1e-21);
+    recorder.contact_at_start(loaded);
+    recorder.contact_at_start(unloaded);
+    recorder.after_step(k + 1, (k + 1) * 0.01);
+  }
+  recorder.finish_laws();
+  ASSERT_EQ(result.laws.cone_excess.size(), 1u);
+  const ConeExcess& u = result.laws.cone_excess[0];
+  EXPECT_EQ(u.body, 0);
+  EXPECT_EQ(u.points, 2);
+  // Torque about z of the unloaded corner: ((0.5, -0.5, -0.5) x (-0.01, 0, 0)) . z = -0.005 N m s;
+  // the loaded corner's Coulomb damping: mu j_n (r . x)^2 / |v| = 0.5 x 0.5 x 0.25 = 0.0625.
+  const double inertia = 1.0 / 6.0, torque = -0.005, damping = 0.0625;
+  const double w1 = (torque / inertia) / (1.0 + damping / inertia);
+  const double w2 = (w1 + torque / inertia) / (1.0 + damping / inertia);
+  EXPECT_NEAR(u.turn_rad, (w1 + w2) * 0.01, 1e-15);
+  // Along the slide: -0.01 N s at 1 m/s on 1 kg, each step.
+  EXPECT_NEAR(u.push_m2s2, -0.02, 1e-15);
+}
+
+TEST(DynamicsRecorder, FindsNoConeExcessWhereEveryFrictionPointPushesEnough) {
+  DynamicsResult result;
+  FakeRun run;
+  DynamicsRecorder recorder(result, {}, [&] { return run.states(); });
+  WorldDefinition scene;
+  scene.sim.friction = 0.5;
+  scene.bodies = {test::box_spec("a", Vec3::Ones(), Vec3(0.0, 1.0, 0.0)),
+                  test::box_spec("floor", Vec3::Ones(), Vec3::Zero())};
+  scene.bodies[1].is_static = true;
+  recorder.measure_contact_laws(scene);
+  recorder.start();
+  recorder.before_step(run.events);
+  SolvedContact c;
+  c.a = 0;
+  c.b = 1;
+  c.normal = Vec3::UnitY();
+  c.impulse = Vec3(0.3, 1.0, 0.0);
+  recorder.contact_at_start(c);
+  recorder.after_step(1, 0.1);
+  recorder.finish_laws();
+  EXPECT_TRUE(result.laws.cone_excess.empty());
 }
 
 TEST(DynamicsRecorder, MeasuresNoContactLawsUnlessAsked) {
