@@ -739,7 +739,7 @@ SoftContact bullet_soft(const BulletSettings& base) {
             base.contact_cfm,
             0.0,
             1.0,
-            {1e-6, 1e-5, 1e-4, 1e-3, 3e-3, 1e-2}}},
+            {1e-6, 1e-5, 1e-4, 1e-3, 3e-3, 1e-2, 3e-2, 1e-1}}},
           [base](const WorldDefinition& scene, const DynamicsOptions& opt,
                  const std::vector<double>& v) {
             BulletSettings s = base;

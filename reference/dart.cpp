@@ -540,7 +540,7 @@ SoftContact dart_soft(const DartSettings& base) {
             base.cfm,
             1e-9,
             1.0,
-            {1e-9, 1e-7, 1e-5, 1e-3, 1e-2}}},
+            {1e-9, 1e-7, 1e-5, 1e-3, 1e-2, 3e-2, 1e-1}}},
           [base](const WorldDefinition& scene, const DynamicsOptions& opt,
                  const std::vector<double>& v) {
             DartSettings s = base;

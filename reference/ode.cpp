@@ -677,7 +677,7 @@ SoftContact ode_soft(const OdeSettings& base) {
             base.cfm,
             0.0,
             1.0,
-            {1e-10, 1e-7, 1e-5, 1e-3, 1e-2}}},
+            {1e-10, 1e-7, 1e-5, 1e-3, 1e-2, 3e-2, 1e-1}}},
           [base](const WorldDefinition& scene, const DynamicsOptions& opt,
                  const std::vector<double>& v) {
             OdeSettings s = base;
