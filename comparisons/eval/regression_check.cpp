@@ -153,19 +153,54 @@ void add_toss_metrics(const CheckSettings& set, CheckRun& run) {
       }
       jobs.push_back(std::move(job));
     }
-    // The backends that run (the engines, a library not cached) run side by side.
-    run_jobs(jobs.size(), set.threads, [&](size_t i) {
+    // The backends that run (the engines, a library not cached), each cut into as many pieces
+    // of the tosses as there are threads, the pieces side by side: two engines of unequal cost
+    // no longer leave a core idle while the slower finishes.
+    struct Piece {
+      size_t job, lo, hi;
+      bool ok = false;
+      std::vector<double> position, angle;
+    };
+    std::vector<Piece> pieces;
+    const size_t cuts = static_cast<size_t>(std::max(1, forking_threads(set.threads)));
+    for (size_t i = 0; i < jobs.size(); ++i) {
       Job& job = jobs[i];
       if (auto hit = job.key.empty() ? std::nullopt : cache.load_derived(job.key, "toss errors")) {
         job.both = *hit;
-        return;
+        continue;
       }
-      const BackendTosses r = evaluate_backend(*job.backend, tosses, job.params);
+      for (size_t c = 0; c < cuts; ++c)
+        pieces.push_back(
+            {i, tosses.size() * c / cuts, tosses.size() * (c + 1) / cuts, false, {}, {}});
+    }
+    run_jobs(pieces.size(), set.threads, [&](size_t k) {
+      Piece& piece = pieces[k];
+      const std::vector<Toss> some(tosses.begin() + static_cast<long>(piece.lo),
+                                   tosses.begin() + static_cast<long>(piece.hi));
+      const BackendTosses r =
+          evaluate_backend(*jobs[piece.job].backend, some, jobs[piece.job].params);
       if (r.status != Status::Ok) return;  // a failed toss: its metrics go missing (worse)
-      for (const TossErrors& e : r.tosses) job.both.push_back(e.position);
-      for (const TossErrors& e : r.tosses) job.both.push_back(e.orientation_deg);
-      if (!job.key.empty()) cache.store_derived(job.key, "toss errors", job.both);
+      piece.ok = true;
+      for (const TossErrors& e : r.tosses) {
+        piece.position.push_back(e.position);
+        piece.angle.push_back(e.orientation_deg);
+      }
     });
+    for (size_t i = 0; i < jobs.size(); ++i) {
+      std::vector<double> position, angle;
+      bool ran = false, ok = true;
+      for (const Piece& piece : pieces) {
+        if (piece.job != i) continue;
+        ran = true;
+        ok = ok && piece.ok;
+        position.insert(position.end(), piece.position.begin(), piece.position.end());
+        angle.insert(angle.end(), piece.angle.begin(), piece.angle.end());
+      }
+      if (!ran || !ok) continue;
+      jobs[i].both = position;
+      jobs[i].both.insert(jobs[i].both.end(), angle.begin(), angle.end());
+      if (!jobs[i].key.empty()) cache.store_derived(jobs[i].key, "toss errors", jobs[i].both);
+    }
     for (const Job& job : jobs) {
       if (job.both.empty()) continue;
       const auto half = job.both.begin() + static_cast<long>(job.both.size() / 2);
