@@ -77,6 +77,23 @@ void name_deep_contact(BackendOutcome& o, const DynamicsResult& run, double side
   if (!o.error.empty() && o.reported_depth_m > 0.1 * side) o.error = "deep_contact";
 }
 
+void name_cone_excess(BackendOutcome& o, const DynamicsResult& run, const Vec3& off_surface,
+                      const Vec3& slide_dir, double deceleration) {
+  if (o.error != "turn" && o.error != "position") return;
+  for (const ConeExcess& u : run.laws.cone_excess) {
+    if (u.body != 0) continue;
+    bool explains = false;
+    if (o.turn_rad > kLandingTurnMark) {
+      explains = std::abs(u.turn_rad) >= 0.5 * o.turn_rad;
+    } else if (deceleration > 0.0) {
+      const Vec3 shift = u.push_m2s2 / deceleration * slide_dir;
+      explains = (off_surface - shift).norm() <= kLandingPositionMark;
+    }
+    if (explains) o.error = "cone_excess";
+    return;
+  }
+}
+
 std::string box_at_rest_expect(const std::string& speed_name, double speed, double dt,
                                const Vec3& position) {
   std::ostringstream o;

@@ -171,6 +171,7 @@ SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<
                         ? "late_landing"
                         : "position";
         name_deep_contact(o, run, s.size.minCoeff());
+        name_cone_excess(o, run, off, launch, s.speed_after > 0.0 ? s.friction * kGravity : 0.0);
       });
   return out;
 }

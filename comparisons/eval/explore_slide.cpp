@@ -231,26 +231,6 @@ SlideSample make_slide_sample(uint64_t seed, uint64_t index) {
   });
 }
 
-namespace {
-
-// Whether the friction the box received beyond the Coulomb cone (the run's ConeExcess, measured
-// by the recorder on the library's own impulses) explains its miss: a turn of which it gave at
-// least half (its spin model is linear in the damping), or a resting place that would be
-// within the mark without the stop's shift it gave.
-bool cone_excess_explains(const SlideSample& s, const DynamicsResult& run, const Vec3& off_surface,
-                          double turn) {
-  for (const ConeExcess& u : run.laws.cone_excess) {
-    if (u.body != 0) continue;
-    if (turn > kLandingTurnMark) return std::abs(u.turn_rad) >= 0.5 * turn;
-    if (s.speed == 0.0 || !(s.deceleration > 0.0)) return false;
-    const Vec3 shift = u.push_m2s2 / s.deceleration * s.velocity.normalized();
-    return (off_surface - shift).norm() <= kLandingPositionMark;
-  }
-  return false;
-}
-
-}  // namespace
-
 SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std::string>& names,
                                     const std::vector<Backend>* table, const ResultCache* cache) {
   SampleOutcome out;
@@ -287,9 +267,9 @@ SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std:
         o.rise_m = largest_rise(run.samples, s.start_position, n);
         if (!o.error.empty() && o.error != "deep_contact" && o.rise_m > kSlideLiftMark)
           o.error = "lift_off";
-        if ((o.error == "turn" || o.error == "position") &&
-            cone_excess_explains(s, run, off - off.dot(n) * n, o.turn_rad))
-          o.error = "cone_excess";
+        name_cone_excess(o, run, off - off.dot(n) * n,
+                         s.speed > 0.0 ? Vec3(s.velocity.normalized()) : Vec3::Zero(),
+                         s.speed > 0.0 ? s.deceleration : 0.0);
       });
   return out;
 }

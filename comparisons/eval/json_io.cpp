@@ -8,6 +8,8 @@
 #include <iostream>
 #include <stdexcept>
 
+#include "comparisons/eval/trajectory.h"
+
 namespace rbx {
 
 Json to_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
@@ -119,17 +121,6 @@ Json contact_laws_json(const DynamicsResult& r) {
     const LawResidual& r = laws.residuals[static_cast<int>(law)];
     j[to_string(law)] = {{"worst", r.worst}, {"median", r.median}};
   }
-  if (!laws.cone_excess.empty()) {
-    Json u = Json::array();
-    for (const ConeExcess& f : laws.cone_excess)
-      u.push_back({{"body", static_cast<size_t>(f.body) < r.finals.size()
-                                ? r.finals[static_cast<size_t>(f.body)].name
-                                : std::to_string(f.body)},
-                   {"points", f.points},
-                   {"turn_rad", f.turn_rad},
-                   {"push_m2s2", f.push_m2s2}});
-    j["cone_excess"] = u;
-  }
   return j;
 }
 
@@ -182,12 +173,14 @@ void write_text(const std::string& path, const std::string& text) {
 void write_json(const std::string& path, const Json& j) { write_text(path, j.dump(2) + "\n"); }
 
 void put_timing(const Timing& t, Json& into) {
-  into["runtime_s"] = t.median_s;
-  into["timing"] = {{"q25_s", t.q25_s},
-                    {"q75_s", t.q75_s},
+  // Five significant digits: a run time moves by more than that between runs, and 17 digits
+  // of every timing would cost results.json a sixth of its size budget.
+  into["runtime_s"] = round_sig5(t.median_s);
+  into["timing"] = {{"q25_s", round_sig5(t.q25_s)},
+                    {"q75_s", round_sig5(t.q75_s)},
                     {"calls", t.calls},
                     {"rounds", t.rounds},
-                    {"cold_s", t.cold_s}};
+                    {"cold_s", round_sig5(t.cold_s)}};
 }
 
 Timing timing_of(const Json& from) {

@@ -10,12 +10,13 @@ trap 'rm -rf "$work"' EXIT
 extra=(--oversubscribe)
 [ "$(id -u)" -eq 0 ] && extra+=(--allow-run-as-root)
 strip_explore() { /usr/bin/python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); j.pop("timing"); print(json.dumps(j, indent=1, sort_keys=True))' "$1"; }
-# results.json: every run time (key runtime_s) removed; everything else must match.
+# results.json: every run time (keys runtime_s and timing: a run's median, quartiles, cold call
+# and the counts its timing chose) removed; everything else must match.
 strip_results() {
   /usr/bin/python3 -c '
 import json, sys
 def strip(x):
-    if isinstance(x, dict): return {k: strip(v) for k, v in x.items() if k != "runtime_s"}
+    if isinstance(x, dict): return {k: strip(v) for k, v in x.items() if k not in ("runtime_s", "timing")}
     if isinstance(x, list): return [strip(v) for v in x]
     return x
 print(json.dumps(strip(json.load(open(sys.argv[1]))), indent=1, sort_keys=True))' "$1"

@@ -529,6 +529,20 @@ TEST(ExploreLanding, ALandingResolvedAStepLateIsNamedByItsMeasuredOffset) {
   EXPECT_EQ(o.backends[2].error, "");
 }
 
+TEST(ExploreLanding, FrictionBeyondTheConeNamesBulletsTurnAfterALanding) {
+  // Seed 4242, sample 60: a box that lands and slides on, which Bullet turns by 0.0145 rad: its
+  // solver keeps an earlier sweep's friction at a corner whose normal impulse fell to zero
+  // (docs/contact_laws.md). The turn that friction gives, measured on Bullet's own impulses,
+  // names the miss; custom, on the same landing, meets the closed form.
+  const LandingSample s = make_landing_sample(4242, 60);
+  ASSERT_TRUE(s.slides);
+  const SampleOutcome o = evaluate_landing_sample(s, {"bullet", "custom"});
+  ASSERT_EQ(o.backends.size(), 2u);
+  EXPECT_EQ(o.backends[0].error, "cone_excess");
+  EXPECT_GT(o.backends[0].turn_rad, kLandingTurnMark);
+  EXPECT_EQ(o.backends[1].error, "");
+}
+
 TEST(ExploreLanding, ShrinkKeepsTheSignature) {
   // The one-point hull variant of MuJoCo (MPR, one contact point per step) rests more than
   // 1 mm off on some landings; shrinking rounds the design while the harness still shows it on
