@@ -170,6 +170,7 @@ void read_runs(SceneEvaluation& ev) {
           ev.stability.push_back(stability_row(name, true, sw));
     }
   if (ev.json.contains("expect")) ev.known_failure = ev.json["expect"].value("known_failure", "");
+  ev.has_geometry = ev.json.contains("geometry") && !ev.json["geometry"].empty();
   if (!ev.json.contains("backends")) return;
   const Json& stability = ev.json.value("stability", Json::object());
   for (const auto& [name, bj] : ev.json["backends"].items()) {
@@ -182,6 +183,16 @@ void read_runs(SceneEvaluation& ev) {
     r.message = bj.value("message", "");
     if (bj.contains("runtime_s")) r.runtime_s = bj["runtime_s"].get<double>();
     if (stability.contains(name)) r.stability = stability[name].value("verdict", "");
+    if (bj.contains("contact_phase")) {
+      const Json& p = bj["contact_phase"];
+      auto cell = [&](const char* k) {
+        ContactPhaseCell c;
+        if (p.contains(k) && p[k].is_number()) c.error = p[k].get<double>();
+        if (p.contains(k) && p[k].is_string()) c.failure = p[k].get<std::string>();
+        return c;
+      };
+      r.contact_phase = ContactPhaseRow{cell("written"), cell("1_3"), cell("2_3"), cell("worst")};
+    }
     ev.runs.push_back(std::move(r));
   }
 }

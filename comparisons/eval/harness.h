@@ -95,12 +95,26 @@ Json stability_json(const StabilityRow& row);
 
 /// One backend's run on a scene, as the scene's JSON records it ("backends" and "stability"):
 /// read back once (read_runs), so that what renders a scene reads no JSON.
+/// One run of a contact phase: its velocity error (energy norm), or its failure ("error: ...");
+/// neither where the phase was not run.
+struct ContactPhaseCell {
+  std::optional<double> error;
+  std::string failure;
+};
+
+/// A backend's velocity error with first contact as written and 1/3 and 2/3 of a step later,
+/// and the worst of them (the scene's "contact_phase").
+struct ContactPhaseRow {
+  ContactPhaseCell written, one_third, two_thirds, worst;
+};
+
 struct BackendRun {
   std::string backend;
   Status status = Status::Ok;       // the first failure of its calls, else ok (or touching)
   std::string message;              // the first failure's message, or a note on an ok answer
   std::optional<double> runtime_s;  // its calls' summed median time (s), where recorded
   std::string stability;  // the stability check's verdict; "" where that check did not run
+  std::optional<ContactPhaseRow> contact_phase;  // where the scene's impacts were rerun so
 };
 
 /// Everything the harness learned about one scene.
@@ -124,6 +138,7 @@ struct SceneEvaluation {
   // Every stability run, by backend: the scene's step, then its sweep's (read_runs).
   std::vector<StabilityRow> stability;
   std::string known_failure;  // the scene's [expect] known_failure ("ENGINE: why"), "" if none
+  bool has_geometry = false;  // the contact check drew the pair's geometry (its figure exists)
   // The scene's [ensemble] run (the report's, run_scene_ensembles), also in `json` as
   // "ensemble"; null when none ran.
   std::shared_ptr<const EnsembleResult> ensemble;

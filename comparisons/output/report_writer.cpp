@@ -131,16 +131,15 @@ std::string contact_phase_section(const std::vector<Scene>& scenes,
   Table phases({"scene", "backend", "as written", "1/3 later", "2/3 later", "worst"});
   for (size_t i = 0; i < evs.size(); ++i)
     for (const std::string& c : cols) {
-      const Json& bj = evs[i].json["backends"];
-      if (!bj.contains(c) || !bj[c].contains("contact_phase")) continue;
-      const Json& p = bj[c]["contact_phase"];
-      auto cell = [&](const char* k) {
-        if (!p.contains(k)) return std::string("-");
-        return p[k].is_number() ? fmt_num(p[k].get<double>(), 2)
-                                : md_escape(p[k].get<std::string>());
+      const BackendRun* run = evs[i].run_of(c);
+      if (!run || !run->contact_phase) continue;
+      const ContactPhaseRow& p = *run->contact_phase;
+      auto cell = [](const ContactPhaseCell& x) {
+        if (x.error) return fmt_num(*x.error, 2);
+        return x.failure.empty() ? std::string("-") : md_escape(x.failure);
       };
-      phases.add({md_escape(evs[i].family + "/" + scenes[i].name), c, cell("written"), cell("1_3"),
-                  cell("2_3"), cell("worst")});
+      phases.add({md_escape(evs[i].family + "/" + scenes[i].name), c, cell(p.written),
+                  cell(p.one_third), cell(p.two_thirds), cell(p.worst)});
     }
   if (phases.size() > 0) {
     md << "## Contact phase\n\n";
@@ -257,7 +256,7 @@ std::string scene_details_section(const std::vector<Scene>& scenes,
     if (scenes[i].expect && !scenes[i].expect->known_failure.empty())
       md << "  - known failure: " << scenes[i].expect->known_failure << "\n";
     if (figures_ok) {
-      if (scenes[i].has_check(CheckKind::Contact) && !ev.json["geometry"].empty())
+      if (scenes[i].has_check(CheckKind::Contact) && ev.has_geometry)
         md << "\n![contacts](" << md_url("figures/contact_" + slug + ".png") << ")\n";
       if (find_metric(ev, "custom", "velocity_err_ke") || ev.run_of("bullet"))
         if (scenes[i].has_check(CheckKind::Impulse))

@@ -127,6 +127,38 @@ TEST(Harness, TheTypedRunsAndStabilityRowsSayWhatTheJsonSays) {
   ASSERT_GE(rows, 1u);
 }
 
+TEST(Harness, ContactPhasesAndTheGeometryReadBackTyped) {
+  // The face-face pair of the seed with its closed form: custom is rerun with first contact
+  // 1/3 and 2/3 of a step later; the typed rows carry the JSON's numbers, a failed phase's
+  // message, and nothing for a backend whose phases did not run.
+  const Scene scene = parse_scene(
+      "checks = [\"impulse\"]\n[sim]\nduration = 0.6\nrestitution = 1.0\n[[body]]\n"
+      "name = \"A\"\nposition = [-1, 0, 0]\nvelocity = [1, 0, 0]\n[[body]]\nname = \"B\"\n"
+      "position = [1, 0, 0]\nvelocity = [-1, 0, 0]\n[expect]\n[expect.body.A]\n"
+      "velocity = [-1, 0, 0]\n[expect.body.B]\nvelocity = [1, 0, 0]\n",
+      "face_face.toml");
+  HarnessOptions opt;
+  opt.backends = "custom";
+  opt.sweep = false;
+  opt.timing_budget_s = 0.0;
+  SceneEvaluation ev = evaluate_scene(scene, opt);
+  ASSERT_NE(ev.run_of("custom"), nullptr);
+  ASSERT_TRUE(ev.run_of("custom")->contact_phase.has_value());
+  const Json& p = ev.json["backends"]["custom"]["contact_phase"];
+  const ContactPhaseRow& row = *ev.run_of("custom")->contact_phase;
+  EXPECT_EQ(row.written.error, p["written"].get<double>());
+  EXPECT_EQ(row.one_third.error, p["1_3"].get<double>());
+  EXPECT_EQ(row.worst.error, p["worst"].get<double>());
+  EXPECT_FALSE(ev.has_geometry);  // no contact check
+  // A phase that failed, and a contact check's geometry, as another process would send them.
+  ev.json["backends"]["custom"]["contact_phase"]["2_3"] = "error: diverged";
+  ev.json["geometry"] = {{"pair", "A-B"}};
+  read_runs(ev);
+  EXPECT_FALSE(ev.run_of("custom")->contact_phase->two_thirds.error.has_value());
+  EXPECT_EQ(ev.run_of("custom")->contact_phase->two_thirds.failure, "error: diverged");
+  EXPECT_TRUE(ev.has_geometry);
+}
+
 TEST(Harness, AStabilityNumberWrittenAsNullReadsBackAsNaN) {
   // A run whose energy overflowed has a non-finite drift, which JSON writes as null once the
   // evaluation crosses processes: reading it back gives NaN for the pages to show, not a throw.
