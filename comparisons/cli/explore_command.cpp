@@ -42,7 +42,7 @@ void write_explore(const fs::path& out, const ExploreCampaign& c, bool figure_wa
   for (const auto& [file, text] : c.scenes) write_text((out / file).string(), text);
   write_json((out / "explore.json").string(), c.result);
   const bool figure = figure_wanted && draw_explore_figure(out.string());
-  write_text((out / "explore.md").string(), explore_markdown(c.result, figure));
+  write_text((out / "explore.md").string(), explore_markdown(c.summary, figure));
 }
 
 }  // namespace

@@ -375,6 +375,7 @@ ExploreCampaign run_explore(const ExploreSettings& set, const ParallelRun& par) 
                  {"samples_per_min_per_core", set.count / c.sampling_s * 60.0 / cores},
                  {"ranks", par.ranks()},
                  {"threads_per_rank", par.threads()}};
+  c.summary = read_explore_summary(j);
   return c;
 }
 

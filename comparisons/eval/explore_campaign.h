@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "comparisons/eval/explore.h"
+#include "comparisons/eval/explore_summary.h"
 #include "comparisons/eval/json_io.h"
 #include "comparisons/eval/parallel.h"
 
@@ -33,6 +34,7 @@ void check_shape_pairs(const std::vector<std::string>& pairs, const std::string&
 /// A campaign's outcome, on rank 0 (other ranks get timings only).
 struct ExploreCampaign {
   Json result;                                              // explore.json
+  ExploreSummary summary;                                   // explore.md's part of it, typed
   std::vector<std::pair<std::string, std::string>> scenes;  // shrunk scenes: file, text
   long groups = 0;                                          // disagreement groups
   long reproduced = 0;        // shrunk scenes on which the harness shows the disagreement

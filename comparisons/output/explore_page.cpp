@@ -16,43 +16,53 @@ namespace rbx {
 
 namespace {
 
-// The disagreement groups of an explore result, one row each (both kinds).
-std::string groups_table(const Json& j) {
+// The disagreement groups of an explore result, one row each (every kind).
+std::string groups_table(const ExploreSummary& s) {
   Table g({"backend", "signature", "count", "rate", "scene", "points", "reproduced"});
-  for (const auto& [name, b] : j["backends"].items())
-    for (const Json& x : b["groups"])
-      g.add({name, x["signature"], std::to_string(x["count"].get<long>()), fmt_num(x["rate"], 3),
-             x["scene"].is_string() ? x["scene"].get<std::string>() : std::string("-"),
-             x.contains("points_before") ? std::to_string(x["points_before"].get<int>()) + " -> " +
-                                               std::to_string(x["points_after"].get<int>())
-                                         : std::string("-"),
-             x.value("reproduced", false) ? "yes" : "no"});
+  for (const ExploreBackendSummary& b : s.backends)
+    for (const ExploreGroup& x : b.groups)
+      g.add({b.name, x.signature, std::to_string(x.count), fmt_num(x.rate, 3),
+             x.scene ? *x.scene : std::string("-"),
+             x.points_before ? std::to_string(*x.points_before) + " -> " +
+                                   std::to_string(x.points_after.value_or(0))
+                             : std::string("-"),
+             x.reproduced ? "yes" : "no"});
   return g.markdown();
 }
 
-// A metric's p50 / p90 / p99 from a backend's "errors" object, `digits` significant digits.
-std::string three(const Json& errors, const char* m, int digits = 2) {
-  const Json& e = errors[m];
-  return fmt_num(e["p50"], digits) + " / " + fmt_num(e["p90"], digits) + " / " +
-         fmt_num(e["p99"], digits);
+// A metric's p50 / p90 / p99 over a backend's samples, `digits` significant digits.
+std::string three(const ExploreBackendSummary& b, const char* m, int digits = 2) {
+  const ExplorePercentiles& e = b.error(m);
+  return fmt_num(e.p50, digits) + " / " + fmt_num(e.p90, digits) + " / " + fmt_num(e.p99, digits);
 }
 
 // The table of disagreement rates by the quarter of its step the first contact falls in.
-std::string phase_table(const Json& j) {
+std::string phase_table(const ExploreSummary& s) {
   Table ph({"backend", "0-25 %", "25-50 %", "50-75 %", "75-100 %"});
-  for (const auto& [name, b] : j["backends"].items()) {
-    std::vector<std::string> row = {name};
-    for (const Json& q : b["by_phase_quarter"])
-      row.push_back(fmt_num(q["rate"], 3) + " (" + std::to_string(q["samples"].get<long>()) + ")");
+  for (const ExploreBackendSummary& b : s.backends) {
+    std::vector<std::string> row = {b.name};
+    for (const ExplorePhaseQuarter& q : b.by_phase_quarter)
+      row.push_back(fmt_num(q.rate, 3) + " (" + std::to_string(q.samples) + ")");
     ph.add(row);
   }
   return ph.markdown();
 }
 
-std::string markdown_impact(const Json& j) {
+// A backend's first four cells: name, samples, disagreements, rate.
+std::vector<std::string> counts(const ExploreBackendSummary& b) {
+  return {b.name, std::to_string(b.samples), std::to_string(b.disagreements), fmt_num(b.rate, 3)};
+}
+
+// `head` with `tail` appended.
+std::vector<std::string> cells(std::vector<std::string> head,
+                               const std::vector<std::string>& tail) {
+  head.insert(head.end(), tail.begin(), tail.end());
+  return head;
+}
+
+std::string markdown_impact(const ExploreSummary& s) {
   std::ostringstream o;
-  o << "# rbx explore: " << j["count"] << " random single-point impacts, seed " << j["seed"]
-    << "\n\n"
+  o << "# rbx explore: " << s.count << " random single-point impacts, seed " << s.seed << "\n\n"
     << "Every sample is one body (a box or a hull of 4 to 60 points) hitting a box, free or "
        "static, at one vertex on a face, with restitution e in [0.2, 1], no friction, no "
        "gravity, first contact 2 to 5 steps ahead at a random phase of its step. The closed form "
@@ -62,26 +72,24 @@ std::string markdown_impact(const Json& j) {
        "momenta right (spin: the free rotation after the impact).\n\n## Backends\n\n";
   Table t({"backend", "samples", "disagreements", "rate", "velocity err p50/p90/p99",
            "momentum err p50/p90/p99"});
-  for (const auto& [name, b] : j["backends"].items())
-    t.add({name, std::to_string(b["samples"].get<long>()),
-           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
-           three(b["errors"], "velocity_err_ke"), three(b["errors"], "momentum_err_ke")});
+  for (const ExploreBackendSummary& b : s.backends)
+    t.add(cells(counts(b), {three(b, "velocity_err_ke"), three(b, "momentum_err_ke")}));
   o << t.markdown();
   o << "\n## Disagreement rate by the phase of the contact within its step\n\nThe first contact "
        "falls at this fraction of the step that detects it (0 %: at the step's start, so the "
        "bodies overlap by a whole step of approach when it is seen).\n\n";
-  o << phase_table(j);
+  o << phase_table(s);
   o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B (static: B "
        "is static), the contact's features, the kind of error. Each group's first sample was "
        "shrunk to the scene named; `reproduced` says whether `rbx compare` shows the velocity "
        "error on it.\n\n";
-  o << groups_table(j);
+  o << groups_table(s);
   return o.str();
 }
 
-std::string markdown_landing(const Json& j) {
+std::string markdown_landing(const ExploreSummary& s) {
   std::ostringstream o;
-  o << "# rbx explore: " << j["count"] << " random flat landings with friction, seed " << j["seed"]
+  o << "# rbx explore: " << s.count << " random flat landings with friction, seed " << s.seed
     << "\n\n"
     << "Every sample is a box (sides 0.2 to 2 m, mass 0.1 to 10 kg, any yaw) landing flat on a "
        "static floor, e = 0, mu in [0.1, 1], falling at 0.2 to 2 m/s and sliding at 0.05 to "
@@ -105,31 +113,27 @@ std::string markdown_landing(const Json& j) {
        "norm against the initial kinetic energy.\n\n## Backends\n\n";
   Table t({"backend", "samples", "disagreements", "rate", "position err p50/p90/p99 (m)",
            "turn p50/p90/p99 (rad)", "rest time err p50/p99 (s)", "velocity err p99"});
-  for (const auto& [name, b] : j["backends"].items()) {
-    const Json& e = b["errors"];
-    t.add(
-        {name, std::to_string(b["samples"].get<long>()),
-         std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
-         three(e, "position_err_m"), three(e, "turn_rad"),
-         fmt_num(e["rest_time_err_s"]["p50"], 2) + " / " + fmt_num(e["rest_time_err_s"]["p99"], 2),
-         fmt_num(e["velocity_err_ke"]["p99"], 2)});
+  for (const ExploreBackendSummary& b : s.backends) {
+    const ExplorePercentiles& rest = b.error("rest_time_err_s");
+    t.add(cells(counts(b), {three(b, "position_err_m"), three(b, "turn_rad"),
+                            fmt_num(rest.p50, 2) + " / " + fmt_num(rest.p99, 2),
+                            fmt_num(b.error("velocity_err_ke").p99, 2)}));
   }
   o << t.markdown();
   o << "\n## Disagreement rate by the phase of the first touch within its step\n\nThe first "
        "touch falls at this fraction of the step that detects it (0 %: at the step's start).\n\n";
-  o << phase_table(j);
+  o << phase_table(s);
   o << "\n## Disagreement groups\n\nSignature: backend, box-floor, whether the base slides on "
        "after the landing (slides) or the landing stops it (sticks), the kind of error. Each "
        "group's first sample was shrunk to the scene named; `reproduced` says whether `rbx "
        "compare` shows the same final position or turn on it.\n\n";
-  o << groups_table(j);
+  o << groups_table(s);
   return o.str();
 }
 
-std::string markdown_slide(const Json& j) {
+std::string markdown_slide(const ExploreSummary& s) {
   std::ostringstream o;
-  o << "# rbx explore: " << j["count"] << " random slides with friction, seed " << j["seed"]
-    << "\n\n"
+  o << "# rbx explore: " << s.count << " random slides with friction, seed " << s.seed << "\n\n"
     << "Every sample is a box (sides 0.2 to 2 m, mass 0.1 to 10 kg, any yaw) resting on a static "
        "floor (2 samples in 5, 1 µm into it: zero depth rounds to some corners off) or incline "
        "(any heading, up to where mu cos(theta) - sin(theta) = "
@@ -154,26 +158,23 @@ std::string markdown_slide(const Json& j) {
        "slide's for a box left at rest).\n\n## Backends\n\n";
   Table t({"backend", "samples", "disagreements", "rate", "position err p50/p90/p99 (m)",
            "turn p50/p90/p99 (rad)", "rest time err p50/p90/p99 (s)", "velocity err p99"});
-  for (const auto& [name, b] : j["backends"].items()) {
-    const Json& e = b["errors"];
-    t.add({name, std::to_string(b["samples"].get<long>()),
-           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
-           three(e, "position_err_m"), three(e, "turn_rad"), three(e, "rest_time_err_s"),
-           fmt_num(e["velocity_err_ke"]["p99"], 2)});
-  }
+  for (const ExploreBackendSummary& b : s.backends)
+    t.add(cells(counts(b),
+                {three(b, "position_err_m"), three(b, "turn_rad"), three(b, "rest_time_err_s"),
+                 fmt_num(b.error("velocity_err_ke").p99, 2)}));
   o << t.markdown();
   o << "\n## Disagreement groups\n\nSignature: backend, box-floor or box-incline, the case "
        "(floor, down, up, sticks), the kind of error. Each group's first sample was shrunk to the "
        "scene named; `reproduced` says whether `rbx compare` shows the same final position or "
        "turn on it (a time to rest: the written scene's own run).\n\n";
-  o << groups_table(j);
+  o << groups_table(s);
   return o.str();
 }
 
-std::string markdown_tunnel(const Json& j) {
+std::string markdown_tunnel(const ExploreSummary& s) {
   std::ostringstream o;
-  o << "# rbx explore: " << j["count"] << " random fast projectiles at thin walls, seed "
-    << j["seed"] << "\n\n"
+  o << "# rbx explore: " << s.count << " random fast projectiles at thin walls, seed " << s.seed
+    << "\n\n"
     << "Every sample is a box (sides 0.05 to 0.5 m, mass 0.1 to 10 kg) flying face-on at a static "
        "wall 1 to 10 cm thick, facing any way, with restitution e in [0, 1], no friction, no "
        "gravity, a tangential speed up to half the normal one, and a normal speed that carries it "
@@ -187,24 +188,22 @@ std::string markdown_tunnel(const Json& j) {
        "table says) should not tunnel; those without it can.\n\n## Backends\n\n";
   Table t({"backend", "samples", "disagreements", "rate", "velocity err p50/p90/p99",
            "position err p50/p90/p99 (m)"});
-  for (const auto& [name, b] : j["backends"].items())
-    t.add({name, std::to_string(b["samples"].get<long>()),
-           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
-           three(b["errors"], "velocity_err_ke"), three(b["errors"], "position_err_m")});
+  for (const ExploreBackendSummary& b : s.backends)
+    t.add(cells(counts(b), {three(b, "velocity_err_ke"), three(b, "position_err_m")}));
   o << t.markdown();
   o << "\n## Disagreement rate by the phase of the first touch within its step\n\n";
-  o << phase_table(j);
+  o << phase_table(s);
   o << "\n## Disagreement groups\n\nSignature: backend, box-wall, whether one step can carry "
        "the box past the wall (fast) or not (slow), the kind of error. Each group's first sample "
        "was shrunk to the scene named; `reproduced` says whether `rbx compare` shows the "
        "velocity error on it.\n\n";
-  o << groups_table(j);
+  o << groups_table(s);
   return o.str();
 }
 
-std::string markdown_distance(const Json& j) {
+std::string markdown_distance(const ExploreSummary& s) {
   std::ostringstream o;
-  o << "# rbx explore: " << j["count"] << " random separated pairs, seed " << j["seed"] << "\n\n"
+  o << "# rbx explore: " << s.count << " random separated pairs, seed " << s.seed << "\n\n"
     << "Every sample is a pair of the contact kind's shapes (boxes, hulls of 4 to 2,000 points, "
        "slivers; size ratios up to 1e3) in its poses, moved apart along the exact closest pair's "
        "direction to a gap drawn log-uniformly from 1e-9 to 10 times the smaller body's size "
@@ -217,25 +216,21 @@ std::string markdown_distance(const Json& j) {
   o << "## Backends\n\n";
   Table t({"backend", "samples", "disagreements", "rate", "distance p50/p90/p99 (rel)",
            "witness p50/p90/p99 (rel)", "worst distance (rel)"});
-  for (const auto& [name, b] : j["backends"].items()) {
-    const Json& e = b["errors"];
-    t.add({name, std::to_string(b["samples"].get<long>()),
-           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
-           three(e, "distance_err_rel"), three(e, "witness_err_rel"),
-           fmt_num(e["distance_err_rel"]["max"], 2)});
-  }
+  for (const ExploreBackendSummary& b : s.backends)
+    t.add(cells(counts(b), {three(b, "distance_err_rel"), three(b, "witness_err_rel"),
+                            fmt_num(b.error("distance_err_rel").max, 2)}));
   o << t.markdown();
   o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B, the exact "
        "closest features (of A, then of B), the kind of error. Each group's first sample was "
        "shrunk while the backend's distance query still showed the signature; `reproduced` "
        "says whether `rbx distance` marks it on the scene.\n\n";
-  o << groups_table(j);
+  o << groups_table(s);
   return o.str();
 }
 
-std::string markdown_toi(const Json& j) {
+std::string markdown_toi(const ExploreSummary& s) {
   std::ostringstream o;
-  o << "# rbx explore: " << j["count"] << " random moving pairs, seed " << j["seed"] << "\n\n"
+  o << "# rbx explore: " << s.count << " random moving pairs, seed " << s.seed << "\n\n"
     << "Every sample is a separated pair of the distance kind's (hulls cut to 64 points) moving "
        "over an interval of 1 s: head-on (the touch at a drawn fraction of the interval), "
        "oblique (with a sideways drift), spinning (each body turning up to 2 rad), hair-miss "
@@ -247,32 +242,28 @@ std::string markdown_toi(const Json& j) {
   o << "## Backends\n\n";
   Table t(
       {"backend", "samples", "disagreements", "rate", "time err p50/p90/p99", "worst time err"});
-  for (const auto& [name, b] : j["backends"].items()) {
-    const Json& e = b["errors"];
-    t.add({name, std::to_string(b["samples"].get<long>()),
-           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
-           three(e, "time_err"), fmt_num(e["time_err"]["max"], 2)});
-  }
+  for (const ExploreBackendSummary& b : s.backends)
+    t.add(cells(counts(b), {three(b, "time_err"), fmt_num(b.error("time_err").max, 2)}));
   o << t.markdown();
   o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B, whether the "
        "oracle has a touch (touch, no_touch), the kind of error. Each group's first pair was "
        "shrunk, the motion as drawn, while the row still showed the signature; `reproduced` "
        "says whether `rbx toi` marks it on the scene.\n\n";
-  o << groups_table(j);
+  o << groups_table(s);
   return o.str();
 }
 
 }  // namespace
 
-std::string explore_markdown(const Json& j, bool have_figure) {
-  if (j["kind"] == "distance") return markdown_distance(j);
-  if (j["kind"] == "toi") return markdown_toi(j);
-  if (j["kind"] == "tunnel") return markdown_tunnel(j);
-  if (j["kind"] == "impact") return markdown_impact(j);
-  if (j["kind"] == "landing") return markdown_landing(j);
-  if (j["kind"] == "slide") return markdown_slide(j);
+std::string explore_markdown(const ExploreSummary& s, bool have_figure) {
+  if (s.kind == "distance") return markdown_distance(s);
+  if (s.kind == "toi") return markdown_toi(s);
+  if (s.kind == "tunnel") return markdown_tunnel(s);
+  if (s.kind == "impact") return markdown_impact(s);
+  if (s.kind == "landing") return markdown_landing(s);
+  if (s.kind == "slide") return markdown_slide(s);
   std::ostringstream o;
-  o << "# rbx explore: " << j["count"] << " random contact pairs, seed " << j["seed"] << "\n\n"
+  o << "# rbx explore: " << s.count << " random contact pairs, seed " << s.seed << "\n\n"
     << "Every sample is a random convex pair (boxes, hulls of 4 to 2,000 points, slivers; size "
        "ratios up to 1e3) at a pose biased toward hard cases, checked against the exact oracle. A "
        "disagreement is a status error, a touching mismatch beyond 1e-9 of the smaller body, a "
@@ -288,21 +279,17 @@ std::string explore_markdown(const Json& j, bool have_figure) {
   Table t({"backend", "samples", "disagreements", "rate", "normal p50/p90/p99 (deg)",
            "depth p50/p90/p99 (rel)", "worst point p99 (rel)", "coverage p50/p90/p99 (rel)",
            "coverage misses (> 1 %)"});
-  for (const auto& [name, b] : j["backends"].items()) {
-    const Json& e = b["errors"];
-    t.add({name, std::to_string(b["samples"].get<long>()),
-           std::to_string(b["disagreements"].get<long>()), fmt_num(b["rate"], 3),
-           three(e, "normal_err_deg"), three(e, "depth_err_rel"),
-           fmt_num(e["point_err_rel"]["p99"], 2), three(e, "coverage_err_rel"),
-           std::to_string(b.value("coverage_misses", 0L))});
-  }
+  for (const ExploreBackendSummary& b : s.backends)
+    t.add(cells(counts(b), {three(b, "normal_err_deg"), three(b, "depth_err_rel"),
+                            fmt_num(b.error("point_err_rel").p99, 2), three(b, "coverage_err_rel"),
+                            std::to_string(b.coverage_misses.value_or(0))}));
   o << t.markdown();
   if (have_figure) o << "\n![error distributions per backend](explore_errors.png)\n";
   o << "\n## Disagreement groups\n\nSignature: backend, shape classes of A and B, the exact "
        "oracle's axis (face_a, face_b, edge_edge, or separated), the kind of error. Each group's "
        "first sample was shrunk to the scene named; `reproduced` says whether `rbx compare` shows "
        "the same disagreement on it.\n\n";
-  o << groups_table(j);
+  o << groups_table(s);
   return o.str();
 }
 

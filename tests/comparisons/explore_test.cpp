@@ -19,6 +19,7 @@
 #include "comparisons/eval/explore_detail.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/eval/parallel.h"
+#include "comparisons/output/explore_page.h"
 #include "comparisons/scene/scene_file.h"
 #include "reference/backend.h"
 
@@ -622,6 +623,61 @@ TEST(ExploreShapes, OnlyThePairsNamedAreRun) {
   EXPECT_THROW(check_shape_pairs({"box"}, "contact"), InputError);
   EXPECT_THROW(check_shape_pairs({"box-box"}, "landing"), InputError);
   EXPECT_NO_THROW(check_shape_pairs({"sliver-hull", "box-box"}, "contact"));
+}
+
+// explore.md renders the campaign's typed summary, read once from explore.json: every field the
+// page shows comes through (a group's hull points, a failed shrink's missing scene), and a
+// document without a field the page needs is refused by name, not rendered as null.
+TEST(ExploreSummary, ThePageReadsTypedFieldsAndAMissingOneIsNamed) {
+  const Json percentiles = {{"p50", 0.5}, {"p90", 0.9}, {"p99", 0.99}, {"max", 2.0}};
+  Json j = {{"kind", "distance"}, {"seed", 7}, {"count", 3}, {"backends", Json::object()}};
+  j["backends"]["fcl"] = {
+      {"samples", 3},
+      {"disagreements", 2},
+      {"rate", 2.0 / 3.0},
+      {"errors", {{"distance_err_rel", percentiles}, {"witness_err_rel", percentiles}}},
+      {"groups",
+       {{{"signature", "fcl hull-box f-v distance"},
+         {"count", 2},
+         {"rate", 2.0 / 3.0},
+         {"scene", "scenes/a.toml"},
+         {"points_before", 60},
+         {"points_after", 4},
+         {"reproduced", true}},
+        {{"signature", "fcl box-box f-f overlap"},
+         {"count", 1},
+         {"rate", 1.0 / 3.0},
+         {"scene", nullptr}}}}};
+  const ExploreSummary s = read_explore_summary(j);
+  ASSERT_EQ(s.backends.size(), 1u);
+  const ExploreBackendSummary& b = s.backends[0];
+  EXPECT_EQ(s.kind, "distance");
+  EXPECT_EQ(s.seed, 7u);
+  EXPECT_EQ(b.name, "fcl");
+  EXPECT_EQ(b.disagreements, 2);
+  EXPECT_EQ(b.error("witness_err_rel").max, 2.0);
+  EXPECT_THROW(b.error("time_err"), InputError);
+  ASSERT_EQ(b.groups.size(), 2u);
+  EXPECT_EQ(b.groups[0].points_after.value_or(-1), 4);
+  EXPECT_FALSE(b.groups[1].scene.has_value());
+  const std::string md = explore_markdown(s, false);
+  EXPECT_NE(
+      md.find("| fcl | fcl hull-box f-v distance | 2 | 0.667 | scenes/a.toml | 60 -> 4 | yes |"),
+      std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| fcl | fcl box-box f-f overlap | 1 | 0.333 | - | - | no |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| fcl | 3 | 2 | 0.667 | 0.5 / 0.9 / 0.99 | 0.5 / 0.9 / 0.99 | 2 |"),
+            std::string::npos)
+      << md;
+  j["backends"]["fcl"].erase("rate");
+  try {
+    read_explore_summary(j);
+    ADD_FAILURE() << "a backend without its rate was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rate"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
