@@ -24,7 +24,8 @@ int view_command(const ViewOptions& opt) {
   js << in.rdbuf();
   const std::string out =
       opt.out.empty() ? ev.family + "_" + fs::path(scene.file).stem().string() + ".html" : opt.out;
-  const std::string page = view_page(view_data(scene, ev.json), js.str());
+  const std::string page =
+      view_page(view_data(scene, read_replay(ev.json, kViewMaxEvents)), js.str());
   write_text(out, page);
   std::cout << "view: " << out << " (" << page.size() / 1024 << " kB, "
             << ev.json["backends"].size() << " backends)\n";

@@ -22,30 +22,30 @@ namespace rbx {
 
 namespace {
 
-Json rounded(const Json& v) {
-  if (v.is_number_float()) return round_sig5(v.get<double>());
-  if (v.is_array()) {
-    Json out = Json::array();
-    for (const Json& x : v) out.push_back(rounded(x));
-    return out;
-  }
-  return v;
-}
-
 Json vec_json(const Vec3& v) { return {round_sig5(v.x()), round_sig5(v.y()), round_sig5(v.z())}; }
 
-// A backend's events (or t = 0 contacts), at most kViewMaxEvents, rounded for the page.
-Json events_json(const Json& contacts) {
+// A run's events (or t = 0 contacts), rounded for the page.
+Json events_json(const std::vector<ReplayEvent>& events) {
   Json out = Json::array();
-  for (const Json& c : contacts) {
-    if (out.size() >= kViewMaxEvents) break;
-    out.push_back({{"t", rounded(c.value("time", 0.0))},
-                   {"bodies", c["bodies"]},
-                   {"point", rounded(c["point"])},
-                   {"normal", rounded(c["normal"])},
-                   {"depth", rounded(c["depth"])}});
-  }
+  for (const ReplayEvent& e : events)
+    out.push_back({{"t", round_sig5(e.time)},
+                   {"bodies", {e.body_a, e.body_b}},
+                   {"point", vec_json(e.point)},
+                   {"normal", vec_json(e.normal)},
+                   {"depth", round_sig5(e.depth)}});
   return out;
+}
+
+// {"time": [s], "frames": {BODY: [[x, y, z, qw, qx, qy, qz]]}} of a motion, or without the
+// "time" and "frames" keys' wrapper: `into` gets them.
+void put_motion(const ReplayMotion& m, Json& into) {
+  into["time"] = m.time;
+  into["frames"] = Json::object();
+  for (const ReplayTrack& t : m.tracks) {
+    Json frames = Json::array();
+    for (const ReplayPose& p : t.poses) frames.push_back(p);
+    into["frames"][t.body] = frames;
+  }
 }
 
 // JSON inside a <script> element: no "<", ">" or "&" (their \u escapes mean the same in JSON
@@ -69,7 +69,7 @@ std::string script_safe_json(const Json& j) {
 
 }  // namespace
 
-Json view_data(const Scene& scene, const Json& result) {
+ViewData view_data(const Scene& scene, const Replay& replay) {
   Json d;
   d["scene"] = scene.name;
   d["family"] = scene_family(scene.file);
@@ -103,34 +103,38 @@ Json view_data(const Scene& scene, const Json& result) {
   }
   // Each backend: status, sampled trajectory, events.
   d["backends"] = Json::object();
-  const Json& bj = result.contains("backends") ? result["backends"] : Json::object();
-  for (const auto& [name, b] : bj.items()) {
-    Json v = {{"status", b.value("status", "")}, {"message", b.value("message", "")}};
-    const Json traj = b.value("trajectory", Json::object());
-    v["time"] = traj.value("time", Json::array());
-    v["frames"] = traj.value("bodies", Json::object());
-    const Json contacts = b.value("contacts", Json::array());
-    v["events"] = events_json(contacts);
-    v["events_total"] = contacts.size();
-    d["backends"][name] = v;
+  for (const ReplayRun& run : replay.runs) {
+    Json v = {{"status", run.status}, {"message", run.message}};
+    put_motion(run.motion, v);
+    v["events"] = events_json(run.events);
+    v["events_total"] = run.events_total;
+    v["colour"] = backend_colour(run.backend);  // its toggle and label show it, as figures do
+    d["backends"][run.backend] = v;
   }
   // The reference: the closed form where the scene gives one, else the exact oracle's contacts.
   Json ref = {{"source", ""}, {"contacts", Json::array()}, {"finals", Json::object()}};
-  if (bj.contains("exact") && scene.has_check(CheckKind::Contact)) {
+  ViewData out;
+  const ReplayRun* exact = replay.run_of("exact");
+  if (exact && scene.has_check(CheckKind::Contact)) {
+    out.reference = "exact";
     ref["source"] = "exact";
-    ref["contacts"] = events_json(bj["exact"].value("contacts", Json::array()));
+    ref["contacts"] = events_json(exact->events);
   }
   if (scene.expect) {
     if (scene.expect->contact && scene.expect->contact->normal) {
+      out.reference = "closed form";
       ref["source"] = "closed form";
-      ref["normal"] = vec_json(scene.expect->contact->normal->normalized());
+      const Json normal = vec_json(scene.expect->contact->normal->normalized());
+      ref["normal"] = normal;
       if (scene.expect->contact->depth) ref["depth"] = round_sig5(*scene.expect->contact->depth);
       // Drawn at the exact oracle's deepest point when there is one (the closed form gives no
       // point in most scenes).
-      for (Json& c : ref["contacts"]) c["normal"] = ref["normal"];
+      for (Json& c : ref["contacts"]) c["normal"] = normal;
     }
     for (const ExpectBody& e : scene.expect->bodies) {
       if (!e.velocity && !e.angular_velocity) continue;
+      out.reference = "closed form";
+      out.reference_finals = true;
       ref["source"] = "closed form";
       Json f = Json::object();
       if (e.velocity) f["velocity"] = vec_json(*e.velocity);
@@ -139,36 +143,46 @@ Json view_data(const Scene& scene, const Json& result) {
     }
   }
   d["reference"] = ref;
-  if (result.contains("ghost")) d["ghost"] = result["ghost"];
-  return d;
+  if (replay.ghost) {
+    d["ghost"] = {{"label", replay.ghost_label}};
+    put_motion(*replay.ghost, d["ghost"]);
+    out.ghost_label = replay.ghost_label;
+  }
+  out.title = scene_family(scene.file) + "/" + scene.name;
+  out.description = scene.description;
+  out.duration = scene.sim.duration;
+  out.script = std::move(d);
+  return out;
 }
 
-Json toss_replay_data(const Toss& toss, const std::vector<std::pair<std::string, TossRun>>& runs,
-                      const std::string& title) {
-  auto frame = [](const Vec3& p, const Quat& q) {
+ViewData toss_replay_data(const Toss& toss,
+                          const std::vector<std::pair<std::string, TossRun>>& runs,
+                          const std::string& title) {
+  auto pose = [](const Vec3& p, const Quat& q) {
     const Quat u = q.normalized();
-    return Json::array({round_sig5(p.x()), round_sig5(p.y()), round_sig5(p.z()), round_sig5(u.w()),
-                        round_sig5(u.x()), round_sig5(u.y()), round_sig5(u.z())});
+    return ReplayPose{round_sig5(p.x()), round_sig5(p.y()), round_sig5(p.z()), round_sig5(u.w()),
+                      round_sig5(u.x()), round_sig5(u.y()), round_sig5(u.z())};
   };
   const double t0 = toss.samples.front().time, rate = CubeTossModel{}.sample_rate;
-  Json ghost = {{"label", "the measured cube (motion capture)"},
-                {"time", Json::array()},
-                {"frames", {{"cube", Json::array()}}}};
+  Replay replay;
+  replay.ghost_label = "the measured cube (motion capture)";
+  replay.ghost = ReplayMotion{{}, {ReplayTrack{"cube", {}}}};
   for (const TossSample& s : toss.samples) {
-    ghost["time"].push_back(round_sig5(s.time - t0));
-    ghost["frames"]["cube"].push_back(frame(s.position, s.orientation));
+    replay.ghost->time.push_back(round_sig5(s.time - t0));
+    replay.ghost->tracks[0].poses.push_back(pose(s.position, s.orientation));
   }
-  Json result = {{"backends", Json::object()}, {"ghost", ghost}};
   for (const auto& [name, run] : runs) {
-    Json time = Json::array(), frames = Json::array();
+    ReplayRun r;
+    r.backend = name;
+    r.status = to_string(run.status);
+    r.message = run.message;
+    r.motion.tracks.push_back({"cube", {}});
     if (run.status == Status::Ok)
       for (size_t i = 0; i < run.track.position.size(); ++i) {
-        time.push_back(round_sig5(i / rate));  // sample i of the run is measured sample i
-        frames.push_back(frame(run.track.position[i], run.track.orientation[i]));
+        r.motion.time.push_back(round_sig5(i / rate));  // sample i of the run is measured sample i
+        r.motion.tracks[0].poses.push_back(pose(run.track.position[i], run.track.orientation[i]));
       }
-    result["backends"][name] = {{"status", to_string(run.status)},
-                                {"message", run.message},
-                                {"trajectory", {{"time", time}, {"bodies", {{"cube", frames}}}}}};
+    replay.runs.push_back(std::move(r));
   }
   // The toss's own scene: the cube at its first sample and the floor.
   Scene scene = toss_scene(toss, kPublishedParams);
@@ -177,7 +191,7 @@ Json toss_replay_data(const Toss& toss, const std::vector<std::pair<std::string,
   scene.description =
       "A measured toss of the ContactNets cube, replayed by every backend at its "
       "fitted parameters; the grey ghost is the measurement.";
-  return view_data(scene, result);
+  return view_data(scene, replay);
 }
 
 std::string three_js_path() {
@@ -188,19 +202,9 @@ std::string three_js_path() {
       "three.js not found under /usr/share/javascript/three/ (install Debian's libjs-three)");
 }
 
-namespace {
-
-// The data with each backend's colour (its panel label shows it, as the figures do).
-Json with_colours(Json data) {
-  for (auto& [name, b] : data["backends"].items()) b["colour"] = backend_colour(name);
-  return data;
-}
-
-}  // namespace
-
-std::string view_page(const Json& data, const std::string& three_js, const std::string& three_src) {
-  const std::string title = data.value("family", "") + "/" + data.value("scene", "");
-  const Json& ref = data["reference"];
+std::string view_page(const ViewData& data, const std::string& three_js,
+                      const std::string& three_src) {
+  const std::string& title = data.title;
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>rbx view: "
     << html_escape(title) << "</title>\n<style>\n"
@@ -210,19 +214,15 @@ std::string view_page(const Json& data, const std::string& three_js, const std::
   else
     h << "<script>" << three_js << "</script>\n";
   h << "</head><body>\n<header><h1>" << html_escape(title) << "</h1>\n";
-  if (!data.value("description", "").empty())
-    h << "<p>" << html_escape(data.value("description", "")) << "</p>\n";
+  if (!data.description.empty()) h << "<p>" << html_escape(data.description) << "</p>\n";
   h << "<p>One panel per backend, same camera (drag to orbit, wheel to zoom). Red: the backend's "
        "contact points and normals (from B toward A) of the events near the current time"
-    << (data["duration"].get<double>() > 0 ? "" : " (contact query at t = 0)")
-    << ". Black: the reference ("
-    << html_escape(ref.value("source", "").empty() ? "none for this scene"
-                                                   : ref.value("source", ""))
-    << ")";
-  if (!ref["finals"].empty())
+    << (data.duration > 0 ? "" : " (contact query at t = 0)") << ". Black: the reference ("
+    << html_escape(data.reference.empty() ? "none for this scene" : data.reference) << ")";
+  if (data.reference_finals)
     h << "; at the end of the run, arrows give the closed-form final velocity direction";
-  if (data.contains("ghost"))
-    h << ". Grey ghost in every panel: " << html_escape(data["ghost"].value("label", ""))
+  if (data.ghost_label)
+    h << ". Grey ghost in every panel: " << html_escape(*data.ghost_label)
       << " (shown with the reference)";
   h << ". Trajectories are sampled (at most " << kMaxFrames
     << " frames, thinned to key frames and interpolated between them); at most " << kViewMaxEvents
@@ -233,7 +233,7 @@ std::string view_page(const Json& data, const std::string& three_js, const std::
        "id=\"toggles\"></span></div>\n"
        "</header>\n<div id=\"stage\"><canvas id=\"view\"></canvas><div id=\"labels\"></div></div>\n"
        "<pre id=\"rbx-state\">{}</pre>\n<script id=\"rbx-data\" type=\"application/json\">"
-    << script_safe_json(with_colours(data)) << "</script>\n<script>\n"
+    << script_safe_json(data.script) << "</script>\n<script>\n"
     << kViewScript << "</script>\n</body></html>\n";
   return h.str();
 }
@@ -246,7 +246,8 @@ void write_report_views(const std::string& dir, const std::vector<Scene>& scenes
   for (size_t i = 0; i < scenes.size() && i < evs.size(); ++i) {
     const std::string slug = scene_slug(evs[i].family, scenes[i].file);
     write_text((views / (slug + ".html")).string(),
-               view_page(view_data(scenes[i], evs[i].json), "", "three.min.js"));
+               view_page(view_data(scenes[i], read_replay(evs[i].json, kViewMaxEvents)), "",
+                         "three.min.js"));
   }
 }
 

@@ -168,12 +168,12 @@ std::vector<std::string> check_page(const fs::path& page, const nlohmann::json& 
 }
 
 // Evaluates a scene (no sweep) and returns its view data.
-nlohmann::json data_of(const std::string& file) {
+ViewData data_of(const std::string& file) {
   const Scene scene = load_scene(std::string(RBX_SOURCE_DIR) + "/" + file);
   HarnessOptions opt;
   opt.sweep = false;
   opt.timing_budget_s = 0.0;  // the replay only: no run is timed again
-  return view_data(scene, evaluate_scene(scene, opt).json);
+  return view_data(scene, read_replay(evaluate_scene(scene, opt).json, kViewMaxEvents));
 }
 
 std::string three_js() { return read_file(three_js_path()); }
@@ -192,8 +192,8 @@ TEST(ViewPage, SceneTextIsEscapedInHtmlAndJsonAndMarkdown) {
   HarnessOptions opt;
   opt.sweep = false;
   opt.timing_budget_s = 0.0;  // the replay only: no run is timed again
-  const std::string page =
-      view_page(view_data(scene, evaluate_scene(scene, opt).json), "/*three*/");
+  const std::string page = view_page(
+      view_data(scene, read_replay(evaluate_scene(scene, opt).json, kViewMaxEvents)), "/*three*/");
   // The only </script> closings are the page's own script elements.
   size_t closings = 0;
   for (size_t k = page.find("</script>"); k != std::string::npos; k = page.find("</script>", k + 1))
@@ -207,13 +207,59 @@ TEST(ViewPage, SceneTextIsEscapedInHtmlAndJsonAndMarkdown) {
   fs::remove_all(dir);
 }
 
+// The page reads a scene's runs typed (read_replay): every event counted, the first ones kept, a
+// number the result wrote as null (a non-finite one) read as NaN and drawn as null again, a run
+// without a trajectory read as no frames.
+TEST(ViewPage, RunsAreReadTypedOnceAndTheirEventsCut) {
+  nlohmann::ordered_json result = {{"backends", nlohmann::ordered_json::object()}};
+  nlohmann::ordered_json contacts = nlohmann::ordered_json::array();
+  for (int k = 0; k < 5; ++k)
+    contacts.push_back({{"bodies", {"A", "B"}},
+                        {"time", 0.1 * k},
+                        {"point", {k, nullptr, 0.0}},
+                        {"normal", {0.0, 0.0, 1.0}},
+                        {"depth", 1e-3}});
+  result["backends"]["ode"] = {
+      {"status", "ok"},
+      {"message", ""},
+      {"trajectory",
+       {{"time", {0.0, 0.5}}, {"bodies", {{"A", {{1, 2, 3, 1, 0, 0, 0}, {4, 5, 6, 1, 0, 0, 0}}}}}}},
+      {"contacts", contacts}};
+  result["backends"]["exact"] = {{"status", "error"}, {"message", "no hull"}};
+  const Replay r = read_replay(result, 3);
+  ASSERT_EQ(r.runs.size(), 2u);
+  const ReplayRun& ode = r.runs[0];
+  EXPECT_EQ(ode.backend, "ode");
+  EXPECT_EQ(ode.events_total, 5u);
+  ASSERT_EQ(ode.events.size(), 3u);
+  EXPECT_EQ(ode.events[2].point.x(), 2.0);
+  EXPECT_TRUE(std::isnan(ode.events[2].point.y()));
+  EXPECT_EQ(ode.events[2].body_b, "B");
+  ASSERT_EQ(ode.motion.tracks.size(), 1u);
+  EXPECT_EQ(ode.motion.tracks[0].poses[1][2], 6.0);
+  const ReplayRun* exact = r.run_of("exact");
+  ASSERT_NE(exact, nullptr);
+  EXPECT_EQ(exact->message, "no hull");
+  EXPECT_TRUE(exact->motion.time.empty());
+  EXPECT_EQ(exact->events_total, 0u);
+  EXPECT_EQ(r.run_of("bullet"), nullptr);
+  // Drawn: the first events, the count of all, the null kept null.
+  Scene scene = load_scene(std::string(RBX_SOURCE_DIR) + "/scenes/analytic/headon_e05.toml");
+  const ViewData d = view_data(scene, r);
+  const nlohmann::ordered_json& v = d.script["backends"]["ode"];
+  EXPECT_EQ(v["events"].size(), 3u);
+  EXPECT_EQ(v["events_total"], 5);
+  EXPECT_EQ(v["events"][2]["point"].dump(), "[2.0,null,0.0]");  // NaN is written as null
+  EXPECT_EQ(v["frames"]["A"][1][0], 4.0);
+}
+
 TEST(ViewPage, TrajectoriesAreSampledSoAPageStaysSmall) {
   // 100 bodies: the frame budget keeps the page under 2 MB with three.js inlined (the
   // report's pages of every scene, many_1000 included, are measured in the report).
-  const nlohmann::json d = data_of("scenes/many/many_100.toml");
+  const ViewData d = data_of("scenes/many/many_100.toml");
   const std::string page = view_page(d, three_js());
   EXPECT_LT(page.size(), 2u << 20);
-  for (const auto& [name, b] : d["backends"].items()) {
+  for (const auto& [name, b] : d.script["backends"].items()) {
     EXPECT_GE(b["time"].size(), 2u) << name;
     EXPECT_LE(b["time"].size(), 100u) << name;
   }
@@ -229,11 +275,11 @@ class ViewBrowser : public ::testing::Test {
 
 TEST_F(ViewBrowser, PlaysEveryBackendAndTheBodiesAreDrawnAndMove) {
   const fs::path dir = temp_dir("browser");
-  const nlohmann::json d = data_of("scenes/analytic/headon_e05.toml");
-  ASSERT_GE(d["backends"].size(), 2u);
+  const ViewData d = data_of("scenes/analytic/headon_e05.toml");
+  ASSERT_GE(d.script["backends"].size(), 2u);
   const fs::path page = dir / "headon_e05.html";
   std::ofstream(page) << view_page(d, three_js());
-  const std::vector<std::string> bad = check_page(page, d);
+  const std::vector<std::string> bad = check_page(page, d.script);
   for (const std::string& b : bad) ADD_FAILURE() << b;
   fs::remove_all(dir);
 }
@@ -249,17 +295,17 @@ TEST_F(ViewBrowser, TossReplayShowsTheMeasuredGhost) {
   std::vector<std::pair<std::string, TossRun>> runs;
   for (const char* name : {"custom", "bullet"})
     runs.emplace_back(name, simulate_toss(find_backend(name)->dynamics, toss, kPublishedParams));
-  const nlohmann::json d = toss_replay_data(toss, runs, "toss");
-  ASSERT_EQ(d["ghost"]["time"].size(), toss.samples.size());
-  for (const auto& [name, b] : d["backends"].items())
+  const ViewData d = toss_replay_data(toss, runs, "toss");
+  ASSERT_EQ(d.script["ghost"]["time"].size(), toss.samples.size());
+  for (const auto& [name, b] : d.script["backends"].items())
     EXPECT_EQ(b["time"].size(), toss.samples.size()) << name;  // a pose at every measured sample
   std::ofstream(dir / "toss.html") << view_page(d, three_js());
-  const std::vector<std::string> bad = check_page(dir / "toss.html", d);
+  const std::vector<std::string> bad = check_page(dir / "toss.html", d.script);
   for (const std::string& b : bad) ADD_FAILURE() << b;
-  nlohmann::json cut = d;
-  cut["ghost"]["time"].erase(cut["ghost"]["time"].begin());
+  ViewData cut = d;
+  cut.script["ghost"]["time"].erase(cut.script["ghost"]["time"].begin());
   std::ofstream(dir / "cut.html") << view_page(cut, three_js());
-  const std::vector<std::string> bad_cut = check_page(dir / "cut.html", d);
+  const std::vector<std::string> bad_cut = check_page(dir / "cut.html", d.script);
   ASSERT_FALSE(bad_cut.empty());
   EXPECT_EQ(bad_cut.front().rfind("ghost:", 0), 0u) << bad_cut.front();
   fs::remove_all(dir);
@@ -278,8 +324,8 @@ TEST_F(ViewBrowser, TheCameraFramesTheMovingBodiesNotTheFloor) {
   HarnessOptions opt;
   opt.sweep = false;
   opt.timing_budget_s = 0.0;  // the replay only: no run is timed again
-  std::ofstream(dir / "drop.html")
-      << view_page(view_data(scene, evaluate_scene(scene, opt).json), three_js());
+  std::ofstream(dir / "drop.html") << view_page(
+      view_data(scene, read_replay(evaluate_scene(scene, opt).json, kViewMaxEvents)), three_js());
   const nlohmann::json st = page_state(dir / "drop.html", "", 2000);
   ASSERT_TRUE(st.is_object() && st.contains("framed")) << st.dump();
   // The cube's fall spans about 0.3 m (from z = 0.25 to the floor at 0); the floor is 20 m.
@@ -291,23 +337,23 @@ TEST_F(ViewBrowser, TheCameraFramesTheMovingBodiesNotTheFloor) {
 
 TEST_F(ViewBrowser, FailsOnABrokenPage) {
   const fs::path dir = temp_dir("broken");
-  const nlohmann::json d = data_of("scenes/analytic/headon_e05.toml");
+  const ViewData d = data_of("scenes/analytic/headon_e05.toml");
   // A page that lost a backend: judged against the data it should show.
-  nlohmann::json missing = d;
-  const std::string dropped = missing["backends"].begin().key();
-  missing["backends"].erase(dropped);
+  ViewData missing = d;
+  const std::string dropped = missing.script["backends"].begin().key();
+  missing.script["backends"].erase(dropped);
   std::ofstream(dir / "missing.html") << view_page(missing, three_js());
-  const std::vector<std::string> bad1 = check_page(dir / "missing.html", d);
+  const std::vector<std::string> bad1 = check_page(dir / "missing.html", d.script);
   for (const std::string& b : bad1) std::cout << "missing-backend page: " << b << "\n";
   ASSERT_FALSE(bad1.empty());
   EXPECT_NE(bad1.front().find("backend " + dropped + " not loaded"), std::string::npos)
       << bad1.front();
   // An empty scene: no bodies, so nothing drawn and nothing moves.
-  nlohmann::json empty = d;
-  empty["bodies"] = nlohmann::json::array();
-  empty["shapes"] = nlohmann::json::array();
+  ViewData empty = d;
+  empty.script["bodies"] = nlohmann::json::array();
+  empty.script["shapes"] = nlohmann::json::array();
   std::ofstream(dir / "empty.html") << view_page(empty, three_js());
-  const std::vector<std::string> bad2 = check_page(dir / "empty.html", d);
+  const std::vector<std::string> bad2 = check_page(dir / "empty.html", d.script);
   for (const std::string& b : bad2) std::cout << "empty-scene page: " << b << "\n";
   bool saw_bodies = false, saw_pixels = false;
   for (const std::string& b : bad2) {
@@ -329,7 +375,7 @@ TEST_F(ViewBrowser, WithoutWebGLThePageSaysWhyOnTheScreen) {
   // Chromium with WebGL turned off (--disable-3d-apis): the page cannot draw, and says so in
   // visible text, not only in its hidden state.
   const fs::path dir = temp_dir("no_webgl");
-  const nlohmann::json d = data_of("scenes/analytic/headon_e05.toml");
+  const ViewData d = data_of("scenes/analytic/headon_e05.toml");
   const fs::path page = dir / "page.html", dom = dir / "page.dom";
   std::ofstream(page) << view_page(d, three_js());
   shell(chromium("--disable-3d-apis --dump-dom 'file://" + page.string() + "'", 1000) + " > '" +
