@@ -388,11 +388,10 @@ void make_solver_fair(btDiscreteDynamicsWorld& world, const BulletSettings& sett
   info.m_splitImpulse = 1;
   info.m_splitImpulsePenetrationThreshold = settings.split_impulse_threshold;
   if (settings.split_turn_erp >= 0) info.m_splitImpulseTurnErp = settings.split_turn_erp;
-  // No warm starting: each step's solve starts from zero impulse, not 0.85 of the last
-  // step's. Done by the factor, not by clearing SOLVER_USE_WARMSTARTING: without that flag
-  // solveGroupCacheFriendlyFinish skips writeBackContacts, so the manifold points would
+  // Warm starting set by the factor, never by clearing SOLVER_USE_WARMSTARTING: without that
+  // flag solveGroupCacheFriendlyFinish skips writeBackContacts, so the manifold points would
   // never carry the applied impulses the events below are read from.
-  info.m_warmstartingFactor = 0;
+  info.m_warmstartingFactor = settings.warmstarting_factor;
   // Enough Gauss-Seidel sweeps for multi-point manifolds to converge (default 10); a
   // single-point impact is exact after the first.
   info.m_numIterations = 100;

@@ -46,6 +46,11 @@ struct BulletSettings {
   // of time step as Bullet scales it).
   double contact_erp = 0.2;
   double contact_cfm = 0.0;
+  // The share of each contact point's last-step impulses its solve starts from (Bullet's own
+  // 0.85). 0: every step's solve starts from zero; started from the last step's friction, a
+  // sliding box whose corner loads shift keeps friction that step no longer has, and stops off
+  // Coulomb's slide.
+  double warmstarting_factor = 0.0;
 };
 
 /// `bullet`: native boxes, polyhedral hulls (GJK + EPA axis, clipped manifold), zero hull

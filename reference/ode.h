@@ -18,6 +18,9 @@ struct OdeSettings {
   // The most contacts dCollide returns for a pair (1 to 32): dBoxBox's face manifold has up to
   // 8 points, culled by ODE to this many; the convex path returns what it finds.
   int max_contacts = 32;
+  // m/s: the most a contact's position correction (ERP depth / dt) may push its bodies apart
+  // (dWorldSetContactMaxCorrectingVel, ODE's remedy for "popping"); infinite: ODE's default.
+  double max_correcting_vel = 0.1;
 };
 
 /// `ode-hull`: every body a dCreateConvex geom, ODE's default world.

@@ -93,7 +93,8 @@ struct BackendOutcome {
   double rest_time_err_s = 0.0;  // |measured - closed-form time to rest| (the run's samples)
   // Landing and slide kinds: the deepest contact the library reported in the run (m).
   double reported_depth_m = 0.0;
-  // Slide kind: the highest the box's centre rose off the surface, along its normal (m).
+  // Landing and slide kinds: the highest the box's centre rose off its surface, along the
+  // normal, once on it (m; largest_rise).
   double rise_m = 0.0;
   // Contact kind (measured): how far the points fall short of the exact patch / size
   // (patch_cover.h); counted, not yet a disagreement (docs/explore.md).
@@ -279,7 +280,9 @@ bool realize_landing(LandingSample& s);
 
 /// Runs the sample's scene through each named dynamics backend against its closed form:
 /// status error, then a turn above kLandingTurnMark, then a position above
-/// kLandingPositionMark.
+/// kLandingPositionMark (late_landing where a landing resolved a step late explains it); a turn
+/// or position named deep_contact (name_deep_contact), else lift_off where the box rose off the
+/// floor by more than kSlideLiftMark after its first touch, else cone_excess (name_cone_excess).
 SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<std::string>& names,
                                       const std::vector<Backend>* table = nullptr,
                                       const ResultCache* cache = nullptr);
@@ -363,9 +366,12 @@ double slide_rest_time(const Scene& scene);
 /// along that plane; `end` when there is none.
 double measured_rest_time(const std::vector<StateSample>& samples, const Vec3& normal, double end);
 
-/// The highest the first body's centre rose above `start` along `normal` in a run's samples (m;
-/// 0 when it never did). A sliding box of the closed form never leaves its surface.
-double largest_rise(const std::vector<StateSample>& samples, const Vec3& start, const Vec3& normal);
+/// The highest the first body's centre rose above its resting height (`rest`, along `normal`) in
+/// a run's samples, once it had reached that height (m; 0 when it never rose): from `start` for
+/// a box that starts on its surface, from its first touch for one that lands. A box of the
+/// closed form never leaves its surface.
+double largest_rise(const std::vector<StateSample>& samples, const Vec3& start, const Vec3& rest,
+                    const Vec3& normal);
 
 /// Runs the sample's scene through each named dynamics backend against its closed form:
 /// status error, then a turn above kLandingTurnMark, then a position along the surface above

@@ -154,8 +154,10 @@ std::string describe_outcome(const BackendOutcome& b) {
            " m off its surface while sliding (the closed form's box never leaves it)";
   if (b.error == "late_landing")
     return "rests " + fmt_num(b.position_err_m, 3) +
-           " m further along its launch, the slide of the rest of its step after the touch: the "
-           "landing resolved at the step after it (no time of impact)";
+           " m off along its launch: the landing resolved at the step after the touch (no time "
+           "of impact), the slide of the rest of that step, or less where the deeper landing "
+           "pushed back harder and its friction took more of the slide (Coulomb's throughout, "
+           "measured on the run's steps)";
   if (b.error == "position" || b.error == "turn" || b.error == "rest_time")
     return "rests " + fmt_num(b.position_err_m, 3) + " m from the closed form, turned by " +
            fmt_num(b.turn_rad, 3) + " rad, its time to rest off by " +

@@ -174,6 +174,36 @@ ShrinkResult shrink_with(const ContactSample& start, const ShowsDisagreement& sh
 // ---------------------------------------------------------------------------------------------
 // Reproduction through the harness
 
+namespace {
+
+// Slide and landing kinds' rest_time and lift_off: the harness checks final states, not when the
+// box came to rest or how high it rose on the way; the written scene's own run (every step
+// sampled) against its closed form, read from the scene. What was measured goes to `d`.
+bool own_run_reproduces(const Scene& scene, const std::vector<RigidBody>& bodies,
+                        const BackendOutcome& b, std::ostringstream& d) {
+  const Backend* be = find_backend(b.backend);
+  const DynamicsResult run =
+      be ? run_dynamics_isolated(*be, scene, DynamicsOptions{0.0, 1}).result : DynamicsResult{};
+  const Vec3 n = bodies[1].orientation * Vec3::UnitZ();
+  const bool ran = run.status == Status::Ok;
+  if (b.error == "lift_off") {
+    const Vec3 rest =
+        scene.expect && !scene.expect->bodies.empty() && scene.expect->bodies.front().position
+            ? *scene.expect->bodies.front().position
+            : bodies[0].position;
+    const double rise = ran ? largest_rise(run.samples, bodies[0].position, rest, n) : -1.0;
+    d << "rose " << rise << " m off its surface (the scene's own run, every step)";
+    return rise > kSlideLiftMark;
+  }
+  const double off = ran ? std::abs(measured_rest_time(run.samples, n, scene.sim.duration) -
+                                    slide_rest_time(scene))
+                         : -1.0;
+  d << "time to rest off by " << off << " s (the scene's own run, every step)";
+  return off > kSlideRestTimeMark;
+}
+
+}  // namespace
+
 bool harness_reproduces(const std::string& scene_text, const std::string& path,
                         const BackendOutcome& b, std::string* detail) {
   const Scene scene = parse_scene(scene_text, path);
@@ -240,25 +270,7 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
     ok = metric("velocity_err_ke") > kMarkVelocityErr;
     d << "velocity_err_ke " << metric("velocity_err_ke");
   } else if ((b.error == "rest_time" || b.error == "lift_off") && status == "ok") {
-    // Slide kind: the harness checks final states, not when the box came to rest or how high
-    // it rose on the way; the written scene's own run (every step sampled) against its closed
-    // form, read from the scene.
-    const Backend* be = find_backend(b.backend);
-    const DynamicsResult run =
-        be ? run_dynamics_isolated(*be, scene, DynamicsOptions{0.0, 1}).result : DynamicsResult{};
-    const Vec3 n = bodies[1].orientation * Vec3::UnitZ();
-    const bool ran = run.status == Status::Ok;
-    if (b.error == "lift_off") {
-      const double rise = ran ? largest_rise(run.samples, bodies[0].position, n) : -1.0;
-      ok = rise > kSlideLiftMark;
-      d << "rose " << rise << " m off its surface (the scene's own run, every step)";
-    } else {
-      const double off = ran ? std::abs(measured_rest_time(run.samples, n, scene.sim.duration) -
-                                        slide_rest_time(scene))
-                             : -1.0;
-      ok = off > kSlideRestTimeMark;
-      d << "time to rest off by " << off << " s (the scene's own run, every step)";
-    }
+    ok = own_run_reproduces(scene, bodies, b, d);
   } else if ((b.error == "position" || b.error == "turn" || b.error == "late_landing" ||
               b.error == "deep_contact" || b.error == "cone_excess") &&
              status == "ok") {

@@ -126,11 +126,19 @@ double measured_rest_time(const std::vector<StateSample>& samples, const Vec3& n
   return t;
 }
 
-double largest_rise(const std::vector<StateSample>& samples, const Vec3& start,
+double largest_rise(const std::vector<StateSample>& samples, const Vec3& start, const Vec3& rest,
                     const Vec3& normal) {
+  // A start within a tenth of the mark of the rest height is on the surface (a slide's, or a
+  // written scene's rounding of it); a landing's starts a drop above.
+  bool reached = (start - rest).dot(normal) <= 0.1 * kSlideLiftMark;
   double rise = 0.0;
-  for (const StateSample& k : samples)
-    rise = std::max(rise, (k.bodies[0].position - start).dot(normal));
+  for (const StateSample& k : samples) {
+    const double h = (k.bodies[0].position - rest).dot(normal);
+    if (reached)
+      rise = std::max(rise, h);
+    else
+      reached = h <= 0.0;
+  }
   return rise;
 }
 
@@ -264,7 +272,7 @@ SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std:
         else if (!(o.rest_time_err_s <= kSlideRestTimeMark))
           o.error = "rest_time";
         name_deep_contact(o, run, s.size.minCoeff());
-        o.rise_m = largest_rise(run.samples, s.start_position, n);
+        o.rise_m = largest_rise(run.samples, s.start_position, s.start_position, n);
         if (!o.error.empty() && o.error != "deep_contact" && o.rise_m > kSlideLiftMark)
           o.error = "lift_off";
         name_cone_excess(o, run, off - off.dot(n) * n,
