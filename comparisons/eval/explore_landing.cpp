@@ -211,7 +211,8 @@ SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<
         o.rise_m = largest_rise(run.samples, s.start_position, s.expect_position, Vec3::UnitZ());
         if ((o.error == "turn" || o.error == "position") && o.rise_m > kSlideLiftMark)
           o.error = "lift_off";
-        name_cone_excess(o, run, off, launch, s.speed_after > 0.0 ? s.friction * kGravity : 0.0);
+        name_cone_excess(o, run, off, launch, s.speed_after > 0.0 ? s.friction * kGravity : 0.0,
+                         turn_about(inputs[0].orientation, f.orientation, Vec3::UnitZ()));
       });
   return out;
 }

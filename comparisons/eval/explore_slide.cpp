@@ -277,7 +277,8 @@ SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std:
           o.error = "lift_off";
         name_cone_excess(o, run, off - off.dot(n) * n,
                          s.speed > 0.0 ? Vec3(s.velocity.normalized()) : Vec3::Zero(),
-                         s.speed > 0.0 ? s.deceleration : 0.0);
+                         s.speed > 0.0 ? s.deceleration : 0.0,
+                         turn_about(inputs[0].orientation, f.orientation, n));
       });
   return out;
 }

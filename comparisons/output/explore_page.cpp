@@ -111,7 +111,8 @@ std::string markdown_landing(const ExploreSummary& s) {
        "it; docs/references.md says whose model does this), and a turn or position miss "
        "cone_excess where "
        "the friction the library applied beyond the Coulomb cone (measured on its own impulses, "
-       "docs/contact_laws.md) gave at least half the turn or moved the stop past the mark. Time "
+       "docs/contact_laws.md) gave at least half the turn or the part of it past the mark, or "
+       "moved the stop past the mark. Time "
        "to rest: the first step "
        "whose horizontal speed is below 1 mm/s, the box moving less than 0.1 mm after it, read "
        "from every step (one step's resolution); reported, not marked. Velocity error: the final "
@@ -159,7 +160,8 @@ std::string markdown_slide(const ExploreSummary& s) {
        "whose model does this), and a turn or position miss is named cone_excess where the "
        "friction the library applied beyond the Coulomb cone (measured on its own impulses, "
        "docs/contact_laws.md; Bullet leaves it at points with no normal impulse) gave at least "
-       "half the turn, or moved the stop by what puts it past the mark. Velocity error: "
+       "half the turn or the part of it past the mark, or moved the stop by what puts it past the "
+       "mark. Velocity error: "
        "the final velocities in the energy norm against the launch's kinetic energy (a 1 m/s "
        "slide's for a box left at rest).\n\n## Backends\n\n";
   Table t({"backend", "samples", "disagreements", "rate", "position err p50/p90/p99 (m)",

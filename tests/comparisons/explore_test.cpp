@@ -545,6 +545,22 @@ TEST(ExploreLanding, FrictionBeyondTheConeNamesBulletsTurnAfterALanding) {
   EXPECT_EQ(o.backends[1].error, "");
 }
 
+TEST(ExploreLanding, FrictionBeyondTheConeThatTurnedTheBoxPastTheMarkNamesIt) {
+  // Seed 9090, sample 493: Bullet turns a sliding landing by 1.4e-3 rad about the vertical, and
+  // the friction it applied beyond the cone gave 48 % of that turn, the same way: without it the
+  // box turns 7e-4 rad, within the mark. The turn past the mark is that friction's.
+  const LandingSample s = make_landing_sample(9090, 493);
+  const SampleOutcome o = evaluate_landing_sample(s, {"bullet"});
+  ASSERT_EQ(o.backends.size(), 1u);
+  EXPECT_EQ(o.backends[0].error, "cone_excess");
+  EXPECT_GT(o.backends[0].turn_rad, kLandingTurnMark);
+  // The signed turn about an axis: a quarter turn about z read about z, and about x as none.
+  const Quat from(Eigen::AngleAxisd(0.3, Vec3::UnitX()));
+  const Quat to = Quat(Eigen::AngleAxisd(-M_PI / 2, Vec3::UnitZ())) * from;
+  EXPECT_NEAR(explore_detail::turn_about(from, to, Vec3::UnitZ()), -M_PI / 2, 1e-12);
+  EXPECT_NEAR(explore_detail::turn_about(from, to, Vec3::UnitX()), 0.0, 1e-12);
+}
+
 TEST(ExploreLanding, ALateLandingThatTookMoreOfTheSlideIsNamedFromItsOwnSteps) {
   // Seed 9090, sample 625: a sliding landing with little slide left after it (v_h' 0.066 m/s,
   // mu 0.96). ODE and MuJoCo resolve it a step late, deeper, push back harder than m vn and,
