@@ -426,6 +426,7 @@ BenchResults run_bench(const BenchPlan& plan) {
   out.mhz = cpu_mhz();
   out.cases = total;
   for (const CaseSet& set : sets) set.collect(times, out);
+  fill_exponents(out);
   return out;
 }
 

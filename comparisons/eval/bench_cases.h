@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <functional>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -213,12 +214,29 @@ struct BenchResults {
   std::vector<BroadRow> broad;
   std::vector<StepRow> step;
   std::vector<ExploreRow> explore;
+  // The growth exponent of time against size of each series (fit_exponent; NaN where a series
+  // has fewer than two sizes): the narrow phase's by "backend/variant/pose kind"
+  // (series_exponent), the broad phase's by method. Filled from the rows (fill_exponents).
+  std::map<std::string, double> narrow_exponents, broad_exponents;
 };
 
-/// Builds every family's groups of cases, times each group interleaved and returns the rows.
+/// Builds every family's groups of cases, times each group interleaved and returns the rows
+/// with their exponents.
 BenchResults run_bench(const BenchPlan& plan);
 
 /// Least-squares slope of log(time) against log(size): the exponent of time against size.
 double fit_exponent(const std::vector<std::pair<double, double>>& points);
+
+/// The least-squares exponent of one narrow-phase series (hull sizes only, the box excluded).
+double series_exponent(const std::vector<NarrowRow>& rows, const std::string& backend,
+                       const std::string& variant, const std::string& pose);
+
+/// The key of a narrow-phase series in BenchResults::narrow_exponents.
+std::string narrow_series(const std::string& backend, const std::string& variant,
+                          const std::string& pose);
+
+/// Fills the results' exponents from their rows: every narrow_backends() series of every pose
+/// kind, every broad-phase method of kBenchBroadPhaseMethods.
+void fill_exponents(BenchResults& results);
 
 }  // namespace rbx

@@ -61,16 +61,6 @@ PerfGoal ratio_goal(const std::string& goal, const std::string& label, const Ben
 
 }  // namespace
 
-double series_exponent(const std::vector<NarrowRow>& rows, const std::string& backend,
-                       const std::string& variant, const std::string& pose) {
-  std::vector<std::pair<double, double>> pts;
-  for (const NarrowRow& r : rows)
-    if (r.backend == backend && r.variant == variant && r.pose == pose && r.vertices > 8 &&
-        std::isfinite(r.ns_per_query.median))
-      pts.push_back({static_cast<double>(r.vertices), r.ns_per_query.median});
-  return fit_exponent(pts);
-}
-
 // The profiles behind the contact-query goals (perf and cachegrind, 2026-11-28, after the inner
 // polytope, the region's centre and the scan on AVX; hulls of random points on a sphere), each a
 // measured cause.

@@ -27,8 +27,4 @@ struct PerfGoal {
 /// The goals, judged on the rows of a run.
 std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& results);
 
-/// The least-squares exponent of one narrow-phase series (hull sizes only, the box excluded).
-double series_exponent(const std::vector<NarrowRow>& rows, const std::string& backend,
-                       const std::string& variant, const std::string& pose);
-
 }  // namespace rbx

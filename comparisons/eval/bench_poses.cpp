@@ -97,6 +97,35 @@ std::vector<RigidBody> cube_crowd(int n, std::mt19937_64& rng) {
   return bodies;
 }
 
+double series_exponent(const std::vector<NarrowRow>& rows, const std::string& backend,
+                       const std::string& variant, const std::string& pose) {
+  std::vector<std::pair<double, double>> pts;
+  for (const NarrowRow& r : rows)
+    if (r.backend == backend && r.variant == variant && r.pose == pose && r.vertices > 8 &&
+        std::isfinite(r.ns_per_query.median))
+      pts.push_back({static_cast<double>(r.vertices), r.ns_per_query.median});
+  return fit_exponent(pts);
+}
+
+std::string narrow_series(const std::string& backend, const std::string& variant,
+                          const std::string& pose) {
+  return backend + "/" + variant + "/" + pose;
+}
+
+void fill_exponents(BenchResults& results) {
+  for (const NarrowBackend& b : narrow_backends())
+    for (const PoseKind& k : kPoseKinds)
+      results.narrow_exponents[narrow_series(b.backend, b.variant, k.name)] =
+          series_exponent(results.narrow, b.backend, b.variant, k.name);
+  for (BroadPhaseMethod m : kBenchBroadPhaseMethods) {
+    std::vector<std::pair<double, double>> pts;
+    for (const BroadRow& r : results.broad)
+      if (r.method == to_string(m) && std::isfinite(r.ns_per_step.median))
+        pts.push_back({static_cast<double>(r.bodies), r.ns_per_step.median});
+    results.broad_exponents[to_string(m)] = fit_exponent(pts);
+  }
+}
+
 double fit_exponent(const std::vector<std::pair<double, double>>& points) {
   if (points.size() < 2) return NAN;
   double sx = 0, sy = 0, sxx = 0, sxy = 0;

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "comparisons/eval/json_io.h"
@@ -35,6 +36,12 @@ std::string cpu_model() {
   while (std::getline(in, line))
     if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
   return "unknown CPU";
+}
+
+// A series' exponent, NaN where the run has none.
+double exponent(const std::map<std::string, double>& exponents, const std::string& series) {
+  const auto it = exponents.find(series);
+  return it == exponents.end() ? NAN : it->second;
 }
 
 // A number for perf.json: null when not finite.
@@ -142,8 +149,9 @@ Json perf_json(const BenchPlan& plan, const BenchResults& results,
   j["exponents"] = Json::object();
   for (const NarrowBackend& b : nb)
     for (const PoseKind& k : kPoseKinds) {
-      const double e = series_exponent(results.narrow, b.backend, b.variant, k.name);
-      if (std::isfinite(e)) j["exponents"][b.backend + "/" + b.variant + "/" + k.name] = e;
+      const std::string key = narrow_series(b.backend, b.variant, k.name);
+      const double e = exponent(results.narrow_exponents, key);
+      if (std::isfinite(e)) j["exponents"][key] = e;
     }
 
   return j;
@@ -269,7 +277,9 @@ std::string narrow_markdown(const BenchPlan& plan, const BenchResults& results) 
           }
         md << " " << time_cell(t, true) << note << " |";
       }
-      md << " " << bench_num(series_exponent(results.narrow, b.backend, b.variant, k.name), 2)
+      md << " "
+         << bench_num(
+                exponent(results.narrow_exponents, narrow_series(b.backend, b.variant, k.name)), 2)
          << " |\n";
     }
     md << "\n![narrow phase, " << k.name << "](figures/perf_narrowphase_" << k.name << ".png)\n\n";
@@ -404,18 +414,15 @@ std::string broad_markdown(const BenchPlan& plan, const BenchResults& results) {
   md << "---:|---:|\n";
   for (BroadPhaseMethod m : kBenchBroadPhaseMethods) {
     md << "| " << to_string(m) << " |";
-    std::vector<std::pair<double, double>> pts;
     double pairs = 0.0;
     for (int n : plan.crowd_sizes)
       for (const BroadRow& r : results.broad)
         if (r.method == to_string(m) && r.bodies == n) {
           md << " " << time_cell(r.ns_per_step, true) << " |";
-          if (std::isfinite(r.ns_per_step.median))
-            pts.push_back({static_cast<double>(n), r.ns_per_step.median});
           pairs = r.pairs_per_step;
         }
-    md << " " << bench_num(fit_exponent(pts), 2) << " | " << bench_num(pairs, 4) << " (at "
-       << plan.crowd_sizes.back() << ") |\n";
+    md << " " << bench_num(exponent(results.broad_exponents, to_string(m)), 2) << " | "
+       << bench_num(pairs, 4) << " (at " << plan.crowd_sizes.back() << ") |\n";
   }
   md << "\n![broad phase](figures/perf_broadphase.png)\n\n";
   return md.str();

@@ -109,5 +109,37 @@ TEST(PerfReport, AStepGoalIsJudgedOnTheMedianRatio) {
   EXPECT_EQ(judged, 2);
 }
 
+// The pages print exponents the evaluation computed: each narrow series' slope of log time over
+// log size from its hull rows (the box row left out), each broad-phase method's over its crowd
+// sizes, NaN for a series with one size.
+TEST(BenchExponents, FilledFromTheRowsNotByThePages) {
+  BenchResults results;
+  for (int n : {8, 16, 64, 256}) {
+    NarrowRow r;
+    r.backend = "custom";
+    r.variant = "default";
+    r.pose = "touching";
+    r.vertices = n;
+    r.ns_per_query = rounds_of(n == 8 ? 1e9 : std::pow(n, 1.5), {1.0});  // the box: an outlier
+    results.narrow.push_back(r);
+  }
+  NarrowRow alone = results.narrow.back();
+  alone.pose = "deep";  // one size: no slope
+  results.narrow.push_back(alone);
+  const std::string tree = to_string(kBenchBroadPhaseMethods[0]);
+  for (int n : {100, 1000, 10000}) {
+    BroadRow b;
+    b.method = tree;
+    b.bodies = n;
+    b.ns_per_step = rounds_of(std::pow(n, 1.2), {1.0});
+    results.broad.push_back(b);
+  }
+  fill_exponents(results);
+  EXPECT_NEAR(results.narrow_exponents.at(narrow_series("custom", "default", "touching")), 1.5,
+              1e-12);
+  EXPECT_TRUE(std::isnan(results.narrow_exponents.at(narrow_series("custom", "default", "deep"))));
+  EXPECT_NEAR(results.broad_exponents.at(tree), 1.2, 1e-12);
+}
+
 }  // namespace
 }  // namespace rbx
