@@ -367,9 +367,9 @@ double slide_rest_time(const Scene& scene);
 double measured_rest_time(const std::vector<StateSample>& samples, const Vec3& normal, double end);
 
 /// The highest the first body's centre rose above its resting height (`rest`, along `normal`) in
-/// a run's samples, once it had reached that height (m; 0 when it never rose): from `start` for
-/// a box that starts on its surface, from its first touch for one that lands. A box of the
-/// closed form never leaves its surface.
+/// a run's samples, once it had come within a tenth of kSlideLiftMark of that height (m; 0 when
+/// it never rose): from `start` for a box that starts on its surface, from its first touch for
+/// one that lands. A box of the closed form never leaves its surface.
 double largest_rise(const std::vector<StateSample>& samples, const Vec3& start, const Vec3& rest,
                     const Vec3& normal);
 

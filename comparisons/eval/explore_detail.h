@@ -72,16 +72,13 @@ void name_deep_contact(BackendOutcome& o, const DynamicsResult& run, double side
 /// friction it received beyond the Coulomb cone (the run's ConeExcess, measured by the recorder
 /// on the library's own impulses) explains it: a turn of which that friction gave at least half
 /// (its spin model is linear in the damping), or whose part past the mark it gave (the box's
-/// own turn about the surface normal, `turn_about_normal`, signed as the recorder's, within the
-/// mark without it), or a resting place (`off_surface`, against the closed form, in the
+/// turn from `start` to `end`, less that friction's turn about the surface's unit `normal`,
+/// within the mark), or a resting place (`off_surface`, against the closed form, in the
 /// surface) that would be within the mark without the shift of the stop that friction gave
 /// along `slide_dir` at `deceleration` (m/s^2; 0: no slide to shift).
 void name_cone_excess(BackendOutcome& o, const DynamicsResult& run, const Vec3& off_surface,
-                      const Vec3& slide_dir, double deceleration, double turn_about_normal);
-
-/// The signed angle (rad, in (-pi, pi]) by which orientation `to` is turned from `from` about
-/// the unit `axis` (the turn's component about it).
-double turn_about(const Quat& from, const Quat& to, const Vec3& axis);
+                      const Vec3& slide_dir, double deceleration, const Quat& start,
+                      const Quat& end, const Vec3& normal);
 
 /// The [expect] block of a box that ends at rest at `position`, unturned (landing and slide
 /// kinds), the slide's discretisation bound written with the speed's name and value.

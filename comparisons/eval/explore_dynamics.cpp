@@ -77,20 +77,19 @@ void name_deep_contact(BackendOutcome& o, const DynamicsResult& run, double side
   if (!o.error.empty() && o.reported_depth_m > 0.1 * side) o.error = "deep_contact";
 }
 
-double turn_about(const Quat& from, const Quat& to, const Vec3& axis) {
-  const Quat q = (to * from.inverse()).normalized();
-  return 2.0 * std::atan2(q.vec().dot(axis), q.w());
-}
-
 void name_cone_excess(BackendOutcome& o, const DynamicsResult& run, const Vec3& off_surface,
-                      const Vec3& slide_dir, double deceleration, double turn_about_normal) {
+                      const Vec3& slide_dir, double deceleration, const Quat& start,
+                      const Quat& end, const Vec3& normal) {
   if (o.error != "turn" && o.error != "position") return;
   for (const ConeExcess& u : run.laws.cone_excess) {
     if (u.body != 0) continue;
     bool explains = false;
     if (o.turn_rad > kLandingTurnMark) {
+      // The whole turn left once the excess's turn about the normal is taken back (a tilt or a
+      // turn the other way stays).
+      const Quat without = Quat(Eigen::AngleAxisd(-u.turn_rad, normal)) * end;
       explains = std::abs(u.turn_rad) >= 0.5 * o.turn_rad ||
-                 std::abs(turn_about_normal - u.turn_rad) <= kLandingTurnMark;
+                 rotation_angle(start, without) <= kLandingTurnMark;
     } else if (deceleration > 0.0) {
       const Vec3 shift = u.push_m2s2 / deceleration * slide_dir;
       explains = (off_surface - shift).norm() <= kLandingPositionMark;

@@ -47,39 +47,53 @@ ExploreBody landing_floor(const LandingSample& s, double travel) {
   return e;
 }
 
-// A position miss that a late landing accounts for, measured on the run's own steps: the landing
-// was resolved after the step of its touch (no time of impact), the friction of that step was
-// Coulomb's at the step's own normal impulse, and from the state after it the box
-// slides to rest as Coulomb's slide does (v^2 / 2 mu g along its speed, within the slide's own
-// discretisation, v dt / 2). Found a step late the box is deeper, and a library that then pushes
-// back harder than m vn takes, with the same cone, more of what was left of the slide: the rest
-// moves by less than the late step's slide alone, and the run is still Coulomb's throughout.
+// A position miss that a late landing accounts for, measured on the run's own steps: the floor
+// first acted after the step of the touch (no time of impact); the landing's friction, summed
+// over the steps it took to stop the fall, was Coulomb's at their summed normal impulse; and from
+// the state after it the box slid to rest as Coulomb's slide does (v^2 / 2 mu g along its speed,
+// within the slide's own discretisation, v dt / 2). Found a step late the box is deeper, and a
+// library that then pushes back harder than m vn takes, with the same cone, more of what was left
+// of the slide: the rest is then along the launch, past the late step's slide less the slide left
+// after the landing (v_h'^2 / 2 mu g) and short of the late step's slide alone (`late`), each
+// within `slack`.
 bool late_landing_accounts(const std::vector<StateSample>& samples, const LandingSample& s,
-                           const Vec3& rest) {
+                           const Vec3& off, const Vec3& launch, double late, double slack) {
   const double mu = s.friction, dt = s.dt;
-  size_t landed = 0;  // the first sample after the touch whose fall was stopped
-  for (size_t k = 1; k < samples.size() && landed == 0; ++k)
-    if (samples[k].time > s.contact_time &&
-        samples[k].bodies[0].velocity.z() >= -0.1 * s.fall_speed)
-      landed = k;
+  const double left = s.speed_after * s.speed_after / (2.0 * mu * kGravity);
+  const double along = off.dot(launch);
+  if (!(along >= late - left - slack && along <= late + slack &&
+        (off - along * launch).norm() <= 1e-5))
+    return false;
+  // The first sample the floor acted on (its fall slower than free fall's, beyond round-off),
+  // and the first whose fall it had stopped.
+  size_t first = 0, landed = 0;
+  for (size_t k = 1; k < samples.size() && landed == 0; ++k) {
+    const double free_fall = -s.fall_speed - kGravity * samples[k].time;
+    const double vz = samples[k].bodies[0].velocity.z();
+    if (first == 0 && vz > free_fall + 1e-9 * s.fall_speed) first = k;
+    if (first != 0 && vz >= -0.1 * s.fall_speed) landed = k;
+  }
   const double touch_step_end = (s.steps_before + 1) * dt;
-  if (landed == 0 || !(samples[landed].time > touch_step_end + 1e-6 * dt)) return false;
-  const Vec3 before = samples[landed - 1].bodies[0].velocity;
+  if (landed == 0 || !(samples[first].time > touch_step_end + 1e-6 * dt)) return false;
+  const Vec3 before = samples[first - 1].bodies[0].velocity;
   const Vec3 after = samples[landed].bodies[0].velocity;
   const Vec3 h_after(after.x(), after.y(), 0.0);
-  // The step's normal impulse per unit mass: the fall it stopped and the step's gravity.
-  const double normal = after.z() - before.z() + kGravity * dt;
+  // The landing's normal impulse per unit mass: the fall it stopped and its steps' gravity.
+  const double normal =
+      after.z() - before.z() + kGravity * (samples[landed].time - samples[first - 1].time);
   const double tangential = (Vec3(before.x(), before.y(), 0.0) - h_after).norm();
   const double v = h_after.norm();
-  // Coulomb: a base still slipping after the step (above the time to rest's 1 mm/s) had mu
-  // times the normal impulse (to 1 %: a soft contact's cone is met to its solver's tolerance); a
-  // stopped one at most that (to round-off). A landing with too little friction is not a late one.
+  // Coulomb: a base still slipping after the landing (above the time to rest's 1 mm/s) had mu
+  // times the normal impulse (to 1 %: a soft contact meets its cone to its solver's tolerance);
+  // a stopped one at most that (to round-off). A landing with too little friction is not a
+  // late one.
   const bool coulomb = v > 1e-3 ? std::abs(tangential - mu * normal) <= 1e-2 * mu * normal
                                 : tangential <= mu * normal * (1.0 + 1e-9) + 1e-12;
   if (!coulomb) return false;
   const Vec3& p = samples[landed].bodies[0].position;
   Vec3 stop(p.x(), p.y(), 0.0);
   if (v > 0.0) stop += v / (2.0 * mu * kGravity) * h_after;  // v^2 / 2 mu g along h_after / v
+  const Vec3 rest = s.expect_position + off;
   return (Vec3(rest.x(), rest.y(), 0.0) - stop).norm() <= 0.5 * v * dt + 1e-5;
 }
 
@@ -204,7 +218,7 @@ SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<
         else if (!(o.position_err_m <= kLandingPositionMark))
           o.error = (std::abs(off.dot(launch) - late) <= slack &&
                      (off - off.dot(launch) * launch).norm() <= 1e-5) ||
-                            late_landing_accounts(run.samples, s, f.position)
+                            late_landing_accounts(run.samples, s, off, launch, late, slack)
                         ? "late_landing"
                         : "position";
         name_deep_contact(o, run, s.size.minCoeff());
@@ -212,7 +226,7 @@ SampleOutcome evaluate_landing_sample(const LandingSample& s, const std::vector<
         if ((o.error == "turn" || o.error == "position") && o.rise_m > kSlideLiftMark)
           o.error = "lift_off";
         name_cone_excess(o, run, off, launch, s.speed_after > 0.0 ? s.friction * kGravity : 0.0,
-                         turn_about(inputs[0].orientation, f.orientation, Vec3::UnitZ()));
+                         inputs[0].orientation, f.orientation, Vec3::UnitZ());
       });
   return out;
 }

@@ -137,7 +137,7 @@ double largest_rise(const std::vector<StateSample>& samples, const Vec3& start, 
     if (reached)
       rise = std::max(rise, h);
     else
-      reached = h <= 0.0;
+      reached = h <= 0.1 * kSlideLiftMark;
   }
   return rise;
 }
@@ -277,8 +277,8 @@ SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std:
           o.error = "lift_off";
         name_cone_excess(o, run, off - off.dot(n) * n,
                          s.speed > 0.0 ? Vec3(s.velocity.normalized()) : Vec3::Zero(),
-                         s.speed > 0.0 ? s.deceleration : 0.0,
-                         turn_about(inputs[0].orientation, f.orientation, n));
+                         s.speed > 0.0 ? s.deceleration : 0.0, inputs[0].orientation, f.orientation,
+                         n);
       });
   return out;
 }

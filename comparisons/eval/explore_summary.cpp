@@ -1,3 +1,4 @@
+// read_explore_summary: explore.json read once into what explore.md shows.
 #include "comparisons/eval/explore_summary.h"
 
 #include "comparisons/scene/scene_file.h"  // InputError
@@ -54,17 +55,24 @@ const ExplorePercentiles& ExploreBackendSummary::error(const std::string& metric
 }
 
 ExploreSummary read_explore_summary(const Json& j) {
+  ExploreSummary s;
   try {
-    ExploreSummary s;
     s.kind = j.at("kind").get<std::string>();
     s.seed = j.at("seed").get<uint64_t>();
     s.count = j.at("count").get<long>();
-    for (const auto& [name, b] : j.at("backends").items())
-      s.backends.push_back(read_backend(name, b));
-    return s;
+    if (!j.at("backends").is_object())
+      throw InputError("explore.json: \"backends\" is not an object");
   } catch (const Json::exception& e) {
     throw InputError(std::string("explore.json: ") + e.what());
   }
+  for (const auto& [name, b] : j["backends"].items()) {
+    try {
+      s.backends.push_back(read_backend(name, b));
+    } catch (const Json::exception& e) {
+      throw InputError("explore.json: backend " + name + ": " + e.what());
+    }
+  }
+  return s;
 }
 
 }  // namespace rbx

@@ -47,6 +47,7 @@ struct ExploreBackendSummary {
   const ExplorePercentiles& error(const std::string& metric) const;
 };
 
+/// A campaign as explore.md shows it: what was drawn, and each backend's tallies.
 struct ExploreSummary {
   std::string kind;  // contact | distance | impact | landing | slide | tunnel | toi
   uint64_t seed = 0;

@@ -1,3 +1,5 @@
+// read_replay: a scene's result object (harness.h) read once into the typed runs a replay page
+// draws (comparisons/output/view_page.h).
 #include "comparisons/eval/replay.h"
 
 #include <limits>
@@ -28,7 +30,8 @@ ReplayMotion read_motion(const Json& m) {
     ReplayTrack track{body, {}};
     for (const Json& f : frames) {
       ReplayPose pose;
-      for (size_t k = 0; k < pose.size(); ++k) pose[k] = k < f.size() ? number(f[k]) : 0.0;
+      for (size_t k = 0; k < pose.size(); ++k)
+        pose[k] = k < f.size() ? number(f[k]) : std::numeric_limits<double>::quiet_NaN();
       track.poses.push_back(pose);
     }
     out.tracks.push_back(std::move(track));
@@ -39,7 +42,8 @@ ReplayMotion read_motion(const Json& m) {
 ReplayEvent read_event(const Json& c) {
   ReplayEvent e;
   e.time = c.contains("time") ? number(c["time"]) : 0.0;
-  if (c.contains("bodies") && c["bodies"].size() == 2) {
+  if (c.contains("bodies") && c["bodies"].size() == 2 && c["bodies"][0].is_string() &&
+      c["bodies"][1].is_string()) {
     e.body_a = c["bodies"][0].get<std::string>();
     e.body_b = c["bodies"][1].get<std::string>();
   }

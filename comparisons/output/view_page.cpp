@@ -24,20 +24,20 @@ namespace {
 
 Json vec_json(const Vec3& v) { return {round_sig5(v.x()), round_sig5(v.y()), round_sig5(v.z())}; }
 
-// A run's events (or t = 0 contacts), rounded for the page.
+// A run's events (or t = 0 contacts), at most kViewMaxEvents, rounded for the page.
 Json events_json(const std::vector<ReplayEvent>& events) {
   Json out = Json::array();
   for (const ReplayEvent& e : events)
-    out.push_back({{"t", round_sig5(e.time)},
-                   {"bodies", {e.body_a, e.body_b}},
-                   {"point", vec_json(e.point)},
-                   {"normal", vec_json(e.normal)},
-                   {"depth", round_sig5(e.depth)}});
+    if (out.size() < kViewMaxEvents)
+      out.push_back({{"t", round_sig5(e.time)},
+                     {"bodies", {e.body_a, e.body_b}},
+                     {"point", vec_json(e.point)},
+                     {"normal", vec_json(e.normal)},
+                     {"depth", round_sig5(e.depth)}});
   return out;
 }
 
-// {"time": [s], "frames": {BODY: [[x, y, z, qw, qx, qy, qz]]}} of a motion, or without the
-// "time" and "frames" keys' wrapper: `into` gets them.
+// A motion's "time" (s) and "frames" ({BODY: [[x, y, z, qw, qx, qy, qz]]}), put into `into`.
 void put_motion(const ReplayMotion& m, Json& into) {
   into["time"] = m.time;
   into["frames"] = Json::object();

@@ -135,6 +135,7 @@ TEST(BenchExponents, FilledFromTheRowsNotByThePages) {
     results.broad.push_back(b);
   }
   fill_exponents(results);
+  // Exact power laws: the fitted slopes are theirs to round-off of the logarithms.
   EXPECT_NEAR(results.narrow_exponents.at(narrow_series("custom", "default", "touching")), 1.5,
               1e-12);
   EXPECT_TRUE(std::isnan(results.narrow_exponents.at(narrow_series("custom", "default", "deep"))));

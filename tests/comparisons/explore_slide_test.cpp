@@ -241,6 +241,7 @@ TEST(ExploreSlide, TheRiseIsTheCentresHighestOffTheSurfaceAlongItsNormal) {
   }
   EXPECT_EQ(largest_rise(run, start, start, n), 0.0);
   run[3].bodies[0].position += 2e-3 * n + 1e-5 * n;
+  // Below, 1e-15 m: the round-off of positions of a few metres.
   EXPECT_NEAR(largest_rise(run, start, start, n), 2e-3, 1e-15);
   // Landing from 5 mm above its resting height: the fall is not a rise; the first sample at or
   // below the rest height starts the count, and a hop 1 mm up after it is one.
@@ -451,6 +452,9 @@ TEST(ExploreLanding, OdeCorrectingSpeedCapMeasuredOnTheFamily) {
   // 0.1 m/s, half a millimetre at most, and the flight that loses the slide goes with it.
   EXPECT_GT(p99(rise["no cap"]), 1e-3);
   EXPECT_LT(p99(rise["cap 0.1"]), 0.1 * p99(rise["no cap"]));
+  // A lower cap bounds the pop further; what rejects it is the tosses' soft contact
+  // (docs/references.md), not this family.
+  EXPECT_LE(p99(rise["cap 0.01"]), p99(rise["cap 0.1"]));
   EXPECT_LE(misses["cap 0.1"], misses["no cap"]);
 }
 

@@ -546,29 +546,45 @@ TEST(ExploreLanding, FrictionBeyondTheConeNamesBulletsTurnAfterALanding) {
 }
 
 TEST(ExploreLanding, FrictionBeyondTheConeThatTurnedTheBoxPastTheMarkNamesIt) {
-  // Seed 9090, sample 493: Bullet turns a sliding landing by 1.4e-3 rad about the vertical, and
-  // the friction it applied beyond the cone gave 48 % of that turn, the same way: without it the
-  // box turns 7e-4 rad, within the mark. The turn past the mark is that friction's.
+  // Seed 9090, sample 493: Bullet turns a sliding landing about the vertical just past the mark,
+  // and the friction it applied beyond the cone gave under half of that turn, the same way:
+  // without it the box's turn is within the mark. The turn past the mark is that friction's.
   const LandingSample s = make_landing_sample(9090, 493);
   const SampleOutcome o = evaluate_landing_sample(s, {"bullet"});
   ASSERT_EQ(o.backends.size(), 1u);
   EXPECT_EQ(o.backends[0].error, "cone_excess");
   EXPECT_GT(o.backends[0].turn_rad, kLandingTurnMark);
-  // The signed turn about an axis: a quarter turn about z read about z, and about x as none.
-  const Quat from(Eigen::AngleAxisd(0.3, Vec3::UnitX()));
-  const Quat to = Quat(Eigen::AngleAxisd(-M_PI / 2, Vec3::UnitZ())) * from;
-  EXPECT_NEAR(explore_detail::turn_about(from, to, Vec3::UnitZ()), -M_PI / 2, 1e-12);
-  EXPECT_NEAR(explore_detail::turn_about(from, to, Vec3::UnitX()), 0.0, 1e-12);
+}
+
+TEST(ExploreLanding, FrictionBeyondTheConeDoesNotNameATiltOrATurnTheOtherWay) {
+  // The rule on its own: an excess that turned the box by 0.6 mrad about the floor's normal
+  // names a 1.4 mrad turn that way (0.8 left, within the 1 mrad mark), not the same turn the
+  // other way (2.0 left), nor a tilt of 1.4 mrad about a horizontal axis (the excess turns
+  // nothing about it), though each turn is past the mark and under twice the excess.
+  DynamicsResult run;
+  run.laws.cone_excess.push_back({0, 10, 6e-4, 0.0});
+  const Quat start(Eigen::AngleAxisd(0.3, Vec3::UnitZ()));
+  const auto named = [&](const Quat& turn) {
+    BackendOutcome o;
+    o.error = "turn";
+    o.turn_rad = explore_detail::rotation_angle(start, turn * start);
+    explore_detail::name_cone_excess(o, run, Vec3::Zero(), Vec3::UnitX(), 1.0, start, turn * start,
+                                     Vec3::UnitZ());
+    return o.error;
+  };
+  EXPECT_EQ(named(Quat(Eigen::AngleAxisd(1.4e-3, Vec3::UnitZ()))), "cone_excess");
+  EXPECT_EQ(named(Quat(Eigen::AngleAxisd(-1.4e-3, Vec3::UnitZ()))), "turn");
+  EXPECT_EQ(named(Quat(Eigen::AngleAxisd(1.4e-3, Vec3::UnitX()))), "turn");
 }
 
 TEST(ExploreLanding, ALateLandingThatTookMoreOfTheSlideIsNamedFromItsOwnSteps) {
-  // Seed 9090, sample 625: a sliding landing with little slide left after it (v_h' 0.066 m/s,
-  // mu 0.96). ODE and MuJoCo resolve it a step late, deeper, push back harder than m vn and,
-  // with the same cone, take more of the short slide: they rest 1.03 and 1.06 mm long where the
-  // late step's slide alone says 1.2. Their own steps show it (a late landing, Coulomb's at its
-  // own impulse, then Coulomb's slide), which names it; custom meets the closed form. ODE with
-  // its friction pyramid on fixed axes (ODE's default, dPlaneSpace) is not Coulomb's on a
-  // diagonal slide, and its misses keep their kind.
+  // Seed 9090, sample 625: a sliding landing with little slide left after it. ODE and MuJoCo
+  // resolve it a step late, deeper, push back harder than m vn and, with the same cone, take
+  // more of the short slide: they rest past the mark, but short of the late step's slide alone.
+  // Their own steps show it (a late landing, Coulomb's at its own impulse, then Coulomb's
+  // slide), which names it; custom meets the closed form. ODE with its friction pyramid on
+  // fixed axes (ODE's default, dPlaneSpace) is not Coulomb's on a diagonal slide, and its
+  // misses keep their kind.
   const LandingSample s = make_landing_sample(9090, 625);
   ASSERT_TRUE(s.slides);
   Backend plane = *find_backend("ode");

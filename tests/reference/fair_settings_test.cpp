@@ -515,7 +515,7 @@ TEST(OdeSettingsMeasured, DefaultErpKeepsAStackUpAtAKnownCostForInelasticImpacts
   OdeSettings no_erp, erp;
   erp.max_correcting_vel = no_erp.max_correcting_vel = INFINITY;
   no_erp.erp = 0.0;
-  const double drift_default = stack_drift(ode.dynamics(resting_stack(), {}));
+  const double drift_default = stack_drift(ode_at_settings().dynamics(resting_stack(), {}, erp));
   const double drift_no_erp = stack_drift(ode_at_settings().dynamics(resting_stack(), {}, no_erp));
   std::printf("[measured] ode resting stack drift: ERP 0.2 %.3g m, ERP 0 %.3g m\n", drift_default,
               drift_no_erp);
