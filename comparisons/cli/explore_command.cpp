@@ -41,7 +41,10 @@ void write_explore(const fs::path& out, const ExploreCampaign& c, bool figure_wa
     if (f.path().extension() == ".toml") fs::remove(f.path());
   for (const auto& [file, text] : c.scenes) write_text((out / file).string(), text);
   write_json((out / "explore.json").string(), c.result);
-  const bool figure = figure_wanted && draw_explore_figure(out.string());
+  // The figure draws the contact kind's error distributions; the other kinds' pages give theirs
+  // as percentiles in their tables.
+  const bool figure =
+      figure_wanted && c.summary.kind == "contact" && draw_explore_figure(out.string());
   write_text((out / "explore.md").string(), explore_markdown(c.summary, figure));
 }
 

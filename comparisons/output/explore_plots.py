@@ -29,6 +29,9 @@ def main(out):
     # The metrics the document has (one written before patch coverage was measured has none).
     metrics = [(key, label) for key, label in METRICS
                if any(key in j["backends"][n]["errors"] for n in names)]
+    if not metrics:
+        sys.exit(f"explore_plots.py: no contact-kind errors in {out}/explore.json "
+                 f"(kind {j.get('kind', '?')}): no figure")
     fig, axes = plt.subplots(1, len(metrics), figsize=(5 * len(metrics), 4.2), sharey=True)
     for ax, (key, label) in zip(axes, metrics):
         for k, name in enumerate(names):

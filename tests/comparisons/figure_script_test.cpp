@@ -56,6 +56,12 @@ TEST(FigureScript, AFailingScriptGivesItsStatusAndItsErrorInTheLog) {
   // No explore.json: the script stops with Python's error, on stderr, into the log.
   EXPECT_GT(run_figure_script("explore_plots.py", {dir.string()}, log.string()), 0);
   EXPECT_NE(read(log).find("explore.json"), std::string::npos) << read(log);
+  // A kind whose errors the figure does not draw (a landing's): one line saying so, no figure.
+  std::ofstream(dir / "explore.json") << R"({"kind": "landing", "backends": {"ode":
+    {"errors": {"position_err_m": {"n": 0}}}}})";
+  EXPECT_GT(run_figure_script("explore_plots.py", {dir.string()}, log.string()), 0);
+  EXPECT_NE(read(log).find("no contact-kind errors"), std::string::npos) << read(log);
+  EXPECT_FALSE(fs::exists(dir / "explore_errors.png"));
   fs::remove_all(dir);
 }
 
