@@ -8,7 +8,7 @@ namespace rbx {
 
 namespace {
 
-std::string num(double x, int digits = 3) {
+std::string goal_num(double x, int digits = 3) {
   NumberFormat f;
   f.digits = digits;
   f.non_finite = "—";
@@ -34,8 +34,8 @@ const StepRow* find_step(const std::vector<StepRow>& rows, const std::string& sc
 std::string ratio_text(const RatioSpread& r, int digits = 3) {
   if (r.rounds == 0) return "not measured";
   // The range at the median's precision: at two digits 1.06 reads "1.1", above a median of 1.08.
-  return num(r.median, digits) + " (" + num(r.q25, digits) + "-" + num(r.q75, digits) + " over " +
-         std::to_string(r.rounds) + " rounds)";
+  return goal_num(r.median, digits) + " (" + goal_num(r.q25, digits) + "-" +
+         goal_num(r.q75, digits) + " over " + std::to_string(r.rounds) + " rounds)";
 }
 
 // A goal on one ratio a / b of two timed rows: met when the median ratio is at most `limit`.
@@ -51,10 +51,10 @@ PerfGoal ratio_goal(const std::string& goal, const std::string& label, const Ben
   }
   const RatioSpread r = bench_ratio(*a, *b);
   g.ratios.push_back({label, r});
-  g.measured = "medians " +
-               (unit == "ns" ? fmt_duration_ns(a->median) : num(a->median) + " " + unit) + " vs " +
-               (unit == "ns" ? fmt_duration_ns(b->median) : num(b->median) + " " + unit) +
-               "; ratio round by round " + ratio_text(r);
+  g.measured =
+      "medians " + (unit == "ns" ? fmt_duration_ns(a->median) : goal_num(a->median) + " " + unit) +
+      " vs " + (unit == "ns" ? fmt_duration_ns(b->median) : goal_num(b->median) + " " + unit) +
+      "; ratio round by round " + ratio_text(r);
   g.met = r.rounds > 0 && r.median <= limit;
   return g;
 }
@@ -97,7 +97,7 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
   };
   const double fast_exp = series_exponent(nr, "custom", "default", "touching");
   goals.push_back({"custom, touching: time grows no faster than N^1.2",
-                   "exponent " + num(fast_exp) +
+                   "exponent " + goal_num(fast_exp) +
                        " (N = " + std::to_string(plan.hull_sizes.front()) + " to " +
                        std::to_string(plan.hull_sizes.back()) + ")",
                    std::isfinite(fast_exp) && fast_exp <= 1.2,
@@ -121,7 +121,7 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
     goals.push_back(
         {"broad phase (tree, the world's default): pair finding grows no faster than "
          "N^1.2",
-         "exponent " + num(e) + " (" + std::to_string(plan.crowd_sizes.front()) + " to " +
+         "exponent " + goal_num(e) + " (" + std::to_string(plan.crowd_sizes.front()) + " to " +
              std::to_string(plan.crowd_sizes.back()) + " bodies)",
          std::isfinite(e) && e <= 1.2,
          "",
@@ -145,7 +145,8 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
       g.ratios.push_back({"N = " + std::to_string(n), r});
       g.met = g.met && r.rounds > 0 && r.median <= 1.0;
       g.measured += (g.measured.empty() ? "" : ", ") + ("N = " + std::to_string(n) + ": ") +
-                    num(r.median, 2) + "x (" + num(r.q25, 2) + "-" + num(r.q75, 2) + ")";
+                    goal_num(r.median, 2) + "x (" + goal_num(r.q25, 2) + "-" + goal_num(r.q75, 2) +
+                    ")";
     }
     if (g.ratios.empty()) {
       g.measured = "not measured";
@@ -177,10 +178,11 @@ std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& resu
   for (const ExploreRow& r : results.explore)
     goals.push_back({"rbx explore: at least 50,000 contact samples per minute per core through " +
                          r.backends + " on hulls under 100 points",
-                     num(r.samples_per_minute.median, 3) + " per minute (" +
-                         num(r.samples_per_minute.q25, 3) + "-" + num(r.samples_per_minute.q75, 3) +
-                         " over " + std::to_string(r.samples_per_minute.rounds) +
-                         " rounds; one thread, " + std::to_string(r.samples) +
+                     goal_num(r.samples_per_minute.median, 3) + " per minute (" +
+                         goal_num(r.samples_per_minute.q25, 3) + "-" +
+                         goal_num(r.samples_per_minute.q75, 3) + " over " +
+                         std::to_string(r.samples_per_minute.rounds) + " rounds; one thread, " +
+                         std::to_string(r.samples) +
                          " samples of seed 1, as `rbx explore --bench --threads 1`)",
                      r.samples_per_minute.median >= 50000.0,
                      "",

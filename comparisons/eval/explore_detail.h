@@ -117,6 +117,15 @@ std::string points_shrunk(int before, int after, int kept, int tried);
 // shrink_group's JSON.
 std::string toi_group(const Json& g, uint64_t seed, long count, int budget);
 
+// The landing and slide kinds' gravity (m/s^2, down: -z).
+constexpr double kGravity = 9.81;
+// Both kinds draw sizes that keep mu sz at most this fraction of min(sx, sy): a fifth clear of
+// tipping (the friction's moment about the centre is mu N sz / 2, which the pressure can balance
+// while the contact force stays inside the base: mu sz < min(sx, sy); on an incline at rest the
+// same with tan(theta) < mu in place of mu), so that a turn is the backend's, not the edge of the
+// closed form.
+constexpr double kNoTipMargin = 0.8;
+
 // The first of up to `attempts` draws from the sample's own stream that `draw` realizes (draw
 // fills the sample and says whether it is valid); throws when none is.
 template <class Sample, class Draw>

@@ -18,12 +18,8 @@ using namespace explore_detail;
 
 namespace {
 
-constexpr double kGravity = 9.81;  // m/s^2, down (-z)
-// Drawn sizes keep mu sz at most this fraction of min(sx, sy): a fifth clear of tipping
-// (mu sz = min(sx, sy)), so that a turn is the backend's, not the edge of the closed form.
-constexpr double kNoTipMargin = 0.8;
 // After the closed-form rest, the run goes on this long (s): a backend's rest is seen at rest.
-constexpr double kSettleTime = 0.1;
+constexpr double kLandingSettleTime = 0.1;
 
 // The box and the floor of a landing as scene bodies (box first: A, then B as impact).
 ExploreBody landing_box(const LandingSample& s) {
@@ -122,7 +118,7 @@ bool realize_landing(LandingSample& s) {
   s.rest_time = tc + s.speed_after / (mu * g);
   const double before = s.slide_speed * tc;
   const double after = s.speed_after * s.speed_after / (2.0 * mu * g);
-  s.duration = std::ceil((s.rest_time + kSettleTime) / s.dt) * s.dt;
+  s.duration = std::ceil((s.rest_time + kLandingSettleTime) / s.dt) * s.dt;
   const double heading = s.heading_deg * M_PI / 180.0;
   const Vec3 dir(std::cos(heading), std::sin(heading), 0.0);
   s.start_position = Vec3(0.0, 0.0, 0.5 * s.size.z() + s.drop);

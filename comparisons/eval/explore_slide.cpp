@@ -16,17 +16,11 @@ using namespace explore_detail;
 
 namespace {
 
-constexpr double kGravity = 9.81;  // m/s^2, down (-z)
-// As the landing kind's: mu sz at most this fraction of min(sx, sy), a fifth clear of tipping
-// (the friction's moment about the centre is mu N sz / 2, which the pressure can balance while
-// the contact force stays inside the base: mu sz < min(sx, sy); on an incline at rest the same
-// with tan(theta) < mu in place of mu).
-constexpr double kNoTipMargin = 0.8;
 // The least deceleration drawn, as a multiple of g (mu cos(theta) - sin(theta) at least this on
 // an incline, so that the box sticks with margin after it stops; mu >= 0.1 on a floor).
 constexpr double kLeastDeceleration = 0.1;
 // After the closed-form rest the run goes on this long (s): a creep or a turn at rest shows.
-constexpr double kSettleTime = 0.2;
+constexpr double kSlideSettleTime = 0.2;
 // Speed (m/s) along the surface below which the box counts as stopped (kSlideRestTimeMark), and
 // the distance (m) it may then move for good: a library's resting jitter (Bullet hops by a few
 // micrometres at a few mm/s now and then) is not a slide, and a creep past it is not a rest; a
@@ -171,7 +165,7 @@ bool realize_slide(SlideSample& s) {
   if (s.incline_deg == 0) s.deceleration = mu * g;
   s.stop_distance = s.speed * s.speed / (2.0 * s.deceleration);
   s.rest_time = s.speed / s.deceleration;
-  s.duration = std::ceil((s.rest_time + kSettleTime) / s.dt) * s.dt;
+  s.duration = std::ceil((s.rest_time + kSlideSettleTime) / s.dt) * s.dt;
   surface = slide_surface(s);  // sized for the path
   s.start_position = (0.5 * s.size.z() - kStartDepth) * s.normal;
   s.velocity = s.speed * dir;

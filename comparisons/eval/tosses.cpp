@@ -66,7 +66,7 @@ double parse_field(const std::string& s, const std::string& where, const char* c
   return v;
 }
 
-std::string num(double x) { return fmt_num(x, 6); }
+std::string six_digits(double x) { return fmt_num(x, 6); }
 
 }  // namespace
 
@@ -123,15 +123,15 @@ std::vector<Toss> parse_tosses(const std::string& text, const std::string& path)
     } else {
       const TossSample& prev = tosses.back().samples.back();
       if (!(s.time > prev.time))
-        throw InputError(where + ": time " + num(s.time) + " s not after the previous " +
-                         num(prev.time) + " s of toss " + std::to_string(id));
+        throw InputError(where + ": time " + six_digits(s.time) + " s not after the previous " +
+                         six_digits(prev.time) + " s of toss " + std::to_string(id));
       const double i = static_cast<double>(tosses.back().samples.size());
       const double at = (s.time - tosses.back().samples.front().time) * rate;
       if (std::fabs(at - i) > kGridTolerance)
-        throw InputError(where + ": time " + num(s.time) + " s is off the 148 Hz sample grid (" +
-                         "sample " + fmt_num(i, 10) + " of toss " + std::to_string(id) +
-                         " expected at " + num(tosses.back().samples.front().time + i / rate) +
-                         " s)");
+        throw InputError(where + ": time " + six_digits(s.time) +
+                         " s is off the 148 Hz sample grid (" + "sample " + fmt_num(i, 10) +
+                         " of toss " + std::to_string(id) + " expected at " +
+                         six_digits(tosses.back().samples.front().time + i / rate) + " s)");
     }
     tosses.back().samples.push_back(s);
   }
@@ -234,13 +234,14 @@ TossRun simulate_toss(const DynamicsFn& dynamics, const Toss& toss, const Contac
     // A sample off the measured time would compare different instants (a backend bug).
     if (std::fabs(r.samples[i].time - static_cast<double>(i) / model.sample_rate) > 0.5 * opt.dt) {
       run.status = Status::Error;
-      run.message = which + ": sample " + std::to_string(i) + " at t = " + num(r.samples[i].time) +
-                    " s, expected " + num(static_cast<double>(i) / model.sample_rate) + " s";
+      run.message = which + ": sample " + std::to_string(i) +
+                    " at t = " + six_digits(r.samples[i].time) + " s, expected " +
+                    six_digits(static_cast<double>(i) / model.sample_rate) + " s";
       return run;
     }
     if (!c.position.allFinite() || !c.orientation.coeffs().allFinite()) {
       run.status = Status::Error;
-      run.message = which + ": non-finite state at t = " + num(r.samples[i].time) + " s";
+      run.message = which + ": non-finite state at t = " + six_digits(r.samples[i].time) + " s";
       return run;
     }
     run.track.position.push_back(c.position);
@@ -301,7 +302,8 @@ Backend toss_backend(const Backend& backend, const ContactParams& params) {
 
 std::string soft_text(const ContactParams& params) {
   std::string s;
-  for (const auto& [name, v] : params.soft) s += (s.empty() ? "" : ", ") + name + " " + num(v);
+  for (const auto& [name, v] : params.soft)
+    s += (s.empty() ? "" : ", ") + name + " " + six_digits(v);
   return s;
 }
 
@@ -394,8 +396,8 @@ std::vector<std::pair<std::string, double>> read_soft(const std::string& path,
       throw InputError(where + ": not a soft-contact parameter of " + name + " (" +
                        (known.empty() ? "it has none" : "it has " + known) + ")");
     if (!v.is_number() || !(v.get<double>() >= sp->lo && v.get<double>() <= sp->hi))
-      throw InputError(where + ": must be a number in [" + num(sp->lo) + ", " + num(sp->hi) +
-                       "], got " + v.dump());
+      throw InputError(where + ": must be a number in [" + six_digits(sp->lo) + ", " +
+                       six_digits(sp->hi) + "], got " + v.dump());
     out.emplace_back(k, v.get<double>());
   }
   return out;
@@ -427,9 +429,10 @@ std::vector<std::pair<std::string, ContactParams>> read_params_file(const std::s
     p.friction = b["friction"].get<double>();
     if (!(p.restitution >= 0.0 && p.restitution <= 1.0))
       throw InputError(path + ": " + key + ".restitution: must be in [0, 1], got " +
-                       num(p.restitution));
+                       six_digits(p.restitution));
     if (!(p.friction >= 0.0 && std::isfinite(p.friction)))
-      throw InputError(path + ": " + key + ".friction: must be >= 0, got " + num(p.friction));
+      throw InputError(path + ": " + key + ".friction: must be >= 0, got " +
+                       six_digits(p.friction));
     if (b.contains("soft")) p.soft = read_soft(path, key, name, b["soft"]);
     out.emplace_back(name, p);
   }

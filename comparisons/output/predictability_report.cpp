@@ -13,7 +13,7 @@ namespace rbx {
 namespace {
 
 // A number as the tables show it.
-std::string num(double x) { return fmt_num(x, 2); }
+std::string two_digits(double x) { return fmt_num(x, 2); }
 
 // "the physics'" / "the engine's" / "-": whose spread the step test says it is.
 std::string verdict_text(const BackendEnsemble& b) {
@@ -58,11 +58,12 @@ std::string scene_part(const std::string& title, const std::string& slug, const 
   std::ostringstream md;
   const Nudge& nudge = e.settings.nudge;
   md << "### " << md_escape(title) << "\n\n"
-     << e.settings.count << " copies of " << num(e.duration) << " s at dt = " << num(e.dt)
-     << " s, every moving body nudged by Gaussian amounts of " << num(nudge.position) << " m, "
-     << num(nudge.orientation) << " rad, " << num(nudge.velocity) << " m/s and "
-     << num(nudge.angular_velocity) << " rad/s per component (input spread: position "
-     << num(e.input.position) << " m, velocity " << num(e.input.velocity) << " m/s).\n\n";
+     << e.settings.count << " copies of " << two_digits(e.duration)
+     << " s at dt = " << two_digits(e.dt) << " s, every moving body nudged by Gaussian amounts of "
+     << two_digits(nudge.position) << " m, " << two_digits(nudge.orientation) << " rad, "
+     << two_digits(nudge.velocity) << " m/s and " << two_digits(nudge.angular_velocity)
+     << " rad/s per component (input spread: position " << two_digits(e.input.position)
+     << " m, velocity " << two_digits(e.input.velocity) << " m/s).\n\n";
   const bool step_test = std::any_of(e.backends.begin(), e.backends.end(),
                                      [](const BackendEnsemble& b) { return b.step_tested; });
   std::vector<std::string> header = {
@@ -78,16 +79,16 @@ std::string scene_part(const std::string& title, const std::string& slug, const 
     std::vector<std::string> cells = {
         "**" + md_escape(b.backend) + "**",
         std::to_string(b.runs) + (b.failed ? " (" + std::to_string(b.failed) + ")" : ""),
-        num(b.spread.position),
-        num(b.spread.position_range),
-        num(b.spread.orientation),
-        num(b.spread.velocity),
-        num(b.amplification),
-        num(b.velocity_amplification),
+        two_digits(b.spread.position),
+        two_digits(b.spread.position_range),
+        two_digits(b.spread.orientation),
+        two_digits(b.spread.velocity),
+        two_digits(b.amplification),
+        two_digits(b.velocity_amplification),
         std::to_string(b.sequences.size()),
         std::to_string(b.clusters)};
     if (step_test) {
-      cells.push_back(b.step_tested ? num(b.step_ratio) : "-");
+      cells.push_back(b.step_tested ? two_digits(b.step_ratio) : "-");
       cells.push_back(verdict_text(b));
     }
     t.add(cells);
@@ -134,7 +135,7 @@ std::string predictability_summary_markdown(const std::vector<Scene>& scenes,
         continue;
       }
       const std::string verdict = verdict_text(*b);
-      cells.push_back(num(b->amplification) + (verdict == "-" ? "" : ", " + verdict));
+      cells.push_back(two_digits(b->amplification) + (verdict == "-" ? "" : ", " + verdict));
     }
     t.add(cells);
   }

@@ -1,12 +1,17 @@
-// Fixtures shared by the test suites: bodies built by hand, named rotations, and the exact
-// box-box penetration depth by the separating-axis theorem. Engine types only, so every suite
-// (engine, reference, comparisons) can use them.
+// Fixtures shared by the test suites: bodies and poses built by hand, named and random rotations,
+// the exact box-box penetration depth by the separating-axis theorem, a temporary folder. Engine
+// types only, so every suite (engine, reference, comparisons) can use them.
 #pragma once
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <limits>
 #include <memory>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,6 +20,28 @@
 #include "engine/polyhedron.h"
 
 namespace rbx::test {
+
+/// An empty folder of the system's temporary directory for one test process, named by `name`
+/// and the process id (ctest runs each test in a process of its own).
+inline std::filesystem::path temp_dir(const std::string& name) {
+  const std::filesystem::path p =
+      std::filesystem::temp_directory_path() / ("rbx_" + name + "_" + std::to_string(getpid()));
+  std::filesystem::remove_all(p);
+  std::filesystem::create_directories(p);
+  return p;
+}
+
+/// The pose at `p`, turned by `q`.
+inline Pose at(const Vec3& p, const Quat& q = Quat::Identity()) { return {p, q}; }
+
+/// A rotation drawn uniformly: a normalised four-dimensional Gaussian.
+inline Quat random_rotation(std::mt19937& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  return Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
+}
+
+/// The same double to the bit (-0 and 0 differ, a NaN equals itself).
+inline bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 /// A box body with the given full extents, mass, pose and velocities (solid mass model).
 inline RigidBody box_body(const std::string& name, const Vec3& size, double mass,

@@ -14,9 +14,12 @@
 #include "engine/detect.h"
 #include "reference/backend.h"
 #include "reference/custom.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {
+
+using test::temp_dir;
 
 // The backends under test, by their registry names.
 const Backend& custom = custom_adapter().backend("custom");
@@ -58,13 +61,6 @@ CheckRun run_check(ReportOptions opt) {
   r.code = check_command(opt);
   r.out = testing::internal::GetCapturedStdout();
   return r;
-}
-
-fs::path temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("rbx_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
 }
 
 // A contact scene (axis_x: the normal is exactly -x) and an impact with a closed form

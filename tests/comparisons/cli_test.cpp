@@ -20,11 +20,14 @@
 #include <vector>
 
 #include "tests/common/bad_input.h"
+#include "tests/common/fixtures.h"
 
 namespace fs = std::filesystem;
 using rbx::test::bad_input_catalogue;
 
 namespace {
+
+using rbx::test::temp_dir;
 
 struct CmdResult {
   int code = -1;
@@ -52,13 +55,6 @@ CmdResult rbx_in(const std::string& where, const std::string& args) {
 
 // Runs the built rbx binary from the source folder.
 CmdResult rbx(const std::string& args) { return rbx_in(RBX_SOURCE_DIR, args); }
-
-fs::path temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("rbx_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
 
 TEST(Cli, BadSceneExitsTwoWithOneLineAndNoOutputFile) {
   const fs::path dir = temp_dir("bad");

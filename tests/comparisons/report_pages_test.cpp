@@ -20,23 +20,19 @@
 #include "comparisons/output/markdown_html.h"
 #include "comparisons/output/scorecard.h"  // md_escape, md_code, md_url
 #include "comparisons/output/table.h"      // html_escape
+#include "tests/common/fixtures.h"
 
 namespace fs = std::filesystem;
 
 namespace rbx {
 namespace {
 
+using test::temp_dir;
+
 std::string read(const fs::path& p) {
   std::stringstream s;
   s << std::ifstream(p).rdbuf();
   return s.str();
-}
-
-fs::path temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("rbx_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
 }
 
 // `rbx report ARGS` from the source folder; the exit code.

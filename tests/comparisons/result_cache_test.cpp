@@ -15,18 +15,14 @@
 #include "comparisons/eval/explore_check.h"
 #include "comparisons/eval/harness.h"
 #include "comparisons/scene/scene_file.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {
 
-namespace fs = std::filesystem;
+using test::temp_dir;
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("rbx_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
+namespace fs = std::filesystem;
 
 // The evaluation without what may differ between runs: timings and the "cached" labels.
 Json without_timings(Json j) {

@@ -19,21 +19,16 @@
 #include <vector>
 
 #include "comparisons/scene/scene_file.h"
+#include "tests/common/fixtures.h"
 
 namespace fs = std::filesystem;
 using namespace rbx;
 
 namespace {
 
-const char* const kHeader = "toss,t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
+using test::temp_dir;
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path p =
-      fs::temp_directory_path() / ("rbx_tosses_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
+const char* const kHeader = "toss,t,px,py,pz,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz\n";
 
 // One CSV row of a cube at rest orientation, moving at v (m/s) along x.
 std::string row(long toss, double t, double z, const std::string& quat = "1,0,0,0") {

@@ -19,25 +19,20 @@
 #include "comparisons/output/view_page.h"
 #include "comparisons/scene/scene_file.h"
 #include "engine/format.h"
+#include "tests/common/fixtures.h"
 
 namespace fs = std::filesystem;
 
 namespace rbx {
 namespace {
 
+using test::temp_dir;
+
 std::string read_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-fs::path temp_dir(const std::string& name) {
-  const fs::path p =
-      fs::temp_directory_path() / ("rbx_view_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
 }
 
 // Runs a shell command, returns its exit code.

@@ -34,20 +34,20 @@ BodySpec pyramid_spec(MassModel model, bool is_static) {
 }
 
 // Round-off on O(1) coordinates after a rotation and a few sums.
-constexpr double kRoundOff = 1e-14;
+constexpr double kRotationRoundOff = 1e-14;
 
 TEST(Body, PoseIsTheCentreOfMassOfEitherMassModel) {
   for (const auto& [model, com_height] :
        {std::pair{MassModel::Solid, 0.75}, std::pair{MassModel::Vertices, 0.6}}) {
     const RigidBody b = make_body(pyramid_spec(model, false));
     // position = spec.position + R * com, with R taking local z to world -y.
-    EXPECT_LT((b.position - Vec3(1, 2 - com_height, 3)).norm(), kRoundOff);
-    EXPECT_LT((b.shape_origin_offset - Vec3(0, 0, -com_height)).norm(), kRoundOff);
+    EXPECT_LT((b.position - Vec3(1, 2 - com_height, 3)).norm(), kRotationRoundOff);
+    EXPECT_LT((b.shape_origin_offset - Vec3(0, 0, -com_height)).norm(), kRotationRoundOff);
     // The stored shape is re-centred: its own centre of mass (same model) is the origin.
     const MassProperties own = mass_properties(*b.shape, b.mass, model);
-    EXPECT_LT(own.center_of_mass.norm(), kRoundOff);
+    EXPECT_LT(own.center_of_mass.norm(), kRotationRoundOff);
     // The apex is where the scene put it, whatever the model: spec.position + R (0, 0, 3).
-    EXPECT_LT((b.world_vertex(4) - Vec3(1, -1, 3)).norm(), kRoundOff);
+    EXPECT_LT((b.world_vertex(4) - Vec3(1, -1, 3)).norm(), kRotationRoundOff);
   }
 }
 

@@ -14,7 +14,7 @@ namespace rbx {
 namespace {
 
 // Radii and centres are a square root and a rotation of O(1) numbers: round-off ~1e-16.
-constexpr double kRoundOff = 1e-12;
+constexpr double kRadiusRoundOff = 1e-12;
 
 RigidBody body_with(const ConvexPolyhedron& shape, const Vec3& position,
                     const Quat& orientation = Quat::Identity()) {
@@ -31,8 +31,8 @@ TEST(BoundingSphere, RadiusIsHalfTheBoxDiagonal) {
   const Quat q(Eigen::AngleAxisd(0.4, Vec3(1, -1, 2).normalized()));
   const RigidBody b = body_with(make_box(Vec3(1, 2, 3)), Vec3(4, -5, 6), q);
   const BoundingSphere s = bounding_sphere(b);
-  EXPECT_NEAR(s.radius, std::sqrt(14.0) / 2, kRoundOff);
-  EXPECT_LE((s.center - Vec3(4, -5, 6)).norm(), kRoundOff);
+  EXPECT_NEAR(s.radius, std::sqrt(14.0) / 2, kRadiusRoundOff);
+  EXPECT_LE((s.center - Vec3(4, -5, 6)).norm(), kRadiusRoundOff);
 }
 
 TEST(BoundingSphere, OffCentreShapeUsesItsBoxCentreInTheWorld) {
@@ -43,8 +43,8 @@ TEST(BoundingSphere, OffCentreShapeUsesItsBoxCentreInTheWorld) {
   const Quat q(Eigen::AngleAxisd(1.1, Vec3(0, 1, 1).normalized()));
   const Vec3 p(1, 2, 3);
   const BoundingSphere s = bounding_sphere(body_with(tetra, p, q));
-  EXPECT_NEAR(s.radius, std::sqrt(3.0) / 2, kRoundOff);
-  EXPECT_LE((s.center - (q * Vec3(0.5, 0.5, 0.5) + p)).norm(), kRoundOff);
+  EXPECT_NEAR(s.radius, std::sqrt(3.0) / 2, kRadiusRoundOff);
+  EXPECT_LE((s.center - (q * Vec3(0.5, 0.5, 0.5) + p)).norm(), kRadiusRoundOff);
 }
 
 TEST(BoundingCheck, SumOfRadiiIsTheThreshold) {

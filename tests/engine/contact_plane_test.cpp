@@ -11,14 +11,12 @@
 
 #include "engine/contact_plane_detail.h"
 #include "engine/detect.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {
 
-Quat random_rotation(std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  return Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
-}
+using test::random_rotation;
 
 // Shapes of every path of the chooser: small ones scanned (box, prism), hierarchies climbed
 // (icospheres of 80 and 320 triangles, a 24-sided prism).

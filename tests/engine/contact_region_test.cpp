@@ -10,14 +10,12 @@
 
 #include "engine/detect.h"
 #include "engine/manifold.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {
 
-Quat random_rotation(std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  return Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
-}
+using test::random_rotation;
 
 std::optional<ContactPoint> contact(const ConvexPolyhedron& a, const Pose& pa,
                                     const ConvexPolyhedron& b, const Pose& pb) {

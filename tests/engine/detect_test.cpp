@@ -19,7 +19,7 @@ namespace {
 // Every configuration below has coordinates of order 1 and goes through a handful of flops
 // (a rotation, a centroid, a projection), so round-off is ~1e-15; 1e-12 leaves a wide margin
 // and is still far below every geometric distance the tests distinguish (>= 1e-2).
-constexpr double kRoundOff = 1e-12;
+constexpr double kDetectRoundOff = 1e-12;
 
 Pose pose_at(const Vec3& position, const Quat& orientation = Quat::Identity()) {
   Pose p;
@@ -124,9 +124,9 @@ TEST(Detect, FaceFaceBoxesAlongX) {
   for (const auto& hit : {face_test(s.a, s.pa, s.b, s.pb), detect(s.a, s.pa, s.b, s.pb)}) {
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->feature, "face");
-    expect_vec_near(hit->point, Vec3(0.5, 0, 0), kRoundOff);
-    expect_vec_near(hit->normal, Vec3(-1, 0, 0), kRoundOff);
-    EXPECT_NEAR(hit->depth, 0.1, kRoundOff);
+    expect_vec_near(hit->point, Vec3(0.5, 0, 0), kDetectRoundOff);
+    expect_vec_near(hit->normal, Vec3(-1, 0, 0), kDetectRoundOff);
+    EXPECT_NEAR(hit->depth, 0.1, kDetectRoundOff);
   }
 }
 
@@ -142,9 +142,9 @@ TEST(Detect, CubeCornerIntoFaceIsAVertexHit) {
   for (const auto& hit : {vertex_test(s.a, s.pa, s.b, s.pb), detect(s.a, s.pa, s.b, s.pb)}) {
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->feature, "vertex");
-    expect_vec_near(hit->point, Vec3(0, 0, 0.4), kRoundOff);
-    expect_vec_near(hit->normal, Vec3(0, 0, 1), kRoundOff);
-    EXPECT_NEAR(hit->depth, 0.1, kRoundOff);
+    expect_vec_near(hit->point, Vec3(0, 0, 0.4), kDetectRoundOff);
+    expect_vec_near(hit->normal, Vec3(0, 0, 1), kDetectRoundOff);
+    EXPECT_NEAR(hit->depth, 0.1, kDetectRoundOff);
   }
 }
 
@@ -160,9 +160,9 @@ TEST(Detect, EdgeLandingFlatAveragesItsVerticesOnTheSameFace) {
   const Pose pb = pose_at(Vec3::Zero());
   const auto hit = vertex_test(a, pa, b, pb);
   ASSERT_TRUE(hit.has_value());
-  expect_vec_near(hit->point, Vec3(0, 0, 0.48), kRoundOff);
-  expect_vec_near(hit->normal, Vec3(0, 0, 1), kRoundOff);
-  EXPECT_NEAR(hit->depth, 0.02, kRoundOff);
+  expect_vec_near(hit->point, Vec3(0, 0, 0.48), kDetectRoundOff);
+  expect_vec_near(hit->normal, Vec3(0, 0, 1), kDetectRoundOff);
+  EXPECT_NEAR(hit->depth, 0.02, kDetectRoundOff);
 }
 
 TEST(Detect, EdgePiercingAFaceTakesTheFaceNormal) {
@@ -174,8 +174,8 @@ TEST(Detect, EdgePiercingAFaceTakesTheFaceNormal) {
   const Pose pa = pose_at(Vec3(0.45, 0.3, -0.2)), pb = pose_at(Vec3(-1, 0, 0));
   const auto hit = edge_test(a, pa, b, pb);
   ASSERT_TRUE(hit.has_value());
-  expect_vec_near(hit->normal, Vec3(1, 0, 0), kRoundOff);
-  EXPECT_NEAR(hit->depth, 0.05, kRoundOff);
+  expect_vec_near(hit->normal, Vec3(1, 0, 0), kDetectRoundOff);
+  EXPECT_NEAR(hit->depth, 0.05, kDetectRoundOff);
 }
 
 TEST(Detect, CrossedBarsAreAnEdgeHit) {
@@ -190,9 +190,9 @@ TEST(Detect, CrossedBarsAreAnEdgeHit) {
   for (const auto& hit : {edge_test(s.a, s.pa, s.b, s.pb), detect(s.a, s.pa, s.b, s.pb)}) {
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->feature, "edge");
-    expect_vec_near(hit->point, Vec3(0, -0.5, 0.4), kRoundOff);
-    expect_vec_near(hit->normal, Vec3(0, 0, 1), kRoundOff);
-    EXPECT_NEAR(hit->depth, 0.1, kRoundOff);
+    expect_vec_near(hit->point, Vec3(0, -0.5, 0.4), kDetectRoundOff);
+    expect_vec_near(hit->normal, Vec3(0, 0, 1), kDetectRoundOff);
+    EXPECT_NEAR(hit->depth, 0.1, kDetectRoundOff);
   }
 }
 
@@ -212,9 +212,9 @@ TEST(Detect, TiltedEdgeNormalIsEaCrossEb) {
   const auto hit = detect(s.a, s.pa, s.b, s.pb);
   ASSERT_TRUE(hit.has_value());
   EXPECT_EQ(hit->feature, "edge");
-  expect_vec_near(hit->point, expected_point, kRoundOff);
-  expect_vec_near(hit->normal, s.n, kRoundOff);
-  EXPECT_NEAR(hit->depth, 0.1, kRoundOff);
+  expect_vec_near(hit->point, expected_point, kDetectRoundOff);
+  expect_vec_near(hit->normal, s.n, kDetectRoundOff);
+  EXPECT_NEAR(hit->depth, 0.1, kDetectRoundOff);
 }
 
 // ---- Argument order, separation, touching, rotation ----------------------------------------
@@ -227,9 +227,9 @@ TEST(Detect, SwappingArgumentsFlipsTheNormalOnly) {
     const auto ab = detect(s.a, s.pa, s.b, s.pb), ba = detect(s.b, s.pb, s.a, s.pa);
     ASSERT_TRUE(ab.has_value() && ba.has_value());
     EXPECT_EQ(ba->feature, "vertex");
-    expect_vec_near(ba->point, ab->point, kRoundOff);
-    expect_vec_near(ba->normal, -ab->normal, kRoundOff);
-    EXPECT_NEAR(ba->depth, ab->depth, kRoundOff);
+    expect_vec_near(ba->point, ab->point, kDetectRoundOff);
+    expect_vec_near(ba->normal, -ab->normal, kDetectRoundOff);
+    EXPECT_NEAR(ba->depth, ab->depth, kDetectRoundOff);
   }
   {
     // B's bottom-face centroids (0.3 -+ 1/12, 0.2 -+ 1/12, 0.4) average to (0.3, 0.2, 0.4).
@@ -240,12 +240,12 @@ TEST(Detect, SwappingArgumentsFlipsTheNormalOnly) {
     ASSERT_TRUE(ab.has_value() && ba.has_value());
     EXPECT_EQ(ab->feature, "face");
     EXPECT_EQ(ba->feature, "face");
-    expect_vec_near(ab->point, Vec3(0.3, 0.2, 0.4), kRoundOff);
-    expect_vec_near(ba->point, Vec3(0.3, 0.2, 0.4), kRoundOff);
-    expect_vec_near(ab->normal, Vec3(0, 0, -1), kRoundOff);
-    expect_vec_near(ba->normal, Vec3(0, 0, 1), kRoundOff);
-    EXPECT_NEAR(ab->depth, 0.1, kRoundOff);
-    EXPECT_NEAR(ba->depth, 0.1, kRoundOff);
+    expect_vec_near(ab->point, Vec3(0.3, 0.2, 0.4), kDetectRoundOff);
+    expect_vec_near(ba->point, Vec3(0.3, 0.2, 0.4), kDetectRoundOff);
+    expect_vec_near(ab->normal, Vec3(0, 0, -1), kDetectRoundOff);
+    expect_vec_near(ba->normal, Vec3(0, 0, 1), kDetectRoundOff);
+    EXPECT_NEAR(ab->depth, 0.1, kDetectRoundOff);
+    EXPECT_NEAR(ba->depth, 0.1, kDetectRoundOff);
   }
   {
     // Crossed bars: each bar's edges pierce the other, so each order finds its own first edge
@@ -254,9 +254,9 @@ TEST(Detect, SwappingArgumentsFlipsTheNormalOnly) {
     const CrossedBars s;
     const auto ab = detect(s.a, s.pa, s.b, s.pb), ba = detect(s.b, s.pb, s.a, s.pa);
     ASSERT_TRUE(ab.has_value() && ba.has_value());
-    expect_vec_near(ba->normal, -ab->normal, kRoundOff);
-    EXPECT_NEAR(ba->depth, ab->depth, kRoundOff);
-    expect_vec_near(ba->point, Vec3(-0.5, 0, 0.5), kRoundOff);
+    expect_vec_near(ba->normal, -ab->normal, kDetectRoundOff);
+    EXPECT_NEAR(ba->depth, ab->depth, kDetectRoundOff);
+    expect_vec_near(ba->point, Vec3(-0.5, 0, 0.5), kDetectRoundOff);
   }
 }
 
@@ -293,8 +293,8 @@ TEST(Detect, ExactlyTouchingIsDetectedWithZeroDepth) {
     const auto hit = detect(s.a, s.pa, s.b, s.pb);
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->feature, "face");
-    expect_vec_near(hit->point, Vec3(0.5, 0, 0), kRoundOff);
-    expect_vec_near(hit->normal, Vec3(-1, 0, 0), kRoundOff);
+    expect_vec_near(hit->point, Vec3(0.5, 0, 0), kDetectRoundOff);
+    expect_vec_near(hit->normal, Vec3(-1, 0, 0), kDetectRoundOff);
     EXPECT_EQ(hit->depth, 0.0);
   }
   {
@@ -303,8 +303,8 @@ TEST(Detect, ExactlyTouchingIsDetectedWithZeroDepth) {
     const auto hit = detect(s.a, s.pa, s.b, s.pb);
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->feature, "edge");
-    expect_vec_near(hit->point, Vec3(0, -0.5, 0.5), kRoundOff);
-    expect_vec_near(hit->normal, Vec3(0, 0, 1), kRoundOff);
+    expect_vec_near(hit->point, Vec3(0, -0.5, 0.5), kDetectRoundOff);
+    expect_vec_near(hit->normal, Vec3(0, 0, 1), kDetectRoundOff);
     EXPECT_EQ(hit->depth, 0.0);
   }
 }
@@ -314,7 +314,7 @@ TEST(Detect, GapsBelowTheToleranceCountAsTouching) {
   // a gap of a tenth of it is touching, a gap ten times larger is not.
   const FaceFace base;
   const double tol = point_in_mesh_tolerance(base.a, base.b);
-  EXPECT_NEAR(tol, 1e-9 * std::sqrt(3.0), kRoundOff * 1e-9);
+  EXPECT_NEAR(tol, 1e-9 * std::sqrt(3.0), kDetectRoundOff * 1e-9);
   const FaceFace near(0.1 + 0.1 * tol), far(0.1 + 10 * tol);
   EXPECT_TRUE(detect(near.a, near.pa, near.b, near.pb).has_value());
   EXPECT_FALSE(detect(far.a, far.pa, far.b, far.pb).has_value());
@@ -329,27 +329,27 @@ TEST(Detect, RotatedPosesGiveWorldFrameResults) {
     const auto hit = detect(s.a, rotate_pose(r, s.pa), s.b, rotate_pose(r, s.pb));
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->feature, "face");
-    expect_vec_near(hit->point, r * Vec3(0.5, 0, 0), kRoundOff);
-    expect_vec_near(hit->normal, r * Vec3(-1, 0, 0), kRoundOff);
-    EXPECT_NEAR(hit->depth, 0.1, kRoundOff);
+    expect_vec_near(hit->point, r * Vec3(0.5, 0, 0), kDetectRoundOff);
+    expect_vec_near(hit->normal, r * Vec3(-1, 0, 0), kDetectRoundOff);
+    EXPECT_NEAR(hit->depth, 0.1, kDetectRoundOff);
   }
   {
     const CornerIntoFace s;
     const auto hit = detect(s.a, rotate_pose(r, s.pa), s.b, rotate_pose(r, s.pb));
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->feature, "vertex");
-    expect_vec_near(hit->point, r * Vec3(0, 0, 0.4), kRoundOff);
-    expect_vec_near(hit->normal, r * Vec3(0, 0, 1), kRoundOff);
-    EXPECT_NEAR(hit->depth, 0.1, kRoundOff);
+    expect_vec_near(hit->point, r * Vec3(0, 0, 0.4), kDetectRoundOff);
+    expect_vec_near(hit->normal, r * Vec3(0, 0, 1), kDetectRoundOff);
+    EXPECT_NEAR(hit->depth, 0.1, kDetectRoundOff);
   }
   {
     const CrossedBars s;
     const auto hit = detect(s.a, rotate_pose(r, s.pa), s.b, rotate_pose(r, s.pb));
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->feature, "edge");
-    expect_vec_near(hit->point, r * Vec3(0, -0.5, 0.4), kRoundOff);
-    expect_vec_near(hit->normal, r * Vec3(0, 0, 1), kRoundOff);
-    EXPECT_NEAR(hit->depth, 0.1, kRoundOff);
+    expect_vec_near(hit->point, r * Vec3(0, -0.5, 0.4), kDetectRoundOff);
+    expect_vec_near(hit->normal, r * Vec3(0, 0, 1), kDetectRoundOff);
+    EXPECT_NEAR(hit->depth, 0.1, kDetectRoundOff);
   }
   {
     // Only B turned, by 90 deg about its long axis y: a (1, 4, 1) bar maps onto itself, so the
@@ -358,8 +358,8 @@ TEST(Detect, RotatedPosesGiveWorldFrameResults) {
     const Pose pb = pose_at(s.pb.position, Quat(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY())));
     const auto hit = detect(s.a, s.pa, s.b, pb);
     ASSERT_TRUE(hit.has_value());
-    expect_vec_near(hit->normal, Vec3(0, 0, 1), kRoundOff);
-    EXPECT_NEAR(hit->depth, 0.1, kRoundOff);
+    expect_vec_near(hit->normal, Vec3(0, 0, 1), kDetectRoundOff);
+    EXPECT_NEAR(hit->depth, 0.1, kDetectRoundOff);
   }
 }
 
@@ -369,9 +369,9 @@ TEST(Detect, FastVariantMatchesSeed) {
   const auto seed = detect(s.a, s.pa, s.b, s.pb, DetectorVariant::Faithful);
   const auto fast = detect(s.a, s.pa, s.b, s.pb, DetectorVariant::Accelerated);
   ASSERT_TRUE(seed.has_value() && fast.has_value());
-  expect_vec_near(fast->point, seed->point, kRoundOff);
-  expect_vec_near(fast->normal, seed->normal, kRoundOff);
-  EXPECT_NEAR(fast->depth, seed->depth, kRoundOff);
+  expect_vec_near(fast->point, seed->point, kDetectRoundOff);
+  expect_vec_near(fast->normal, seed->normal, kDetectRoundOff);
+  EXPECT_NEAR(fast->depth, seed->depth, kDetectRoundOff);
   EXPECT_EQ(fast->feature, seed->feature);
 }
 
@@ -415,8 +415,8 @@ TEST(SeedCorrection, EdgeCrossingIsVjMinusVi) {
   const Vec3 literal = v_i + t * (v_i - v_i);  // the seed's printed formula: always v_i
   const Vec3 corrected = v_i + t * (v_j - v_i);
   // The literal "crossing" is 1.5 off the plane, the corrected one on it.
-  EXPECT_NEAR(literal.x(), -2.0, kRoundOff);
-  EXPECT_NEAR(corrected.x(), -0.5, kRoundOff);
+  EXPECT_NEAR(literal.x(), -2.0, kDetectRoundOff);
+  EXPECT_NEAR(corrected.x(), -0.5, kDetectRoundOff);
   // With the literal formula every crossing, and every average of crossings, is an end vertex
   // of A's edge; none of A's eight vertices is inside B, so the literal edge test can find
   // nothing. Ours finds the contact.
@@ -424,7 +424,7 @@ TEST(SeedCorrection, EdgeCrossingIsVjMinusVi) {
     EXPECT_FALSE(point_in_mesh(s.b, s.pb, s.pa.apply(v), point_in_mesh_tolerance(s.a, s.b)));
   const auto hit = edge_test(s.a, s.pa, s.b, s.pb);
   ASSERT_TRUE(hit.has_value());
-  expect_vec_near(hit->point, Vec3(0, -0.5, 0.4), kRoundOff);
+  expect_vec_near(hit->point, Vec3(0, -0.5, 0.4), kDetectRoundOff);
 }
 
 TEST(SeedCorrection, BothOrdersSeeAVertexOfBInAFaceOfA) {
@@ -436,9 +436,9 @@ TEST(SeedCorrection, BothOrdersSeeAVertexOfBInAFaceOfA) {
   EXPECT_FALSE(vertex_test(s.b, s.pb, s.a, s.pa).has_value());  // the seed's single order
   const auto hit = detect_feature(Feature::Vertex, s.b, s.pb, s.a, s.pa);
   ASSERT_TRUE(hit.has_value());
-  expect_vec_near(hit->point, Vec3(0, 0, 0.4), kRoundOff);
-  expect_vec_near(hit->normal, Vec3(0, 0, -1), kRoundOff);
-  EXPECT_NEAR(hit->depth, 0.1, kRoundOff);
+  expect_vec_near(hit->point, Vec3(0, 0, 0.4), kDetectRoundOff);
+  expect_vec_near(hit->normal, Vec3(0, 0, -1), kDetectRoundOff);
+  EXPECT_NEAR(hit->depth, 0.1, kDetectRoundOff);
 }
 
 TEST(SeedCorrection, FaceNormalIsNegated) {
@@ -448,7 +448,7 @@ TEST(SeedCorrection, FaceNormalIsNegated) {
   // depth separates.
   const FaceFace s;
   const Vec3 literal = s.a.planes()[2].normal;
-  expect_vec_near(literal, Vec3(1, 0, 0), kRoundOff);
+  expect_vec_near(literal, Vec3(1, 0, 0), kDetectRoundOff);
   const auto hit = face_test(s.a, s.pa, s.b, s.pb);
   ASSERT_TRUE(hit.has_value());
   const Vec3 b_to_a = s.pa.position - s.pb.position;
@@ -457,11 +457,11 @@ TEST(SeedCorrection, FaceNormalIsNegated) {
   // Overlap after moving A by 0.05 along each: the literal grows it to 0.15 (measured along
   // the x axis), ours shrinks it to 0.05; by the full depth ours leaves the bodies touching.
   EXPECT_NEAR(overlap_along(s.a, shifted(s.pa, 0.05 * literal), s.b, s.pb, Vec3(-1, 0, 0)), 0.15,
-              kRoundOff);
+              kDetectRoundOff);
   EXPECT_NEAR(overlap_along(s.a, shifted(s.pa, 0.05 * hit->normal), s.b, s.pb, Vec3(-1, 0, 0)),
-              0.05, kRoundOff);
+              0.05, kDetectRoundOff);
   EXPECT_NEAR(overlap_along(s.a, shifted(s.pa, hit->depth * hit->normal), s.b, s.pb, hit->normal),
-              0.0, kRoundOff);
+              0.0, kDetectRoundOff);
 }
 
 TEST(SeedCorrection, EdgeNormalIsEaCrossEb) {
@@ -478,7 +478,7 @@ TEST(SeedCorrection, EdgeNormalIsEaCrossEb) {
       }
     const auto hit = edge_test(s.a, s.pa, s.b, s.pb);
     ASSERT_TRUE(hit.has_value());
-    expect_vec_near(hit->normal, Vec3(0, 0, 1), kRoundOff);
+    expect_vec_near(hit->normal, Vec3(0, 0, 1), kDetectRoundOff);
   }
   {
     // Tilted bar: e_a = (cos a, 0, -sin a) crosses B's top plane (normal z); the literal
@@ -486,14 +486,14 @@ TEST(SeedCorrection, EdgeNormalIsEaCrossEb) {
     // move 2.5 along -+y to clear B (B spans |y| <= 2, A |y| <= 0.5) against 0.1 along ours.
     const TiltedBar s;
     const Vec3 literal = s.e_a.cross(Vec3::UnitZ()).normalized();
-    expect_vec_near(literal, Vec3(0, -1, 0), kRoundOff);
+    expect_vec_near(literal, Vec3(0, -1, 0), kDetectRoundOff);
     const auto hit = edge_test(s.a, s.pa, s.b, s.pb);
     ASSERT_TRUE(hit.has_value());
-    EXPECT_NEAR(hit->normal.dot(literal), 0.0, kRoundOff);
-    expect_vec_near(hit->normal, s.n, kRoundOff);
-    EXPECT_NEAR(overlap_along(s.a, s.pa, s.b, s.pb, literal), 2.5, kRoundOff);
-    EXPECT_NEAR(overlap_along(s.a, s.pa, s.b, s.pb, -literal), 2.5, kRoundOff);
-    EXPECT_NEAR(hit->depth, 0.1, kRoundOff);
+    EXPECT_NEAR(hit->normal.dot(literal), 0.0, kDetectRoundOff);
+    expect_vec_near(hit->normal, s.n, kDetectRoundOff);
+    EXPECT_NEAR(overlap_along(s.a, s.pa, s.b, s.pb, literal), 2.5, kDetectRoundOff);
+    EXPECT_NEAR(overlap_along(s.a, s.pa, s.b, s.pb, -literal), 2.5, kDetectRoundOff);
+    EXPECT_NEAR(hit->depth, 0.1, kDetectRoundOff);
   }
 }
 
@@ -554,10 +554,10 @@ TEST(Detect, AgreesWithSeparatingAxisOracle) {
       }
       ++hits;
       const double tol = point_in_mesh_tolerance(box, other);
-      EXPECT_NEAR(hit->normal.norm(), 1.0, kRoundOff);
+      EXPECT_NEAR(hit->normal.norm(), 1.0, kDetectRoundOff);
       EXPECT_TRUE(point_in_mesh(box, pa, hit->point, tol)) << "trial " << trial;
       EXPECT_TRUE(point_in_mesh(other, pb, hit->point, tol)) << "trial " << trial;
-      EXPECT_GE(hit->depth, truth - kRoundOff) << "trial " << trial;
+      EXPECT_GE(hit->depth, truth - kDetectRoundOff) << "trial " << trial;
     }
   }
   // Keep the sample representative: both outcomes well populated.

@@ -6,14 +6,17 @@
 
 #include <cmath>
 
+#include "tests/common/fixtures.h"
+
 namespace rbx {
 namespace {
 
+using test::at;
+
 // Round-off of GJK's last simplex on unit-scale shapes: a few dozen operations on coordinates of
 // order 1 (~1e-15); 1e-12 leaves a wide margin and is far below any wrong feature (>= 1e-3 here).
-constexpr double kRoundOff = 1e-12;
+constexpr double kGjkRoundOff = 1e-12;
 
-Pose at(const Vec3& p, const Quat& q = Quat::Identity()) { return {p, q}; }
 Quat about(double deg, const Vec3& axis) { return Quat(Eigen::AngleAxisd(deg * M_PI / 180, axis)); }
 
 // The answer in both body orders: the same distance, the points swapped.
@@ -22,9 +25,9 @@ void expect_pair(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedr
   for (bool swapped : {false, true}) {
     const Separation s = swapped ? shape_distance(b, pb, a, pa) : shape_distance(a, pa, b, pb);
     ASSERT_FALSE(s.overlapping);
-    EXPECT_NEAR(s.distance, distance, kRoundOff);
-    EXPECT_NEAR(((swapped ? s.point_b : s.point_a) - on_a).norm(), 0.0, kRoundOff);
-    EXPECT_NEAR(((swapped ? s.point_a : s.point_b) - on_b).norm(), 0.0, kRoundOff);
+    EXPECT_NEAR(s.distance, distance, kGjkRoundOff);
+    EXPECT_NEAR(((swapped ? s.point_b : s.point_a) - on_a).norm(), 0.0, kGjkRoundOff);
+    EXPECT_NEAR(((swapped ? s.point_a : s.point_b) - on_b).norm(), 0.0, kGjkRoundOff);
   }
 }
 
@@ -57,14 +60,14 @@ TEST(ShapeDistance, ParallelFacesGiveTheGapAndPointsStraightAcross) {
   const ConvexPolyhedron cube = make_box(Vec3::Ones());
   const Separation s = shape_distance(cube, at(Vec3::Zero()), cube, at(Vec3(1.5, 0.2, -0.1)));
   ASSERT_FALSE(s.overlapping);
-  EXPECT_NEAR(s.distance, 0.5, kRoundOff);
-  EXPECT_NEAR(s.point_a.x(), 0.5, kRoundOff);
-  EXPECT_NEAR(s.point_b.x(), 1.0, kRoundOff);
-  EXPECT_NEAR((s.point_b - s.point_a - Vec3(0.5, 0, 0)).norm(), 0.0, kRoundOff);
-  EXPECT_GE(s.point_a.y(), -0.3 - kRoundOff);
-  EXPECT_LE(s.point_a.y(), 0.5 + kRoundOff);
-  EXPECT_GE(s.point_a.z(), -0.5 - kRoundOff);
-  EXPECT_LE(s.point_a.z(), 0.4 + kRoundOff);
+  EXPECT_NEAR(s.distance, 0.5, kGjkRoundOff);
+  EXPECT_NEAR(s.point_a.x(), 0.5, kGjkRoundOff);
+  EXPECT_NEAR(s.point_b.x(), 1.0, kGjkRoundOff);
+  EXPECT_NEAR((s.point_b - s.point_a - Vec3(0.5, 0, 0)).norm(), 0.0, kGjkRoundOff);
+  EXPECT_GE(s.point_a.y(), -0.3 - kGjkRoundOff);
+  EXPECT_LE(s.point_a.y(), 0.5 + kGjkRoundOff);
+  EXPECT_GE(s.point_a.z(), -0.5 - kGjkRoundOff);
+  EXPECT_LE(s.point_a.z(), 0.4 + kGjkRoundOff);
 }
 
 TEST(ShapeDistance, FromAHairToTenSizesApart) {

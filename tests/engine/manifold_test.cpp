@@ -9,11 +9,13 @@
 #include <vector>
 
 #include "engine/detect.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {
 
-Pose at(const Vec3& p, const Quat& q = Quat::Identity()) { return {p, q}; }
+using test::at;
+using test::random_rotation;
 
 TEST(Manifold, FaceLandingHasTheFourCorners) {
   // A unit cube 1 mm into a 4 x 4 x 1 slab: the four base corners, each 1 mm deep, normal +z,
@@ -151,11 +153,6 @@ TEST(Manifold, NothingWhenApart) {
   const ConvexPolyhedron cube = make_box(Vec3::Ones());
   EXPECT_FALSE(build_manifold(cube, at(Vec3(0, 0, 1.01)), cube, at(Vec3::Zero()),
                               DetectorVariant::Faithful));
-}
-
-Quat random_rotation(std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  return Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
 }
 
 TEST(Manifold, EitherBodyOrderGivesTheSamePointsWithTheNormalReversed) {

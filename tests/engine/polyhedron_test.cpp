@@ -20,7 +20,7 @@ namespace {
 
 // Volumes are sums of a few dozen to a few thousand triple products of O(1) coordinates:
 // round-off ~1e-15 relative per term, so 1e-12 relative is a safe bound.
-constexpr double kRelRoundOff = 1e-12;
+constexpr double kVolumeRoundOff = 1e-12;
 
 using Triangles = std::vector<std::array<int, 3>>;
 
@@ -56,7 +56,7 @@ TEST(PolyhedronBuilders, BoxCountsAndVolume) {
   EXPECT_EQ(box.triangles().size(), 12u);
   EXPECT_EQ(box.edges().size(), 18u);
   EXPECT_EQ(box.planes().size(), 12u);
-  EXPECT_NEAR(box.volume(), 2.0 * 3.0 * 5.0, 30.0 * kRelRoundOff);
+  EXPECT_NEAR(box.volume(), 2.0 * 3.0 * 5.0, 30.0 * kVolumeRoundOff);
   // Bounds are the half extents around the origin.
   EXPECT_EQ(box.bounds().min, Vec3(-1, -1.5, -2.5));
   EXPECT_EQ(box.bounds().max, Vec3(1, 1.5, 2.5));
@@ -79,7 +79,7 @@ TEST(PolyhedronBuilders, PlanesAreUnitAndOutward) {
   for (const ConvexPolyhedron& s :
        {make_box(Vec3(1, 2, 3)), make_icosphere(2.0, 1), make_prism(1.0, 0.5, 7)}) {
     for (const Plane& p : s.planes()) {
-      EXPECT_NEAR(p.normal.norm(), 1.0, kRelRoundOff);
+      EXPECT_NEAR(p.normal.norm(), 1.0, kVolumeRoundOff);
       EXPECT_GT(p.offset, 0.0);
       for (const Vec3& v : s.vertices()) EXPECT_LE(p.distance(v), 1e-12);
     }
@@ -123,7 +123,8 @@ TEST(PolyhedronBuilders, PrismVolume) {
   const double r = 0.7, h = 1.3;
   for (int n : {3, 4, 6, 17, 64}) {
     const double expected = 0.5 * n * r * r * std::sin(2 * M_PI / n) * h;
-    EXPECT_NEAR(make_prism(r, h, n).volume(), expected, expected * kRelRoundOff) << "sides " << n;
+    EXPECT_NEAR(make_prism(r, h, n).volume(), expected, expected * kVolumeRoundOff)
+        << "sides " << n;
   }
 }
 
@@ -133,7 +134,7 @@ TEST(PolyhedronBuilders, IcosahedronVolume) {
   const double radius = 1.7;
   const double a = 4 * radius / std::sqrt(10 + 2 * std::sqrt(5.0));
   const double expected = 5.0 / 12.0 * (3 + std::sqrt(5.0)) * a * a * a;
-  EXPECT_NEAR(make_icosphere(radius, 0).volume(), expected, expected * kRelRoundOff);
+  EXPECT_NEAR(make_icosphere(radius, 0).volume(), expected, expected * kVolumeRoundOff);
 }
 
 TEST(PolyhedronBuilders, IcosphereVolumeIncreasesTowardTheBall) {
@@ -159,7 +160,7 @@ TEST(PolyhedronBuilders, TranslatedMovesVerticesPlanesAndBounds) {
   // Each moved vertex is on its moved triangle's plane.
   for (size_t f = 0; f < moved.triangles().size(); ++f)
     EXPECT_NEAR(moved.planes()[f].distance(moved.vertices()[moved.triangles()[f][0]]), 0.0,
-                kRelRoundOff);
+                kVolumeRoundOff);
   EXPECT_EQ(moved.bounds().min, box.bounds().min + offset);
 }
 
@@ -263,7 +264,7 @@ TEST(PolyhedronBuilders, TheVertexScanIsTheLoopsFirstHighestBitForBit) {
 
 TEST(PolyhedronValidation, AcceptsTheTetrahedron) {
   const ConvexPolyhedron t = ConvexPolyhedron::from_triangles(tetra_vertices(), tetra_triangles());
-  EXPECT_NEAR(t.volume(), 1.0 / 6.0, kRelRoundOff);
+  EXPECT_NEAR(t.volume(), 1.0 / 6.0, kVolumeRoundOff);
   EXPECT_EQ(t.edges().size(), 6u);
 }
 

@@ -14,10 +14,7 @@
 namespace rbx {
 namespace {
 
-Quat random_rotation(std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  return Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
-}
+using test::random_rotation;
 
 RigidBody body_of(const char* name, const ConvexPolyhedron& shape, const Vec3& position,
                   const Quat& orientation, bool is_static) {

@@ -12,16 +12,18 @@
 
 #include "engine/distance.h"
 #include "reference/exact.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {
 
+using test::at;
+
 // Round-off of closed-form cases at unit scale: the candidates are computed in closed form from
 // coordinates of order 1 (~1e-16 each); 1e-12 leaves a wide margin and still catches a wrong
 // feature (the gaps here are >= 0.25).
-constexpr double kRoundOff = 1e-12;
+constexpr double kDistanceRoundOff = 1e-12;
 
-Pose at(const Vec3& p, const Quat& q = Quat::Identity()) { return {p, q}; }
 Quat about(double deg, const Vec3& axis) { return Quat(Eigen::AngleAxisd(deg * M_PI / 180, axis)); }
 
 TEST(ExactDistance, ClosedFormsWithTheirFeatures) {
@@ -33,31 +35,31 @@ TEST(ExactDistance, ClosedFormsWithTheirFeatures) {
   ExactDistance d =
       exact_distance(cube, at(Vec3::Zero(), corner_to_x), cube, at(Vec3(tip + 0.75, 0, 0)));
   ASSERT_FALSE(d.overlapping);
-  EXPECT_NEAR(d.distance, 0.25, kRoundOff);
-  EXPECT_NEAR((d.point_a - Vec3(tip, 0, 0)).norm(), 0.0, kRoundOff);
-  EXPECT_NEAR((d.point_b - Vec3(tip + 0.25, 0, 0)).norm(), 0.0, kRoundOff);
+  EXPECT_NEAR(d.distance, 0.25, kDistanceRoundOff);
+  EXPECT_NEAR((d.point_a - Vec3(tip, 0, 0)).norm(), 0.0, kDistanceRoundOff);
+  EXPECT_NEAR((d.point_b - Vec3(tip + 0.25, 0, 0)).norm(), 0.0, kDistanceRoundOff);
   EXPECT_EQ(d.feature_a, "vertex");
   EXPECT_EQ(d.feature_b, "face");
   // Two edges crossing at right angles, sqrt(2) + 0.3 - sqrt(2) = 0.3 apart.
   const double h = std::sqrt(2.0) / 2, c = std::sqrt(2.0) + 0.3;
   d = exact_distance(cube, at(Vec3::Zero(), about(45, Vec3::UnitZ())), cube,
                      at(Vec3(c, 0, 0), about(45, Vec3::UnitY())));
-  EXPECT_NEAR(d.distance, 0.3, kRoundOff);
-  EXPECT_NEAR((d.point_a - Vec3(h, 0, 0)).norm(), 0.0, kRoundOff);
-  EXPECT_NEAR((d.point_b - Vec3(c - h, 0, 0)).norm(), 0.0, kRoundOff);
+  EXPECT_NEAR(d.distance, 0.3, kDistanceRoundOff);
+  EXPECT_NEAR((d.point_a - Vec3(h, 0, 0)).norm(), 0.0, kDistanceRoundOff);
+  EXPECT_NEAR((d.point_b - Vec3(c - h, 0, 0)).norm(), 0.0, kDistanceRoundOff);
   EXPECT_EQ(d.feature_a, "edge");
   EXPECT_EQ(d.feature_b, "edge");
   // Parallel faces 0.5 apart: a pair straight across, A's on its x = 0.5 face (a corner of A
   // over B's face is found first), B's on its x = 1 face.
   d = exact_distance(cube, at(Vec3::Zero()), cube, at(Vec3(1.5, 0.2, -0.1)));
-  EXPECT_NEAR(d.distance, 0.5, kRoundOff);
-  EXPECT_NEAR((d.point_b - d.point_a - Vec3(0.5, 0, 0)).norm(), 0.0, kRoundOff);
+  EXPECT_NEAR(d.distance, 0.5, kDistanceRoundOff);
+  EXPECT_NEAR((d.point_b - d.point_a - Vec3(0.5, 0, 0)).norm(), 0.0, kDistanceRoundOff);
   EXPECT_EQ(d.feature_b, "face");
   // Overlapping: no distance; exactly touching: 0.
   EXPECT_TRUE(exact_distance(cube, at(Vec3::Zero()), cube, at(Vec3(0.9, 0, 0))).overlapping);
   d = exact_distance(cube, at(Vec3::Zero()), cube, at(Vec3(1.0, 0.3, 0)));
   EXPECT_FALSE(d.overlapping);
-  EXPECT_NEAR(d.distance, 0.0, kRoundOff);
+  EXPECT_NEAR(d.distance, 0.0, kDistanceRoundOff);
 }
 
 // A tetrahedron's outward triangles from its four corners.

@@ -23,6 +23,8 @@
 namespace rbx {
 namespace {
 
+using test::random_rotation;
+
 using test::cube_symmetries;
 
 // Round-off bound for closed-form cases at unit scale: rotations from quaternions and
@@ -446,11 +448,6 @@ ConvexPolyhedron random_shape(std::mt19937& rng) {
   std::vector<Vec3> v;
   for (const Vec3& p : base.vertices()) v.push_back(m * p);
   return ConvexPolyhedron::from_triangles(v, base.triangles());
-}
-
-Quat random_rotation(std::mt19937& rng) {
-  std::normal_distribution<double> g(0.0, 1.0);
-  return Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
 }
 
 TEST(ExactSatRandom, InvariantsAgainstBruteForce) {

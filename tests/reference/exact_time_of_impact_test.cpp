@@ -13,15 +13,16 @@
 #include "engine/settings.h"
 #include "engine/time_of_impact.h"
 #include "reference/exact.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {
 
+using test::at;
+
 // Round-off of a quotient of unit-scale projections (~1e-16 each) over speeds of order 1: 1e-12
 // leaves a wide margin and still catches a wrong axis (the times here differ by >= 0.05 s).
-constexpr double kRoundOff = 1e-12;
-
-Pose at(const Vec3& p, const Quat& q = Quat::Identity()) { return {p, q}; }
+constexpr double kQuotientRoundOff = 1e-12;
 
 TEST(ExactTranslationImpact, ClosedForms) {
   const ConvexPolyhedron cube = make_box(Vec3::Ones());
@@ -30,8 +31,8 @@ TEST(ExactTranslationImpact, ClosedForms) {
   ExactImpact hit = exact_translation_impact(cube, at(Vec3::Zero()), Vec3(0.5, 0, 0), cube,
                                              at(Vec3(1.5, 0, 0)), Vec3(-1.5, 0, 0), 1.0);
   ASSERT_TRUE(hit.time);
-  EXPECT_NEAR(*hit.time, 0.25, kRoundOff);
-  EXPECT_NEAR((hit.normal - Vec3(-1, 0, 0)).norm(), 0.0, kRoundOff);
+  EXPECT_NEAR(*hit.time, 0.25, kQuotientRoundOff);
+  EXPECT_NEAR((hit.normal - Vec3(-1, 0, 0)).norm(), 0.0, kQuotientRoundOff);
   // The same within dt = 0.2 s: no contact yet.
   EXPECT_FALSE(exact_translation_impact(cube, at(Vec3::Zero()), Vec3(0.5, 0, 0), cube,
                                         at(Vec3(1.5, 0, 0)), Vec3(-1.5, 0, 0), 0.2)
@@ -49,7 +50,7 @@ TEST(ExactTranslationImpact, ClosedForms) {
       cube, at(Vec3::Zero(), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()))), Vec3::Zero(), cube,
       at(Vec3(c, 0, 0), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY()))), Vec3(-1, 0, 0), 1.0);
   ASSERT_TRUE(hit.time);
-  EXPECT_NEAR(*hit.time, 0.3, kRoundOff);
+  EXPECT_NEAR(*hit.time, 0.3, kQuotientRoundOff);
   EXPECT_NEAR((hit.normal - Vec3(-1, 0, 0)).norm(), 0.0, 1e-9);
   // Overlapping at the start: 0.
   hit = exact_translation_impact(cube, at(Vec3::Zero()), Vec3::Zero(), cube, at(Vec3(0.9, 0, 0)),

@@ -37,7 +37,7 @@ namespace rbx {
 namespace {
 
 // Round-off bound for a GJK distance between unit-scale boxes that ends on exact vertices.
-constexpr double kRoundOff = 1e-12;
+constexpr double kGjkBoxRoundOff = 1e-12;
 
 /// Unit cube as an fcl::Convex (quadrilateral faces, counter-clockwise seen from outside).
 std::shared_ptr<fcl::Convexd> unit_cube_convex() {
@@ -139,9 +139,9 @@ TEST(FclIndepDistance, SeparatedBoxConvexIsAnsweredThroughTheIsolation) {
       run_isolated_capturing_stderr([] { return indep_box_convex_distance(1.1); }, &child_stderr);
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   ASSERT_EQ(r.contacts.size(), 1u);
-  EXPECT_NEAR(-r.contacts[0].depth, 0.1, kRoundOff);      // min_distance
-  EXPECT_NEAR(r.contacts[0].point.x(), 0.5, kRoundOff);   // nearest point on A
-  EXPECT_NEAR(r.contacts[0].normal.x(), 0.6, kRoundOff);  // nearest point on B
+  EXPECT_NEAR(-r.contacts[0].depth, 0.1, kGjkBoxRoundOff);      // min_distance
+  EXPECT_NEAR(r.contacts[0].point.x(), 0.5, kGjkBoxRoundOff);   // nearest point on A
+  EXPECT_NEAR(r.contacts[0].normal.x(), 0.6, kGjkBoxRoundOff);  // nearest point on B
   EXPECT_TRUE(child_stderr.empty()) << child_stderr;
 }
 

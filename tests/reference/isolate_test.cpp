@@ -18,8 +18,12 @@
 #include <string>
 #include <thread>
 
+#include "tests/common/fixtures.h"
+
 namespace rbx {
 namespace {
+
+using test::same_bits;
 
 // Wall time (s) of one call.
 template <class F>
@@ -30,7 +34,6 @@ double seconds_of(F&& f) {
 }
 
 // True when the two doubles have the same bits (NaN payloads and the sign of zero included).
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // After run_isolated returns, its child has been reaped: this process has no child left.
 void expect_no_child_left() {

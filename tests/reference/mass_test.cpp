@@ -12,9 +12,9 @@ namespace rbx {
 namespace {
 
 // The backends under test, by their registry names.
-const Backend& bullet_hull = bullet_adapter().backend("bullet-hull");
-const Backend& fcl_hull = fcl_adapter().backend("fcl-hull");
-const Backend& mujoco_hull = mujoco_adapter().backend("mujoco-hull");
+const Backend& bullet_hull_mass = bullet_adapter().backend("bullet-hull");
+const Backend& fcl_hull_mass = fcl_adapter().backend("fcl-hull");
+const Backend& mujoco_hull_mass = mujoco_adapter().backend("mujoco-hull");
 
 RigidBody box_body(const Vec3& size, double mass) {
   BodySpec spec;
@@ -35,7 +35,7 @@ Mat3 box_inertia(const Vec3& s, double m) {
 TEST(LibraryMass, MujocoMeshInertiaIsExact) {
   // MuJoCo integrates the mesh volume: exact up to its float vertices (relative 1e-7).
   const Vec3 size(1, 2, 3);
-  const MassResult r = mujoco_hull.mass(box_body(size, 6));
+  const MassResult r = mujoco_hull_mass.mass(box_body(size, 6));
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   EXPECT_NEAR(r.mass, 6, 1e-12);
   EXPECT_LT(r.center_of_mass.norm(), 1e-6);
@@ -47,7 +47,7 @@ TEST(LibraryMass, FclConvexInertiaIsPerUnitMassNotPerUnitDensity) {
   // the unit-density convention of Box and of the parallel-axis shift the result is I / V.
   // Box 1 x 2 x 3 (V = 6) of 6 kg: density 1, so the adapter's scaling is 1 and FCL gives I/6.
   const Vec3 size(1, 2, 3);
-  const MassResult r = fcl_hull.mass(box_body(size, 6));
+  const MassResult r = fcl_hull_mass.mass(box_body(size, 6));
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   EXPECT_NEAR(r.volume, 6, 1e-12);  // volume and centre of mass are right
   EXPECT_LT(r.center_of_mass.norm(), 1e-12);
@@ -60,7 +60,7 @@ TEST(LibraryMass, BulletHullInertiaIsTheMarginInflatedBoundingBox) {
   // support points with margin, getAabb adds the margin, the routine adds it again): full
   // extents size + 6k, I = m/12 ((b+6k)^2 + (c+6k)^2), ...
   const Vec3 size(1, 2, 3);
-  const MassResult r = bullet_hull.mass(box_body(size, 6));
+  const MassResult r = bullet_hull_mass.mass(box_body(size, 6));
   ASSERT_EQ(r.status, Status::Ok) << r.message;
   const Vec3 grown = size + Vec3::Constant(6 * 0.04);
   // Bullet writes 1/12 as 0.08333333 (relative error 4e-8): 1e-7 relative.

@@ -8,11 +8,14 @@
 #include <cstring>
 #include <limits>
 
+#include "tests/common/fixtures.h"
+
 namespace rbx {
 namespace {
 
+using test::same_bits;
+
 // Bitwise equality: the encoding promises the same bits (NaN and -0.0 included), not nearness.
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 bool same_bits(const Vec3& a, const Vec3& b) {
   return same_bits(a.x(), b.x()) && same_bits(a.y(), b.y()) && same_bits(a.z(), b.z());
 }
