@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "comparisons/eval/explore_check.h"
+#include "comparisons/eval/harness.h"
 #include "comparisons/eval/regression_check.h"
 #include "comparisons/eval/select_backends.h"
 #include "comparisons/scene/scene.h"
@@ -68,6 +69,10 @@ struct ReportOptions {
   bool quiet = false;    // no progress line
   int threads = 0;       // report: threads per rank (0: the cores of the node, divided among ranks)
   bool check = false;    // report --check: also compare this run with the baseline (rbx check)
+  /// report: each contact query and main dynamics run of the scenes timed at least this long
+  /// (HarnessOptions::timing_budget_s); 0: one call each, the answers unchanged. Tests that
+  /// check a report's answers, not its timings, pass 0.
+  double timing_budget_s = HarnessOptions{}.timing_budget_s;
 };
 
 /// `rbx report`: accuracy report over a scene library.

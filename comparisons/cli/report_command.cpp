@@ -122,6 +122,7 @@ int report_command(const ReportOptions& opt) {
   hopt.backends = opt.backends;
   hopt.cache_dir = ResultCache::default_dir();  // filled for rbx check, never read: own timings
   hopt.cache_reads = false;
+  hopt.timing_budget_s = opt.timing_budget_s;
   // Scenes spread over MPI ranks (under mpirun) and threads, results back in scene order on
   // rank 0 (eval/parallel.h): the report is the same for any number of ranks and threads.
   ParallelRun par(opt.threads);
