@@ -400,8 +400,8 @@ bool solve_active_set(std::vector<RigidBody>& bodies, const std::vector<BodyInve
 // Staggered projections (every island). Outline of solve_island:
 //   remember the start                 (IslandSolver constructor)
 //   active sets for small islands, then rounds of two stages until neither moves    (solve)
-//     a stage: projected Gauss-Seidel sweeps to convergence, steady drifts taken at once
-//              (stage; normal_sweep or friction_sweep)
+//     a stage: projected Gauss-Seidel iterations to convergence, steady drifts taken at once
+//              (stage; normal_iteration or friction_iteration)
 //   energy guard: restitution scaled down by bisection where the solve added energy
 //              (guard_energy)
 
@@ -411,11 +411,11 @@ struct IslandSolver {
                std::vector<Row>& rows_in, const ContactSolverSettings& settings_in,
                SolverWork& work_in);
 
-  double normal_sweep();
-  double friction_sweep();
+  double normal_iteration();
+  double friction_iteration();
   void rescale();
   void unknowns(bool friction, std::vector<double>& out) const;
-  double sweeps_to_bound(bool friction, const std::vector<double>& d) const;
+  double iterations_to_bound(bool friction, const std::vector<double>& d) const;
   void take_drift(bool friction, const std::vector<double>& d, double count);
   int stage(bool friction);
   void solve();
@@ -431,11 +431,11 @@ struct IslandSolver {
   const double mu;
   double speed_scale = 0.0;                     // m/s, the largest speed in the problem
   double converged = 0.0;                       // m/s, the convergence test's threshold
-  std::vector<double> before, after, d, drift;  // the stages' buffers, kept across sweeps
+  std::vector<double> before, after, d, drift;  // the stages' buffers, kept across iterations
   std::vector<int> involved;                    // the bodies in the problem
   std::vector<std::pair<Vec3, Vec3>> start;     // their velocities before the solve
   double kinetic_before = 0.0;                  // J, their kinetic energy before the solve
-  long budget_left = 0;  // sweeps this solve may still take (WorldSettings::sweep_budget)
+  long budget_left = 0;  // iterations this solve may still take (WorldSettings::iteration_budget)
 };
 
 IslandSolver::IslandSolver(std::vector<RigidBody>& bodies_in,
@@ -457,9 +457,9 @@ IslandSolver::IslandSolver(std::vector<RigidBody>& bodies_in,
   kinetic_before = kinetic();
 }
 
-// One sweep of the normal stage (friction impulses held); returns the largest velocity change
+// One iteration of the normal stage (friction impulses held); returns the largest velocity change
 // at a point (m/s).
-double IslandSolver::normal_sweep() {
+double IslandSolver::normal_iteration() {
   double change = 0.0;
   for (Row& r : rows) {
     RigidBody &a = bodies[r.a], &b = bodies[r.b];
@@ -477,9 +477,9 @@ double IslandSolver::normal_sweep() {
   return change;
 }
 
-// One sweep of the friction stage (normal impulses held); returns the largest velocity change
+// One iteration of the friction stage (normal impulses held); returns the largest velocity change
 // at a point (m/s).
-double IslandSolver::friction_sweep() {
+double IslandSolver::friction_iteration() {
   double change = 0.0;
   for (Row& r : rows) {
     RigidBody &a = bodies[r.a], &b = bodies[r.b];
@@ -515,9 +515,9 @@ void IslandSolver::unknowns(bool friction, std::vector<double>& out) const {
   }
 }
 
-// How many sweeps of the drift d (per sweep) the unknowns can take before one reaches its
+// How many iterations of the drift d (per iteration) the unknowns can take before one reaches its
 // bound (j_n = 0, or |j_t| = mu j_n); infinity if none would.
-double IslandSolver::sweeps_to_bound(bool friction, const std::vector<double>& dd) const {
+double IslandSolver::iterations_to_bound(bool friction, const std::vector<double>& dd) const {
   double s = std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < rows.size(); ++k) {
     const Row& r = rows[k];
@@ -534,7 +534,7 @@ double IslandSolver::sweeps_to_bound(bool friction, const std::vector<double>& d
   return s;
 }
 
-// Takes `count` sweeps of the drift d at once: the rows' impulses and the bodies' velocities.
+// Takes `count` iterations of the drift d at once: the rows' impulses and the bodies' velocities.
 void IslandSolver::take_drift(bool friction, const std::vector<double>& dd, double count) {
   for (size_t k = 0; k < rows.size(); ++k) {
     Row& r = rows[k];
@@ -551,7 +551,7 @@ void IslandSolver::take_drift(bool friction, const std::vector<double>& dd, doub
   }
 }
 
-// Converged: a sweep that changes no point's velocity by more than `convergence` of the
+// Converged: an iteration that changes no point's velocity by more than `convergence` of the
 // problem's speeds is a fixed point to round-off (see ContactSolverSettings). The speeds are the
 // bodies' at the start and the velocity change each accumulated impulse alone gives its point
 // (j_n k_n): under a resting stack those are much larger than the motion and cancel, and every
@@ -563,26 +563,27 @@ void IslandSolver::rescale() {
   converged = settings.tunables.convergence * std::max(scale, 1e-300);
 }
 
-// Sweeps of one stage until converged; returns how many changed something.
+// Iterations of one stage until converged; returns how many changed something.
 // Steady drift: where the targets are inconsistent with the bodies' degrees of freedom (four
 // points of a face, three of them free; some get a restitution target and some rest), the
-// sweeps end with the same velocities every time while the impulses move along the null space
-// of K by the same amount each sweep, until one reaches its bound; measured on cube tosses,
-// over 10,000 sweeps (the cap) with a constant violation of 4.7e-6 m/s. When two sweeps in a row
-// moved the impulses by the same vector (to `drift_match`), the sweeps still to come before the
-// first bound are taken at once, as the iteration would take them (their impulses applied to the
-// bodies), and sweeping goes on from there; it only ever stops at the same convergence test, so the
-// answer is still the fixed point.
+// iterations end with the same velocities every time while the impulses move along the null space
+// of K by the same amount each iteration, until one reaches its bound; measured on cube tosses,
+// over 10,000 iterations (the cap) with a constant violation of 4.7e-6 m/s. When two iterations in
+// a row moved the impulses by the same vector (to `drift_match`), the iterations still to come
+// before the first bound are taken at once, as the iteration would take them (their impulses
+// applied to the bodies), and iterating goes on from there; it only ever stops at the same
+// convergence test, so the answer is still the fixed point.
 int IslandSolver::stage(bool friction) {
   const WorldSettings& tun = settings.tunables;
   int moving = 0;
   rescale();
   unknowns(friction, before);
   drift.clear();
-  const bool budgeted = tun.sweep_budget > 0;
-  for (int sweep = 0; sweep < tun.max_sweeps && !(budgeted && budget_left <= 0); ++sweep) {
+  const bool budgeted = tun.iteration_budget > 0;
+  for (int iteration = 0; iteration < tun.max_iterations && !(budgeted && budget_left <= 0);
+       ++iteration) {
     --budget_left;
-    if ((friction ? friction_sweep() : normal_sweep()) <= converged) break;
+    if ((friction ? friction_iteration() : normal_iteration()) <= converged) break;
     ++moving;
     unknowns(friction, after);
     d.resize(after.size());
@@ -593,7 +594,7 @@ int IslandSolver::stage(bool friction) {
       if (!drift.empty()) off = std::max(off, std::abs(d[i] - drift[i]));
     }
     if (!drift.empty() && size > 0.0 && off <= tun.drift_match * size) {
-      const double count = std::floor(sweeps_to_bound(friction, d)) - 1.0;
+      const double count = std::floor(iterations_to_bound(friction, d)) - 1.0;
       if (count >= 1.0 && std::isfinite(count)) {
         take_drift(friction, d, count);
         ++work.drifts_taken;
@@ -604,20 +605,20 @@ int IslandSolver::stage(bool friction) {
     drift.swap(d);
     before.swap(after);
   }
-  work.sweeps += moving;
+  work.iterations += moving;
   return moving;
 }
 
 // Staggered projections (Kaufman, Sueda, James & Pai 2008): the normal impulses with the
 // friction impulses held, then the friction impulses inside the cones those normal impulses
 // give, repeated until neither moves. Each stage is a convex problem that projected
-// Gauss-Seidel solves to convergence; interleaving both in one sweep instead cycled at 1e-8 m/s
+// Gauss-Seidel solves to convergence; interleaving both in one iteration instead cycled at 1e-8 m/s
 // on a five-cube stack (the cone radius moving under the friction rows). The active-set answer
 // comes first; the projections then start from it (they find it converged) or, where it was
 // refused, from zero.
 void IslandSolver::solve() {
   ++work.solves;
-  budget_left = settings.tunables.sweep_budget;
+  budget_left = settings.tunables.iteration_budget;
   if (rows.size() <= static_cast<size_t>(std::max(settings.active_set_rows, 0)))
     work.active_set += solve_active_set(bodies, inv, rows, mu, converged);
   for (int round = 0; round < settings.tunables.max_stage_rounds && !rows.empty(); ++round) {
@@ -720,7 +721,7 @@ std::vector<Row> make_rows(const std::vector<RigidBody>& bodies,
       // |v_rel| alone: a body sliding to rest while it moves or turns carries round-off of
       // ~1e-16 of |v| + |w||r| in every v_rel, which a test relative to |v_rel| alone cannot
       // pass (measured on a cube toss at mu 0.6: one sticking point changed by 5.5e-17 m/s
-      // every sweep for 10,000 sweeps, against a threshold of 4.6e-17).
+      // every iteration for 10,000 iterations, against a threshold of 4.6e-17).
       const RigidBody &ba = bodies[r.a], &bb = bodies[r.b];
       const double terms = ba.velocity.norm() + ba.angular_velocity.norm() * r.ra.norm() +
                            bb.velocity.norm() + bb.angular_velocity.norm() * r.rb.norm();
@@ -733,8 +734,8 @@ std::vector<Row> make_rows(const std::vector<RigidBody>& bodies,
 
 // Islands: rows that share a moving body (static bodies do not join them) are one problem;
 // separate islands cannot affect each other, so each is solved to its own convergence
-// instead of sweeping every row until the slowest island converges (many_1000: ~1,700
-// sweeps of every row per step for one face contact). Islands in the order of their first row.
+// instead of iterating every row until the slowest island converges (many_1000: ~1,700
+// iterations of every row per step for one face contact). Islands in the order of their first row.
 void solve_islands(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>& inv,
                    std::vector<Row>& rows, const ContactSolverSettings& settings,
                    SolverWork& work) {
@@ -777,7 +778,7 @@ std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies
   if (work) {
     work->solves += done.solves;
     work->active_set += done.active_set;
-    work->sweeps += done.sweeps;
+    work->iterations += done.iterations;
     work->drifts_taken += done.drifts_taken;
   }
   // Every point's impulses, the friction impulse back in world axes.

@@ -42,8 +42,8 @@ struct ContactSolverSettings {
   double rest_speed = 0.0;   // m/s: approaches slower than this get e = 0 (resting contact)
   // Islands of at most this many points are solved by active sets first (see
   // solve_contact_velocities): 32 points, 96 unknowns, hold a stack of eight boxes on face
-  // contacts, whose friction the projections settle only after very many sweeps once anything
-  // in it slides; larger piles go to the projections at O(points) per sweep. 0 leaves every
+  // contacts, whose friction the projections settle only after very many iterations once anything
+  // in it slides; larger piles go to the projections at O(points) per iteration. 0 leaves every
   // island to the projections alone (tests compare the two).
   int active_set_rows = 32;
   WorldSettings tunables;  // convergence test and caps of the projections
@@ -64,7 +64,7 @@ struct SolvedPoint {
 struct SolverWork {
   int solves = 0;        // island solves (the energy guard's restarts included)
   int active_set = 0;    // of them, settled by active sets
-  long sweeps = 0;       // projected Gauss-Seidel sweeps, both stages, every island
+  long iterations = 0;   // projected Gauss-Seidel iterations, both stages, every island
   int drifts_taken = 0;  // steady drifts taken at once (see solve_island)
 };
 

@@ -125,7 +125,7 @@ void support_corners(std::vector<ManifoldPoint>& pts, const Vec3& n, double slac
     pts.assign(1, deepest);
     return;
   }
-  // In the order the points were found (deterministic, and the solver sweeps in that order).
+  // In the order the points were found (deterministic, and the solver iterates in that order).
   std::sort(hull.begin(), hull.end(),
             [](const Planar& a, const Planar& b) { return a.index < b.index; });
   size_t kept = 0;

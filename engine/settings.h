@@ -21,21 +21,21 @@ struct WorldSettings {
 
   // Contact solver (engine/contact_solver.cpp).
 
-  /// Relative: a sweep that changes no point's velocity by more than this fraction of the
+  /// Relative: an iteration that changes no point's velocity by more than this fraction of the
   /// island's largest speed is a fixed point to round-off (the seed's closed forms are checked
   /// to 1e-9; 1e-14 leaves five digits).
   double convergence = 1e-14;
-  /// Projected Gauss-Seidel sweeps of one stage at most: bounds pathological graphs (a chain of
-  /// n bodies converges in O(n^2) sweeps).
-  int max_sweeps = 10000;
+  /// Projected Gauss-Seidel iterations of one stage at most: bounds pathological graphs (a chain of
+  /// n bodies converges in O(n^2) iterations).
+  int max_iterations = 10000;
   /// Rounds of the two stages (normal, then friction) at most, for the same reason.
   int max_stage_rounds = 100;
-  /// Sweeps of one island solve at most, both stages and every round together; 0: no budget,
+  /// Iterations of one island solve at most, both stages and every round together; 0: no budget,
   /// the solve runs to convergence within the caps above (the engine's only mode). The
-  /// iteration budget other engines expose, kept for comparison: the report sweeps it along
+  /// iteration budget other engines expose, kept for comparison: the report steps it through
   /// with theirs (reference/custom.cpp, custom_budget); the active sets come first either way.
-  long sweep_budget = 0;
-  /// Relative: two sweeps that moved the impulses by the same vector to this fraction of its
+  long iteration_budget = 0;
+  /// Relative: two iterations that moved the impulses by the same vector to this fraction of its
   /// size are a steady drift, taken at once up to the first bound (solve_island).
   double drift_match = 1e-9;
 

@@ -392,7 +392,7 @@ void make_solver_fair(btDiscreteDynamicsWorld& world, const BulletSettings& sett
   // flag solveGroupCacheFriendlyFinish skips writeBackContacts, so the manifold points would
   // never carry the applied impulses the events below are read from.
   info.m_warmstartingFactor = settings.warmstarting_factor;
-  // Enough Gauss-Seidel sweeps for multi-point manifolds to converge (default 10); a
+  // Enough Gauss-Seidel iterations for multi-point manifolds to converge (default 10); a
   // single-point impact is exact after the first.
   info.m_numIterations = 100;
   info.m_erp2 = settings.contact_erp;
@@ -683,10 +683,10 @@ DynamicsResult dynamics_run(const WorldDefinition& scene, const DynamicsOptions&
 
 MassResult bullet_hull_mass(const RigidBody& body);
 
-// The budget swept along: Bullet's sequential-impulse sweeps (library default 10; the fair
+// The budget swept along: Bullet's sequential-impulse iterations (library default 10; the fair
 // world's 100, make_solver_fair).
 SolverBudget bullet_budget() {
-  return {"m_numIterations (sequential-impulse sweeps)", {1, 3, 10, 30, 100}, 10, 100};
+  return {"m_numIterations (sequential-impulse iterations)", {1, 3, 10, 30, 100}, 10, 100};
 }
 
 // `bullet` mass: btBoxShape::calculateLocalInertia for boxes (the solid box's, exact), the hull

@@ -57,9 +57,9 @@ DynamicsResult run_dynamics(const WorldDefinition& scene, const DynamicsOptions&
   try {
     SimSettings sim = scene.sim;
     if (opt.dt > 0) sim.dt = opt.dt;
-    // A swept budget caps the projections' sweeps per island solve (custom_budget).
+    // A swept budget caps the projections' iterations per island solve (custom_budget).
     WorldSettings tunables;
-    tunables.sweep_budget = opt.budget;
+    tunables.iteration_budget = opt.budget;
     World world(sim, make_bodies(scene), model, DetectorVariant::Accelerated,
                 BroadPhaseMethod::Tree, tunables);
     world.set_response(response);
@@ -142,15 +142,17 @@ DynamicsResult custom_seed_dynamics_with(const WorldDefinition& scene, const Dyn
   return run_dynamics(scene, opt, ContactModel::Seed, response);
 }
 
-// The budget swept along: the projected Gauss-Seidel sweeps of one island solve, both stages
-// together (WorldSettings::sweep_budget). The engine itself has no budget: it solves to
+// The budget swept along: the projected Gauss-Seidel iterations of one island solve, both stages
+// together (WorldSettings::iteration_budget). The engine itself has no budget: it solves to
 // convergence (configured 0), and islands of up to 32 points are settled by active sets first,
 // which no budget limits.
 SolverBudget custom_budget() {
-  return {"sweep_budget (projected Gauss-Seidel sweeps per island solve, after the active sets)",
-          {1, 10, 100, 1000},
-          0,
-          0};
+  return {
+      "iteration_budget (projected Gauss-Seidel iterations per island solve, after the active "
+      "sets)",
+      {1, 10, 100, 1000},
+      0,
+      0};
 }
 
 const Adapter& custom_adapter() {

@@ -210,7 +210,7 @@ TEST(ContactSolver, EveryAnswerMeetsTheContactConditions) {
   // the speed; the margin is round-off of the inertia products at speeds and impulses of order
   // 1), at Newton's targets or, where the energy guard acted, at the scaled ones it reports
   // (checked: they are Newton's when the energy did not grow). The projections alone miss on
-  // one of these landings by 2.9e-6 m/s (trial 506: sweeps capped), which is why the active
+  // one of these landings by 2.9e-6 m/s (trial 506: iterations capped), which is why the active
   // sets come first.
   std::mt19937 rng(20261124);
   std::uniform_real_distribution<double> pos(0.0, 1.0);
@@ -309,7 +309,7 @@ StackOfFive stack_of_five(double mu, std::mt19937* rng = nullptr) {
 }
 
 TEST(ContactSolver, AStackOfFiveThatSlidesIsSettledByActiveSets) {
-  // At mu = 0.5 the projections alone converge on the stack only after thousands of sweeps a
+  // At mu = 0.5 the projections alone converge on the stack only after thousands of iterations a
   // step once anything slides (an ensemble of friction/stack_five found it); the active sets
   // settle it, and the answer meets every contact condition to round-off of speeds of order
   // g dt (1e-12 m/s).
@@ -344,19 +344,19 @@ TEST(ContactSolver, NudgedStacksOfFiveAreSettledByActiveSets) {
 
 TEST(ContactSolver, ASweepBudgetStopsTheProjectionsShort) {
   // The stack of five on the projections alone: unbudgeted they sweep to convergence; with a
-  // budget of 5 sweeps per island solve (the iteration budget other engines expose, swept by
+  // budget of 5 iterations per island solve (the iteration budget other engines expose, swept by
   // the report) no solve takes more, and the answer breaks the contact conditions by more.
   StackOfFive free_run = stack_of_five(0.5), budgeted = free_run;
   free_run.settings.active_set_rows = 0;
   budgeted.settings.active_set_rows = 0;
-  budgeted.settings.tunables.sweep_budget = 5;
+  budgeted.settings.tunables.iteration_budget = 5;
   SolverWork free_work, budget_work;
   const auto a = solve_contact_velocities(free_run.bodies, free_run.manifolds, free_run.approach,
                                           free_run.settings, &free_work);
   const auto b = solve_contact_velocities(budgeted.bodies, budgeted.manifolds, budgeted.approach,
                                           budgeted.settings, &budget_work);
-  EXPECT_GT(free_work.sweeps, 5L * free_work.solves);
-  EXPECT_LE(budget_work.sweeps, 5L * budget_work.solves);
+  EXPECT_GT(free_work.iterations, 5L * free_work.solves);
+  EXPECT_LE(budget_work.iterations, 5L * budget_work.solves);
   EXPECT_GT(breach(budgeted.bodies, budgeted.manifolds, b, 0.5),
             10 * breach(free_run.bodies, free_run.manifolds, a, 0.5) + 1e-12);
 }
@@ -368,7 +368,7 @@ TEST(ContactSolver, ProjectionsAloneTakeASteadyDriftAtOnce) {
   // rest (targets 0). Projected Gauss-Seidel alone reaches velocities that repeat every sweep
   // while the impulses move along the face's null space by the same amount each time, until a
   // corner's impulse reaches zero. Checked: that drift is taken at once (without it the normal
-  // stage ran its 10,000 sweeps, the cap, and more rounds after: 10x the toss run's time at
+  // stage ran its 10,000 iterations, the cap, and more rounds after: 10x the toss run's time at
   // mu = 0.18), and the answer still meets every contact condition to 1e-12 (round-off at
   // 0.1 m/s).
   std::vector<RigidBody> bodies = {
@@ -399,7 +399,7 @@ TEST(ContactSolver, ProjectionsAloneTakeASteadyDriftAtOnce) {
   const auto solved = solve_contact_velocities(bodies, {pm}, approach, s, &work);
   EXPECT_LE(breach(bodies, {pm}, solved, 0.18), 1e-12);
   EXPECT_GE(work.drifts_taken, 1);
-  EXPECT_LT(work.sweeps, 1000);
+  EXPECT_LT(work.iterations, 1000);
 }
 
 }  // namespace
