@@ -533,7 +533,7 @@ TEST(ExploreLanding, ALandingResolvedAStepLateIsNamedByItsMeasuredOffset) {
 
 TEST(ExploreLanding, FrictionBeyondTheConeNamesBulletsTurnAfterALanding) {
   // Seed 4242, sample 60: a box that lands and slides on, which Bullet turns by 0.0145 rad: its
-  // solver keeps an earlier sweep's friction at a corner whose normal impulse fell to zero
+  // solver keeps an earlier iteration's friction at a corner whose normal impulse fell to zero
   // (docs/contact_laws.md). The turn that friction gives, measured on Bullet's own impulses,
   // names the miss; custom, on the same landing, meets the closed form.
   const LandingSample s = make_landing_sample(4242, 60);

@@ -342,10 +342,10 @@ TEST(ContactSolver, NudgedStacksOfFiveAreSettledByActiveSets) {
   }
 }
 
-TEST(ContactSolver, ASweepBudgetStopsTheProjectionsShort) {
-  // The stack of five on the projections alone: unbudgeted they sweep to convergence; with a
-  // budget of 5 iterations per island solve (the iteration budget other engines expose, swept by
-  // the report) no solve takes more, and the answer breaks the contact conditions by more.
+TEST(ContactSolver, AnIterationBudgetStopsTheProjectionsShort) {
+  // The stack of five on the projections alone: unbudgeted they iterate to convergence; with a
+  // budget of 5 iterations per island solve (the iteration budget other engines expose, studied
+  // by the report) no solve takes more, and the answer breaks the contact conditions by more.
   StackOfFive free_run = stack_of_five(0.5), budgeted = free_run;
   free_run.settings.active_set_rows = 0;
   budgeted.settings.active_set_rows = 0;
@@ -365,7 +365,7 @@ TEST(ContactSolver, ProjectionsAloneTakeASteadyDriftAtOnce) {
   // One step of a measured cube toss (ContactNets cube, 10.48 cm, 0.37 kg, at e = 0.125,
   // mu = 0.18, 1,480 steps per second), the state as the toss run met it: the cube rocks onto
   // a face, two corners approaching at 0.084 m/s (Newton's targets, 0.0105 m/s) and two at
-  // rest (targets 0). Projected Gauss-Seidel alone reaches velocities that repeat every sweep
+  // rest (targets 0). Projected Gauss-Seidel alone reaches velocities that repeat every iteration
   // while the impulses move along the face's null space by the same amount each time, until a
   // corner's impulse reaches zero. Checked: that drift is taken at once (without it the normal
   // stage ran its 10,000 iterations, the cap, and more rounds after: 10x the toss run's time at
