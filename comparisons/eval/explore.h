@@ -318,7 +318,8 @@ constexpr double kSlideRestTimeMark = 3e-3;  // s
 /// left it (lift_off), which the closed form's box never does. A tenth of the position mark, as
 /// the rest drift is: above any rise from round-off or a stiff contact's give (the boxes of
 /// Bullet, ODE and DART rise at most 3.4e-6 m on seed 8086 x 1,000), below the few tenths of a
-/// millimetre a short flight takes, which shifts a rest by the 3 ms of its mark.
+/// millimetre a short flight takes. A lower flight can still move a short slide's rest past its
+/// mark; hop_accounts_for_rest names that one from the box's own normal momentum.
 constexpr double kSlideLiftMark = 1e-4;  // m
 
 /// One random slide: its design (drawn) and the closed form (derived by realize_slide).
@@ -373,11 +374,22 @@ double measured_rest_time(const std::vector<StateSample>& samples, const Vec3& n
 double largest_rise(const std::vector<StateSample>& samples, const Vec3& start, const Vec3& rest,
                     const Vec3& normal);
 
+/// Whether a slide's time to rest (`rest`, measured) is off the closed form's (`closed_form`)
+/// by what the box's normal momentum just before it stopped accounts for, to within
+/// kSlideRestTimeMark, in a run whose box rose off its surface (`rise` above a tenth of
+/// kSlideLiftMark, where largest_rise stops reading it as on the surface). Up to a time t the
+/// normal impulse is m g_n t + m v_n(t), so with Coulomb's friction at mu N while it slides the
+/// box's speed along the surface is v - a t - mu v_n(t): a box still coming down from a hop at
+/// its last sliding sample stops later than v / a by mu |v_n| / a, one moving off its surface
+/// earlier.
+bool hop_accounts_for_rest(const std::vector<StateSample>& samples, const Vec3& normal, double rest,
+                           double closed_form, double friction, double deceleration, double rise);
+
 /// Runs the sample's scene through each named dynamics backend against its closed form:
 /// status error, then a turn above kLandingTurnMark, then a position along the surface above
 /// kLandingPositionMark, then a time to rest above kSlideRestTimeMark; any of these named
 /// deep_contact (name_deep_contact), else lift_off where the box rose off its surface by more
-/// than kSlideLiftMark on the way.
+/// than kSlideLiftMark on the way, or where hop_accounts_for_rest explains a rest_time miss.
 SampleOutcome evaluate_slide_sample(const SlideSample& s, const std::vector<std::string>& names,
                                     const std::vector<Backend>* table = nullptr,
                                     const ResultCache* cache = nullptr);

@@ -216,7 +216,7 @@ TEST(ExploreSlide, TheBoxStartsAMicrometreIntoItsSurfaceEveryCornerOfItsBaseIn) 
 TEST(ExploreSlide, FrictionBeyondTheConeNamesBulletsTurn) {
   // Seed 8086, sample 416: a box sliding on a floor that Bullet turns by 0.011 rad. Its solver
   // bounds a point's friction by mu times its normal impulse only while that impulse is
-  // positive, so a corner whose normal impulse fell to zero keeps an earlier sweep's friction
+  // positive, so a corner whose normal impulse fell to zero keeps an earlier iteration's friction
   // (docs/contact_laws.md). The run's own impulses measure the turn that friction gives, and
   // name the miss; the written scene shows it again. Custom leaves no friction at a point
   // without load.
@@ -267,6 +267,61 @@ TEST(ExploreSlide, ABoxThatRoseOffItsSurfaceNamesTheDisagreement) {
   EXPECT_TRUE(harness_reproduces(s.text, "slide.toml", o.backends[0], &detail)) << detail;
   EXPECT_EQ(o.backends[1].error, "");
   EXPECT_LT(o.backends[1].rise_m, 1e-9);  // round-off on the incline's pose
+}
+
+TEST(ExploreSlide, AHopAccountsForALateRestByTheNormalMomentumBeforeTheStop) {
+  // A slide up a 20 deg incline, mu = 1 (a = g (cos + sin) = 12.57 m/s^2), whose closed-form rest
+  // is at 5 ms; the run rests at 9 ms, 4 ms late, its box coming down at 0.036 m/s at its last
+  // sliding sample (8 ms): mu |v_n| / a = 2.86 ms of it, leaving 1.14 ms, within the 3 ms mark.
+  const double theta = 20.0 * M_PI / 180.0, mu = 1.0;
+  const double a = 9.81 * (std::cos(theta) + std::sin(theta));
+  const Vec3 n(std::sin(theta), 0.0, std::cos(theta));
+  std::vector<StateSample> run(12);
+  for (int k = 0; k < 12; ++k) {
+    run[k].time = 1e-3 * k;
+    run[k].bodies.resize(1);
+  }
+  run[8].bodies[0].velocity = -0.036 * n;
+  // The landing that stopped it: no normal motion left at the rest, which the account does not
+  // read.
+  run[9].bodies[0].velocity = Vec3(0.0, 0.0, 0.0);
+  const double rise = 6e-5;  // the hop: more than a tenth of the lift mark, less than the mark
+  EXPECT_TRUE(hop_accounts_for_rest(run, n, 9e-3, 5e-3, mu, a, rise));
+  // Moving off the surface, or along it, the momentum takes nothing from the lateness (or makes
+  // it earlier).
+  run[8].bodies[0].velocity = 0.036 * n;
+  EXPECT_FALSE(hop_accounts_for_rest(run, n, 9e-3, 5e-3, mu, a, rise));
+  run[8].bodies[0].velocity = Vec3(0.0, 0.0, 0.0);
+  EXPECT_FALSE(hop_accounts_for_rest(run, n, 9e-3, 5e-3, mu, a, rise));
+  // Coming down faster: 0.09 m/s accounts for 7.2 ms, 3.2 ms more than the 4 ms seen, past the
+  // mark the other way; 0.08 m/s for 6.4 ms, 2.4 ms more, within it.
+  run[8].bodies[0].velocity = -0.09 * n;
+  EXPECT_FALSE(hop_accounts_for_rest(run, n, 9e-3, 5e-3, mu, a, rise));
+  run[8].bodies[0].velocity = -0.08 * n;
+  EXPECT_TRUE(hop_accounts_for_rest(run, n, 9e-3, 5e-3, mu, a, rise));
+  // A box that never left its surface (a soft contact's sinking, not a hop) is not named so, nor
+  // one that rests at its first sample.
+  run[8].bodies[0].velocity = -0.036 * n;
+  EXPECT_FALSE(hop_accounts_for_rest(run, n, 9e-3, 5e-3, mu, a, 0.5e-5));
+  EXPECT_FALSE(hop_accounts_for_rest(run, n, 0.0, 5e-3, mu, a, rise));
+}
+
+TEST(ExploreSlide, ASmallHopThatDelaysTheRestNamesTheDisagreement) {
+  // Seed 31337, sample 660: a box launched up a 20 deg incline at 0.07 m/s, mu = 1. MuJoCo's box
+  // leaves the surface at its first step at mu times its slip, rises 59 micrometres (under the
+  // lift mark), flies without friction and rests 3.3 ms late; at its last sliding sample it comes
+  // down at 0.036 m/s, which accounts for 2.8 ms of it, so the rest_time miss is named lift_off,
+  // and the written scene's own run shows it again. custom's box stays on the surface and rests
+  // on time.
+  const SlideSample s = make_slide_sample(31337, 660);
+  const SampleOutcome o = evaluate_slide_sample(s, {"mujoco", "custom"});
+  ASSERT_EQ(o.backends.size(), 2u);
+  EXPECT_EQ(o.backends[0].error, "lift_off");
+  EXPECT_LT(o.backends[0].rise_m, kSlideLiftMark);
+  EXPECT_GT(o.backends[0].rest_time_err_s, kSlideRestTimeMark);
+  std::string detail;
+  EXPECT_TRUE(harness_reproduces(s.text, "slide.toml", o.backends[0], &detail)) << detail;
+  EXPECT_EQ(o.backends[1].error, "");
 }
 
 TEST(ExploreSlide, ARestTimeDisagreementIsReproducedFromTheWrittenScene) {
@@ -370,9 +425,9 @@ TEST(ExploreSlide, BulletWarmStartingMeasuredOnSlidesLandingsAndImpacts) {
   // Bullet's warm starting (reference/bullet.h), measured at rbx's 0 and Bullet's own 0.85 on
   // the three random families it can move, on a seed not used while choosing it: slides and
   // landings (friction carried from step to step) and single-point impacts (an impulse carried
-  // into the step after the bounce). Started from 0.85 of the last step's friction, a sweep
-  // whose corner loads shift keeps friction the step no longer has: landings and slides stop
-  // off the closed form; an impact, whose contact is gone the step after, is the same either
+  // into the step after the bounce). Started from 0.85 of the last step's friction, an
+  // iteration whose corner loads shift keeps friction the step no longer has: landings and slides
+  // stop off the closed form; an impact, whose contact is gone the step after, is the same either
   // way. 0 stays.
   const std::vector<Backend> table = {
       bullet_with("warm 0", [](BulletSettings& s) { s.warmstarting_factor = 0.0; }),
