@@ -37,7 +37,6 @@ struct SimSettings {
   double restitution = 1.0;     // e in [0, 1]
   double friction = 0.0;        // Coulomb mu >= 0 (the seed omits friction)
   Integrator integrator = Integrator::Symplectic;
-  std::vector<double> sweep_dt;   // s, time steps for error against run time
   double max_energy_ratio = 1e3;  // guard: stop when E > ratio * max(E0, tiny)
 
   /// Number of steps to cover `duration`: step_count(duration, dt) (throws std::domain_error when

@@ -223,11 +223,11 @@ struct DynamicsOptions {
   int budget = 0;         // the solver's iteration budget (Backend::budget); 0: as configured
 };
 
-/// A dynamics backend's solver iteration budget, swept by the harness at the scene's step (the
+/// A dynamics backend's solver iteration budget, studied by the harness at the scene's step (the
 /// other axis of error against run time, beside the step). Empty `values`: no budget to turn.
 struct SolverBudget {
   std::string what;         // what is counted, in the library's own terms
-  std::vector<int> values;  // swept, ascending, the library's default among them
+  std::vector<int> values;  // studied, ascending, the library's default among them
   int library_default = 0;  // the library's own default (0: it solves to convergence)
   int configured = 0;       // what the backend runs with (0: not an iteration count)
 };

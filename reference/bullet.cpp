@@ -683,7 +683,7 @@ DynamicsResult dynamics_run(const WorldDefinition& scene, const DynamicsOptions&
 
 MassResult bullet_hull_mass(const RigidBody& body);
 
-// The budget swept along: Bullet's sequential-impulse iterations (library default 10; the fair
+// The budget studied: Bullet's sequential-impulse iterations (library default 10; the fair
 // world's 100, make_solver_fair).
 SolverBudget bullet_budget() {
   return {"m_numIterations (sequential-impulse iterations)", {1, 3, 10, 30, 100}, 10, 100};

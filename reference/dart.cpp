@@ -393,7 +393,7 @@ DynamicsResult dart_dynamics_with(const WorldDefinition& scene, const DynamicsOp
     auto world = dart::simulation::World::create();
     world->setGravity(scene.sim.gravity);
     world->setTimeStep(dt);
-    // A swept budget (dart_budget) runs PGS with that many iterations.
+    // A studied budget (dart_budget) runs PGS with that many iterations.
     namespace cs = dart::constraint;
     if (opt.budget > 0 || !settings.dantzig) {
       auto pgs = std::make_shared<cs::PgsBoxedLcpSolver>();
@@ -513,8 +513,8 @@ DynamicsResult dart_hull_dynamics(const WorldDefinition& scene, const DynamicsOp
   return dart_dynamics_with(scene, opt, dart_hull_settings());
 }
 
-// The budget swept along: PGS iterations of the boxed LCP (DART's PGS default: 30). rbx runs
-// Dantzig (a pivoting solve: no iteration count), so the sweep shows what PGS gives up.
+// The budget studied: PGS iterations of the boxed LCP (DART's PGS default: 30). rbx runs
+// Dantzig (a pivoting solve: no iteration count), so the study shows what PGS gives up.
 SolverBudget dart_budget() {
   return {"PgsBoxedLcpSolver iterations (configured: Dantzig, exact)", {5, 10, 30, 100}, 30, 0};
 }

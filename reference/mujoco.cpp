@@ -667,7 +667,7 @@ DynamicsResult mujoco_dynamics_with(const WorldDefinition& scene, const Dynamics
     r.message = error;
     return r;
   }
-  if (opt.budget > 0) m->opt.iterations = opt.budget;  // the swept budget (mujoco_budget)
+  if (opt.budget > 0) m->opt.iterations = opt.budget;  // the studied budget (mujoco_budget)
   const mjModel* mc = m.get();
   mjData* dd = d.get();
   set_state(mc, dd, bodies);
@@ -771,7 +771,7 @@ const AtSettings<MujocoSettings>& mujoco_at_settings() {
   return entries;
 }
 
-// The budget swept along: the constraint solver's iterations (Newton, MuJoCo's default solver;
+// The budget studied: the constraint solver's iterations (Newton, MuJoCo's default solver;
 // it stops earlier at its tolerance, 1e-8), library default 100, which rbx keeps.
 SolverBudget mujoco_budget() {
   return {"opt.iterations (Newton solver)", {1, 3, 10, 100}, 100, 100};

@@ -544,7 +544,7 @@ DynamicsResult ode_dynamics_with(const WorldDefinition& scene, const DynamicsOpt
 
   WorldOwner w;
   create_world(w, scene, settings);
-  // A swept budget (ode_budget) steps with the iterative quick step; otherwise the exact step.
+  // A studied budget (ode_budget) steps with the iterative quick step; otherwise the exact step.
   const int budget = opt.budget;
   if (budget > 0) dWorldSetQuickStepNumIterations(w.world, budget);
   // The quick step shuffles its constraints with ODE's one random generator, shared by the whole
@@ -659,9 +659,9 @@ const AtSettings<OdeSettings>& ode_at_settings() {
   return entries;
 }
 
-// The budget swept along: the iterations of ODE's quick step (dWorldQuickStep, successive
+// The budget studied: the iterations of ODE's quick step (dWorldQuickStep, successive
 // over-relaxation; library default 20). rbx runs the exact step (dWorldStep, a pivoting LCP
-// solve: no iteration count), so the sweep shows what the quick step costs and gives up.
+// solve: no iteration count), so the study shows what the quick step costs and gives up.
 SolverBudget ode_budget() {
   return {
       "dWorldQuickStep iterations (configured: dWorldStep, exact)", {5, 10, 20, 50, 100}, 20, 0};

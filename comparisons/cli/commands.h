@@ -161,7 +161,7 @@ struct ViewOptions {
   std::string out;       // --out FILE ("" : FAMILY_STEM.html in the current folder)
 };
 
-/// `rbx view SCENE`: evaluates the scene (no time-step sweep) and writes its replay page.
+/// `rbx view SCENE`: evaluates the scene (no dt study) and writes its replay page.
 int view_command(const ViewOptions& opt);
 
 }  // namespace rbx

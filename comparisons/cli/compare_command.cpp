@@ -48,7 +48,7 @@ int compare_command(const SceneCommandOptions& opt) {
   std::ostream& out = opt.json == "-" ? std::cerr : std::cout;
   HarnessOptions hopt;
   hopt.backends = opt.backends;
-  hopt.sweep = false;
+  hopt.studies = false;
   Json result;
   result["scenes"] = Json::array();
   int failed = 0;

@@ -17,7 +17,7 @@ int view_command(const ViewOptions& opt) {
   const Scene scene = load_scene_for_command(opt.scene, so);
   HarnessOptions hopt;
   hopt.backends = opt.backends;
-  hopt.sweep = false;
+  hopt.studies = false;
   const SceneEvaluation ev = evaluate_scene(scene, hopt);
   std::ifstream in(three_js_path(), std::ios::binary);
   std::ostringstream js;

@@ -11,12 +11,12 @@
 
 namespace rbx {
 
-std::vector<SweepPoint> budget_points(
+std::vector<ErrorRuntimePoint> budget_points(
     const Backend& be, const Scene& scene, const DynRun& main, const ResultCache& cache,
     const std::vector<RigidBody>& bodies,
     const std::function<double(const std::vector<BodyFinal>&)>& error_of,
     const std::string& against, std::vector<std::string>* skipped) {
-  std::vector<SweepPoint> points;
+  std::vector<ErrorRuntimePoint> points;
   for (int budget : be.budget.values) {
     std::optional<DynRun> other;
     if (budget != be.budget.configured)
@@ -59,7 +59,7 @@ std::vector<BudgetRow> budget_rows(const std::vector<SceneEvaluation>& evs) {
   for (const SceneEvaluation& ev : evs) {
     std::map<std::string, std::vector<std::pair<int, double>>> per_backend;
     std::vector<std::string> met;
-    for (const SweepPoint& p : ev.sweep) {
+    for (const ErrorRuntimePoint& p : ev.error_vs_runtime) {
       if (p.kind != "budget") continue;
       if (!per_backend.count(p.backend)) met.push_back(p.backend);
       per_backend[p.backend].emplace_back(p.budget, p.error);
@@ -76,7 +76,7 @@ std::vector<BudgetRow> budget_rows(const std::vector<SceneEvaluation>& evs) {
         if (be && budget == be->budget.library_default) a.at_default.push_back(error);
     }
   }
-  // Budgets: the lower middle of an even count (a budget that was swept); errors: the median.
+  // Budgets: the lower middle of an even count (a budget of the study); errors: the median.
   const auto lower_middle = [](std::vector<int> v) {
     std::sort(v.begin(), v.end());
     return v[(v.size() - 1) / 2];

@@ -86,7 +86,7 @@ void Evaluator::contact_pair(const RigidBody& a, const RigidBody& b, bool first_
       touching_answer(name, pair, run.result, truth, std::max(tol, 1e-6 * size),
                       ex && ex->touching ? stated : "exact", depth_src);
       // Timed like any answer; no normal to score: its error is the depth it is scored at.
-      out_.sweep.push_back(
+      out_.error_vs_runtime.push_back(
           {name, "contact-touching", 0.0, run.timing, true_touch ? true_depth : 0.0, depth_src});
       continue;
     }
@@ -119,7 +119,7 @@ void Evaluator::contact_pair(const RigidBody& a, const RigidBody& b, bool first_
     metric("contact", name, pair, "normal_err_deg", angle, normal_src);
     metric("contact", name, pair, "depth_err", derr, depth_src);
     if (sat.touching && !sat.manifold.empty()) point_metrics(name, pair, run.result, *c, sat, a, b);
-    out_.sweep.push_back({name, "contact", 0.0, run.timing, angle, normal_src});
+    out_.error_vs_runtime.push_back({name, "contact", 0.0, run.timing, angle, normal_src});
     // The same query with the library's shapes built once (its "prebuilt" variant): the
     // figures time both, so that the cost of building a shape shows apart from the query.
     if (const std::optional<ContactRun>& pr = runs.prebuilt[i]) {
@@ -128,7 +128,8 @@ void Evaluator::contact_pair(const RigidBody& a, const RigidBody& b, bool first_
         out_.disagreements.push_back(name + " on " + pair +
                                      ": the prebuilt variant answers differently");
       else
-        out_.sweep.push_back({name, "contact-prebuilt", 0.0, pr->timing, angle, normal_src});
+        out_.error_vs_runtime.push_back(
+            {name, "contact-prebuilt", 0.0, pr->timing, angle, normal_src});
     }
     // Disagreement marks: beyond round-off-level tolerance of the truth (1e-6 rad ~ 6e-5 deg;
     // depth within the scene's tolerance or 1e-6 of the body size).

@@ -82,9 +82,9 @@ Evaluator::DynamicsFrame Evaluator::dynamics_frame() {
         "contact phases: gravity or a spinning body (the closed form depends on the phase)");
 
   fr.sample_every = std::max<long>(1, scene_.sim.steps() / 400);
-  fr.wants_sweep = opt_.sweep && (scene_.has_check(CheckKind::Impulse) ||
-                                  scene_.has_check(CheckKind::Trajectory));
-  fr.dts = sweep_steps(scene_);
+  fr.wants_studies = opt_.studies && (scene_.has_check(CheckKind::Impulse) ||
+                                      scene_.has_check(CheckKind::Trajectory));
+  fr.dts = dt_study_steps(scene_);
   fr.finest = fr.dts.back();
   return fr;
 }
@@ -104,23 +104,23 @@ void Evaluator::backend_dynamics(const std::string& name, const DynRun& main,
     stopped_run(name, main, fr);
     return;
   }
-  const SweepRuns sw = sweep_runs(backend(name), main, fr);
+  const StudyRuns sw = study_runs(backend(name), main, fr);
   std::string against;
   const std::vector<std::optional<RefState>> ref = velocity_reference(name, main, sw, fr, against);
   contact_phases(name, main, fr, bj);
-  if (fr.wants_sweep && !against.empty()) {
+  if (fr.wants_studies && !against.empty()) {
     const auto error_of = [&](const std::vector<BodyFinal>& finals) {
       return ke_norm_error(inputs_, finals, ref, fr.e0_kin);
     };
     for (const DynRun& r : sw.runs) {
       if (r.result.status != Status::Ok) continue;
       if (!fr.have_expect && &r == &sw.runs.back()) continue;  // zero by construction
-      out_.sweep.push_back(
+      out_.error_vs_runtime.push_back(
           {name, "dynamics", r.dt, Timing::once(r.runtime_s), error_of(r.result.finals), against});
     }
-    const std::vector<SweepPoint> budgets = budget_points(
+    const std::vector<ErrorRuntimePoint> budgets = budget_points(
         backend(name), scene_, main, cache_, inputs_, error_of, against, &out_.skipped);
-    out_.sweep.insert(out_.sweep.end(), budgets.begin(), budgets.end());
+    out_.error_vs_runtime.insert(out_.error_vs_runtime.end(), budgets.begin(), budgets.end());
   }
   trajectory_divergence(name, main, sw, fr);
   // Contact time: first event against the finest-step run of the same backend.
@@ -141,10 +141,11 @@ void Evaluator::backend_dynamics(const std::string& name, const DynRun& main,
         name, main.result.finals,
         fr.have_expect ? ke_norm_error(inputs_, main.result.finals, fr.expected, fr.e0_kin) : 0.0);
   if (scene_.has_check(CheckKind::Stability)) stability(name, main, fr);
-  // The verdict at every other swept step (report rows; not metrics of the check).
-  if (sw.stability_sweep)
+  // The verdict at every other step of the dt study (report rows; not metrics of the check).
+  if (sw.stability_dt_study)
     for (const DynRun& r : sw.runs)
-      if (std::abs(r.dt - scene_.sim.dt) > 1e-15 * r.dt) stability(name, r, fr, /*swept=*/true);
+      if (std::abs(r.dt - scene_.sim.dt) > 1e-15 * r.dt)
+        stability(name, r, fr, /*study_step=*/true);
 }
 
 void Evaluator::stopped_run(const std::string& name, const DynRun& main, const DynamicsFrame& fr) {

@@ -1,7 +1,7 @@
 // The harness's evaluation of one scene (evaluate_scene, comparisons/eval/harness.h), one class
 // whose checks live each in its own file: harness.cpp (the run and the JSON around it),
 // contact_check.cpp, dynamics_check.cpp (the main runs and what is measured on them),
-// sweep_check.cpp (the time-step study, contact phases, trajectories), stability_check.cpp and
+// dt_study_check.cpp (the time-step study, contact phases, trajectories), stability_check.cpp and
 // mass_check.cpp. Internal to eval/.
 #pragma once
 
@@ -143,17 +143,17 @@ class Evaluator {
     bool have_expect = false;
     bool phases = false;  // the contact-phase runs apply
     long sample_every = 1;
-    bool wants_sweep = false;
-    std::vector<double> dts;  // the sweep's steps, finest last
+    bool wants_studies = false;
+    std::vector<double> dts;  // the dt study's steps, finest last
     double finest = 0.0;
   };
 
-  // The swept runs of one backend; `fine` is the finest step's when it ran.
-  struct SweepRuns {
+  // The dt study's runs of one backend; `fine` is the finest step's when it ran.
+  struct StudyRuns {
     std::optional<DynRun> fine;
     std::vector<DynRun> runs;
-    bool wants_velocity = false;   // the impulse or trajectory check asks for velocity errors
-    bool stability_sweep = false;  // a stability verdict at every step of the scene's own sweep
+    bool wants_velocity = false;      // the impulse or trajectory check asks for velocity errors
+    bool stability_dt_study = false;  // a verdict at every step of its own dt study
   };
 
   void dynamics_checks();
@@ -161,7 +161,7 @@ class Evaluator {
   DynamicsFrame dynamics_frame();
 
   // Every metric of one backend's dynamics, in a fixed order: velocity against the closed form
-  // or its finest step, the contact phases, the sweep, trajectory divergence, contact time,
+  // or its finest step, the contact phases, the dt study, trajectory divergence, contact time,
   // conservation, [expect], stability.
   void backend_dynamics(const std::string& name, const DynRun& main, const DynamicsFrame& fr);
 
@@ -169,14 +169,14 @@ class Evaluator {
   // under test (no final state to compare is not a pass).
   void stopped_run(const std::string& name, const DynRun& main, const DynamicsFrame& fr);
 
-  // The backend at every step of the sweep (or only the finest, the self-consistency
-  // reference, when no sweep is asked for).
-  SweepRuns sweep_runs(const Backend& be, const DynRun& main, const DynamicsFrame& fr);
+  // The backend at every step of the dt study (or only the finest, the self-consistency
+  // reference, when no study is asked for).
+  StudyRuns study_runs(const Backend& be, const DynRun& main, const DynamicsFrame& fr);
 
   // The final velocities the main run is measured against ([expect], else the finest step's
   // run; `against` names it, "" : none) and the velocity error metric against them.
   std::vector<std::optional<RefState>> velocity_reference(const std::string& name,
-                                                          const DynRun& main, const SweepRuns& sw,
+                                                          const DynRun& main, const StudyRuns& sw,
                                                           const DynamicsFrame& fr,
                                                           std::string& against);
 
@@ -188,7 +188,7 @@ class Evaluator {
   // State divergence over time: how far any point of a body is from where the finest-step run
   // puts it at the same sample time, |dx| + (size / 2) * rotation angle (an upper bound),
   // relative to the body's size.
-  void trajectory_divergence(const std::string& name, const DynRun& main, const SweepRuns& sw,
+  void trajectory_divergence(const std::string& name, const DynRun& main, const StudyRuns& sw,
                              const DynamicsFrame& fr);
 
   // Conservation: momentum (where it is an invariant), energy against what e allows.
@@ -210,10 +210,10 @@ class Evaluator {
 
   // Stability on stiff and extreme scenes: non-finite states, energy drift, momentum drift,
   // maximum penetration (whole run and at rest), tunnelling, jitter at rest, and a verdict.
-  // `swept`: a run at another step of the scene's sweep: its verdict goes to the JSON's
-  // `stability_sweep` (and the report's table), not to the metrics.
+  // `study_step`: a run at another step of the scene's dt study: its verdict goes to the JSON's
+  // `stability_dt_study` (and the report's table), not to the metrics.
   void stability(const std::string& name, const DynRun& run, const DynamicsFrame& fr,
-                 bool swept = false);
+                 bool study_step = false);
 
   // The deepest exact overlap of every finite sample; a cached reference run's overlaps are
   // cached with it (they cost more than the run).
@@ -235,7 +235,7 @@ class Evaluator {
   SceneEvaluation out_;
   Json backends_json_;
   Json stability_json_;
-  Json stability_sweep_json_;  // per backend: the verdicts at the other swept steps
+  Json stability_dt_study_json_;  // per backend: the verdicts at the dt study's other steps
 };
 
 }  // namespace rbx::eval_detail

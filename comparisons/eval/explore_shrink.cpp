@@ -220,7 +220,7 @@ bool harness_reproduces(const std::string& scene_text, const std::string& path,
   const Scene scene = parse_scene(scene_text, path);
   HarnessOptions hopt;
   hopt.backends = b.backend;
-  hopt.sweep = false;
+  hopt.studies = false;
   hopt.timing_budget_s = 0.0;  // one query each: no timing repeats
   const SceneEvaluation ev = evaluate_scene(scene, hopt);
   const std::vector<RigidBody> bodies = make_bodies(scene);

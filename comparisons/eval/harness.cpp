@@ -40,17 +40,17 @@ SceneEvaluation Evaluator::run() {
     causes.push_back(
         {{"backend", c.backend}, {"check", c.check}, {"kind", c.kind}, {"detail", c.detail}});
   j["causes"] = causes;
-  Json sweep = Json::array();
-  for (const SweepPoint& s : out_.sweep) {
+  Json points = Json::array();
+  for (const ErrorRuntimePoint& s : out_.error_vs_runtime) {
     Json point = {{"backend", s.backend}, {"kind", s.kind}, {"dt", s.dt}, {"error", s.error}};
     point["against"] = s.against;
     put_timing(s.timing, point);
     if (s.kind == "budget") point["budget"] = s.budget;
-    sweep.push_back(std::move(point));
+    points.push_back(std::move(point));
   }
-  j["sweep"] = sweep;
+  j["error_vs_runtime"] = points;
   j["stability"] = stability_json_.is_null() ? Json::object() : stability_json_;
-  if (!stability_sweep_json_.is_null()) j["stability_sweep"] = stability_sweep_json_;
+  if (!stability_dt_study_json_.is_null()) j["stability_dt_study"] = stability_dt_study_json_;
   j["skipped"] = out_.skipped;
   // A documented limitation excuses the engine it names only ("ENGINE: why"): any other
   // engine's or the oracle's failure (a wrong derivation) still fails the scene.
@@ -128,10 +128,10 @@ double number_at(const Json& s, const char* key) {
   return v.is_null() ? std::numeric_limits<double>::quiet_NaN() : v.get<double>();
 }
 
-StabilityRow stability_row(const std::string& backend, bool swept, const Json& s) {
+StabilityRow stability_row(const std::string& backend, bool study_step, const Json& s) {
   StabilityRow r;
   r.backend = backend;
-  r.swept = swept;
+  r.study_step = study_step;
   r.status = s.at("status");
   r.dt = number_at(s, "dt");
   r.restitution = number_at(s, "restitution");
@@ -165,8 +165,8 @@ void read_runs(SceneEvaluation& ev) {
   if (ev.json.contains("stability"))
     for (const auto& [name, s] : ev.json["stability"].items()) {
       ev.stability.push_back(stability_row(name, false, s));
-      if (ev.json.contains("stability_sweep") && ev.json["stability_sweep"].contains(name))
-        for (const Json& sw : ev.json["stability_sweep"][name])
+      if (ev.json.contains("stability_dt_study") && ev.json["stability_dt_study"].contains(name))
+        for (const Json& sw : ev.json["stability_dt_study"][name])
           ev.stability.push_back(stability_row(name, true, sw));
     }
   if (ev.json.contains("expect")) ev.known_failure = ev.json["expect"].value("known_failure", "");

@@ -20,7 +20,7 @@ namespace rbx {
 /// Harness settings.
 struct HarnessOptions {
   std::string backends;           // --backends LIST ("" : the scene's, or all that serve a check)
-  bool sweep = true;              // run the time-step sweep for error against run time
+  bool studies = true;            // run the dt and budget studies for error against run time
   double timing_budget_s = 0.01;  // per contact query and per main dynamics run, each backend:
                                   // timed at least this long (timing.h); 0: the answers only
   /// Backends to choose from; nullptr: the registry (reference/registry.cpp). Tests pass their
@@ -59,7 +59,7 @@ struct Metric {
 };
 
 /// One point of error against run time.
-struct SweepPoint {
+struct ErrorRuntimePoint {
   std::string backend;
   std::string kind;    // "dynamics" (a time step), "budget" (a solver budget at the scene's
                        // step), "contact" or "contact-prebuilt" (a query)
@@ -73,12 +73,12 @@ struct SweepPoint {
 struct EnsembleResult;  // comparisons/eval/ensemble.h
 
 /// One stability run of a backend: at the scene's step, or at another step of the scene's
-/// stability sweep. The scene's JSON holds it as "stability" (the scene's step) and
-/// "stability_sweep" (stability_json and read_runs convert).
+/// dt study. The scene's JSON holds it as "stability" (the scene's step) and
+/// "stability_dt_study" (stability_json and read_runs convert).
 struct StabilityRow {
   std::string backend;
-  bool swept = false;  // a step of the stability sweep, not the scene's own
-  std::string status;  // the run's status
+  bool study_step = false;  // a step of the scene's dt study, not the scene's own
+  std::string status;       // the run's status
   double dt = 0.0, restitution = 0.0;
   bool nonfinite = false;
   double energy_growth_rel = 0.0, energy_drift_rel = 0.0, energy_change_rel = 0.0;
@@ -122,7 +122,7 @@ struct SceneEvaluation {
   std::string family;  // folder under scenes/, or "scenes"
   Json json;           // the contract's per-scene object, metrics included
   std::vector<Metric> metrics;
-  std::vector<SweepPoint> sweep;
+  std::vector<ErrorRuntimePoint> error_vs_runtime;
   std::vector<std::string> skipped;          // what was left out, and why
   std::vector<std::string> expect_failures;  // violated [expect] entries, "SUBJECT: what"
                                              // (custom: the engine; exact: the oracle)
@@ -135,7 +135,7 @@ struct SceneEvaluation {
   std::vector<std::string> deviations;     // beyond the scene's tolerance, yet close
   std::vector<Cause> causes;               // why each impact miss happened, measured
   std::vector<BackendRun> runs;            // every backend that ran, by name (read_runs)
-  // Every stability run, by backend: the scene's step, then its sweep's (read_runs).
+  // Every stability run, by backend: the scene's step, then its dt study's (read_runs).
   std::vector<StabilityRow> stability;
   std::string known_failure;  // the scene's [expect] known_failure ("ENGINE: why"), "" if none
   bool has_geometry = false;  // the contact check drew the pair's geometry (its figure exists)

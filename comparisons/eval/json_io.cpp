@@ -68,7 +68,7 @@ Json settings_json(const Scene& scene) {
   j["friction"] = s.friction;
   j["integrator"] = s.integrator == Integrator::Euler ? "euler" : "symplectic";
   j["max_energy_ratio"] = s.max_energy_ratio;
-  if (!s.sweep_dt.empty()) j["sweep_dt"] = s.sweep_dt;
+  if (!scene.dt_study.empty()) j["dt_study"] = scene.dt_study;
   return j;
 }
 

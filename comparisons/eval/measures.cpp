@@ -206,10 +206,10 @@ std::vector<double> parallel_map(size_t n, const std::function<double(size_t)>& 
   return out;
 }
 
-// Default time steps for the sweep: the scene's dt scaled by 4, 2, 1, 1/2, 1/4.
-std::vector<double> sweep_steps(const Scene& scene) {
-  if (!scene.sim.sweep_dt.empty()) {
-    std::vector<double> s = scene.sim.sweep_dt;
+// Default time steps for the dt study: the scene's dt scaled by 4, 2, 1, 1/2, 1/4.
+std::vector<double> dt_study_steps(const Scene& scene) {
+  if (!scene.dt_study.empty()) {
+    std::vector<double> s = scene.dt_study;
     std::sort(s.rbegin(), s.rend());
     return s;
   }

@@ -1,5 +1,5 @@
 // What the harness measures, as free functions of the bodies and the runs: contact queries and
-// dynamics runs (through the reference-result cache), energies and momenta, the sweep's steps
+// dynamics runs (through the reference-result cache), energies and momenta, the dt study's steps
 // and contact phases, and the stability check's trace (exact overlaps, tunnelling, drift).
 #pragma once
 
@@ -86,9 +86,9 @@ std::string fmt_dt(double dt);
 /// state (the exact oracle does not). A thrown exception is rethrown here.
 std::vector<double> parallel_map(size_t n, const std::function<double(size_t)>& f);
 
-/// Time steps of the sweep, coarsest first: the scene's sweep_dt, else its dt scaled by 4, 2,
+/// Time steps of the dt study, coarsest first: the scene's dt_study, else its dt scaled by 4, 2,
 /// 1, 1/2, 1/4.
-std::vector<double> sweep_steps(const Scene& scene);
+std::vector<double> dt_study_steps(const Scene& scene);
 
 /// Contact phases besides the scene as written (phase 0: first contact on a step boundary, as
 /// every analytic scene is written): first contact 1/3 and 2/3 of a step later.

@@ -247,13 +247,13 @@ bool CheckSettings::selected(const std::string& backend) const {
 }
 
 CheckRun measure_check(const std::vector<Scene>& scenes, const CheckSettings& set) {
-  // Every error metric of every scene (no sweep: accuracy at the scene's dt). Every scene runs
+  // Every error metric of every scene (no dt study: accuracy at the scene's dt). Every scene runs
   // its own backends even with --backends: which metrics a backend gets can depend on the
   // others' results (angular metrics where any backend's bodies rotate), so only a whole run
   // measures each metric as the baseline did. The references come from the cache.
   CheckRun run;
   HarnessOptions hopt;
-  hopt.sweep = false;
+  hopt.studies = false;
   hopt.timing_budget_s = 0.0;  // timings never fail the check: the answers only
   hopt.registry = set.registry;
   // A test's own table may name a broken copy like a library: it never reads or fills the cache.

@@ -16,11 +16,11 @@ std::string encode_evaluation(const SceneEvaluation& ev) {
   j["metrics"] = Json::array();
   for (const Metric& m : ev.metrics)
     j["metrics"].push_back({m.check, m.backend, m.pair, m.name, m.value, m.against});
-  j["sweep"] = Json::array();
-  for (const SweepPoint& p : ev.sweep)
-    j["sweep"].push_back({p.backend, p.kind, p.dt, p.error, p.against, p.budget, p.timing.median_s,
-                          p.timing.q25_s, p.timing.q75_s, p.timing.calls, p.timing.rounds,
-                          p.timing.cold_s});
+  j["error_vs_runtime"] = Json::array();
+  for (const ErrorRuntimePoint& p : ev.error_vs_runtime)
+    j["error_vs_runtime"].push_back({p.backend, p.kind, p.dt, p.error, p.against, p.budget,
+                                     p.timing.median_s, p.timing.q25_s, p.timing.q75_s,
+                                     p.timing.calls, p.timing.rounds, p.timing.cold_s});
   j["skipped"] = ev.skipped;
   j["expect_failures"] = ev.expect_failures;
   j["expect_checked"] = ev.expect_checked;
@@ -40,8 +40,8 @@ SceneEvaluation decode_evaluation(const std::string& text) {
   ev.family = j["family"];
   ev.json = j["json"];
   for (const Json& m : j["metrics"]) ev.metrics.push_back({m[0], m[1], m[2], m[3], m[4], m[5]});
-  for (const Json& p : j["sweep"])
-    ev.sweep.push_back(
+  for (const Json& p : j["error_vs_runtime"])
+    ev.error_vs_runtime.push_back(
         {p[0], p[1], p[2], Timing{p[6], p[7], p[8], p[9], p[10], p[11]}, p[3], p[4], p[5]});
   ev.skipped = j["skipped"].get<std::vector<std::string>>();
   ev.expect_failures = j["expect_failures"].get<std::vector<std::string>>();

@@ -4,7 +4,7 @@
 namespace rbx::eval_detail {
 
 void Evaluator::stability(const std::string& name, const DynRun& run, const DynamicsFrame& fr,
-                          bool swept) {
+                          bool study_step) {
   const StabilityGeometry geo = stability_geometry(inputs_);
   StabilityInvariants inv{fr.e0, fr.p0, fr.h0, fr.closed, fr.p_scale, fr.h_scale};
   const StabilityTrace tr =
@@ -12,7 +12,7 @@ void Evaluator::stability(const std::string& name, const DynRun& run, const Dyna
   const double jitter = rest_jitter(inputs_, run.result.samples, scene_.sim.gravity);
   StabilityRow row;
   row.backend = name;
-  row.swept = swept;
+  row.study_step = study_step;
   row.status = to_string(run.result.status);
   row.dt = run.dt;
   row.restitution = scene_.sim.restitution;
@@ -46,8 +46,8 @@ void Evaluator::stability(const std::string& name, const DynRun& run, const Dyna
   const StabilityVerdict verdict = stability_verdict(facts);
   row.verdict = verdict.verdict;
   row.why = verdict.why;
-  if (swept) {
-    stability_sweep_json_[name].push_back(stability_json(row));
+  if (study_step) {
+    stability_dt_study_json_[name].push_back(stability_json(row));
     return;
   }
   stability_json_[name] = stability_json(row);

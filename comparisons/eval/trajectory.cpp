@@ -177,7 +177,7 @@ void share_mass_properties(Json& scene) {
 Json results_scene_json(const Json& scene_result) {
   Json j = scene_result;
   j.erase("metrics");
-  j.erase("sweep");
+  j.erase("error_vs_runtime");
   if (!j.contains("backends")) return j;
   share_mass_properties(j);
   for (auto& [name, b] : j["backends"].items()) {

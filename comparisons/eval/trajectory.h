@@ -48,7 +48,8 @@ inline constexpr const char* kMassProperties[] = {"mass", "static", "center_of_m
 
 /// A scene's result object for results.json, the report's data, kept within its size budget
 /// without losing a number:
-/// - `metrics` and `sweep` are left out: metrics.csv and sweep.csv hold every one of them;
+/// - `metrics` and `error_vs_runtime` are left out: metrics.csv and error_vs_runtime.csv hold every
+/// one of them;
 /// - the scene's `bodies` holds each body's mass properties as most backends report them (ties:
 ///   the first backend's), and a backend's body entry keeps only the properties that differ
 ///   from them (its `final` state always);

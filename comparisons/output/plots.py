@@ -4,7 +4,7 @@ family (law_plots.py), the distance and time-of-impact queries' errors (query_pl
 per-scene velocity bars, a 3-D picture of each contact scene with every backend's contact point
 and normal, and each ensemble's final positions (ensemble_plots.py).
 
-Usage: plots.py REPORT_DIR [JOBS]  (reads results.json, sweep.csv, laws.csv and queries.json,
+Usage: plots.py REPORT_DIR [JOBS]  (reads results.json, error_vs_runtime.csv, laws.csv and queries.json,
 writes figures/*.png and *.svg; JOBS processes share the figures, default 1)
 """
 import csv
@@ -84,9 +84,9 @@ def error_vs_runtime(report, out):
     """One point per (backend, time step), and per (backend, solver budget) at the scene's step:
     the median over the family's closed-form scenes with the 25-75 % band; contacts: one point
     per backend for the normal and for the depth."""
-    rows = list(csv.DictReader(open(os.path.join(report, "sweep.csv"))))
+    rows = list(csv.DictReader(open(os.path.join(report, "error_vs_runtime.csv"))))
     metrics = list(csv.DictReader(open(os.path.join(report, "metrics.csv"))))
-    sweeps = defaultdict(list)  # (family, scene, backend) -> [(dt, runtime, error)]
+    studies = defaultdict(list)  # (family, scene, backend) -> [(dt, runtime, error)]
     budgets = defaultdict(list)  # (family, scene, backend) -> [(budget, runtime, error)]
     qtime = defaultdict(lambda: defaultdict(list))  # family, backend -> query times (s)
     ptime = defaultdict(lambda: defaultdict(list))  # the same with the shapes prebuilt
@@ -98,22 +98,22 @@ def error_vs_runtime(report, out):
                 continue
             point = (float(r["runtime_s"]), float(r["error"]))
             if r["kind"] == "dynamics":
-                sweeps[(r["family"], r["scene"], r["backend"])].append((float(r["dt"]),) + point)
+                studies[(r["family"], r["scene"], r["backend"])].append((float(r["dt"]),) + point)
             else:
                 budgets[(r["family"], r["scene"], r["backend"])].append((int(r["budget"]),) + point)
         elif r["kind"] == "contact-prebuilt":
             ptime[r["family"]][r["backend"]].append(float(r["runtime_s"]))
         else:
             qtime[r["family"]][r["backend"]].append(float(r["runtime_s"]))
-    # Scenes differ in dt (and some set their own sweep_dt), so the points of a step curve are
-    # the k-th step of each scene's sweep, coarse to fine; a budget curve's points are the
+    # Scenes differ in dt (and some set their own dt_study), so the points of a step curve are
+    # the k-th step of each scene's dt study, coarse to fine; a budget curve's points are the
     # budgets themselves. Only points every scene of the family has are drawn, so the same
     # scenes stand behind every point of a curve.
     dyn = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))  # family, backend, k
     bud = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))  # family, backend, budget
     nscenes = defaultdict(lambda: defaultdict(int))
     nbudget = defaultdict(lambda: defaultdict(int))
-    for (family, _, backend), pts in sweeps.items():
+    for (family, _, backend), pts in studies.items():
         nscenes[family][backend] += 1
         for k, (_, runtime, error) in enumerate(sorted(pts, reverse=True)):
             dyn[family][backend][k].append((runtime, error))

@@ -289,7 +289,7 @@ std::string report_summary_markdown(const std::vector<Scene>& scenes,
      << (in.views_ok ? " (its numbers and its 3-D replay)" : " (its numbers)")
      << ". Every table in full, and every scene's numbers: [details.md](details.md) "
         "([details.html](details.html)); as data: [metrics.csv](metrics.csv), "
-        "[sweep.csv](sweep.csv), [stability.csv](stability.csv), "
+        "[error_vs_runtime.csv](error_vs_runtime.csv), [stability.csv](stability.csv), "
         "[laws.csv](laws.csv), [results.json](results.json).\n\n";
   md << glance_markdown(rows);
   // The causes name one scene each here; details.md names every one.

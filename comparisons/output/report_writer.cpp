@@ -180,7 +180,7 @@ std::string disagreement_section(const std::vector<Scene>& scenes,
   return md.str();
 }
 
-// Every stability verdict, at the scene's step and along its own sweep.
+// Every stability verdict, at the scene's step and along its own dt study.
 std::string stability_section(const std::vector<Scene>& scenes,
                               const std::vector<SceneEvaluation>& evs) {
   std::ostringstream md;
@@ -196,7 +196,7 @@ std::string stability_section(const std::vector<Scene>& scenes,
             "at rest", "tunnelled", "jitter (m/s)", "why"});
   bool any_stab = false;
   for (size_t i = 0; i < evs.size(); ++i) {
-    // The verdict at the scene's step, then at the other steps of its own sweep (if it names
+    // The verdict at the scene's step, then at the other steps of its own dt study (if it names
     // one), each backend's rows together.
     for (const StabilityRow& s : evs[i].stability) {
       any_stab = true;
@@ -285,12 +285,13 @@ std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs,
                                       const std::string& figures_msg) {
   std::ostringstream md;
   md << "## Error against run time\n\n";
-  md << "Dynamics: each backend is run at every time step of the scene's `sweep_dt` (default 4, "
+  md << "Dynamics: each backend is run at every time step of the scene's `dt_study` (default 4, "
         "2, 1, 1/2 and 1/4 times `dt`). One point per (backend, time step): the **median over the "
         "family's closed-form scenes** of the velocity error in the kinetic-energy norm, with the "
         "25-75 % band as a bar, against the median run time of one scene run; the large open "
         "marker is the coarsest step; the same scenes stand behind every point of a curve "
-        "(self-consistency errors are in `sweep.csv` only). Contacts: one point per backend, "
+        "(self-consistency errors are in `error_vs_runtime.csv` only). Contacts: one point per "
+        "backend, "
         "normal angle error and depth error in two panels, median over the scenes with the 25-75 "
         "% band on both axes and the worst scene as a small hollow marker; filled markers time "
         "the backend as it runs (the library's shape built in each query), the larger hollow "
@@ -299,13 +300,13 @@ std::string error_vs_runtime_markdown(const std::vector<SceneEvaluation>& evs,
         "drawn at "
         "1e-15 "
         "in the grey band. The dashed line is the Pareto front over backends. Numbers: "
-        "`sweep.csv`, `metrics.csv`.\n\n";
-  // A family's figure is named for its kind of sweep point (plots.py): contact queries (timed
-  // per call or prebuilt) "-contact"; only figures plots.py drew are linked (a dynamics family
-  // with no closed form has none).
+        "`error_vs_runtime.csv`, `metrics.csv`.\n\n";
+  // A family's figure is named for its kind of error-against-run-time point (plots.py): contact
+  // queries (timed per call or prebuilt) "-contact"; only figures plots.py drew are linked (a
+  // dynamics family with no closed form has none).
   std::set<std::string> families;
   for (const SceneEvaluation& ev : evs)
-    for (const SweepPoint& p : ev.sweep)
+    for (const ErrorRuntimePoint& p : ev.error_vs_runtime)
       families.insert(ev.family + (p.kind.rfind("contact", 0) == 0 ? "-contact" : ""));
   if (!figures_ok) md << "_Figures were not drawn: " << figures_msg << "_\n\n";
   for (const std::string& f : families) {
@@ -327,8 +328,9 @@ std::string solver_budgets_markdown(const std::vector<SceneEvaluation>& evs) {
   md << "## Solver budgets\n\n"
         "Each dynamics backend with an iteration budget is also run at the scene's own step "
         "along that budget (the right-hand panel of each error-against-run-time figure in "
-        "report.md; `sweep.csv`, kind `budget`), measured against the same truth as the step "
-        "sweep. A backend's own "
+        "report.md; `error_vs_runtime.csv`, kind `budget`), measured against the same truth as the "
+        "step "
+        "dt study. A backend's own "
         "converged error on a scene is its error at the largest budget; the table gives the "
         "smallest budget from which every larger one is within "
      << fmt_num(100 * kBudgetConvergedRel, 3) << " % of it (or both are round-off, under "
@@ -341,7 +343,7 @@ std::string solver_budgets_markdown(const std::vector<SceneEvaluation>& evs) {
     if (!be || !named.insert(r.backend).second) continue;
     std::string values;
     for (int v : be->budget.values) values += (values.empty() ? "" : ", ") + std::to_string(v);
-    md << "- `" << r.backend << "`: " << be->budget.what << "; swept " << values
+    md << "- `" << r.backend << "`: " << be->budget.what << "; studied at " << values
        << "; library default "
        << (be->budget.library_default > 0 ? std::to_string(be->budget.library_default)
                                           : std::string("none (it solves to convergence)"))
@@ -386,7 +388,8 @@ std::string report_details_markdown(const std::vector<Scene>& scenes,
   md << "# rbx accuracy report: every table\n\n"
         "The summary, its figures and the real tosses are in [report.md](report.md) "
         "([index.html](index.html) as a page); here, every table in full and every scene's "
-        "numbers. The same numbers as CSV: [metrics.csv](metrics.csv), [sweep.csv](sweep.csv), "
+        "numbers. The same numbers as CSV: [metrics.csv](metrics.csv), "
+        "[error_vs_runtime.csv](error_vs_runtime.csv), "
         "[stability.csv](stability.csv), [laws.csv](laws.csv).\n\n";
   std::vector<FailureCause> causes;
   const std::vector<ScoreRow> rows = score_rows(scenes, evs, cols, &causes);
@@ -418,10 +421,10 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
   // Compact: two-space indentation tripled the size (13.9 MB against 4.4 MB for the library).
   write_text((tmp / "results.json").string(), results.dump() + "\n");
 
-  std::ostringstream metrics, sweep, stab;
+  std::ostringstream metrics, points, stab;
   metrics << "scene,family,check,backend,pair,metric,value,against\n";
-  sweep << "scene,family,backend,kind,dt,budget,runtime_s,error,against,runtime_q25_s,"
-           "runtime_q75_s,calls,rounds,cold_s\n";
+  points << "scene,family,backend,kind,dt,budget,runtime_s,error,against,runtime_q25_s,"
+            "runtime_q75_s,calls,rounds,cold_s\n";
   stab << "scene,family,backend,dt,restitution,verdict,energy_growth_rel,energy_drift_rel,"
           "max_penetration_rel,rest_penetration_rel,tunnelled_pairs,jitter_rms_mps\n";
   for (size_t i = 0; i < evs.size(); ++i) {
@@ -429,14 +432,14 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
     for (const Metric& m : evs[i].metrics)
       metrics << sc << "," << fam << "," << m.check << "," << m.backend << "," << m.pair << ","
               << m.name << "," << fmt_num(m.value, 17) << "," << csv_escape(m.against) << "\n";
-    for (const SweepPoint& p : evs[i].sweep)
-      sweep << sc << "," << fam << "," << p.backend << "," << p.kind << "," << fmt_num(p.dt, 17)
-            << "," << p.budget << "," << fmt_num(p.timing.median_s, 6) << ","
-            << fmt_num(p.error, 17) << "," << csv_escape(p.against) << ","
-            << fmt_num(p.timing.q25_s, 6) << "," << fmt_num(p.timing.q75_s, 6) << ","
-            << p.timing.calls << "," << p.timing.rounds << "," << fmt_num(p.timing.cold_s, 6)
-            << "\n";
-    for (const StabilityRow& s : evs[i].stability)  // the scene's step, then its sweep
+    for (const ErrorRuntimePoint& p : evs[i].error_vs_runtime)
+      points << sc << "," << fam << "," << p.backend << "," << p.kind << "," << fmt_num(p.dt, 17)
+             << "," << p.budget << "," << fmt_num(p.timing.median_s, 6) << ","
+             << fmt_num(p.error, 17) << "," << csv_escape(p.against) << ","
+             << fmt_num(p.timing.q25_s, 6) << "," << fmt_num(p.timing.q75_s, 6) << ","
+             << p.timing.calls << "," << p.timing.rounds << "," << fmt_num(p.timing.cold_s, 6)
+             << "\n";
+    for (const StabilityRow& s : evs[i].stability)  // the scene's step, then its dt study
       stab << sc << "," << fam << "," << s.backend << "," << fmt_num(s.dt, 17) << ","
            << fmt_num(s.restitution, 17) << "," << s.verdict << ","
            << fmt_num(s.energy_growth_rel, 17) << "," << fmt_num(s.energy_drift_rel, 17) << ","
@@ -445,7 +448,7 @@ void write_report_tables(const std::string& dir, const std::vector<Scene>& scene
            << (s.jitter_rms_mps ? fmt_num(*s.jitter_rms_mps, 17) : "") << "\n";
   }
   write_text((tmp / "metrics.csv").string(), metrics.str());
-  write_text((tmp / "sweep.csv").string(), sweep.str());
+  write_text((tmp / "error_vs_runtime.csv").string(), points.str());
   write_text((tmp / "stability.csv").string(), stab.str());
   write_text((tmp / "laws.csv").string(), laws_csv(scenes, evs, report_columns(evs)));
 }

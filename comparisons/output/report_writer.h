@@ -1,5 +1,5 @@
-// The accuracy report's files (`rbx report`): details.md, results.json, metrics.csv, sweep.csv,
-// stability.csv and the figures, from the scenes' evaluations.
+// The accuracy report's files (`rbx report`): details.md, results.json, metrics.csv,
+// error_vs_runtime.csv, stability.csv and the figures, from the scenes' evaluations.
 #pragma once
 
 #include <string>
@@ -38,7 +38,7 @@ std::string report_details_markdown(const std::vector<Scene>& scenes,
                                     const std::vector<SceneEvaluation>& evs,
                                     const std::string& report_dir, bool figures_ok, bool views_ok);
 
-/// results.json, metrics.csv, sweep.csv and stability.csv into `dir`.
+/// results.json, metrics.csv, error_vs_runtime.csv and stability.csv into `dir`.
 void write_report_tables(const std::string& dir, const std::vector<Scene>& scenes,
                          const std::vector<SceneEvaluation>& evs);
 

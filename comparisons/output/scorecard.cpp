@@ -106,7 +106,7 @@ void add_scene(ScoreRow& row, const Scene& scene, const SceneEvaluation& ev,
       row.depth_error.push_back(std::max(truth_metric(ev, b, "depth_err"), 0.0));
     }
     if (const double c = truth_metric(ev, b, "coverage_err_rel"); c >= 0) row.coverage.push_back(c);
-    for (const SweepPoint& p : ev.sweep) {
+    for (const ErrorRuntimePoint& p : ev.error_vs_runtime) {
       if (p.backend == b && (p.kind == "contact" || p.kind == "contact-touching"))
         row.time.push_back(p.timing.median_s);
       if (p.backend == b && p.kind == "contact-prebuilt") row.prebuilt.push_back(p.timing.median_s);
@@ -505,12 +505,12 @@ std::string query_time_markdown(const std::vector<SceneEvaluation>& evs,
   std::map<std::string, std::vector<Timing>> per_call;
   std::map<std::string, std::vector<double>> prebuilt, built;
   for (const SceneEvaluation& ev : evs)
-    for (size_t k = 0; k < ev.sweep.size(); ++k) {
-      const SweepPoint& p = ev.sweep[k];
+    for (size_t k = 0; k < ev.error_vs_runtime.size(); ++k) {
+      const ErrorRuntimePoint& p = ev.error_vs_runtime[k];
       if ((p.kind == "contact" || p.kind == "contact-touching") && p.timing.rounds > 0)
         per_call[p.backend].push_back(p.timing);
       if (p.kind != "contact-prebuilt" || k == 0 || p.timing.rounds == 0) continue;
-      const SweepPoint& call = ev.sweep[k - 1];
+      const ErrorRuntimePoint& call = ev.error_vs_runtime[k - 1];
       if (call.kind != "contact" || call.backend != p.backend || call.timing.rounds == 0) continue;
       prebuilt[p.backend].push_back(p.timing.median_s);
       built[p.backend].push_back(call.timing.median_s - p.timing.median_s);

@@ -98,6 +98,9 @@ struct Scene : WorldDefinition {
   std::vector<std::string> expect_set_aside_by;
   std::optional<Expect> expect;
   std::optional<EnsembleSpec> ensemble;  // [ensemble]: in the report's Predictability section
+  // [sim] dt_study: the time steps (s) each dynamics backend also runs at for error against run
+  // time; empty, the scene's dt scaled by 4, 2, 1, 1/2 and 1/4 (dt_study_steps).
+  std::vector<double> dt_study;
 
   /// True when `checks` holds c.
   bool has_check(CheckKind c) const;

@@ -148,7 +148,8 @@ void apply_override(Reader& r, toml::table& root, const std::string& item, bool&
 
 // ---- sections --------------------------------------------------------------------------------
 
-void read_sim(const Reader& r, const toml::table& sim, SimSettings& s, bool force) {
+void read_sim(const Reader& r, const toml::table& sim, SimSettings& s,
+              std::vector<double>& dt_study, bool force) {
   r.check_keys(sim, "sim.", keys_under("sim."), false);
   auto get = [&](const char* k) { return sim.get(k); };
   if (const toml::node* n = get("dt")) {
@@ -182,15 +183,15 @@ void read_sim(const Reader& r, const toml::table& sim, SimSettings& s, bool forc
         one_of(r, *n, "sim.integrator", "sim.integrator", {"euler", "symplectic"}, "integrator");
     s.integrator = i == "euler" ? Integrator::Euler : Integrator::Symplectic;
   }
-  if (const toml::node* n = get("sweep_dt")) {
-    const toml::array& a = r.array(*n, "sim.sweep_dt", "sim.sweep_dt");
+  if (const toml::node* n = get("dt_study")) {
+    const toml::array& a = r.array(*n, "sim.dt_study", "sim.dt_study");
     for (size_t k = 0; k < a.size(); ++k) {
-      const std::string key = "sim.sweep_dt[" + std::to_string(k) + "]";
-      const double dt = r.number(*a.get(k), key, "sim.sweep_dt");
+      const std::string key = "sim.dt_study[" + std::to_string(k) + "]";
+      const double dt = r.number(*a.get(k), key, "sim.dt_study");
       if (!(dt > 0))
         r.fail(line_of(a.get(k)), key, "time step must be > 0 s, got " + num(dt),
-               "write e.g. sweep_dt = [1e-2, 1e-3, 1e-4]");
-      s.sweep_dt.push_back(dt);
+               "write e.g. dt_study = [1e-2, 1e-3, 1e-4]");
+      dt_study.push_back(dt);
     }
   }
   if (const toml::node* n = get("max_energy_ratio")) {
@@ -204,7 +205,7 @@ void read_sim(const Reader& r, const toml::table& sim, SimSettings& s, bool forc
 
   // A run of more than 1e8 steps is refused unless forced: it is nearly always a unit slip. Even
   // forced, the count must be one a run can take (finite, at most 2^53; see kMaxStepCount).
-  // Blamed key: a sweep entry for its own step; for sim.dt, the duration when the file sets it
+  // Blamed key: a dt_study entry for its own step; for sim.dt, the duration when the file sets it
   // (a week at 1e-3 is a long duration), unless only the step came from --set.
   const toml::node* duration_node = sim.get("duration");
   const bool blame_duration =
@@ -237,9 +238,9 @@ void read_sim(const Reader& r, const toml::table& sim, SimSettings& s, bool forc
                      : "shorten duration or raise dt");
   };
   refuse(s.dt, "sim.dt", sim.get("dt"));
-  if (const toml::node* n = sim.get("sweep_dt"))
-    for (size_t k = 0; k < s.sweep_dt.size(); ++k)
-      refuse(s.sweep_dt[k], "sim.sweep_dt[" + std::to_string(k) + "]", n->as_array()->get(k));
+  if (const toml::node* n = sim.get("dt_study"))
+    for (size_t k = 0; k < dt_study.size(); ++k)
+      refuse(dt_study[k], "sim.dt_study[" + std::to_string(k) + "]", n->as_array()->get(k));
 }
 
 // The table of [expect.KIND] (node `n` of [expect] `t`), a question about the first two bodies:
@@ -535,9 +536,9 @@ Scene parse_scene(const std::string& text, const std::string& path,
     scene.backends = names_from(r, *n, "backends", kBackends, "backend");
 
   if (const toml::node* n = root.get("sim"))
-    read_sim(r, r.table(*n, "sim"), scene.sim, force);
+    read_sim(r, r.table(*n, "sim"), scene.sim, scene.dt_study, force);
   else
-    read_sim(r, toml::table{}, scene.sim, force);
+    read_sim(r, toml::table{}, scene.sim, scene.dt_study, force);
 
   // Bodies, with unique names.
   const fs::path folder = fs::path(path).parent_path();
@@ -561,7 +562,7 @@ Scene parse_scene(const std::string& text, const std::string& path,
   // reported as not checked with the key that changed it. A step size, the integrator, the
   // checks, the backends or the expectation itself leave it standing.
   static const std::vector<std::string> kKeepExpect = {"sim.dt",
-                                                       "sim.sweep_dt",
+                                                       "sim.dt_study",
                                                        "sim.integrator",
                                                        "sim.max_energy_ratio",
                                                        "name",

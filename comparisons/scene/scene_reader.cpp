@@ -28,7 +28,7 @@ const KeyInfo kKeys[] = {
     {"sim.restitution", "1.0"},
     {"sim.friction", "0.0"},
     {"sim.integrator", "\"symplectic\""},
-    {"sim.sweep_dt", "[1e-2, 1e-3, 1e-4]"},
+    {"sim.dt_study", "[1e-2, 1e-3, 1e-4]"},
     {"sim.max_energy_ratio", "1e3"},
     {"body.name", "\"A\""},
     {"body.shape", "\"box\""},

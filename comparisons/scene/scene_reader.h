@@ -192,8 +192,16 @@ class Reader {
   /// Unknown keys of a table, first in file order, with the nearest valid key suggested.
   void check_keys(const toml::table& t, const std::string& prefix,
                   const std::vector<std::string>& allowed, bool sections) const {
+    // Keys an older rbx read, by the name that replaced them: a scene written for it gets the
+    // new name, not a guess.
+    static const std::pair<const char*, const char*> kRenamed[] = {
+        {"sim.sweep_dt", "sim.dt_study"}};
     for (const auto& [key, node] : in_file_order(t)) {
       if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+      for (const auto& [old_key, new_key] : kRenamed)
+        if (prefix + key == old_key)
+          fail(key_line(t, key), prefix + key, "renamed",
+               "write " + std::string(new_key) + " (the same value)");
       const std::string best = nearest(key, allowed);
       const bool section = sections && node->is_table();
       fail(key_line(t, key), prefix + key,

@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
   }
   rbx::HarnessOptions opt;
   opt.backends = "exact,fcl";
-  opt.sweep = false;
+  opt.studies = false;
   const rbx::SceneEvaluation ev = rbx::evaluate_scene(scene, opt);
   std::printf("harness: %zu metrics\n", ev.metrics.size());
   return ev.metrics.empty() ? 1 : 0;

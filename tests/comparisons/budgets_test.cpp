@@ -1,5 +1,5 @@
 // Solver budgets: the smallest budget that reaches a backend's own converged error, the rows the
-// report shows, and the harness's sweep along each backend's budget.
+// report shows, and the harness's study along each backend's budget.
 #include "comparisons/eval/budgets.h"
 
 #include <gtest/gtest.h>
@@ -31,9 +31,10 @@ SceneEvaluation budget_scene(const std::string& family,
                              const std::vector<std::pair<int, double>>& points) {
   SceneEvaluation ev;
   ev.family = family;
-  ev.sweep.push_back({"bullet", "dynamics", 0.02, Timing::once(1e-3), 9.0, "analytic"});
+  ev.error_vs_runtime.push_back({"bullet", "dynamics", 0.02, Timing::once(1e-3), 9.0, "analytic"});
   for (const auto& [budget, error] : points)
-    ev.sweep.push_back({"bullet", "budget", 0.01, Timing::once(1e-3), error, "analytic", budget});
+    ev.error_vs_runtime.push_back(
+        {"bullet", "budget", 0.01, Timing::once(1e-3), error, "analytic", budget});
   return ev;
 }
 
@@ -59,7 +60,7 @@ TEST(BudgetRows, GiveTheWorstAndTheMedianSceneOfEachFamily) {
   EXPECT_EQ(rows[1].every_scene, 10);
 }
 
-TEST(BudgetSweep, RunsEveryBudgetOfEveryBackendAtTheScenesStep) {
+TEST(BudgetStudy, RunsEveryBudgetOfEveryBackendAtTheScenesStep) {
   // A head-on impact of two cubes, face on face: one four-point manifold, a closed form.
   const Scene scene = load_scene(RBX_SOURCE_DIR "/scenes/analytic/headon_e05.toml");
   HarnessOptions opt;
@@ -68,28 +69,28 @@ TEST(BudgetSweep, RunsEveryBudgetOfEveryBackendAtTheScenesStep) {
   opt.timing_budget_s = 0.0;  // the verdicts only: no run is timed again
   const SceneEvaluation ev = evaluate_scene(scene, opt);
   std::map<std::string, std::vector<std::pair<int, double>>> points;
-  for (const SweepPoint& p : ev.sweep)
+  for (const ErrorRuntimePoint& p : ev.error_vs_runtime)
     if (p.kind == "budget") {
       EXPECT_DOUBLE_EQ(p.dt, scene.sim.dt) << p.backend;
       EXPECT_EQ(p.against, "analytic") << p.backend;
       points[p.backend].emplace_back(p.budget, p.error);
     }
   for (const char* name : {"bullet", "ode", "custom"}) {
-    std::vector<int> swept;
-    for (const auto& pt : points[name]) swept.push_back(pt.first);
-    EXPECT_EQ(swept, find_backend(name)->budget.values) << name;
+    std::vector<int> studied;
+    for (const auto& pt : points[name]) studied.push_back(pt.first);
+    EXPECT_EQ(studied, find_backend(name)->budget.values) << name;
   }
   EXPECT_EQ(points.count("custom-seed"), 0u);  // one impulse in closed form: no budget
   // The JSON names each budget point's budget.
   int in_json = 0;
-  for (const Json& p : ev.json["sweep"])
+  for (const Json& p : ev.json["error_vs_runtime"])
     if (p["kind"] == "budget") in_json += p.contains("budget") ? 1 : 0;
   EXPECT_EQ(in_json, static_cast<int>(points["bullet"].size() + points["ode"].size() +
                                       points["custom"].size()));
-  // The custom engine settles a four-point island by active sets, which no sweep budget limits.
+  // The custom engine settles a four-point island by active sets, which no iteration budget limits.
   EXPECT_EQ(converged_budget(points["custom"]), 1);
   // Bullet's sequential impulses over the four points converge along the budget: far off after
-  // one sweep, round-off at the fair world's 100 (so the budget reaches its solver).
+  // one iteration, round-off at the fair world's 100 (so the budget reaches its solver).
   const auto& bullet = points["bullet"];
   EXPECT_GT(bullet.front().second, 1e-3);
   EXPECT_LE(bullet.back().second, kBudgetRoundoff);
@@ -99,7 +100,7 @@ TEST(BudgetSweep, RunsEveryBudgetOfEveryBackendAtTheScenesStep) {
   EXPECT_GT(points["ode"].front().second, 10 * points["ode"].back().second);
 }
 
-TEST(SolverBudgets, AreSweptOverFourValuesOrMoreWithTheLibraryDefault) {
+TEST(SolverBudgets, AreStudiedOverFourValuesOrMoreWithTheLibraryDefault) {
   int with_budget = 0;
   for (const Backend& b : backends()) {
     if (b.budget.values.empty()) continue;
@@ -108,7 +109,7 @@ TEST(SolverBudgets, AreSweptOverFourValuesOrMoreWithTheLibraryDefault) {
     EXPECT_GE(b.budget.values.size(), 4u) << b.name;
     EXPECT_TRUE(std::is_sorted(b.budget.values.begin(), b.budget.values.end())) << b.name;
     EXPECT_GT(b.budget.values.front(), 0) << b.name;
-    // The library's default is swept, unless it has none (it solves to convergence).
+    // The library's default is studied, unless it has none (it solves to convergence).
     if (b.budget.library_default != 0) {
       EXPECT_NE(std::find(b.budget.values.begin(), b.budget.values.end(), b.budget.library_default),
                 b.budget.values.end())

@@ -588,7 +588,7 @@ TEST(Cli, ReportWritesEverythingIntoItsFolder) {
       rbx("report scenes/seed/face_face.toml --out '" + (dir / "out").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* f : {"report.md", "details.md", "index.html", "details.html", "results.json",
-                        "metrics.csv", "sweep.csv", "stability.csv"})
+                        "metrics.csv", "error_vs_runtime.csv", "stability.csv"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
   // Where the time went, each part in the order it ran (explore's samples run for the whole
   // library only).

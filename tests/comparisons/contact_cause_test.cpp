@@ -118,7 +118,7 @@ std::string details_for(const Backend& lib, Scene& scene, SceneEvaluation& ev) {
   const std::vector<Backend> table = {*find_backend("custom"), *find_backend("exact"), lib};
   HarnessOptions opt;
   opt.registry = &table;
-  opt.sweep = false;
+  opt.studies = false;
   ev = evaluate_scene(scene, opt);
   return report_details_markdown({scene}, {ev}, "/nonexistent", false, false);
 }

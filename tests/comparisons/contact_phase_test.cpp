@@ -34,7 +34,7 @@ TEST(ContactPhase, ShiftedRunsKeepTheClosedForm) {
                                 *find_backend("ode")};
   HarnessOptions opt;
   opt.registry = &table;
-  opt.sweep = false;
+  opt.studies = false;
   const SceneEvaluation ev = evaluate_scene(scene, opt);
   // Tolerances: custom and Bullet's box-box path solve one impulse in closed form, so round-off
   // of a few ulps of 1 m/s; ODE's LCP with CFM 1e-10 (our setting) leaves ~1e-8 (measured
@@ -67,7 +67,7 @@ TEST(ContactPhase, NotRunUnderGravity) {
   std::vector<Backend> table = {*find_backend("custom")};
   HarnessOptions opt;
   opt.registry = &table;
-  opt.sweep = false;
+  opt.studies = false;
   const SceneEvaluation ev = evaluate_scene(scene, opt);
   EXPECT_EQ(find(ev, "custom", "velocity_err_ke_phase_1_3"), nullptr);
   EXPECT_TRUE(std::any_of(ev.skipped.begin(), ev.skipped.end(),
@@ -114,7 +114,7 @@ TEST(ContactPhase, WhyFollowsTheRecord) {
       recorder("four_points", face_record(4, 0.0)), recorder("silent", none)};
   HarnessOptions opt;
   opt.registry = &table;
-  opt.sweep = false;
+  opt.studies = false;
   opt.phases = false;  // the records are the same in every run here
   const SceneEvaluation ev = evaluate_scene(scene, opt);
   auto cause = [&](const std::string& backend) {

@@ -113,7 +113,7 @@ TEST(ExploreSlide, CustomMeetsTheClosedFormOnEveryCase) {
     ++seen[slide_case(s)];
     HarnessOptions h;
     h.backends = "custom";
-    h.sweep = false;
+    h.studies = false;
     h.timing_budget_s = 0.0;
     const SceneEvaluation ev = evaluate_scene(parse_scene(s.text, "slide.toml"), h);
     EXPECT_TRUE(ev.expect_checked) << i;

@@ -54,7 +54,7 @@ TEST(ExploreTunnel, CustomMeetsTheClosedFormThroughTheHarness) {
     const TunnelSample s = make_tunnel_sample(2, i);
     HarnessOptions h;
     h.backends = "custom";
-    h.sweep = false;
+    h.studies = false;
     h.phases = false;
     h.timing_budget_s = 0.0;
     const SceneEvaluation ev = evaluate_scene(parse_scene(s.text, "tunnel.toml"), h);

@@ -35,12 +35,12 @@ std::vector<Backend> table_with_failing_backends() {
   return {thrower, *find_backend("custom"), *find_backend("exact"), failer};
 }
 
-// The scene evaluated with table_with_failing_backends(), no time-step sweep.
+// The scene evaluated with table_with_failing_backends(), no dt study.
 SceneEvaluation evaluate_beside_failing_backends(const Scene& scene) {
   const std::vector<Backend> table = table_with_failing_backends();
   HarnessOptions opt;
   opt.registry = &table;
-  opt.sweep = false;
+  opt.studies = false;
   return evaluate_scene(scene, opt);
 }
 
@@ -118,7 +118,7 @@ TEST(Harness, TheTypedRunsAndStabilityRowsSayWhatTheJsonSays) {
   EXPECT_EQ(ev.run_of("custom")->stability, stability["custom"]["verdict"]);
   size_t rows = 0;
   for (const StabilityRow& row : ev.stability) {
-    ASSERT_FALSE(row.swept);  // the scene names no stability sweep
+    ASSERT_FALSE(row.study_step);  // the scene names no dt study
     ASSERT_TRUE(stability.contains(row.backend)) << row.backend;
     EXPECT_EQ(stability_json(row), stability[row.backend]) << row.backend;
     ++rows;
@@ -139,7 +139,7 @@ TEST(Harness, ContactPhasesAndTheGeometryReadBackTyped) {
       "face_face.toml");
   HarnessOptions opt;
   opt.backends = "custom";
-  opt.sweep = false;
+  opt.studies = false;
   opt.timing_budget_s = 0.0;
   SceneEvaluation ev = evaluate_scene(scene, opt);
   ASSERT_NE(ev.run_of("custom"), nullptr);
@@ -203,7 +203,7 @@ TEST(Harness, BodiesThatStartStillAreJudgedAgainstTheMotionTheRunMade) {
   const std::vector<Backend> table = {apart};
   HarnessOptions opt;
   opt.registry = &table;
-  opt.sweep = false;
+  opt.studies = false;
   const SceneEvaluation ev = evaluate_scene(scene, opt);
   const auto value = [&](const std::string& name) {
     for (const Metric& m : ev.metrics)
@@ -224,11 +224,11 @@ TEST(Harness, ATouchingAnswerIsTimedLikeAnyOther) {
       load_scene(std::string(RBX_SOURCE_DIR) + "/scenes/contact/touching_zero_depth.toml");
   HarnessOptions opt;
   opt.backends = "libccd-mpr";
-  opt.sweep = false;
+  opt.studies = false;
   const SceneEvaluation ev = evaluate_scene(scene, opt);
   ASSERT_EQ(ev.json["backends"]["libccd-mpr"]["status"], "touching");
   int points = 0;
-  for (const SweepPoint& p : ev.sweep) {
+  for (const ErrorRuntimePoint& p : ev.error_vs_runtime) {
     if (p.backend != "libccd-mpr" || p.kind != "contact-touching") continue;
     ++points;
     EXPECT_GT(p.timing.rounds, 0);
@@ -247,7 +247,7 @@ TEST(Harness, ADynamicsRunIsTimedAgainWarmAndItsAnsweringRunReportedApart) {
   for (const double budget : {0.0, 0.002}) {
     HarnessOptions opt;
     opt.backends = "custom,ode";
-    opt.sweep = false;
+    opt.studies = false;
     opt.timing_budget_s = budget;
     const SceneEvaluation ev = evaluate_scene(scene, opt);
     for (const char* name : {"custom", "ode"}) {
@@ -286,7 +286,7 @@ TEST(Harness, BodiesOverlappingAtRestThroughEveryBackendAreJudgedInFiniteNumbers
       "position = [0.2, 0, 0]\n",
       "overlap_at_rest.toml");
   HarnessOptions opt;
-  opt.sweep = false;
+  opt.studies = false;
   const SceneEvaluation ev = evaluate_scene(scene, opt);
   int judged = 0;
   for (const auto& [name, st] : ev.json["stability"].items()) {
@@ -333,7 +333,7 @@ TEST(HarnessExpect, AnEngineRunThatStopsFailsItsExpectationAndReferencesDoNotBin
       "[expect]\n[expect.body.A]\nvelocity = [-1, 0, 0]\n",
       "headon.toml");
   HarnessOptions opt;
-  opt.sweep = false;
+  opt.studies = false;
   // The engine: checked and passed.
   opt.backends = "custom";
   SceneEvaluation ev = evaluate_scene(scene, opt);
@@ -377,7 +377,7 @@ TEST(HarnessExpect, ItBindsTheEnginesItNamesTheCustomEngineByDefault) {
     return r;
   };
   HarnessOptions opt;
-  opt.sweep = false;
+  opt.studies = false;
   opt.registry = &table;
   const auto run = [&](const std::string& expect) {
     return evaluate_scene(parse_scene(text + expect + body, "headon.toml"), opt);
@@ -414,7 +414,7 @@ TEST(HarnessExpect, AStatedPatchBindsTheOracleAndTheEnginesAcrossTheNormal) {
   };
   std::vector<Backend> table = {*find_backend("custom")};
   HarnessOptions opt;
-  opt.sweep = false;
+  opt.studies = false;
   opt.registry = &table;
   const auto run = [&](const std::string& expect, double x) {
     return evaluate_scene(parse_scene(text + expect + patch(x), "patch.toml"), opt);
@@ -483,8 +483,8 @@ TEST(HarnessExpect, AKnownFailureExcusesAnEngineItBinds) {
 namespace rbx {
 namespace {
 
-TEST(Harness, TheThinWallGetsAVerdictAtEverySweptStep) {
-  // stress/tunnel_thin_wall names its own sweep (1e-2 .. 5e-5 s): the stability verdict is
+TEST(Harness, TheThinWallGetsAVerdictAtEveryStepOfItsDtStudy) {
+  // stress/tunnel_thin_wall names its own dt study (1e-2 .. 5e-5 s): the stability verdict is
   // given at each step. The custom engine's time of impact keeps the plate from passing the
   // wall at every one; the seed's algorithm passes through at the written 1e-2 s.
   const Scene scene =
@@ -492,15 +492,15 @@ TEST(Harness, TheThinWallGetsAVerdictAtEverySweptStep) {
   HarnessOptions opt;
   opt.backends = "custom,custom-seed";
   const SceneEvaluation ev = evaluate_scene(scene, opt);
-  ASSERT_TRUE(ev.json.contains("stability_sweep"));
-  const Json& swept = ev.json["stability_sweep"]["custom"];
-  ASSERT_EQ(swept.size(), scene.sim.sweep_dt.size() - 1);  // every step but the scene's own
+  ASSERT_TRUE(ev.json.contains("stability_dt_study"));
+  const Json& others = ev.json["stability_dt_study"]["custom"];
+  ASSERT_EQ(others.size(), scene.dt_study.size() - 1);  // every step but the scene's own
   std::vector<double> dts;
-  for (const Json& s : swept) {
+  for (const Json& s : others) {
     dts.push_back(s["dt"].get<double>());
     EXPECT_EQ(s["tunnelled_pairs"].get<int>(), 0) << "custom at dt = " << s["dt"];
   }
-  for (double dt : scene.sim.sweep_dt) {
+  for (double dt : scene.dt_study) {
     if (dt == scene.sim.dt) continue;
     EXPECT_NE(std::find(dts.begin(), dts.end(), dt), dts.end()) << dt;
   }
@@ -525,7 +525,7 @@ SceneEvaluation with_stated_point(const std::string& point) {
       "stated_point.toml");
   HarnessOptions opt;
   opt.backends = "exact";
-  opt.sweep = false;
+  opt.studies = false;
   return evaluate_scene(scene, opt);
 }
 
@@ -558,7 +558,7 @@ TEST(HarnessExpect, MetricsNameTheTruthTheExpectBlockHolds) {
         "truth.toml");
     HarnessOptions opt;
     opt.backends = "custom";
-    opt.sweep = false;
+    opt.studies = false;
     const SceneEvaluation ev = evaluate_scene(scene, opt);
     int named = 0;
     for (const Metric& m : ev.metrics)

@@ -43,7 +43,7 @@ TEST_P(CacheScenes, CachedResultsAreByteIdenticalToAnUncachedRun) {
   const fs::path dir = temp_dir("cache_identical");
   const Scene scene = load_scene(std::string(RBX_SOURCE_DIR) + "/scenes/" + GetParam());
   HarnessOptions opt;
-  opt.sweep = false;
+  opt.studies = false;
   const std::string plain = without_timings(evaluate_scene(scene, opt).json).dump();
   opt.cache_dir = dir.string();
   const SceneEvaluation cold = evaluate_scene(scene, opt);  // fills the cache

@@ -123,7 +123,7 @@ TEST(BadInputCatalogue, CoversEveryCaseOfTheBrief) {
                                "mesh_vertex_missing_z",
                                "huge_size",
                                "huge_radius",
-                               "sweep_dt_absurd"})
+                               "dt_study_absurd"})
     EXPECT_NE(std::find(names.begin(), names.end(), required), names.end()) << required;
 }
 
@@ -194,7 +194,7 @@ gravity = [0, 0, -9.81]
 restitution = 0.5
 friction = 0.25
 integrator = "euler"
-sweep_dt = [1e-2, 1e-3]
+dt_study = [1e-2, 1e-3]
 max_energy_ratio = 10.0
 
 [[body]]
@@ -271,7 +271,7 @@ TEST(SceneFile, ReadsEveryKey) {
   EXPECT_EQ(s.sim.restitution, 0.5);
   EXPECT_EQ(s.sim.friction, 0.25);
   EXPECT_EQ(s.sim.integrator, Integrator::Euler);
-  EXPECT_EQ(s.sim.sweep_dt, (std::vector<double>{1e-2, 1e-3}));
+  EXPECT_EQ(s.dt_study, (std::vector<double>{1e-2, 1e-3}));
   EXPECT_EQ(s.sim.max_energy_ratio, 10.0);
 
   ASSERT_EQ(s.bodies.size(), 6u);
@@ -353,7 +353,7 @@ TEST(SceneFile, DefaultsAreTheContracts) {
   EXPECT_EQ(s.sim.restitution, 1.0);
   EXPECT_EQ(s.sim.friction, 0.0);
   EXPECT_EQ(s.sim.integrator, Integrator::Symplectic);
-  EXPECT_TRUE(s.sim.sweep_dt.empty());
+  EXPECT_TRUE(s.dt_study.empty());
   EXPECT_EQ(s.sim.max_energy_ratio, 1e3);
   EXPECT_FALSE(s.expect.has_value());
 
@@ -494,28 +494,28 @@ TEST(SceneOverrides, ForceStillRefusesUncountableStepCounts) {
             }),
             "t.toml: --set sim.dt: duration 1 s at dt = 1e-320 s is inf steps, more than "
             "2^53, the most a run can count, even with --force; shorten duration or raise dt");
-  // A sweep step is checked too, and named (not the duration).
+  // A dt study's step is checked too, and named (not the duration).
   EXPECT_EQ(input_error([&] {
               parse_scene(
-                  "[sim]\nduration = 1e10\nsweep_dt = [1e-2, 1e-12]\n[[body]]\nname = "
+                  "[sim]\nduration = 1e10\ndt_study = [1e-2, 1e-12]\n[[body]]\nname = "
                   "\"A\"\n",
                   "t.toml", {"force=true"});
             }),
-            "t.toml:3: sim.sweep_dt[1]: duration 1e+10 s at dt = 1e-12 s is 1e+22 steps, more than "
+            "t.toml:3: sim.dt_study[1]: duration 1e+10 s at dt = 1e-12 s is 1e+22 steps, more than "
             "2^53, the most a run can count, even with --force; shorten duration or raise dt");
   // At the limit, forced, is accepted and counted exactly.
   const Scene s = parse_scene(text, "t.toml", {"sim.duration=9007199254740.992", "force=true"});
   EXPECT_EQ(s.sim.steps(), 9007199254740992L);
 }
 
-TEST(SceneOverrides, UnforcedSweepStepBlamesTheSweepEntry) {
-  // 1 s at a sweep step of 1e-12 s is 1e12 steps; the key at fault is the sweep entry, not the
-  // duration on line 2.
+TEST(SceneOverrides, UnforcedDtStudyStepBlamesItsEntry) {
+  // 1 s at a dt study's step of 1e-12 s is 1e12 steps; the key at fault is the dt_study entry, not
+  // the duration on line 2.
   EXPECT_EQ(input_error([] {
-              parse_scene("[sim]\nduration = 1.0\nsweep_dt = [1e-12]\n[[body]]\nname = \"A\"\n",
+              parse_scene("[sim]\nduration = 1.0\ndt_study = [1e-12]\n[[body]]\nname = \"A\"\n",
                           "t.toml");
             }),
-            "t.toml:3: sim.sweep_dt[0]: duration 1 s at dt = 1e-12 s is 1e+12 steps, more than the "
+            "t.toml:3: sim.dt_study[0]: duration 1 s at dt = 1e-12 s is 1e+12 steps, more than the "
             "limit of 1e8; shorten duration, raise dt, or pass --force to run it anyway");
 }
 

@@ -59,7 +59,7 @@ TEST_P(SceneExpect, ClosedFormHolds) {
   const Scene s = load_scene(GetParam());
   HarnessOptions opt;
   opt.backends = "custom,custom-seed,exact";
-  opt.sweep = false;
+  opt.studies = false;
   opt.timing_budget_s = 0.0;  // the verdicts only: no run is timed again
   const SceneEvaluation ev = evaluate_scene(s, opt);
   EXPECT_TRUE(ev.json["expect"]["checked"].get<bool>());

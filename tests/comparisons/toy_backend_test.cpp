@@ -52,7 +52,7 @@ TEST(ToyBackend, ItsEntryAloneBringsItIntoTheHarnessThePagesAndTheBench) {
   // The harness runs it beside the oracle on a scene of the library and scores it.
   HarnessOptions opt;
   opt.backends = "exact,toy-spheres";
-  opt.sweep = false;
+  opt.studies = false;
   opt.timing_budget_s = 0.0;
   const SceneEvaluation ev =
       evaluate_scene(load_scene(std::string(RBX_SOURCE_DIR) + "/scenes/contact/axis_x.toml"), opt);

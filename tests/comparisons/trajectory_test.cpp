@@ -128,15 +128,15 @@ TEST(Trajectory, ResultsShareTheMassPropertiesMostBackendsReportAndKeepEveryOthe
   };
   const Json scene = {
       {"metrics", Json::array({{{"name", "velocity_err_ke"}}})},
-      {"sweep", Json::array({{{"dt", 0.01}}})},
+      {"error_vs_runtime", Json::array({{{"dt", 0.01}}})},
       {"backends",
        {{"custom", {{"bodies", {{"A", body(1, inertia, 0)}, {"B", body(2, inertia, 5)}}}}},
         {"seed", {{"bodies", {{"A", body(1, other, 0)}, {"B", body(2, inertia, 5)}}}}},
         {"ode", {{"bodies", {{"A", body(1, inertia, 0)}, {"B", body(2, inertia, 5.5)}}}}}}}};
   const Json out = results_scene_json(scene);
-  // metrics.csv and sweep.csv hold these.
+  // metrics.csv and error_vs_runtime.csv hold these.
   EXPECT_FALSE(out.contains("metrics"));
-  EXPECT_FALSE(out.contains("sweep"));
+  EXPECT_FALSE(out.contains("error_vs_runtime"));
   // The scene's block: what most backends report.
   EXPECT_EQ(out["bodies"]["A"]["inertia"], inertia);
   EXPECT_EQ(out["bodies"]["B"]["center_of_mass"], Json::array({5, 0, 0}));

@@ -162,11 +162,11 @@ std::vector<std::string> check_page(const fs::path& page, const nlohmann::json& 
   return bad;
 }
 
-// Evaluates a scene (no sweep) and returns its view data.
+// Evaluates a scene (no dt study) and returns its view data.
 ViewData data_of(const std::string& file) {
   const Scene scene = load_scene(std::string(RBX_SOURCE_DIR) + "/" + file);
   HarnessOptions opt;
-  opt.sweep = false;
+  opt.studies = false;
   opt.timing_budget_s = 0.0;  // the replay only: no run is timed again
   return view_data(scene, read_replay(evaluate_scene(scene, opt).json, kViewMaxEvents));
 }
@@ -185,7 +185,7 @@ TEST(ViewPage, SceneTextIsEscapedInHtmlAndJsonAndMarkdown) {
   const Scene scene = load_scene((dir / "evil.toml").string());
   ASSERT_EQ(scene.name, evil);
   HarnessOptions opt;
-  opt.sweep = false;
+  opt.studies = false;
   opt.timing_budget_s = 0.0;  // the replay only: no run is timed again
   const std::string page = view_page(
       view_data(scene, read_replay(evaluate_scene(scene, opt).json, kViewMaxEvents)), "/*three*/");
@@ -317,7 +317,7 @@ TEST_F(ViewBrowser, TheCameraFramesTheMovingBodiesNotTheFloor) {
          "size = [0.1, 0.1, 0.1]\nposition = [0, 0, 0.2]\n";
   const Scene scene = load_scene((dir / "drop.toml").string());
   HarnessOptions opt;
-  opt.sweep = false;
+  opt.studies = false;
   opt.timing_budget_s = 0.0;  // the replay only: no run is timed again
   std::ofstream(dir / "drop.html") << view_page(
       view_data(scene, read_replay(evaluate_scene(scene, opt).json, kViewMaxEvents)), three_js());

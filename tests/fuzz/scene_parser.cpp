@@ -93,8 +93,8 @@ void check_scene(const Scene& scene, bool forced) {
   if (!forced) require(sim.duration / sim.dt <= 1e8, "accepted more than 1e8 steps unforced");
   // Forced or not, every step count is one a run can take (finite, at most 2^53).
   require(sim.duration / sim.dt <= kMaxStepCount, "accepted more than 2^53 steps");
-  for (const double dt : sim.sweep_dt)
-    require(sim.duration / dt <= kMaxStepCount, "accepted a sweep step of more than 2^53 steps");
+  for (const double dt : scene.dt_study)
+    require(sim.duration / dt <= kMaxStepCount, "accepted a dt study step of more than 2^53 steps");
   std::set<std::string> names;
   for (const BodySpec& b : scene.bodies) {
     require(!b.name.empty(), "accepted a body without a name");

@@ -247,7 +247,7 @@ TEST(Libccd, RandomBoxPairsAgainstSeparatingAxes) {
 }
 
 TEST(Libccd, EpaUnderestimatesPinned) {
-  // A pair from the random sweep above on which libccd 2.1's ccdGJKPenetration returns a depth
+  // A pair from the random scan above on which libccd 2.1's ccdGJKPenetration returns a depth
   // below the true minimum: translating B by it along its normal leaves the boxes overlapping.
   // The same result for every epa_tolerance from 1e-4 to 1e-12 and without an iteration cap,
   // so it is the library's, not the adapter's settings. FCL's own patched EPA (fcl-epa) gets

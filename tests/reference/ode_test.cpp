@@ -302,7 +302,7 @@ TEST(OdeDynamics, CubeCornerOnStaticSlab) {
 }
 
 TEST(OdeDynamics, AQuickStepRunDoesNotDependOnTheRunsBeforeIt) {
-  // The quick step (a swept budget) shuffles its constraints with ODE's random generator, one
+  // The quick step (a studied budget) shuffles its constraints with ODE's random generator, one
   // per process. A cube sliding flat on a slab (four contact points with friction, so the order
   // matters) run three times in one process: the third run must repeat the first bit for bit,
   // though the second advanced the generator.

@@ -3,29 +3,29 @@
 
 namespace rbx::eval_detail {
 
-Evaluator::SweepRuns Evaluator::sweep_runs(const Backend& be, const DynRun& main,
+Evaluator::StudyRuns Evaluator::study_runs(const Backend& be, const DynRun& main,
                                            const DynamicsFrame& fr) {
-  SweepRuns sw;
+  StudyRuns sw;
   // Velocity errors belong to the impulse and trajectory checks: a stability-only scene
   // does not pay for the self-consistency run.
   sw.wants_velocity =
       scene_.has_check(CheckKind::Impulse) || scene_.has_check(CheckKind::Trajectory);
-  sw.stability_sweep =
-      scene_.has_check(CheckKind::Stability) && !scene_.sim.sweep_dt.empty() && fr.wants_sweep;
-  if (!fr.wants_sweep && (fr.have_expect || !sw.wants_velocity) &&
+  sw.stability_dt_study =
+      scene_.has_check(CheckKind::Stability) && !scene_.dt_study.empty() && fr.wants_studies;
+  if (!fr.wants_studies && (fr.have_expect || !sw.wants_velocity) &&
       !scene_.has_check(CheckKind::Trajectory))
     return sw;
-  const std::vector<double> to_run = fr.wants_sweep ? fr.dts : std::vector<double>{fr.finest};
+  const std::vector<double> to_run = fr.wants_studies ? fr.dts : std::vector<double>{fr.finest};
   for (double dt : to_run) {
     if (std::abs(dt - scene_.sim.dt) <= 1e-15 * dt) {
       sw.runs.push_back(main);
       continue;
     }
     // The finest run of a trajectory check is sampled at the same times as the main run; so
-    // is every swept run of a stability scene that names its own sweep (its verdict is given
+    // is every run of a stability scene that names its own dt study (its verdict is given
     // at each step: the thin wall must not tunnel at any).
     const bool sample =
-        (scene_.has_check(CheckKind::Trajectory) && dt == fr.finest) || sw.stability_sweep;
+        (scene_.has_check(CheckKind::Trajectory) && dt == fr.finest) || sw.stability_dt_study;
     const long every =
         sample ? std::max<long>(1, std::lround(fr.sample_every * scene_.sim.dt / dt)) : 0;
     sw.runs.push_back(run_dynamics(be, scene_, dt, every, cache_, inputs_));
@@ -36,7 +36,7 @@ Evaluator::SweepRuns Evaluator::sweep_runs(const Backend& be, const DynRun& main
 
 std::vector<std::optional<RefState>> Evaluator::velocity_reference(const std::string& name,
                                                                    const DynRun& main,
-                                                                   const SweepRuns& sw,
+                                                                   const StudyRuns& sw,
                                                                    const DynamicsFrame& fr,
                                                                    std::string& against) {
   std::vector<std::optional<RefState>> ref;
@@ -109,7 +109,7 @@ void Evaluator::contact_phases(const std::string& name, const DynRun& main, cons
 }
 
 void Evaluator::trajectory_divergence(const std::string& name, const DynRun& main,
-                                      const SweepRuns& sw, const DynamicsFrame& fr) {
+                                      const StudyRuns& sw, const DynamicsFrame& fr) {
   if (!scene_.has_check(CheckKind::Trajectory) || !sw.fine || sw.fine->result.samples.empty() ||
       std::abs(fr.finest - scene_.sim.dt) <= 1e-15)
     return;
