@@ -401,7 +401,7 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
 
 std::optional<ContactPoint> find_contact(const ConvexPolyhedron& a, const Pose& pa,
                                          const ConvexPolyhedron& b, const Pose& pb,
-                                         DetectorVariant variant, DetectionCache& cache,
+                                         Detector detector, DetectionCache& cache,
                                          ContactScratch& scratch,
                                          std::vector<ManifoldPoint>* patch) {
   // 1. The features in contact and 2. the chosen plane: proved to overlap, or found by the
@@ -414,7 +414,7 @@ std::optional<ContactPoint> find_contact(const ConvexPolyhedron& a, const Pose& 
     c.point = contact_region_centre(a, pa, b, pb, *plane, c.feature, scratch, patch);
     return c;
   }
-  auto c = detect(a, pa, b, pb, variant, cache);
+  auto c = detect(a, pa, b, pb, detector, cache);
   if (!c) return c;
   const ContactPlane plane =
       choose_contact_plane(a, pa, b, pb, c->normal, c->depth, PlaneMethod::Automatic, scratch);

@@ -38,12 +38,12 @@ Vec3 contact_region_centre(const ConvexPolyhedron& a, const Pose& pa, const Conv
 /// first stages of its contact pipeline (docs/contact_plane.md). Shapes proved to overlap
 /// (choose_overlap_plane) take the chosen plane and the centre of the contact region, with no
 /// detector. The others (touching within the tolerance, apart, or too close to tell) are left
-/// to the detector `variant` (both give the same answer); a hit takes the chosen plane (the
-/// overlap along the tests' normal bounding it) and keeps the detector's point. With `patch`,
+/// to `detector`, faithful or accelerated (both give the same answer); a hit takes the chosen plane
+/// (the overlap along the tests' normal bounding it) and keeps the detector's point. With `patch`,
 /// also the contact patch on that plane (contact_region_centre), which build_manifold reduces.
 std::optional<ContactPoint> find_contact(const ConvexPolyhedron& a, const Pose& pa,
                                          const ConvexPolyhedron& b, const Pose& pb,
-                                         DetectorVariant variant, DetectionCache& cache,
+                                         Detector detector, DetectionCache& cache,
                                          ContactScratch& scratch,
                                          std::vector<ManifoldPoint>* patch = nullptr);
 

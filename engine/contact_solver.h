@@ -22,7 +22,7 @@
 namespace rbx {
 
 /// Which response a world runs (the contact model; the detector is the other axis,
-/// DetectorVariant). `Seed`: the seed's algorithm with its corrections (first hit, single-point
+/// Detector). `Seed`: the seed's algorithm with its corrections (first hit, single-point
 /// impulse, frictionless), `custom-seed`. `Extended`: manifolds, simultaneous impulses with
 /// Coulomb friction, resting contact, position projection and time of impact, `custom`.
 enum class ContactModel { Seed, Extended };

@@ -16,8 +16,8 @@ namespace {
 
 }  // namespace
 
-const char* to_string(DetectorVariant variant) {
-  return variant == DetectorVariant::Faithful ? "faithful" : "accelerated";
+const char* to_string(Detector detector) {
+  return detector == Detector::Faithful ? "faithful" : "accelerated";
 }
 
 // The prepared pair of each implementation, their storage, and which one is live.
@@ -35,9 +35,9 @@ DetectionCache::DetectionCache(DetectionCache&&) noexcept = default;
 DetectionCache& DetectionCache::operator=(DetectionCache&&) noexcept = default;
 
 void DetectionCache::prepare(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                             const Pose& pb, DetectorVariant variant) {
+                             const Pose& pb, Detector detector) {
   // The one switch point between the two implementations.
-  if (variant == DetectorVariant::Accelerated) {
+  if (detector == Detector::Accelerated) {
     state_->accelerated.prepare(a, pa, b, pb, state_->workspace);
     state_->live = State::Live::Accelerated;
   } else {
@@ -120,31 +120,30 @@ std::optional<ContactPoint> edge_test(const ConvexPolyhedron& a, const Pose& pa,
 
 std::optional<ContactPoint> detect_feature(Feature feature, const ConvexPolyhedron& a,
                                            const Pose& pa, const ConvexPolyhedron& b,
-                                           const Pose& pb, DetectorVariant variant,
+                                           const Pose& pb, Detector detector,
                                            DetectionCache& cache) {
-  cache.prepare(a, pa, b, pb, variant);
+  cache.prepare(a, pa, b, pb, detector);
   return cache.test(feature);
 }
 
 std::optional<ContactPoint> detect_feature(Feature feature, const ConvexPolyhedron& a,
                                            const Pose& pa, const ConvexPolyhedron& b,
-                                           const Pose& pb, DetectorVariant variant) {
+                                           const Pose& pb, Detector detector) {
   DetectionCache cache;
-  return detect_feature(feature, a, pa, b, pb, variant, cache);
+  return detect_feature(feature, a, pa, b, pb, detector, cache);
 }
 
 std::optional<ContactPoint> detect(const ConvexPolyhedron& a, const Pose& pa,
-                                   const ConvexPolyhedron& b, const Pose& pb,
-                                   DetectorVariant variant, DetectionCache& cache) {
-  cache.prepare(a, pa, b, pb, variant);
+                                   const ConvexPolyhedron& b, const Pose& pb, Detector detector,
+                                   DetectionCache& cache) {
+  cache.prepare(a, pa, b, pb, detector);
   return cache.detect();
 }
 
 std::optional<ContactPoint> detect(const ConvexPolyhedron& a, const Pose& pa,
-                                   const ConvexPolyhedron& b, const Pose& pb,
-                                   DetectorVariant variant) {
+                                   const ConvexPolyhedron& b, const Pose& pb, Detector detector) {
   DetectionCache cache;
-  return detect(a, pa, b, pb, variant, cache);
+  return detect(a, pa, b, pb, detector, cache);
 }
 
 }  // namespace rbx

@@ -24,10 +24,10 @@ namespace rbx {
 /// `Accelerated` culls with bounding volume trees and must return the same answers bit for bit
 /// (tests/engine/accelerated_detect_test.cpp). Both `custom` and `custom-seed` run Accelerated;
 /// the bench's "faithful" rows and custom's "faithful" query variant run Faithful.
-enum class DetectorVariant { Faithful, Accelerated };
+enum class Detector { Faithful, Accelerated };
 
 /// "faithful" | "accelerated".
-const char* to_string(DetectorVariant variant);
+const char* to_string(Detector detector);
 
 /// The detector's state for one pair of shapes, passed in explicitly: both shapes placed at
 /// their poses (prepared once, then shared by the face, vertex and edge tests) and reusable
@@ -42,7 +42,7 @@ class DetectionCache {
 
   /// Places a and b at pa and pb for the tests that follow, with the given implementation.
   void prepare(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b, const Pose& pb,
-               DetectorVariant variant);
+               Detector detector);
   /// One kind of test in both orders on the prepared pair: (A, B), then (B, A) with the normal
   /// flipped (seed correction 8 (both orders, normal flipped)). Throws std::logic_error when
   /// nothing was prepared.
@@ -96,22 +96,22 @@ std::optional<ContactPoint> edge_test(const ConvexPolyhedron& a, const Pose& pa,
 /// One kind of test in both orders (see DetectionCache::test), on the caller's cache.
 std::optional<ContactPoint> detect_feature(Feature feature, const ConvexPolyhedron& a,
                                            const Pose& pa, const ConvexPolyhedron& b,
-                                           const Pose& pb, DetectorVariant variant,
+                                           const Pose& pb, Detector detector,
                                            DetectionCache& cache);
 /// The same with a cache of its own (convenient; a caller making many queries keeps one).
 std::optional<ContactPoint> detect_feature(Feature feature, const ConvexPolyhedron& a,
                                            const Pose& pa, const ConvexPolyhedron& b,
                                            const Pose& pb,
-                                           DetectorVariant variant = DetectorVariant::Accelerated);
+                                           Detector detector = Detector::Accelerated);
 
 /// The full detector in the seed's order (face, vertex, edge; each in both orders): the first
 /// hit, or nothing when the shapes do not touch. On the caller's cache.
 std::optional<ContactPoint> detect(const ConvexPolyhedron& a, const Pose& pa,
-                                   const ConvexPolyhedron& b, const Pose& pb,
-                                   DetectorVariant variant, DetectionCache& cache);
+                                   const ConvexPolyhedron& b, const Pose& pb, Detector detector,
+                                   DetectionCache& cache);
 /// The same with a cache of its own.
 std::optional<ContactPoint> detect(const ConvexPolyhedron& a, const Pose& pa,
                                    const ConvexPolyhedron& b, const Pose& pb,
-                                   DetectorVariant variant = DetectorVariant::Accelerated);
+                                   Detector detector = Detector::Accelerated);
 
 }  // namespace rbx

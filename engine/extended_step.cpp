@@ -113,7 +113,7 @@ std::vector<PairManifold> ExtendedStep::detect_manifolds(WorldState& world) {
     if (a.is_static && b.is_static) continue;
     if (grow_ > 0.0 && !spheres_touch(spheres_[pair.first], spheres_[pair.second])) continue;
     if (separated(world, a, b, pair.first, pair.second)) continue;  // the detector finds nothing
-    auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant,
+    auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.detector,
                             world.tunables.position_slop, detection_, contact_scratch_);
     if (m) manifolds.push_back({pair.first, pair.second, std::move(*m), a.pose(), b.pose()});
   }
@@ -310,8 +310,9 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
       const double s =
           q.squaredNorm() > 0.0 ? std::clamp(-p.dot(q) / q.squaredNorm(), 0.0, 1.0) : 0.0;
       if ((p + s * q).norm() > facts[lo].radius + facts[hi].radius) continue;
-      const TimeOfImpact t = time_of_impact(a, b, dt, world.variant, world.tunables.toi_max_samples,
-                                            &facts[lo].principal, &facts[hi].principal);
+      const TimeOfImpact t =
+          time_of_impact(a, b, dt, world.detector, world.tunables.toi_max_samples,
+                         &facts[lo].principal, &facts[hi].principal);
       if (!t.certified) report_uncertified(world, lo, hi);
       if (t.time) hits.emplace_back(*t.time, lo, hi);
     }
@@ -339,7 +340,7 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
     // else by the pair's kept axis or a new one.
     if (separated(world, a, b, i, j, travel[i] + travel[j])) continue;
     const TimeOfImpact t =
-        time_of_impact(world.bodies[i], world.bodies[j], dt, world.variant,
+        time_of_impact(world.bodies[i], world.bodies[j], dt, world.detector,
                        world.tunables.toi_max_samples, &facts[i].principal, &facts[j].principal);
     if (!t.certified) report_uncertified(world, i, j);
     if (t.time) hits.emplace_back(*t.time, i, j);
@@ -351,7 +352,7 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
     RigidBody &a = world.bodies[i], &b = world.bodies[j];
     a = advanced(a, t, &facts[i].principal);
     b = advanced(b, t, &facts[j].principal);
-    if (auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.variant,
+    if (auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), world.detector,
                                 world.tunables.position_slop, detection_, contact_scratch_)) {
       const std::vector<PairManifold> one = {{i, j, std::move(*m), a.pose(), b.pose()}};
       const auto approach = normal_velocities(world.bodies, one);

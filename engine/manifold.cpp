@@ -153,28 +153,29 @@ void support_corners(std::vector<ManifoldPoint>& pts, const Vec3& n, double slac
 
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
                                               const ConvexPolyhedron& b, const Pose& pb,
-                                              DetectorVariant variant, double support_slack) {
+                                              Detector detector, double support_slack) {
   DetectionCache cache;
   ContactScratch scratch;
-  return build_manifold(a, pa, b, pb, variant, support_slack, cache, scratch);
+  return build_manifold(a, pa, b, pb, detector, support_slack, cache, scratch);
 }
 
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
                                               const ConvexPolyhedron& b, const Pose& pb,
-                                              DetectorVariant variant, double support_slack,
+                                              Detector detector, double support_slack,
                                               DetectionCache& cache, ContactScratch& scratch) {
   ContactManifold m;
   m.points.reserve(8);  // a face contact's corners, and a few clipped ones, in one allocation
-  if (!build_manifold(a, pa, b, pb, variant, support_slack, cache, scratch, m)) return std::nullopt;
+  if (!build_manifold(a, pa, b, pb, detector, support_slack, cache, scratch, m))
+    return std::nullopt;
   return m;
 }
 
 bool build_manifold(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                    const Pose& pb, DetectorVariant variant, double support_slack,
-                    DetectionCache& cache, ContactScratch& scratch, ContactManifold& m) {
+                    const Pose& pb, Detector detector, double support_slack, DetectionCache& cache,
+                    ContactScratch& scratch, ContactManifold& m) {
   // 1-3. The features in contact, the chosen plane and the patch clipped on it: the query's
   // own pipeline (engine/contact_region.h), so that `custom` answers with this manifold.
-  auto contact = find_contact(a, pa, b, pb, variant, cache, scratch, &m.points);
+  auto contact = find_contact(a, pa, b, pb, detector, cache, scratch, &m.points);
   if (!contact) return false;
   m.normal = contact->normal;
   m.depth = contact->depth;

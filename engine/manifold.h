@@ -47,18 +47,18 @@ struct ContactManifold {
 /// one of each); the answer does not depend on them.
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
                                               const ConvexPolyhedron& b, const Pose& pb,
-                                              DetectorVariant variant, double support_slack,
+                                              Detector detector, double support_slack,
                                               DetectionCache& cache, ContactScratch& scratch);
 
 /// The same into `out`, whose lists are reused (a caller that queries again allocates nothing
 /// once they have grown); false, and `out` unspecified, when A and B do not touch.
 bool build_manifold(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
-                    const Pose& pb, DetectorVariant variant, double support_slack,
-                    DetectionCache& cache, ContactScratch& scratch, ContactManifold& out);
+                    const Pose& pb, Detector detector, double support_slack, DetectionCache& cache,
+                    ContactScratch& scratch, ContactManifold& out);
 /// The same on a cache and scratch of its own (allocated for the one query: tests and tools).
 std::optional<ContactManifold> build_manifold(const ConvexPolyhedron& a, const Pose& pa,
                                               const ConvexPolyhedron& b, const Pose& pb,
-                                              DetectorVariant variant,
+                                              Detector detector,
                                               double support_slack = WorldSettings{}.position_slop);
 
 }  // namespace rbx

@@ -34,7 +34,7 @@ void SeedStep::collide_pair(WorldState& world, int i, int j, bool bounded) {
   // impulse the pair separates at the contact, so later hits add an impulse only if the new
   // velocities still approach at their own point.
   // Responses change velocities only, so the pair is placed once for the three tests.
-  detection_.prepare(*a.shape, a.pose(), *b.shape, b.pose(), world.variant);
+  detection_.prepare(*a.shape, a.pose(), *b.shape, b.pose(), world.detector);
   for (Feature feature : {Feature::Face, Feature::Vertex, Feature::Edge}) {
     const auto contact = detection_.test(feature);
     if (!contact) continue;

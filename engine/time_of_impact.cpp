@@ -47,16 +47,16 @@ double travel_bound(const RigidBody& body, double turn_rate, double radius, doub
   return (body.velocity.norm() + turn_rate * momentum * radius) * t;
 }
 
-TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt,
-                            DetectorVariant variant, long max_samples,
-                            const PrincipalFrame* frame_a, const PrincipalFrame* frame_b) {
+TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, Detector detector,
+                            long max_samples, const PrincipalFrame* frame_a,
+                            const PrincipalFrame* frame_b) {
   // One detection cache for every sample (its scratch lists allocated once).
   DetectionCache cache;
   const auto pose_at = [&](const RigidBody& body, double t, const PrincipalFrame* frame) {
     return advanced_pose(body, t, frame);
   };
   auto touching = [&](double t) {
-    return detect(*a.shape, pose_at(a, t, frame_a), *b.shape, pose_at(b, t, frame_b), variant,
+    return detect(*a.shape, pose_at(a, t, frame_a), *b.shape, pose_at(b, t, frame_b), detector,
                   cache)
         .has_value();
   };

@@ -56,9 +56,8 @@ struct TimeOfImpact {
 /// dt. A search that reaches `max_samples` before dt (bodies skimming past each other at a speed of
 /// millions of their thicknesses per step) is not certified: its answer says so. Meant for pairs
 /// separated at the step's start. `frame_a`, `frame_b` as for advanced.
-TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt,
-                            DetectorVariant variant, long max_samples,
-                            const PrincipalFrame* frame_a = nullptr,
+TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, Detector detector,
+                            long max_samples, const PrincipalFrame* frame_a = nullptr,
                             const PrincipalFrame* frame_b = nullptr);
 
 }  // namespace rbx

@@ -13,9 +13,9 @@
 
 namespace rbx {
 
-World::World(SimSettings sim, std::vector<RigidBody> bodies, ContactModel model,
-             DetectorVariant variant, BroadPhaseMethod broad_phase, const WorldSettings& tunables)
-    : state_(std::move(sim), std::move(bodies), variant, broad_phase, tunables),
+World::World(SimSettings sim, std::vector<RigidBody> bodies, ContactModel model, Detector detector,
+             BroadPhaseMethod broad_phase, const WorldSettings& tunables)
+    : state_(std::move(sim), std::move(bodies), detector, broad_phase, tunables),
       contact_model_(model),
       extended_(tunables) {
   // Energy guard budget: the initial kinetic energy, or the work gravity could do over the
@@ -123,11 +123,11 @@ RunResult World::run() {
   return r;
 }
 
-RunResult run_world(const WorldDefinition& definition, ContactModel model, DetectorVariant variant,
+RunResult run_world(const WorldDefinition& definition, ContactModel model, Detector detector,
                     BroadPhaseMethod broad_phase) {
   std::vector<RigidBody> bodies;
   for (const BodySpec& spec : definition.bodies) bodies.push_back(make_body(spec));
-  World world(definition.sim, std::move(bodies), model, variant, broad_phase);
+  World world(definition.sim, std::move(bodies), model, detector, broad_phase);
   return world.run();
 }
 

@@ -40,7 +40,7 @@ class World {
   /// settings and the extended step's solver, projection and time-of-impact ones
   /// (engine/settings.h).
   World(SimSettings sim, std::vector<RigidBody> bodies, ContactModel model,
-        DetectorVariant variant = DetectorVariant::Accelerated,
+        Detector detector = Detector::Accelerated,
         BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree,
         const WorldSettings& tunables = WorldSettings());
 
@@ -87,7 +87,7 @@ class World {
 
 /// Builds every body of the definition and runs it with the given contact model.
 RunResult run_world(const WorldDefinition& definition, ContactModel model,
-                    DetectorVariant variant = DetectorVariant::Accelerated,
+                    Detector detector = Detector::Accelerated,
                     BroadPhaseMethod broad_phase = BroadPhaseMethod::Tree);
 
 }  // namespace rbx

@@ -19,12 +19,11 @@ BodyFacts BodyFacts::of(const RigidBody& body) {
   return f;
 }
 
-WorldState::WorldState(SimSettings sim_settings, std::vector<RigidBody> start,
-                       DetectorVariant detector, BroadPhaseMethod broad_phase_method,
-                       const WorldSettings& world_tunables)
+WorldState::WorldState(SimSettings sim_settings, std::vector<RigidBody> start, Detector detector,
+                       BroadPhaseMethod broad_phase_method, const WorldSettings& world_tunables)
     : sim(std::move(sim_settings)),
       bodies(std::move(start)),
-      variant(detector),
+      detector(detector),
       tunables(world_tunables),
       broad_phase(broad_phase_method, world_tunables) {
   for (const RigidBody& b : bodies) facts.push_back(BodyFacts::of(b));

@@ -52,13 +52,13 @@ struct BodyFacts {
 /// The state both contact models advance, step by step.
 struct WorldState {
   /// Places the bodies at t = 0, with their facts and the broad phase built from `tunables`.
-  WorldState(SimSettings sim, std::vector<RigidBody> bodies, DetectorVariant variant,
+  WorldState(SimSettings sim, std::vector<RigidBody> bodies, Detector detector,
              BroadPhaseMethod broad_phase, const WorldSettings& tunables);
 
   SimSettings sim;
   std::vector<RigidBody> bodies;  // in scene order
   std::vector<BodyFacts> facts;   // per body, in the same order
-  DetectorVariant variant;
+  Detector detector;
   WorldSettings tunables;
   BroadPhase broad_phase;  // the pairs passing the bounding check, at the step's start poses
   std::vector<CollisionEvent> events;        // every collision resolved so far, in order

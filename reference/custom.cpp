@@ -20,12 +20,12 @@ namespace {
 // point of the manifold, all on the manifold's normal. One detection cache, one contact
 // scratch and one manifold per thread, reused by every query as a world's step reuses its own:
 // their lists are allocated once. Answers do not depend on them.
-ContactResult engine_contact(const RigidBody& a, const RigidBody& b, DetectorVariant variant) {
+ContactResult engine_contact(const RigidBody& a, const RigidBody& b, Detector detector) {
   thread_local DetectionCache cache;
   thread_local ContactScratch scratch;
   thread_local ContactManifold m;
   ContactResult r;
-  if (!build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), variant,
+  if (!build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), detector,
                       WorldSettings{}.position_slop, cache, scratch, m))
     return r;
   r.contacts.reserve(1 + m.points.size());  // no reallocation below: `feature` stays valid
@@ -38,13 +38,13 @@ ContactResult engine_contact(const RigidBody& a, const RigidBody& b, DetectorVar
 
 // `custom`: the accelerated detector where one is needed.
 ContactResult custom_contact(const RigidBody& a, const RigidBody& b) {
-  return engine_contact(a, b, DetectorVariant::Accelerated);
+  return engine_contact(a, b, Detector::Accelerated);
 }
 
 // Variant "faithful" of `custom`: the seed's loops over every primitive (the accelerated
 // detector's reference) where a detector is needed; the same answer, slower on touching poses.
 ContactResult custom_faithful_contact(const RigidBody& a, const RigidBody& b) {
-  return engine_contact(a, b, DetectorVariant::Faithful);
+  return engine_contact(a, b, Detector::Faithful);
 }
 
 BodyFinal final_of(const RigidBody& b) {
@@ -57,11 +57,11 @@ DynamicsResult run_dynamics(const WorldDefinition& scene, const DynamicsOptions&
   try {
     SimSettings sim = scene.sim;
     if (opt.dt > 0) sim.dt = opt.dt;
-    // A swept budget caps the projections' iterations per island solve (custom_budget).
+    // A studied budget caps the projections' iterations per island solve (custom_budget).
     WorldSettings tunables;
     tunables.iteration_budget = opt.budget;
-    World world(sim, make_bodies(scene), model, DetectorVariant::Accelerated,
-                BroadPhaseMethod::Tree, tunables);
+    World world(sim, make_bodies(scene), model, Detector::Accelerated, BroadPhaseMethod::Tree,
+                tunables);
     world.set_response(response);
     const long steps = sim.steps();
     DynamicsRecorder recorder(r, opt, [&] {
@@ -142,7 +142,7 @@ DynamicsResult custom_seed_dynamics_with(const WorldDefinition& scene, const Dyn
   return run_dynamics(scene, opt, ContactModel::Seed, response);
 }
 
-// The budget swept along: the projected Gauss-Seidel iterations of one island solve, both stages
+// The budget studied: the projected Gauss-Seidel iterations of one island solve, both stages
 // together (WorldSettings::iteration_budget). The engine itself has no budget: it solves to
 // convergence (configured 0), and islands of up to 32 points are settled by active sets first,
 // which no budget limits.

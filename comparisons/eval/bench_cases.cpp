@@ -191,7 +191,7 @@ const StepRunner kStepRunners[] = {
      [](const Scene& s) {
        // The `custom` backend's engine (extended contact model) on the faithful detector and
        // the all-pairs bounding check.
-       World w(s.sim, make_bodies(s), ContactModel::Extended, DetectorVariant::Faithful,
+       World w(s.sim, make_bodies(s), ContactModel::Extended, Detector::Faithful,
                BroadPhaseMethod::AllPairs);
        const RunResult r = w.run();
        return r.ok ? std::string() : r.message;

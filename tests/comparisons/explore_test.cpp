@@ -272,7 +272,7 @@ TEST(ExploreShrink, ACoverageMissShrinksToASceneThatStatesThePatch) {
   EXPECT_NE(text.find("\npatch = [["), std::string::npos) << text;
   HarnessOptions opt;
   opt.backends = "custom";
-  opt.sweep = false;
+  opt.studies = false;
   const SceneEvaluation ev = evaluate_scene(parse_scene(text, "shrunk.toml"), opt);
   EXPECT_TRUE(ev.json["expect"]["passed"].get<bool>()) << ev.json["expect"];
 }
@@ -296,7 +296,7 @@ TEST(ExploreShrink, ATieBetweenTwoAxesStatesNeitherNormalNorPatch) {
     EXPECT_NE(block.find("\ndepth = 0.09999"), std::string::npos) << block;
     HarnessOptions opt;
     opt.backends = "custom";
-    opt.sweep = false;
+    opt.studies = false;
     const SceneEvaluation ev = evaluate_scene(parse_scene(tied + block, "tied.toml"), opt);
     EXPECT_TRUE(ev.json["expect"]["passed"].get<bool>()) << ev.json["expect"];
 
@@ -497,7 +497,7 @@ TEST(ExploreLanding, CustomPassesTheExpectOfSampleScenes) {
     ++(s.slides ? slides : sticks);
     HarnessOptions h;
     h.backends = "custom";
-    h.sweep = false;
+    h.studies = false;
     h.timing_budget_s = 0.0;
     const SceneEvaluation ev = evaluate_scene(parse_scene(s.text, "landing.toml"), h);
     EXPECT_TRUE(ev.expect_checked) << i;
@@ -634,7 +634,7 @@ TEST(ExploreLanding, ABoxThatHopsOffTheFloorAfterItsLandingIsNamedLiftOff) {
 }
 
 TEST(ExploreLanding, ShrinkKeepsTheSignature) {
-  // The one-point hull variant of MuJoCo (MPR, one contact point per step) rests more than
+  // MuJoCo's one-point hull backend (MPR, one contact point per step) rests more than
   // 1 mm off on some landings, its box hopping off the floor on the way (lift_off); shrinking
   // rounds the design while the harness still shows it on the scene (the rise: the scene's own
   // run, every step), and the check can fail: custom's box on the same scene stays down.

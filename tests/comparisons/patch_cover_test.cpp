@@ -124,8 +124,8 @@ TEST(PatchCover, TheOraclesPatchIsCoveredByItsOwnPointsAndCustomsManifoldNotByOn
   EXPECT_LE(own.coverage_err, 1e-12);
   EXPECT_EQ(own.worst_point_err, 0.0);
   EXPECT_EQ(own.support_err.value_or(-1), 0.0);
-  const auto m = build_manifold(*in[0].shape, in[0].pose(), *in[1].shape, in[1].pose(),
-                                DetectorVariant::Accelerated);
+  const auto m =
+      build_manifold(*in[0].shape, in[0].pose(), *in[1].shape, in[1].pose(), Detector::Accelerated);
   ASSERT_TRUE(m);
   std::vector<ContactPoint> step;
   for (const ManifoldPoint& p : m->points) step.push_back({p.point, m->normal, p.depth, "step"});

@@ -293,7 +293,7 @@ TEST(TossesSoft, OwnValuesReproduceTheBackendAndAnotherValueMovesIt) {
       EXPECT_NE(moved.track.position, plain.track.position) << b.name << " " << p.name;
     }
   }
-  EXPECT_EQ(tuned, 8);  // mujoco, ode, dart and bullet, each with its -hull variant
+  EXPECT_EQ(tuned, 8);  // mujoco, ode, dart and bullet, each with its -hull backend
 }
 
 TEST(TossesSoft, AnUnknownOrOutOfRangeSoftParameterExitsTwoNamingFileAndKey) {
@@ -537,7 +537,7 @@ TEST(TossesFit, TheCommittedParametersCarryEverySoftnessTriedAndKeepTheBest) {
               e["train_position_error"].get<double>())
         << b.name;
   }
-  EXPECT_EQ(scanned, 8);  // mujoco, ode, dart and bullet, each with its -hull variant
+  EXPECT_EQ(scanned, 8);  // mujoco, ode, dart and bullet, each with its -hull backend
 }
 
 TEST(TossesCommand, JsonIsDeterministicAndHasTheContractFields) {

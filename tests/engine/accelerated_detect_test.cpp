@@ -69,11 +69,11 @@ struct Tally {
   std::map<std::string, int> features;
 };
 
-// Compares the two variants at one pose: the full detector and each feature test alone.
+// Compares the two detectors at one pose: the full detector and each feature test alone.
 void compare_at(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                 const Pose& pb, const std::string& where, Tally& tally) {
-  const auto seed = detect(a, pa, b, pb, DetectorVariant::Faithful);
-  const auto fast = detect(a, pa, b, pb, DetectorVariant::Accelerated);
+  const auto seed = detect(a, pa, b, pb, Detector::Faithful);
+  const auto fast = detect(a, pa, b, pb, Detector::Accelerated);
   expect_same(fast, seed, where);
   if (seed) {
     ++tally.hits;
@@ -82,8 +82,8 @@ void compare_at(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedro
     ++tally.misses;
   }
   for (Feature feature : kFeatures)
-    expect_same(detect_feature(feature, a, pa, b, pb, DetectorVariant::Accelerated),
-                detect_feature(feature, a, pa, b, pb, DetectorVariant::Faithful),
+    expect_same(detect_feature(feature, a, pa, b, pb, Detector::Accelerated),
+                detect_feature(feature, a, pa, b, pb, Detector::Faithful),
                 where + " feature " + to_string(feature));
 }
 
@@ -285,12 +285,11 @@ TEST(AcceleratedDetect, SamePosesNewShapes) {
     const ConvexPolyhedron a = make_box(Vec3::Constant(0.5 + 0.05 * k));
     const ConvexPolyhedron b = make_box(Vec3(1.0, 0.8, 0.6));
     for (Feature feature : kFeatures)
-      expect_same(detect_feature(feature, a, pa, b, pb, DetectorVariant::Accelerated),
-                  detect_feature(feature, a, pa, b, pb, DetectorVariant::Faithful),
+      expect_same(detect_feature(feature, a, pa, b, pb, Detector::Accelerated),
+                  detect_feature(feature, a, pa, b, pb, Detector::Faithful),
                   "size " + std::to_string(k) + " " + to_string(feature));
-    const auto seed = detect(a, pa, b, pb, DetectorVariant::Faithful);
-    expect_same(detect(a, pa, b, pb, DetectorVariant::Accelerated), seed,
-                "size " + std::to_string(k));
+    const auto seed = detect(a, pa, b, pb, Detector::Faithful);
+    expect_same(detect(a, pa, b, pb, Detector::Accelerated), seed, "size " + std::to_string(k));
     hits += seed ? 1 : 0;
   }
   // B (half extents 0.5, 0.4, 0.3, any rotation) lies within its circumsphere of radius
@@ -312,7 +311,7 @@ TEST(AcceleratedDetect, EqualShapesAfterTheFirstAreDestroyed) {
   pb.orientation = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
   auto a = std::make_unique<ConvexPolyhedron>(make_box(Vec3::Constant(1.0)));
   auto b = std::make_unique<ConvexPolyhedron>(make_box(Vec3(1.0, 0.8, 0.6)));
-  const auto first = detect(*a, pa, *b, pb, DetectorVariant::Accelerated);
+  const auto first = detect(*a, pa, *b, pb, Detector::Accelerated);
   ASSERT_TRUE(first.has_value());
   // New objects, built while the old ones are alive so that they get other addresses.
   auto a2 = std::make_unique<ConvexPolyhedron>(make_box(Vec3::Constant(1.0)));
@@ -320,10 +319,9 @@ TEST(AcceleratedDetect, EqualShapesAfterTheFirstAreDestroyed) {
   a.reset();
   b.reset();
   for (Feature feature : kFeatures)
-    expect_same(detect_feature(feature, *a2, pa, *b2, pb, DetectorVariant::Accelerated),
-                detect_feature(feature, *a2, pa, *b2, pb, DetectorVariant::Faithful),
-                to_string(feature));
-  expect_same(detect(*a2, pa, *b2, pb, DetectorVariant::Accelerated), first, "equal shapes");
+    expect_same(detect_feature(feature, *a2, pa, *b2, pb, Detector::Accelerated),
+                detect_feature(feature, *a2, pa, *b2, pb, Detector::Faithful), to_string(feature));
+  expect_same(detect(*a2, pa, *b2, pb, Detector::Accelerated), first, "equal shapes");
 }
 
 // The detector's state is passed in (DetectionCache), not kept per thread: two pairs prepared
@@ -342,7 +340,7 @@ TEST(AcceleratedDetect, InterleavedQueriesOnTwoCachesDoNotInterfere) {
     p1b.position = 0.7 * random_direction(rng);
     p2b.orientation = random_rotation(rng);
     p2b.position = 0.8 * random_direction(rng);
-    for (DetectorVariant v : {DetectorVariant::Accelerated, DetectorVariant::Faithful}) {
+    for (Detector v : {Detector::Accelerated, Detector::Faithful}) {
       // Alone: each pair on a fresh cache.
       std::optional<ContactPoint> alone1[3], alone2[3];
       for (int f = 0; f < 3; ++f) {

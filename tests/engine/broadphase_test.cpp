@@ -312,8 +312,7 @@ TEST(BroadPhase, WorldResultsDoNotDependOnTheMethod) {
   sim.duration = 0.3;
   std::vector<RunResult> results;
   for (BroadPhaseMethod m : kMethods)
-    results.push_back(
-        World(sim, bodies, ContactModel::Seed, DetectorVariant::Accelerated, m).run());
+    results.push_back(World(sim, bodies, ContactModel::Seed, Detector::Accelerated, m).run());
   const RunResult& reference = results[0];
   ASSERT_TRUE(reference.ok) << reference.message;
   EXPECT_GT(reference.events.size(), 50u);  // the scene is busy: the comparison is not vacuous

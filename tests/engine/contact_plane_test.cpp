@@ -78,7 +78,7 @@ TEST(ContactPlane, AxisAlignedBoxesTakeTheAxisOfLeastOverlap) {
     EXPECT_NEAR(p.depth, overlap[axis], 1e-12) << "trial " << trial;
     ++checked;
     // The seed's first hit, for contrast: the test above is one it fails.
-    const auto hit = detect(a, pa, b, pb, DetectorVariant::Faithful);
+    const auto hit = detect(a, pa, b, pb, Detector::Faithful);
     if (hit && (hit->normal - expected).norm() > 1e-6) ++first_hit_wrong;
   }
   EXPECT_GT(checked, 500);

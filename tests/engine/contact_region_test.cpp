@@ -21,7 +21,7 @@ std::optional<ContactPoint> contact(const ConvexPolyhedron& a, const Pose& pa,
                                     const ConvexPolyhedron& b, const Pose& pb) {
   DetectionCache cache;
   ContactScratch scratch;
-  return find_contact(a, pa, b, pb, DetectorVariant::Accelerated, cache, scratch);
+  return find_contact(a, pa, b, pb, Detector::Accelerated, cache, scratch);
 }
 
 TEST(ContactRegion, StackedBoxesTakeTheCentreOfTheirFacesOverlap) {
@@ -128,7 +128,7 @@ TEST(ContactRegion, AScratchReusedByEveryQueryGivesTheAnswersOfAFreshOne) {
     const ConvexPolyhedron& b = all[pick(rng)];
     const Pose pa{random_rotation(rng) * Vec3::UnitX() * unit(rng) * 1.4, random_rotation(rng)};
     const Pose pb{Vec3::Zero(), random_rotation(rng)};
-    const auto reused = find_contact(a, pa, b, pb, DetectorVariant::Accelerated, kept_cache, kept);
+    const auto reused = find_contact(a, pa, b, pb, Detector::Accelerated, kept_cache, kept);
     const auto fresh = contact(a, pa, b, pb);
     ASSERT_EQ(reused.has_value(), fresh.has_value()) << "trial " << trial;
     if (!fresh) continue;
@@ -138,8 +138,8 @@ TEST(ContactRegion, AScratchReusedByEveryQueryGivesTheAnswersOfAFreshOne) {
     EXPECT_EQ(reused->depth, fresh->depth) << "trial " << trial;
     EXPECT_EQ(reused->feature, fresh->feature) << "trial " << trial;
     const auto manifold_reused =
-        build_manifold(a, pa, b, pb, DetectorVariant::Accelerated, 1e-4, kept_cache, kept);
-    const auto manifold_fresh = build_manifold(a, pa, b, pb, DetectorVariant::Accelerated, 1e-4);
+        build_manifold(a, pa, b, pb, Detector::Accelerated, 1e-4, kept_cache, kept);
+    const auto manifold_fresh = build_manifold(a, pa, b, pb, Detector::Accelerated, 1e-4);
     ASSERT_EQ(manifold_reused.has_value(), manifold_fresh.has_value()) << "trial " << trial;
     if (!manifold_fresh) continue;
     EXPECT_EQ(manifold_reused->normal, manifold_fresh->normal) << "trial " << trial;

@@ -17,7 +17,7 @@ using test::box_body;
 // A one-pair problem: the manifold of bodies[0] and bodies[1] at their poses.
 std::vector<PairManifold> manifolds_of(const std::vector<RigidBody>& bodies) {
   const RigidBody &a = bodies[0], &b = bodies[1];
-  auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), DetectorVariant::Faithful);
+  auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), Detector::Faithful);
   if (!m) return {};
   return {{0, 1, *m, a.pose(), b.pose()}};
 }
@@ -297,7 +297,7 @@ StackOfFive stack_of_five(double mu, std::mt19937* rng = nullptr) {
   }
   for (int k = 0; k + 1 < static_cast<int>(st.bodies.size()); ++k) {
     const RigidBody &a = st.bodies[k + 1], &b = st.bodies[k];
-    auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), DetectorVariant::Faithful);
+    auto m = build_manifold(*a.shape, a.pose(), *b.shape, b.pose(), Detector::Faithful);
     if (m) st.manifolds.push_back({k + 1, k, *m, a.pose(), b.pose()});
   }
   st.approach = normal_velocities(st.bodies, st.manifolds);

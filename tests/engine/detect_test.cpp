@@ -366,8 +366,8 @@ TEST(Detect, RotatedPosesGiveWorldFrameResults) {
 TEST(Detect, FastVariantMatchesSeed) {
   // One hand-built pose here; tests/engine/accelerated_detect_test.cpp holds the randomised check.
   const CrossedBars s;
-  const auto seed = detect(s.a, s.pa, s.b, s.pb, DetectorVariant::Faithful);
-  const auto fast = detect(s.a, s.pa, s.b, s.pb, DetectorVariant::Accelerated);
+  const auto seed = detect(s.a, s.pa, s.b, s.pb, Detector::Faithful);
+  const auto fast = detect(s.a, s.pa, s.b, s.pb, Detector::Accelerated);
   ASSERT_TRUE(seed.has_value() && fast.has_value());
   expect_vec_near(fast->point, seed->point, kDetectRoundOff);
   expect_vec_near(fast->normal, seed->normal, kDetectRoundOff);

@@ -22,8 +22,8 @@ TEST(Manifold, FaceLandingHasTheFourCorners) {
   // placed midway between the cube's base (z = -0.001) and the slab's top (z = 0), as the
   // oracle's patch is (docs/contact_manifold.md).
   const ConvexPolyhedron cube = make_box(Vec3::Ones()), slab = make_box(Vec3(4, 4, 1));
-  const auto m = build_manifold(cube, at(Vec3(0, 0, 0.499)), slab, at(Vec3(0, 0, -0.5)),
-                                DetectorVariant::Faithful);
+  const auto m =
+      build_manifold(cube, at(Vec3(0, 0, 0.499)), slab, at(Vec3(0, 0, -0.5)), Detector::Faithful);
   ASSERT_TRUE(m);
   EXPECT_NEAR((m->normal - Vec3::UnitZ()).norm(), 0.0, 1e-12);
   ASSERT_EQ(m->points.size(), 4u);
@@ -43,7 +43,7 @@ TEST(Manifold, CornerLandingIsOnePointAtTheVertex) {
   const ConvexPolyhedron cube = make_box(Vec3::Ones()), slab = make_box(Vec3(4, 4, 1));
   const double half_diagonal = std::sqrt(3.0) / 2;
   const Pose pa = at(Vec3(0, 0, half_diagonal - 0.001), q), pb = at(Vec3(0, 0, -0.5));
-  const auto m = build_manifold(cube, pa, slab, pb, DetectorVariant::Faithful);
+  const auto m = build_manifold(cube, pa, slab, pb, Detector::Faithful);
   ASSERT_TRUE(m);
   ASSERT_EQ(m->points.size(), 1u);
   EXPECT_NEAR(m->points[0].point.norm(), 0.0005, 1e-9);
@@ -57,7 +57,7 @@ TEST(Manifold, CrossedEdgesGiveTheirCrossing) {
   const double h = 0.1 * std::sqrt(2.0);
   const Pose pa = at(Vec3(0, 0, h - 0.025), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX())));
   const Pose pb = at(Vec3(0, 0, -h + 0.025), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY())));
-  const auto m = build_manifold(bar_x, pa, bar_y, pb, DetectorVariant::Faithful);
+  const auto m = build_manifold(bar_x, pa, bar_y, pb, Detector::Faithful);
   ASSERT_TRUE(m);
   ASSERT_EQ(m->points.size(), 1u);
   EXPECT_NEAR(m->points[0].point.norm(), 0.0, 1e-12);
@@ -71,7 +71,7 @@ TEST(Manifold, ACubeTurnedAMicroradianKeepsTheFourCornersOfItsFace) {
   // their neighbours, one of each pair goes, and the four left are the square's corners to 1e-6.
   const ConvexPolyhedron cube = make_box(Vec3::Ones());
   const Pose pa = at(Vec3(0, 0, 0.999), Quat(Eigen::AngleAxisd(1e-6, Vec3::UnitZ())));
-  const auto m = build_manifold(cube, pa, cube, at(Vec3::Zero()), DetectorVariant::Faithful);
+  const auto m = build_manifold(cube, pa, cube, at(Vec3::Zero()), Detector::Faithful);
   ASSERT_TRUE(m);
   ASSERT_EQ(m->points.size(), 4u);
   for (const ManifoldPoint& p : m->points) {
@@ -79,16 +79,15 @@ TEST(Manifold, ACubeTurnedAMicroradianKeepsTheFourCornersOfItsFace) {
     EXPECT_NEAR(std::abs(p.point.y()), 0.5, 1e-6);
   }
   // With no slack the octagon's eight corners stay.
-  EXPECT_EQ(build_manifold(cube, pa, cube, at(Vec3::Zero()), DetectorVariant::Faithful, 0.0)
-                ->points.size(),
-            8u);
+  EXPECT_EQ(
+      build_manifold(cube, pa, cube, at(Vec3::Zero()), Detector::Faithful, 0.0)->points.size(), 8u);
 }
 
 TEST(Manifold, ACubeTurned45DegreesKeepsItsOctagon) {
   // Turned 45 deg, the octagon is the region itself: no corner is near its neighbours' line.
   const ConvexPolyhedron cube = make_box(Vec3::Ones());
   const Pose pa = at(Vec3(0, 0, 0.999), Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ())));
-  const auto m = build_manifold(cube, pa, cube, at(Vec3::Zero()), DetectorVariant::Faithful);
+  const auto m = build_manifold(cube, pa, cube, at(Vec3::Zero()), Detector::Faithful);
   ASSERT_TRUE(m);
   EXPECT_EQ(m->points.size(), 8u);
 }
@@ -103,15 +102,14 @@ TEST(Manifold, ADeepCornerIsItsVertexAndTiltedTheCornersOfItsFaceBelowTheSlab) {
   const Quat q = Quat(Eigen::AngleAxisd(std::atan(std::sqrt(2.0)), Vec3(1, -1, 0).normalized()));
   const ConvexPolyhedron cube = make_box(Vec3::Ones()), slab = make_box(Vec3(4, 4, 1));
   const Pose pb = at(Vec3(0, 0, -0.5));
-  const auto even =
-      build_manifold(cube, at(Vec3(0, 0, 0.1), q), slab, pb, DetectorVariant::Faithful);
+  const auto even = build_manifold(cube, at(Vec3(0, 0, 0.1), q), slab, pb, Detector::Faithful);
   ASSERT_TRUE(even);
   EXPECT_NEAR(std::abs(even->normal.z()), 1.0, 1e-12);
   ASSERT_EQ(even->points.size(), 1u);
   EXPECT_NEAR(even->points[0].depth, std::sqrt(3.0) / 2 - 0.1, 1e-12);
   const Quat tilt(Eigen::AngleAxisd(0.01, Vec3::UnitX()));
   const Pose pa = at(Vec3(0, 0, 0.1), tilt * q);
-  const auto tilted = build_manifold(cube, pa, slab, pb, DetectorVariant::Faithful);
+  const auto tilted = build_manifold(cube, pa, slab, pb, Detector::Faithful);
   ASSERT_TRUE(tilted);
   ASSERT_EQ(tilted->points.size(), 3u);
   double deepest = 0.0;
@@ -141,7 +139,7 @@ TEST(Manifold, ARoundBodyOnAVertexIsThatVertex) {
   const Pose pa = at(Vec3(0, 0, 0.4), q), pb = at(Vec3(0, 0, -0.5));
   int inside = 0;
   for (const Vec3& v : ball.vertices()) inside += pa.apply(v).z() < 0.0 ? 1 : 0;
-  const auto m = build_manifold(ball, pa, slab, pb, DetectorVariant::Faithful);
+  const auto m = build_manifold(ball, pa, slab, pb, Detector::Faithful);
   ASSERT_TRUE(m);
   EXPECT_GT(inside, 1);
   ASSERT_EQ(m->points.size(), 1u);
@@ -151,8 +149,8 @@ TEST(Manifold, ARoundBodyOnAVertexIsThatVertex) {
 
 TEST(Manifold, NothingWhenApart) {
   const ConvexPolyhedron cube = make_box(Vec3::Ones());
-  EXPECT_FALSE(build_manifold(cube, at(Vec3(0, 0, 1.01)), cube, at(Vec3::Zero()),
-                              DetectorVariant::Faithful));
+  EXPECT_FALSE(
+      build_manifold(cube, at(Vec3(0, 0, 1.01)), cube, at(Vec3::Zero()), Detector::Faithful));
 }
 
 TEST(Manifold, EitherBodyOrderGivesTheSamePointsWithTheNormalReversed) {
@@ -177,10 +175,8 @@ TEST(Manifold, EitherBodyOrderGivesTheSamePointsWithTheNormalReversed) {
     const Pose pa{random_rotation(rng) * Vec3::UnitX() * unit(rng) * 1.2, random_rotation(rng)};
     const Pose pb{Vec3::Zero(), random_rotation(rng)};
     const double slop = WorldSettings{}.position_slop;
-    const auto ab =
-        build_manifold(a, pa, b, pb, DetectorVariant::Accelerated, slop, cache, scratch);
-    const auto ba =
-        build_manifold(b, pb, a, pa, DetectorVariant::Accelerated, slop, cache, scratch);
+    const auto ab = build_manifold(a, pa, b, pb, Detector::Accelerated, slop, cache, scratch);
+    const auto ba = build_manifold(b, pb, a, pa, Detector::Accelerated, slop, cache, scratch);
     ASSERT_EQ(ab.has_value(), ba.has_value()) << "trial " << trial;
     if (!ab) continue;
     ++compared;

@@ -62,8 +62,8 @@ TEST(Separation, AWitnessMeansTheDetectorFindsNothing) {
     if (w == Vec3::Zero()) continue;
     ++witnessed;
     if (gap_along(a, pa, b, pb, w) < 20.0 * tol) ++near;
-    EXPECT_FALSE(detect(a, pa, b, pb, DetectorVariant::Accelerated)) << "trial " << k;
-    EXPECT_FALSE(detect(a, pa, b, pb, DetectorVariant::Faithful)) << "trial " << k;
+    EXPECT_FALSE(detect(a, pa, b, pb, Detector::Accelerated)) << "trial " << k;
+    EXPECT_FALSE(detect(a, pa, b, pb, Detector::Faithful)) << "trial " << k;
   }
   // Not vacuous: a good share found a witness, and some of them within a few tolerances.
   EXPECT_GT(witnessed, trials / 10);
@@ -129,7 +129,7 @@ TEST(Separation, BesideAWallTheNearestPointOfItsBoxProvesIt) {
   ASSERT_NE(w, Vec3::Zero());
   EXPECT_GT(gap_along(cube, pa, wall, pb, w), margin);
   EXPECT_NEAR(w.y(), 1.0, 1e-12);
-  EXPECT_FALSE(detect(cube, pa, wall, pb, DetectorVariant::Accelerated));
+  EXPECT_FALSE(detect(cube, pa, wall, pb, Detector::Accelerated));
   // The same pair with the roles swapped (the wall as a): the cube's box sees it from -y.
   const Vec3 v = find_separating_axis(wall, pb, cube, pa, margin);
   ASSERT_NE(v, Vec3::Zero());

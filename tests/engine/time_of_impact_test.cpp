@@ -30,16 +30,14 @@ RigidBody wall() {
 TEST(TimeOfImpact, ThinPlateMeetsThinWallAtTheClosedFormTime) {
   // stress/tunnel_thin_wall: front face -0.295 + 100 t meets 0.995 at t = 0.0129 s; the step
   // 0.02 s starts separated and ends past the wall.
-  const TimeOfImpact hit =
-      time_of_impact(plate(), wall(), 0.02, DetectorVariant::Faithful, kSamples);
+  const TimeOfImpact hit = time_of_impact(plate(), wall(), 0.02, Detector::Faithful, kSamples);
   ASSERT_TRUE(hit.certified);
   ASSERT_TRUE(hit.time);
   const double t = *hit.time;
   // Bisection to 1e-12 of dt plus the detector's touching tolerance (1e-9 of the size, 2e-11 s
   // at 100 m/s).
   EXPECT_NEAR(t, 0.0129, 1e-10);
-  const TimeOfImpact miss =
-      time_of_impact(plate(), wall(), 0.012, DetectorVariant::Faithful, kSamples);
+  const TimeOfImpact miss = time_of_impact(plate(), wall(), 0.012, Detector::Faithful, kSamples);
   EXPECT_TRUE(miss.certified);
   EXPECT_FALSE(miss.time);
 }
@@ -55,7 +53,7 @@ TEST(TimeOfImpact, AFallAtTheSpeedLimitIsCaughtAtItsClosedFormTime) {
   const RigidBody slab = box_body("slab", Vec3(4, 4, 0.01), 1.0, Vec3(0, 0, -0.005),
                                   Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true);
   for (const double dt : {1e-3, 1.0}) {
-    const TimeOfImpact hit = time_of_impact(cube, slab, dt, DetectorVariant::Accelerated, 100);
+    const TimeOfImpact hit = time_of_impact(cube, slab, dt, Detector::Accelerated, 100);
     ASSERT_TRUE(hit.certified) << "dt " << dt;
     ASSERT_TRUE(hit.time) << "dt " << dt;
     // Bisection to 1e-12 of dt, the detector's touching tolerance (1e-9 of the size: 3e-18 s
@@ -82,14 +80,13 @@ TEST(TimeOfImpact, ASearchPastItsSampleLimitIsNotCertified) {
                                         Quat::Identity(), Vec3(1e8, 0, 0));
   const RigidBody floor = box_body("floor", Vec3(1e3, 1e3, 1), 1.0, Vec3(0, 0, -0.5),
                                    Quat::Identity(), Vec3::Zero(), Vec3::Zero(), true);
-  const TimeOfImpact hit =
-      time_of_impact(plate_over, floor, 1e-3, DetectorVariant::Accelerated, 100);
+  const TimeOfImpact hit = time_of_impact(plate_over, floor, 1e-3, Detector::Accelerated, 100);
   EXPECT_FALSE(hit.certified);
   EXPECT_FALSE(hit.time);
   // Over a step of 1 ns (0.1 m, 40 quarter thicknesses of the plate) the search is within its
   // limit: certified, no touch.
   const TimeOfImpact short_step =
-      time_of_impact(plate_over, floor, 1e-9, DetectorVariant::Accelerated, 100);
+      time_of_impact(plate_over, floor, 1e-9, Detector::Accelerated, 100);
   EXPECT_TRUE(short_step.certified);
   EXPECT_FALSE(short_step.time);
 
@@ -98,7 +95,7 @@ TEST(TimeOfImpact, ASearchPastItsSampleLimitIsNotCertified) {
   sim.duration = 0.01;
   WorldSettings tunables;
   tunables.toi_max_samples = 100;
-  World world(sim, {plate_over, floor}, ContactModel::Extended, DetectorVariant::Accelerated,
+  World world(sim, {plate_over, floor}, ContactModel::Extended, Detector::Accelerated,
               BroadPhaseMethod::Tree, tunables);
   const RunResult r = world.run();
   EXPECT_FALSE(r.ok);
@@ -145,7 +142,7 @@ TEST(TimeOfImpact, NoPointTravelsFartherThanTheTravelBound) {
   EXPECT_GT(tightest, 0.2);
 }
 
-// The extended world, every step size of the thin wall's sweep: the plate bounces at -100 m/s.
+// The extended world, every step size of the thin wall's dt study: the plate bounces at -100 m/s.
 TEST(ExtendedWorld, ThinWallNeverTunnels) {
   for (double dt : {1e-2, 5e-3, 1e-3, 2e-4, 1e-4, 5e-5}) {
     SimSettings sim;

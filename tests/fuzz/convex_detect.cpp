@@ -74,8 +74,8 @@ std::string describe(const ContactPoint& c) {
 }
 
 // The contract of a contact (engine/contact.h): unit normal, finite point, finite depth >= 0.
-void check_contact(const ContactPoint& c, const std::string& variant) {
-  const std::string what = variant + ": " + describe(c);
+void check_contact(const ContactPoint& c, const std::string& detector) {
+  const std::string what = detector + ": " + describe(c);
   require(c.point.allFinite(), "non-finite point: " + what);
   require(c.normal.allFinite(), "non-finite normal: " + what);
   // Unit to round-off: a normalised vector is within a few ulps of length 1.
@@ -102,9 +102,8 @@ void convex_detect(const uint8_t* data, size_t size) {
   const Pose pa = decode_pose(in, reach);
   const Pose pb = decode_pose(in, reach);
 
-  const std::optional<ContactPoint> faithful = detect(*a, pa, *b, pb, DetectorVariant::Faithful);
-  const std::optional<ContactPoint> accelerated =
-      detect(*a, pa, *b, pb, DetectorVariant::Accelerated);
+  const std::optional<ContactPoint> faithful = detect(*a, pa, *b, pb, Detector::Faithful);
+  const std::optional<ContactPoint> accelerated = detect(*a, pa, *b, pb, Detector::Accelerated);
   if (faithful) check_contact(*faithful, "Faithful");
   if (accelerated) check_contact(*accelerated, "Accelerated");
 

@@ -40,7 +40,7 @@ void scene_parser(const uint8_t* data, size_t size);
 void obj_loader(const uint8_t* data, size_t size);
 
 /// Custom detector on a random convex pair: the bytes decoded as two point sets (convex_hull)
-/// and two poses, then rbx::detect with DetectorVariant::Faithful and ::Fast. Allowed from
+/// and two poses, then rbx::detect with Detector::Faithful and ::Fast. Allowed from
 /// convex_hull: GeometryError (the pair is skipped). Checked: a contact has a finite unit
 /// normal, a finite depth >= 0 and a finite point; no contact when the world bounding boxes
 /// are apart by more than the detector's own tolerance; Fast gives Seed's answer.

@@ -127,7 +127,7 @@ std::pair<int, int> compare_on_random_pairs(uint64_t seed, int trials, double sk
     const Vec3 vb = va - (gap / arrival) * dir + (skim_draw < skimming ? 50.0 : drift) * side;
     const ExactImpact truth = exact_translation_impact(sa, pa, va, sb, pb, vb, dt);
     const TimeOfImpact ours =
-        time_of_impact(moving(sa, pa, va), moving(sb, pb, vb), dt, DetectorVariant::Accelerated,
+        time_of_impact(moving(sa, pa, va), moving(sb, pb, vb), dt, Detector::Accelerated,
                        WorldSettings{}.toi_max_samples);
     EXPECT_TRUE(ours.certified) << trial;
     EXPECT_EQ(ours.time.has_value(), truth.time.has_value())
@@ -188,9 +188,8 @@ TEST(ExactTranslationImpact, CustomSeesAFastSkimBetweenItsSamples) {
                                     .depth);
   }
   EXPECT_GT(deepest, 0.0);
-  const TimeOfImpact ours =
-      time_of_impact(moving(sa, pa, va), moving(sb, pb, vb), dt, DetectorVariant::Accelerated,
-                     WorldSettings{}.toi_max_samples);
+  const TimeOfImpact ours = time_of_impact(moving(sa, pa, va), moving(sb, pb, vb), dt,
+                                           Detector::Accelerated, WorldSettings{}.toi_max_samples);
   ASSERT_TRUE(ours.certified);
   ASSERT_TRUE(ours.time);
   const double size = std::max(shape_size(sa), shape_size(sb));

@@ -2,7 +2,7 @@
 // OdeSettings and MujocoSettings measured against its alternatives on closed-form scenes (the
 // scenes of scenes/analytic, scenes/seed and scenes/stress rebuilt here with the same bodies,
 // masses, velocities, dt and e), plus the done-criterion of the fair-references issue: the plain
-// backends match the closed form, the `-hull` variants keep the one-point hull's errors.
+// backends match the closed form, the `-hull` backends keep the one-point hull's errors.
 //
 // Error measure: the report's velocity error in the kinetic-energy norm,
 // sqrt(sum m|dv|^2 + dw.I.dw) / sqrt(2 E_ref) (comparisons/eval/metrics.h), recomputed here so that
@@ -902,7 +902,7 @@ TEST(BulletSettingsMeasured, FrictionOnTheSlideFamily) {
 // ---------------------------------------------------------------------------------------------
 // The issue's done-criterion on every closed-form box scene.
 
-TEST(FairReferences, PlainBackendsMatchTheClosedFormHullVariantsDoNot) {
+TEST(FairReferences, PlainBackendsMatchTheClosedFormHullBackendsDoNot) {
   for (const Case& c : box_cases()) {
     EXPECT_LT(measured("bullet", c, ke_error(c, bullet.dynamics(c.scene, {}))), kExact) << c.name;
     EXPECT_LT(measured("ode", c, ke_error(c, ode.dynamics(c.scene, {}))), kOdeSoft) << c.name;
@@ -920,7 +920,7 @@ TEST(FairReferences, PlainBackendsMatchTheClosedFormHullVariantsDoNot) {
     }
     measured("dart-hull", c, ke_error(c, dart_hull.dynamics(c.scene, {})));
   }
-  // The hull variants keep today's one-point errors on the issue's first scene.
+  // The -hull backends keep today's one-point errors on the issue's first scene.
   const Case c = box_cases()[0];
   EXPECT_GT(ke_error(c, bullet_hull.dynamics(c.scene, {})), 0.1);
   EXPECT_GT(ke_error(c, ode_hull.dynamics(c.scene, {})), 0.1);
@@ -986,7 +986,7 @@ TEST(FairReferences, NativeBoxQueriesGiveTheFourCornerFaceManifold) {
     EXPECT_LT((c.normal - Vec3(-1, 0, 0)).norm(), 2e-3);
     EXPECT_NEAR(c.depth, 0.1, 1e-6);
   }
-  // The -hull variants keep their one-point answer.
+  // The -hull backends keep their one-point answer.
   EXPECT_EQ(ode_hull.contact(a, b).contacts.size(), 1u);
   EXPECT_EQ(fcl_hull.contact(a, b).contacts.size(), 1u);
   EXPECT_EQ(mujoco_hull.contact(a, b).contacts.size(), 1u);
