@@ -86,10 +86,13 @@ void DynamicsRecorder::follow_cone_excess(double dt) {
     const Mat3 rot = before_[i].orientation.toRotationMatrix();
     const double inertia = axis.dot(rot * inertia_body_[i] * rot.transpose() * axis);
     const double speed = (v - v.dot(axis) * axis).norm();
+    // The step's friction directions are set from the velocities it starts with (Bullet, ODE
+    // and DART fix them before solving), so its friction damps the spin brought into it, and the
+    // spin its own excess adds meets friction from the next step.
     double& spin = excess_spin_[i];
     spin = speed <= kRestSpeed || !(inertia > 0.0)
                ? 0.0
-               : (spin + torque[i] / inertia) / (1.0 + damping[i] / inertia);
+               : spin / (1.0 + damping[i] / inertia) + torque[i] / inertia;
     ConeExcess& u = cone_excess_[i];
     u.body = static_cast<int>(i);
     u.points += points[i];
