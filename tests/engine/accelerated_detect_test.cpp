@@ -1,7 +1,7 @@
-// The accelerated detector against the faithful seed loops (its reference): on thousands of
+// The accelerated detector against the faithful detector's loops (its reference): on thousands of
 // fixed-seed poses of boxes, prisms and (sheared) icospheres from 8 to 642 vertices, touching, deep
 // and separated, the fast path returns the same hit or miss, feature, point, normal and depth as
-// the seed path, for the full detector and for each feature test alone (the world calls those).
+// the faithful path, for the full detector and for each feature test alone (the world calls those).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -18,19 +18,19 @@
 namespace rbx {
 namespace {
 
-// The fast path evaluates the seed's own floating-point expressions on the same world-frame
-// data and only skips evaluations a bound proves irrelevant, so its answers are expected to be
-// bit-identical: every comparison below is exact (no tolerance).
-void expect_same(const std::optional<ContactPoint>& fast, const std::optional<ContactPoint>& seed,
-                 const std::string& where) {
-  ASSERT_EQ(fast.has_value(), seed.has_value()) << where;
-  if (!seed) return;
-  EXPECT_EQ(fast->feature, seed->feature) << where;
-  EXPECT_EQ(fast->point, seed->point)
-      << where << "\n fast " << fast->point.transpose() << "\n seed " << seed->point.transpose();
-  EXPECT_EQ(fast->normal, seed->normal)
-      << where << "\n fast " << fast->normal.transpose() << "\n seed " << seed->normal.transpose();
-  EXPECT_EQ(fast->depth, seed->depth) << where;
+// The fast path evaluates the faithful path's own floating-point expressions on the same
+// world-frame data and only skips evaluations a bound proves irrelevant, so its answers are
+// expected to be bit-identical: every comparison below is exact (no tolerance).
+void expect_same(const std::optional<ContactPoint>& fast,
+                 const std::optional<ContactPoint>& faithful, const std::string& where) {
+  ASSERT_EQ(fast.has_value(), faithful.has_value()) << where;
+  if (!faithful) return;
+  EXPECT_EQ(fast->feature, faithful->feature) << where;
+  EXPECT_EQ(fast->point, faithful->point) << where << "\n fast " << fast->point.transpose()
+                                          << "\n faithful " << faithful->point.transpose();
+  EXPECT_EQ(fast->normal, faithful->normal) << where << "\n fast " << fast->normal.transpose()
+                                            << "\n faithful " << faithful->normal.transpose();
+  EXPECT_EQ(fast->depth, faithful->depth) << where;
 }
 
 Quat random_rotation(std::mt19937_64& rng) {
@@ -72,12 +72,12 @@ struct Tally {
 // Compares the two detectors at one pose: the full detector and each feature test alone.
 void compare_at(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedron& b,
                 const Pose& pb, const std::string& where, Tally& tally) {
-  const auto seed = detect(a, pa, b, pb, Detector::Faithful);
+  const auto faithful = detect(a, pa, b, pb, Detector::Faithful);
   const auto fast = detect(a, pa, b, pb, Detector::Accelerated);
-  expect_same(fast, seed, where);
-  if (seed) {
+  expect_same(fast, faithful, where);
+  if (faithful) {
     ++tally.hits;
-    ++tally.features[seed->feature];
+    ++tally.features[faithful->feature];
   } else {
     ++tally.misses;
   }
@@ -89,7 +89,8 @@ void compare_at(const ConvexPolyhedron& a, const Pose& pa, const ConvexPolyhedro
 
 // Under the sanitizers (RBX_SANITIZE, CMakeLists.txt) a third of the random poses: there they look
 // for memory errors and undefined behaviour, which the same code paths meet at a third of the
-// count, while the seed reference's tests cost ten times more; the Release pass runs every pose.
+// count, while the faithful reference's tests cost ten times more; the Release pass runs every
+// pose.
 #if defined(RBX_SANITIZE)
 constexpr int kPoseDivisor = 3;
 #else
@@ -160,7 +161,7 @@ void expect_representative(const Tally& t, const std::string& name) {
   EXPECT_GE(t.misses, total / 10) << name << ": too few misses for the sample to test them";
 }
 
-TEST(AcceleratedDetect, BoxesMatchSeed) {
+TEST(AcceleratedDetect, BoxesMatchTheFaithfulDetector) {
   const ConvexPolyhedron a = make_box(Vec3(1, 1, 1)), b = make_box(Vec3(1.2, 0.6, 0.9));
   Tally t;
   random_poses(a, b, 3000, 1, "box-box", t);
@@ -172,7 +173,7 @@ TEST(AcceleratedDetect, BoxesMatchSeed) {
   EXPECT_GT(t.features["edge"], 0);
 }
 
-TEST(AcceleratedDetect, PrismsMatchSeed) {
+TEST(AcceleratedDetect, PrismsMatchTheFaithfulDetector) {
   // 8 sides: 28 triangles (plain loops); 24 sides: 92 triangles (hierarchies); both have
   // fan-triangulated caps, so several coplanar triangles share a plane.
   const ConvexPolyhedron p8 = make_prism(0.5, 0.8, 8), p24 = make_prism(0.5, 1.0, 24);
@@ -190,7 +191,7 @@ TEST(AcceleratedDetect, PrismsMatchSeed) {
   EXPECT_GT(t.features["edge"], 0);
 }
 
-TEST(AcceleratedDetect, IcospheresMatchSeed) {
+TEST(AcceleratedDetect, IcospheresMatchTheFaithfulDetector) {
   const ConvexPolyhedron s1 = sheared_icosphere(1), s2 = sheared_icosphere(2);
   const ConvexPolyhedron i2 = make_icosphere(0.5, 2), i3 = make_icosphere(0.5, 3);
   const ConvexPolyhedron box = make_box(Vec3(1, 1, 1));
@@ -206,7 +207,7 @@ TEST(AcceleratedDetect, IcospheresMatchSeed) {
 
 // Hulls above kLinearVertices search their trees (caps grown over edges, bounded clusters of
 // face planes); the smaller ones above scan. Both sizes against each other and a box.
-TEST(AcceleratedDetect, HullsThatSearchTheirTreesMatchSeed) {
+TEST(AcceleratedDetect, HullsThatSearchTheirTreesMatchTheFaithfulDetector) {
   const ConvexPolyhedron s3 = sheared_icosphere(3), i3 = make_icosphere(0.5, 3);
   const ConvexPolyhedron s2 = sheared_icosphere(2), box = make_box(Vec3(1, 1, 1));
   ASSERT_GT(static_cast<int>(s3.vertices().size()), detail::kLinearVertices);

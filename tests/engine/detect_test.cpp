@@ -363,16 +363,16 @@ TEST(Detect, RotatedPosesGiveWorldFrameResults) {
   }
 }
 
-TEST(Detect, FastVariantMatchesSeed) {
+TEST(Detect, TheAcceleratedDetectorMatchesTheFaithfulOne) {
   // One hand-built pose here; tests/engine/accelerated_detect_test.cpp holds the randomised check.
   const CrossedBars s;
-  const auto seed = detect(s.a, s.pa, s.b, s.pb, Detector::Faithful);
+  const auto faithful = detect(s.a, s.pa, s.b, s.pb, Detector::Faithful);
   const auto fast = detect(s.a, s.pa, s.b, s.pb, Detector::Accelerated);
-  ASSERT_TRUE(seed.has_value() && fast.has_value());
-  expect_vec_near(fast->point, seed->point, kDetectRoundOff);
-  expect_vec_near(fast->normal, seed->normal, kDetectRoundOff);
-  EXPECT_NEAR(fast->depth, seed->depth, kDetectRoundOff);
-  EXPECT_EQ(fast->feature, seed->feature);
+  ASSERT_TRUE(faithful.has_value() && fast.has_value());
+  expect_vec_near(fast->point, faithful->point, kDetectRoundOff);
+  expect_vec_near(fast->normal, faithful->normal, kDetectRoundOff);
+  EXPECT_NEAR(fast->depth, faithful->depth, kDetectRoundOff);
+  EXPECT_EQ(fast->feature, faithful->feature);
 }
 
 TEST(Detect, TestBeforePrepareIsRejected) {
