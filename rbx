@@ -8,7 +8,7 @@
 # `./rbx python [ARGS...]` builds the Python module and runs python3 with `import rbx` working.
 # `./rbx format [--check]` applies (or checks) clang-format on every tracked C++ source.
 # `./rbx fuzz [SECONDS]` builds the libFuzzer targets (tests/fuzz) with clang, ASan and UBSan in
-# build-fuzz/ and runs each for SECONDS (default 60) from its seed corpus, one per core at a time.
+# build-fuzz/ and runs each for SECONDS (default 60) from its starting corpus, one per core at a time.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 # Paths on the command line are the caller's: remember where the caller stands, build from the
@@ -108,7 +108,7 @@ fi
 # Fuzzing: its own build folder and compiler; a crash leaves its input in
 # build-fuzz/crashes/<target>/ (copy it to tests/fuzz/regressions/<target>/ once fixed) and
 # makes the action exit 1. New inputs found go to build-fuzz/corpus/<target>/, never into the
-# committed seed corpus.
+# committed starting corpus.
 if [ "${1:-}" = "fuzz" ]; then
   seconds="${2:-60}"
   if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [ "$seconds" -eq 0 ] || [ $# -gt 2 ]; then

@@ -1,7 +1,7 @@
 // Replays every committed fuzz input through its target's entry function, built with the normal
 // compiler so that `./rbx test` (and `./rbx test --sanitize`) keep every bug the fuzzers found
 // fixed: the regressions (inputs that once crashed or broke an invariant,
-// tests/fuzz/regressions/<target>/) and the seed corpus (tests/fuzz/corpus/<target>/).
+// tests/fuzz/regressions/<target>/) and the starting corpus (tests/fuzz/corpus/<target>/).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -62,10 +62,10 @@ TEST_P(Replay, Regressions) {
   for (const fs::path& f : files) replay(GetParam(), f);
 }
 
-TEST_P(Replay, SeedCorpus) {
+TEST_P(Replay, StartingCorpus) {
   const fs::path dir = fs::path(RBX_SOURCE_DIR) / "tests/fuzz/corpus" / GetParam().name;
   const std::vector<fs::path> files = files_in(dir);
-  // Every target has a seed corpus of at least a handful of inputs (tests/fuzz/README.md).
+  // Every target has a starting corpus of at least a handful of inputs (tests/fuzz/README.md).
   ASSERT_GE(files.size(), 5u) << dir;
   for (const fs::path& f : files) replay(GetParam(), f);
 }

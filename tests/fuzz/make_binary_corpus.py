@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the binary seed inputs of tests/fuzz/corpus (run from anywhere; output is fixed).
+"""Writes the binary inputs of tests/fuzz/corpus (run from anywhere; output is fixed).
 
 convex_detect: two shapes, then two poses, in the decoding of convex_detect.cpp:
   per shape: u8 scale (2^(b % 25 - 12) m), u8 count (4 + b % 13 points), 3 x i8 per point
