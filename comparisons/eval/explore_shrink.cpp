@@ -194,8 +194,8 @@ bool own_run_reproduces(const Scene& scene, const std::vector<RigidBody>& bodies
     const double rise = ran ? largest_rise(run.samples, bodies[0].position, rest, n) : -1.0;
     d << "rose " << rise << " m off its surface (the scene's own run, every step)";
     if (rise > kSlideLiftMark) return true;
-    // A smaller rise names a slide's late rest that the box's normal momentum at its stop
-    // accounts for (a slide's box starts on its surface; a landing's above it).
+    // A smaller rise names a slide's late rest that the box's normal momentum just before it
+    // stopped accounts for (a slide's box starts on its surface; a landing's above it).
     const bool slide = (bodies[0].position - rest).dot(n) <= 0.1 * kSlideLiftMark;
     const double closed_form = ran && slide ? slide_rest_time(scene) : 0.0;
     if (!(closed_form > 0.0)) return false;
