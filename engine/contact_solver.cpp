@@ -1,11 +1,13 @@
 #include "engine/contact_solver.h"
 
-#include <Eigen/Dense>
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <tuple>
 #include <utility>
+
+#include "engine/dense_solve.h"
 
 namespace rbx {
 
@@ -226,11 +228,7 @@ double ActiveSet::solve_guess(Eigen::Index& worst) {
     A.row(q) = KE.row(equations[q]);
     rhs(q) = b(equations[q]);
   }
-  // One step of iterative refinement: the residual of the first solve, solved again and added,
-  // takes the answer's round-off from cond(A) ulps down to a few.
-  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(A);
-  Eigen::VectorXd y = cod.solve(rhs);
-  y += cod.solve(rhs - A * y);
+  const Eigen::VectorXd y = least_norm_solve_refined(A, rhs);
   x = E.leftCols(unknowns) * y;
   w = K * x - b;
   // Each equation K x - b sums `size` terms K_qj x_j and b_q, which cancel at a resting stack
@@ -284,7 +282,7 @@ double ActiveSet::settle_slip_directions(double residual, Eigen::Index& worst) {
       J.col(k) = (crossing(sliding) - g) / kStep;
       turn(slip[sliding[k]], -kStep);
     }
-    Eigen::VectorXd step = -J.colPivHouseholderQr().solve(g);
+    Eigen::VectorXd step = -pivoted_qr_solve(J, g);
     const double largest = step.cwiseAbs().maxCoeff();
     if (!(largest < 1e300)) break;
     if (largest > 0.5) step *= 0.5 / largest;  // at most half a radian a step
