@@ -482,9 +482,11 @@ ContactSample moved_apart(ContactSample s, uint64_t seed, uint64_t index);
 /// distance query (those without one left out) and classifies each answer by rbx distance's
 /// verdict (judge_distance): status error, then overlap (says the pair overlaps), then distance
 /// (off by more than kDistanceDisagreeRel), then witness (the points are not a closest pair).
+/// A library's answer comes from `cache` when it holds one, and is kept there when not.
 SampleOutcome evaluate_distance_sample(const ContactSample& s,
                                        const std::vector<std::string>& names,
-                                       const std::vector<Backend>* table = nullptr);
+                                       const std::vector<Backend>* table = nullptr,
+                                       const ResultCache* cache = nullptr);
 
 // ---------------------------------------------------------------------------------------------
 // Toi kind: the distance kind's separated pairs (gaps 1e-9 to 10 sizes), hulls cut to their
@@ -517,6 +519,8 @@ std::string toi_scene_text(const ToiSample& s, const std::string& header = "");
 /// and its variants' (rows without one left out); classifies each answer by rbx toi's verdict
 /// (judge_toi): status error, then misses (no touch where the oracle has one), then
 /// false_contact (a touch where it has none), then time (over kToiDisagree of the interval).
-SampleOutcome evaluate_toi_sample(const ToiSample& s, const std::vector<std::string>& names);
+/// A library's answer comes from `cache` when it holds one, and is kept there when not.
+SampleOutcome evaluate_toi_sample(const ToiSample& s, const std::vector<std::string>& names,
+                                  const ResultCache* cache = nullptr);
 
 }  // namespace rbx

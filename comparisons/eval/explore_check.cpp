@@ -181,7 +181,7 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
     const std::vector<std::string> encoded =
         run.map(static_cast<size_t>(set.distance), [&](size_t i) {
           return encode(evaluate_distance_sample(make_distance_sample(set.seed, i),
-                                                 distance_backends, table));
+                                                 distance_backends, table, cache));
         });
     tally("explore/distance", encoded, {"distance_err_rel", "witness_err_rel"}, "exact", out);
     if (queries && run.root()) {
@@ -197,7 +197,7 @@ std::vector<ExploreCheckMetric> explore_check_metrics(
       toi_backends.push_back(name);
   if (!toi_backends.empty() && set.toi > 0) {
     const std::vector<std::string> encoded = run.map(static_cast<size_t>(set.toi), [&](size_t i) {
-      return encode(evaluate_toi_sample(make_toi_sample(set.seed, i), toi_backends));
+      return encode(evaluate_toi_sample(make_toi_sample(set.seed, i), toi_backends, cache));
     });
     tally("explore/toi", encoded, {"time_err"}, "exact", out);
     if (queries && run.root()) {

@@ -20,6 +20,20 @@ namespace {
 // sample k (any odd constant would do; this one is the golden ratio's, as in splitmix64).
 constexpr uint64_t kGapStream = 0x9E3779B97F4A7C15ull;
 
+// A library's distance answer on a sample, from the cache when it holds one and kept there when
+// not (never an engine's: ResultCache::caches), keyed apart from the contact answers on the same
+// bodies.
+DistanceResult sample_distance(const Backend& be, const RigidBody& a, const RigidBody& b,
+                               const ResultCache* cache) {
+  if (!cache || !cache->enabled() || !ResultCache::caches(be.name)) return run_distance(be, a, b);
+  const std::string key = "explore distance " + cache->contact_key(be.name, a, b);
+  if (auto hit = cache->load_distance(key)) return hit->result;
+  double runtime_s = 0.0;
+  const DistanceResult r = run_distance(be, a, b, &runtime_s);
+  cache->store(key, r, runtime_s);
+  return r;
+}
+
 // "vertex-face" and the like: the exact closest features, A's first.
 std::string feature_pair(const ExactDistance& e) { return e.feature_a + "-" + e.feature_b; }
 
@@ -53,7 +67,8 @@ ContactSample moved_apart(ContactSample s, uint64_t seed, uint64_t index) {
 
 SampleOutcome evaluate_distance_sample(const ContactSample& s,
                                        const std::vector<std::string>& names,
-                                       const std::vector<Backend>* table) {
+                                       const std::vector<Backend>* table,
+                                       const ResultCache* cache) {
   const RigidBody a = build_body(s.a, "A"), b = build_body(s.b, "B");
   SampleOutcome out;
   out.index = s.index;
@@ -72,7 +87,7 @@ SampleOutcome evaluate_distance_sample(const ContactSample& s,
   for (const std::string& name : names) {
     const Backend* be = find_backend(name, table);
     if (!be || !be->distance) continue;
-    const DistanceResult r = run_distance(*be, a, b);
+    const DistanceResult r = sample_distance(*be, a, b, cache);
     BackendOutcome o;
     o.backend = name;
     if (r.status != Status::Ok) {

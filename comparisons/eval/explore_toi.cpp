@@ -40,6 +40,22 @@ std::pair<RigidBody, RigidBody> moving_bodies(const ToiSample& s) {
   return {a, b};
 }
 
+// A library's time of impact on a sample over `interval`, from the cache when it holds one and
+// kept there when not (never an engine's: ResultCache::caches; a row's variant is in its name).
+ToiResult sample_toi(const ToiSubject& subject, const RigidBody& a, const RigidBody& b,
+                     double interval, const ResultCache* cache) {
+  if (!cache || !cache->enabled() || !subject.library || !ResultCache::caches(subject.name))
+    return run_toi(subject, a, b, interval);
+  const std::string key = "explore toi " +
+                          std::string(reinterpret_cast<const char*>(&interval), sizeof interval) +
+                          cache->contact_key(subject.name, a, b);
+  if (auto hit = cache->load_toi(key)) return hit->result;
+  double runtime_s = 0.0;
+  const ToiResult r = run_toi(subject, a, b, interval, &runtime_s);
+  cache->store(key, r, runtime_s);
+  return r;
+}
+
 }  // namespace
 
 ToiSample make_toi_sample(uint64_t seed, uint64_t index) {
@@ -109,7 +125,8 @@ std::string toi_scene_text(const ToiSample& s, const std::string& header) {
   return text;
 }
 
-SampleOutcome evaluate_toi_sample(const ToiSample& s, const std::vector<std::string>& names) {
+SampleOutcome evaluate_toi_sample(const ToiSample& s, const std::vector<std::string>& names,
+                                  const ResultCache* cache) {
   const auto [a, b] = moving_bodies(s);
   SampleOutcome out;
   out.index = s.pair.index;
@@ -121,7 +138,7 @@ SampleOutcome evaluate_toi_sample(const ToiSample& s, const std::vector<std::str
   if (truth.status != Status::Ok) return out;  // the oracle could not settle it: not counted
   for (const ToiSubject& subject : toi_subjects(names)) {
     if (!subject.fn || subject.name == "exact") continue;
-    const ToiResult r = run_toi(subject, a, b, s.interval);
+    const ToiResult r = sample_toi(subject, a, b, s.interval, cache);
     if (r.status == Status::Unsupported) continue;
     BackendOutcome o;
     o.backend = subject.name;

@@ -64,6 +64,14 @@ std::optional<CachedResult<Result>> decode(const std::optional<std::string>& byt
   return c;
 }
 
+// What is kept of a result: nothing for a timeout (the machine's load at the time, not an answer
+// of the inputs), else the result with its run time.
+template <class Result>
+std::optional<std::string> kept(const Result& r, double runtime_s) {
+  if (r.status == Status::Timeout) return std::nullopt;
+  return encode_result(r, runtime_s);
+}
+
 }  // namespace
 
 bool ResultCache::caches(const std::string& backend) {
@@ -200,8 +208,7 @@ std::optional<CachedResult<DynamicsResult>> ResultCache::load_dynamics(
 }
 
 void ResultCache::store(const std::string& key, const DynamicsResult& d, double runtime_s) const {
-  if (d.status == Status::Timeout) return;
-  write(key, encode_result(d, runtime_s));
+  if (const auto bytes = kept(d, runtime_s)) write(key, *bytes);
 }
 
 namespace {
@@ -241,8 +248,24 @@ std::optional<CachedResult<MassResult>> ResultCache::load_mass(const std::string
 }
 
 void ResultCache::store(const std::string& key, const MassResult& m, double runtime_s) const {
-  if (m.status == Status::Timeout) return;
-  write(key, encode_result(m, runtime_s));
+  if (const auto bytes = kept(m, runtime_s)) write(key, *bytes);
+}
+
+std::optional<CachedResult<DistanceResult>> ResultCache::load_distance(
+    const std::string& key) const {
+  return decode<DistanceResult>(read(key));
+}
+
+void ResultCache::store(const std::string& key, const DistanceResult& r, double runtime_s) const {
+  if (const auto bytes = kept(r, runtime_s)) write(key, *bytes);
+}
+
+std::optional<CachedResult<ToiResult>> ResultCache::load_toi(const std::string& key) const {
+  return decode<ToiResult>(read(key));
+}
+
+void ResultCache::store(const std::string& key, const ToiResult& r, double runtime_s) const {
+  if (const auto bytes = kept(r, runtime_s)) write(key, *bytes);
 }
 
 }  // namespace rbx

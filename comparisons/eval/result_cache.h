@@ -66,6 +66,10 @@ class ResultCache {
   std::optional<CachedContact> load_contact(const std::string& key) const;
   std::optional<CachedResult<DynamicsResult>> load_dynamics(const std::string& key) const;
   std::optional<CachedResult<MassResult>> load_mass(const std::string& key) const;
+  /// A distance query's answer (explore's distance samples), keyed as the caller chooses.
+  std::optional<CachedResult<DistanceResult>> load_distance(const std::string& key) const;
+  /// A time-of-impact query's answer (explore's toi samples), keyed as the caller chooses.
+  std::optional<CachedResult<ToiResult>> load_toi(const std::string& key) const;
   /// Numbers the harness derives from a cached run (keyed by the run's key; the harness's own
   /// code hash is added, so an edit of harness.cpp recomputes them).
   std::optional<std::vector<double>> load_derived(const std::string& run_key,
@@ -79,6 +83,8 @@ class ResultCache {
   void store(const std::string& key, const ContactResult& r, const Timing& timing) const;
   void store(const std::string& key, const DynamicsResult& r, double runtime_s) const;
   void store(const std::string& key, const MassResult& r, double runtime_s) const;
+  void store(const std::string& key, const DistanceResult& r, double runtime_s) const;
+  void store(const std::string& key, const ToiResult& r, double runtime_s) const;
 
  private:
   std::optional<std::string> read(const std::string& key) const;

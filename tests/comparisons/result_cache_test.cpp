@@ -148,6 +148,11 @@ TEST(ResultCache, ExploreSamplesReadALibrarysAnswersBack) {
     std::ofstream(log, std::ios::app) << 'x';
     return fcl(a, b);
   };
+  const auto fcl_distance = table[1].distance;
+  table[1].distance = [fcl_distance, log](const RigidBody& a, const RigidBody& b) {
+    std::ofstream(log, std::ios::app) << 'x';
+    return fcl_distance(a, b);
+  };
   const auto bullet = table[2].dynamics;
   table[2].dynamics = [bullet, log](const WorldDefinition& s, const DynamicsOptions& o) {
     std::ofstream(log, std::ios::app) << 'x';
@@ -155,18 +160,45 @@ TEST(ResultCache, ExploreSamplesReadALibrarysAnswersBack) {
   };
   ExploreCheckSet set;
   set.contact = 12;
+  set.distance = 6;
   set.impact = 3;
-  set.landing = set.slide = set.tunnel = 0;
+  set.landing = set.slide = set.tunnel = set.toi = 0;
   const ParallelRun one(1);
   const auto first = explore_check_metrics({"fcl"}, {"bullet"}, set, &table, &one, &cache);
-  EXPECT_EQ(calls(), 15);
+  EXPECT_EQ(calls(), 21);
   const auto second = explore_check_metrics({"fcl"}, {"bullet"}, set, &table, &one, &cache);
-  EXPECT_EQ(calls(), 15);
+  EXPECT_EQ(calls(), 21);
   ASSERT_EQ(first.size(), second.size());
   for (size_t i = 0; i < first.size(); ++i) {
     EXPECT_EQ(first[i].metric.name, second[i].metric.name);
     EXPECT_EQ(first[i].metric.value, second[i].metric.value) << first[i].metric.name;
   }
+  fs::remove_all(dir);
+}
+
+// The toi kind's library rows (the registry's: their queries and variants) are kept too: a run
+// stores an answer per row and sample, and a second run stores nothing new and measures the same.
+TEST(ResultCache, ExploreToiSamplesKeepALibrarysAnswers) {
+  const fs::path dir = temp_dir("cache_explore_toi");
+  const ResultCache cache(dir.string());
+  const auto files = [&dir] {
+    int n = 0;
+    for (const auto& entry : fs::directory_iterator(dir)) n += entry.is_regular_file() ? 1 : 0;
+    return n;
+  };
+  ExploreCheckSet set;
+  set.contact = set.distance = set.impact = set.landing = set.slide = set.tunnel = 0;
+  set.toi = 4;
+  const ParallelRun one(1);
+  const auto first = explore_check_metrics({"fcl"}, {}, set, nullptr, &one, &cache);
+  const int stored = files();
+  EXPECT_GE(stored, set.toi);  // fcl's rows on every sample the oracle settles
+  const auto second = explore_check_metrics({"fcl"}, {}, set, nullptr, &one, &cache);
+  EXPECT_EQ(files(), stored);
+  ASSERT_EQ(first.size(), second.size());
+  ASSERT_FALSE(first.empty());
+  for (size_t i = 0; i < first.size(); ++i)
+    EXPECT_EQ(first[i].metric.value, second[i].metric.value) << first[i].metric.name;
   fs::remove_all(dir);
 }
 
