@@ -6,7 +6,6 @@
 #include <cmath>
 #include <limits>
 #include <optional>
-#include <set>
 #include <sstream>
 #include <tuple>
 #include <utility>
@@ -241,30 +240,28 @@ bool ExtendedStep::separated(const WorldState& world, const RigidBody& a, const 
   const Vec3 gap_ab = box_lo_[i] - box_hi_[j], gap_ba = box_lo_[j] - box_hi_[i];
   if (gap_ab.maxCoeff() > margin || gap_ba.maxCoeff() > margin) return true;
   const long long key = static_cast<long long>(i) * static_cast<long long>(world.bodies.size()) + j;
-  const auto kept = witnesses_.find(key);
+  Witness* kept = witnesses_.find(key);
   // Proved at the step's start with room for both bodies' travel along the step (no point moves
   // farther): still apart at its end.
-  if (travel >= 0.0 && kept != witnesses_.end() && kept->second.step == steps_ &&
-      kept->second.gap - travel > margin)
-    return true;
-  if (kept != witnesses_.end()) {
+  if (travel >= 0.0 && kept && kept->step == steps_ && kept->gap - travel > margin) return true;
+  if (kept) {
     // The bounding boxes' bound first (exact for boxes), the vertices only when it falls short.
-    const Vec3 u = b.orientation * kept->second.axis;
+    const Vec3 u = b.orientation * kept->axis;
     double gap = gap_bound_along(*a.shape, a.pose(), *b.shape, b.pose(), u);
     if (!(gap > margin)) gap = gap_along(*a.shape, a.pose(), *b.shape, b.pose(), u);
     if (gap > margin) {
-      kept->second.gap = gap;
-      kept->second.step = steps_;
+      kept->gap = gap;
+      kept->step = steps_;
       return true;
     }
   }
   const Vec3 u = find_separating_axis(*a.shape, a.pose(), *b.shape, b.pose(), margin);
   if (u != Vec3::Zero()) {
-    witnesses_[key] = {b.orientation.conjugate() * u,
-                       gap_along(*a.shape, a.pose(), *b.shape, b.pose(), u), steps_};
+    witnesses_.put(key, {b.orientation.conjugate() * u,
+                         gap_along(*a.shape, a.pose(), *b.shape, b.pose(), u), steps_});
     return true;
   }
-  if (kept != witnesses_.end()) witnesses_.erase(kept);
+  if (kept) witnesses_.drop(key);
   return false;
 }
 
@@ -284,8 +281,13 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
     sweep[i] = sweep_length(world.bodies[i], facts[i].radius, dt);
     thinnest = std::min(thinnest, facts[i].thickness);
   }
-  std::set<std::pair<int, int>> touching;
-  for (const PairManifold& pm : manifolds) touching.insert({pm.a, pm.b});
+  // The pairs in contact at the start, sorted (a few per body, looked up for every candidate).
+  touching_.clear();
+  for (const PairManifold& pm : manifolds) touching_.emplace_back(pm.a, pm.b);
+  std::sort(touching_.begin(), touching_.end());
+  const auto touching = [&](const BodyPair& p) {
+    return std::binary_search(touching_.begin(), touching_.end(), p);
+  };
   // Candidates: a pair whose relative sweep exceeds toi_pair_sweep of the thinner thickness
   // (below that, the next step's detection after penetration finds the contact: nothing can
   // pass through) and whose swept spheres meet. The faster body of such a pair sweeps more
@@ -298,7 +300,7 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
       if (j == i) continue;
       if (sweep[j] > sweep[i] || (sweep[j] == sweep[i] && j < i)) continue;  // the faster one asks
       const int lo = static_cast<int>(std::min(i, j)), hi = static_cast<int>(std::max(i, j));
-      if (touching.count({lo, hi})) continue;
+      if (touching({lo, hi})) continue;
       if (!(sweep[i] + sweep[j] >
             world.tunables.toi_pair_sweep * std::min(facts[i].thickness, facts[j].thickness)))
         continue;
@@ -311,8 +313,8 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
           q.squaredNorm() > 0.0 ? std::clamp(-p.dot(q) / q.squaredNorm(), 0.0, 1.0) : 0.0;
       if ((p + s * q).norm() > facts[lo].radius + facts[hi].radius) continue;
       const TimeOfImpact t =
-          time_of_impact(a, b, dt, world.detector, world.tunables.toi_max_samples,
-                         &facts[lo].principal, &facts[hi].principal);
+          time_of_impact(a, b, dt, world.detector, world.tunables.toi_max_samples, &facts[lo],
+                         &facts[hi], &detection_);
       if (!t.certified) report_uncertified(world, lo, hi);
       if (t.time) hits.emplace_back(*t.time, lo, hi);
     }
@@ -329,19 +331,23 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
     const RigidBody& b = world.bodies[i];
     ahead_.push_back(b.is_static ? b : advanced(b, dt, &facts[i].principal));
   }
-  std::set<std::pair<int, int>> asked;
-  for (const auto& [t, i, j] : hits) asked.insert({i, j});
+  // The pairs the fast search above asked (few: fast bodies only).
+  std::vector<BodyPair> asked;
+  for (const auto& [t, i, j] : hits) asked.emplace_back(i, j);
+  std::sort(asked.begin(), asked.end());
   place_boxes(ahead_, facts);
   for (const BodyPair& pair : look_ahead_pairs(world)) {
     const auto [i, j] = pair;
     const RigidBody &a = ahead_[i], &b = ahead_[j];
-    if ((a.is_static && b.is_static) || touching.count(pair) || asked.count(pair)) continue;
+    if ((a.is_static && b.is_static) || touching(pair) ||
+        std::binary_search(asked.begin(), asked.end(), pair))
+      continue;
     // Still apart at the step's end: by the gap proved at its start less both bodies' travel,
     // else by the pair's kept axis or a new one.
     if (separated(world, a, b, i, j, travel[i] + travel[j])) continue;
     const TimeOfImpact t =
         time_of_impact(world.bodies[i], world.bodies[j], dt, world.detector,
-                       world.tunables.toi_max_samples, &facts[i].principal, &facts[j].principal);
+                       world.tunables.toi_max_samples, &facts[i], &facts[j], &detection_);
     if (!t.certified) report_uncertified(world, i, j);
     if (t.time) hits.emplace_back(*t.time, i, j);
   }

@@ -5,13 +5,13 @@
 #pragma once
 
 #include <optional>
-#include <unordered_map>
 #include <vector>
 
 #include "engine/broadphase.h"
 #include "engine/contact_scratch.h"
 #include "engine/contact_solver.h"
 #include "engine/detect.h"
+#include "engine/pair_table.h"
 #include "engine/world_state.h"
 
 namespace rbx {
@@ -81,12 +81,13 @@ class ExtendedStep {
     long step = -1;
   };
   // Per pair (key i * bodies + j) that passed the bounding check but was found apart.
-  std::unordered_map<long long, Witness> witnesses_;
+  PairTable<Witness> witnesses_;
   long steps_ = 0;                     // steps advanced: stamps the witnesses measured in this one
   std::vector<Vec3> box_lo_, box_hi_;  // m, world: place_boxes' boxes
   double grow_ = 0.0;                  // m, this step's growth (look_ahead_growth)
   std::vector<BodyPair> grown_pairs_;  // the start's pairs of spheres grown by grow_
   std::vector<BodyPair> ahead_pairs_;  // scratch: look_ahead_pairs' output
+  std::vector<BodyPair> touching_;     // scratch: the pairs with a manifold at the step's start
   std::vector<BoundingSphere> spheres_;      // scratch: one pose's bounding spheres
   std::vector<Vec3> static_lo_, static_hi_;  // m, world: the static bodies' boxes, once
   // The manifolds' detector cache and contact-plane scratch, reused pair after pair.

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
+#include "engine/body_facts.h"
 #include "engine/detect.h"
 #include "engine/distance.h"
 #include "engine/integrate.h"
@@ -29,9 +31,15 @@ RigidBody advanced(const RigidBody& body, double t, const PrincipalFrame* frame)
 
 Pose advanced_pose(const RigidBody& body, double t, const PrincipalFrame* frame) {
   if (body.is_static) return body.pose();
+  return advanced_pose(body, world_momentum(body), t, frame);
+}
+
+Pose advanced_pose(const RigidBody& body, const Vec3& momentum, double t,
+                   const PrincipalFrame* frame) {
+  if (body.is_static) return body.pose();
   // What advanced() computes of the pose, without copying the body: no gravity, so the centre
   // moves by v t, and the free rotation under the body's world angular momentum.
-  return {body.position + body.velocity * t, free_rotation(body, world_momentum(body), t, frame)};
+  return {body.position + body.velocity * t, free_rotation(body, momentum, t, frame)};
 }
 
 double sweep_length(const RigidBody& body, double radius, double t) {
@@ -48,35 +56,76 @@ double travel_bound(const RigidBody& body, double turn_rate, double radius, doub
 }
 
 TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, Detector detector,
-                            long max_samples, const PrincipalFrame* frame_a,
-                            const PrincipalFrame* frame_b) {
-  // One detection cache for every sample (its scratch lists allocated once).
-  DetectionCache cache;
-  const auto pose_at = [&](const RigidBody& body, double t, const PrincipalFrame* frame) {
-    return advanced_pose(body, t, frame);
-  };
+                            long max_samples, const BodyFacts* facts_a, const BodyFacts* facts_b,
+                            DetectionCache* cache) {
+  std::optional<BodyFacts> own_a, own_b;
+  if (!facts_a) facts_a = &own_a.emplace(BodyFacts::of(a));
+  if (!facts_b) facts_b = &own_b.emplace(BodyFacts::of(b));
+  const PrincipalFrame *frame_a = &facts_a->principal, *frame_b = &facts_b->principal;
+  // One detection cache for every sample (its scratch lists allocated once), the caller's when
+  // given.
+  std::optional<DetectionCache> own_cache;
+  if (!cache) cache = &own_cache.emplace();
+  // The world angular momenta, fixed along the torque-free motion: taken once for every sample.
+  const Vec3 momentum_a = world_momentum(a), momentum_b = world_momentum(b);
+  const auto pose_a = [&](double t) { return advanced_pose(a, momentum_a, t, frame_a); };
+  const auto pose_b = [&](double t) { return advanced_pose(b, momentum_b, t, frame_b); };
   auto touching = [&](double t) {
-    return detect(*a.shape, pose_at(a, t, frame_a), *b.shape, pose_at(b, t, frame_b), detector,
-                  cache)
-        .has_value();
+    return detect(*a.shape, pose_a(t), *b.shape, pose_b(t), detector, *cache).has_value();
   };
-  auto first_touch = [&](double before, double after) {
+  // The pair's travel rate (m/s): no point of either body moves faster under advanced().
+  const auto rate_of = [](const RigidBody& body, const BodyFacts& facts) {
+    return travel_bound(body, facts.turn_rate, facts.radius, 1.0);
+  };
+  const double rate = rate_of(a, *facts_a) + rate_of(b, *facts_b);
+  if (!(rate > 0.0)) return {};  // apart at the start and neither moves
+  // Farther apart than this, the detector finds nothing (the margin ExtendedStep::separated
+  // skips the detector by): a sample there needs no detection.
+  const double reach = separation_margin(std::max(facts_a->own_tol, facts_b->own_tol),
+                                         facts_a->reach, facts_b->reach);
+  const double spin = (a.is_static ? 0.0 : rate_of(a, *facts_a) - a.velocity.norm()) +
+                      (b.is_static ? 0.0 : rate_of(b, *facts_b) - b.velocity.norm());
+  // B's velocity seen from A (a static body does not move, whatever its velocity says).
+  const Vec3 v_rel =
+      (b.is_static ? Vec3::Zero() : b.velocity) - (a.is_static ? Vec3::Zero() : a.velocity);
+  // What the distance at time t proves (conservative advancement, below): how long after
+  // (forward) and before (backward) t the pair stays apart, and how long after t it stays beyond
+  // the detector's reach (`quiet`; 0 when it is not beyond it at t).
+  struct Room {
+    double forward = 0.0, backward = 0.0, quiet = 0.0;
+  };
+  auto room = [&](double t) {
+    const Pose pa = pose_a(t), pb = pose_b(t);
+    const Separation sep = shape_distance(*a.shape, pa, *b.shape, pb);
+    if (sep.overlapping || !(sep.distance > 0)) return Room{};
+    const Vec3 n = (sep.point_b - sep.point_a) / sep.distance;
+    const double approach = -v_rel.dot(n);
+    auto span = [&](double closing, double gap) {
+      return closing > 0 ? gap / closing : std::numeric_limits<double>::infinity();
+    };
+    const double closing = std::max(0.0, approach) + spin;
+    Room r{span(closing, sep.distance), span(std::max(0.0, -approach) + spin, sep.distance)};
+    // The gap along n from the vertices, not the distance's own figure, proves it beyond reach
+    // (the same proof ExtendedStep::separated takes).
+    if (sep.distance > reach) {
+      const double gap = gap_along(*a.shape, pa, *b.shape, pb, -n);
+      if (gap > reach) r.quiet = span(closing, gap - reach);
+    }
+    return r;
+  };
+  // Bisection on the detector between `before` (apart) and `after` (touching). Until `quiet`
+  // the pair is beyond the detector's reach: those midpoints are apart without asking it, and
+  // conservative advancement first moves `quiet` on while it gains a thousandth of the bracket
+  // a step (each a distance, cheaper than the detections it saves). The answer is the same
+  // bisection's.
+  auto first_touch = [&](double before, double after, double quiet) {
     while (after - before > 1e-12 * dt) {
       const double mid = 0.5 * (before + after);
-      (touching(mid) ? after : before) = mid;
+      (!(mid < quiet) && touching(mid) ? after : before) = mid;
     }
     return TimeOfImpact{after, true};
   };
-  // The pair's travel rate (m/s): no point of either body moves faster under advanced().
-  const auto rate_of = [](const RigidBody& body, const PrincipalFrame* frame) {
-    double radius = 0.0;
-    for (const Vec3& v : body.shape->vertices()) radius = std::max(radius, v.norm());
-    const PrincipalFrame own = frame ? *frame : principal_frame(body.inertia_body);
-    return travel_bound(body, free_turn_rate(own), radius, 1.0);
-  };
-  const double rate = rate_of(a, frame_a) + rate_of(b, frame_b);
-  if (!(rate > 0.0)) return {};  // apart at the start and neither moves
-  const double thin = std::min(shape_thickness(*a.shape), shape_thickness(*b.shape));
+  const double thin = std::min(facts_a->thickness, facts_b->thickness);
   const double grid = std::ceil(rate * dt / (0.25 * thin));
   if (grid <= static_cast<double>(max_samples)) {
     const long n = std::max(1L, static_cast<long>(grid));
@@ -91,45 +140,27 @@ TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, D
     // (conservative advancement), each at least the detector's tolerance of travel (an overlap
     // shallower than that is touching to the detector anyway).
     const double least_step = point_in_mesh_tolerance(*a.shape, *b.shape) / rate;
-    const auto spin_of = [&](const RigidBody& body, const PrincipalFrame* frame) {
-      return body.is_static ? 0.0 : rate_of(body, frame) - body.velocity.norm();
-    };
-    const double spin = spin_of(a, frame_a) + spin_of(b, frame_b);
-    // B's velocity seen from A (a static body does not move, whatever its velocity says).
-    const Vec3 v_rel =
-        (b.is_static ? Vec3::Zero() : b.velocity) - (a.is_static ? Vec3::Zero() : a.velocity);
-    // How long after (forward) and before (backward) time t the pair is sure to stay apart.
-    struct Room {
-      double forward = 0.0, backward = 0.0;
-    };
-    auto room = [&](double t) {
-      const Separation sep =
-          shape_distance(*a.shape, pose_at(a, t, frame_a), *b.shape, pose_at(b, t, frame_b));
-      if (sep.overlapping || !(sep.distance > 0)) return Room{};
-      const Vec3 n = (sep.point_b - sep.point_a) / sep.distance;
-      const double approach = -v_rel.dot(n);
-      auto span = [&](double closing) {
-        return closing > 0 ? sep.distance / closing : std::numeric_limits<double>::infinity();
-      };
-      return Room{span(std::max(0.0, approach) + spin), span(std::max(0.0, -approach) + spin)};
-    };
     long walked = 0;
     double before = 0.0;
     Room at_before = room(0.0);
     for (long k = 1; k <= n; ++k) {
       const double t = dt * static_cast<double>(k) / static_cast<double>(n);
-      if (touching(t)) return first_touch(before, t);
+      // The distance first: beyond the detector's reach, no detection.
       const Room at_t = room(t);
+      if (!(at_t.quiet > 0) && touching(t)) return first_touch(before, t, before + at_before.quiet);
       if (!(at_before.forward + at_t.backward > t - before)) {
         // The walk asks the distance at each step, and the detector only where the distance
         // finds the pair touching (the cheaper query first).
-        double clear = before, span = at_before.forward;
+        double clear = before;
+        Room at_clear = at_before;
         for (;;) {
-          const double next = clear + std::max(span, least_step);
+          const double next = clear + std::max(at_clear.forward, least_step);
           if (next >= t) break;
-          span = room(next).forward;
-          if (!(span > 0) && touching(next)) return first_touch(clear, next);
+          const Room at_next = room(next);
+          if (!(at_next.forward > 0) && touching(next))
+            return first_touch(clear, next, clear + at_clear.quiet);
           clear = next;
+          at_clear = at_next;
           if (++walked >= max_samples) return {std::nullopt, false};
         }
       }
@@ -143,11 +174,11 @@ TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, D
   const double least = 0.25 * thin / rate;
   double t = 0.0;
   for (long k = 0; k < max_samples; ++k) {
-    const Pose pa = pose_at(a, t, frame_a), pb = pose_at(b, t, frame_b);
+    const Pose pa = pose_a(t), pb = pose_b(t);
     const Vec3 axis = find_separating_axis(*a.shape, pa, *b.shape, pb, 0.0);
     const double gap = axis == Vec3::Zero() ? 0.0 : gap_along(*a.shape, pa, *b.shape, pb, axis);
     const double next = std::min(dt, t + std::max(least, gap / rate));
-    if (touching(next)) return first_touch(t, next);
+    if (touching(next)) return first_touch(t, next, t);
     if (next >= dt) return {};
     t = next;
   }

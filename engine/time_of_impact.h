@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "engine/body.h"
+#include "engine/body_facts.h"
 #include "engine/detect.h"
 #include "engine/integrate.h"
 
@@ -24,6 +25,11 @@ RigidBody advanced(const RigidBody& body, double t, const PrincipalFrame* frame 
 
 /// advanced(body, t, frame).pose(), without copying the body.
 Pose advanced_pose(const RigidBody& body, double t, const PrincipalFrame* frame = nullptr);
+
+/// The same, with the body's world angular momentum (world_momentum) given: it stays fixed along
+/// the motion, so a caller asking for many times takes it once.
+Pose advanced_pose(const RigidBody& body, const Vec3& momentum, double t,
+                   const PrincipalFrame* frame = nullptr);
 
 /// Largest distance (m) a point of the body can travel over time t with its current velocity:
 /// |v| t + |w| r t, r = `radius`, its bounding radius about the centre of mass (BodyFacts), a
@@ -55,9 +61,11 @@ struct TimeOfImpact {
 /// bisection on the detector between the last separated and the first touching sample, to 1e-12 of
 /// dt. A search that reaches `max_samples` before dt (bodies skimming past each other at a speed of
 /// millions of their thicknesses per step) is not certified: its answer says so. Meant for pairs
-/// separated at the step's start. `frame_a`, `frame_b` as for advanced.
+/// separated at the step's start. `facts_a`, `facts_b`: the bodies' facts kept by the caller (the
+/// same numbers as BodyFacts::of, which is called when they are not given); `cache`: a detection
+/// cache to reuse (the search makes its own when none is given; the answer is the same).
 TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, Detector detector,
-                            long max_samples, const PrincipalFrame* frame_a = nullptr,
-                            const PrincipalFrame* frame_b = nullptr);
+                            long max_samples, const BodyFacts* facts_a = nullptr,
+                            const BodyFacts* facts_b = nullptr, DetectionCache* cache = nullptr);
 
 }  // namespace rbx

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "engine/body.h"
+#include "engine/body_facts.h"
 #include "engine/broadphase.h"
 #include "engine/contact.h"
 #include "engine/detect.h"
@@ -34,19 +35,6 @@ struct SolvedContact {
   Vec3 impulse = Vec3::Zero();   // N s, on a (normal and friction); b takes the opposite
   Vec3 centre_a = Vec3::Zero();  // m, a's centre of mass at detection
   Vec3 centre_b = Vec3::Zero();  // m, b's centre of mass at detection
-};
-
-/// What a body's shape and mass fix for the whole run.
-struct BodyFacts {
-  double thickness = 0.0;    // m, shape_thickness: what a fast body must not pass through
-  double radius = 0.0;       // m, bounding radius about the centre of mass
-  double reach = 1.0;        // m, how far the detector's tolerance reaches beyond it
-  double own_tol = 0.0;      // m, its point-in-mesh tolerance against itself (1e-9 x its size)
-  PrincipalFrame principal;  // its inertia's principal frame (the free rotation's)
-  double turn_rate = 0.0;    // 1 / (kg m^2), free_turn_rate(principal)
-
-  /// The facts of `body`.
-  static BodyFacts of(const RigidBody& body);
 };
 
 /// The state both contact models advance, step by step.
