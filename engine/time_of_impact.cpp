@@ -55,134 +55,184 @@ double travel_bound(const RigidBody& body, double turn_rate, double radius, doub
   return (body.velocity.norm() + turn_rate * momentum * radius) * t;
 }
 
+namespace {
+
+// What the distance at a time t proves (conservative advancement): how long after (forward) and
+// before (backward) t the pair stays apart, and how long after t it stays beyond the detector's
+// reach (`quiet`; 0 when it is not beyond it at t).
+struct Room {
+  double forward = 0.0, backward = 0.0, quiet = 0.0;
+};
+
+// One pair's search (time_of_impact): both bodies moved torque-free over the step, their samples
+// (the detector, the distance) and the bisection between them.
+class ImpactSearch {
+ public:
+  ImpactSearch(const RigidBody& a, const RigidBody& b, const BodyFacts& facts_a,
+               const BodyFacts& facts_b, double dt, Detector detector, DetectionCache& cache);
+  // The pair's travel rate (m/s): no point of either body moves faster under advanced().
+  double rate() const { return rate_; }
+  // Samples on a grid of n intervals, certified between them from the distance.
+  TimeOfImpact on_grid(long n, long max_samples);
+  // Steps of at least `least` (s), longer while a separating axis shows room.
+  TimeOfImpact beyond_grid(double least, long max_samples);
+
+ private:
+  static double rate_of(const RigidBody& body, const BodyFacts& facts) {
+    return travel_bound(body, facts.turn_rate, facts.radius, 1.0);
+  }
+  Pose pose_a(double t) const { return advanced_pose(a_, momentum_a_, t, &facts_a_.principal); }
+  Pose pose_b(double t) const { return advanced_pose(b_, momentum_b_, t, &facts_b_.principal); }
+  bool touching(double t) {
+    return detect(*a_.shape, pose_a(t), *b_.shape, pose_b(t), detector_, cache_).has_value();
+  }
+  Room room(double t) const;
+  TimeOfImpact first_touch(double before, double after, double quiet);
+
+  const RigidBody &a_, &b_;
+  const BodyFacts &facts_a_, &facts_b_;
+  const double dt_;
+  const Detector detector_;
+  DetectionCache& cache_;
+  // The world angular momenta, fixed along the torque-free motion: taken once for every sample.
+  const Vec3 momentum_a_, momentum_b_;
+  const double rate_;
+  // Farther apart than this, the detector finds nothing (the margin ExtendedStep::separated
+  // skips the detector by): a sample there needs no detection.
+  const double reach_;
+  double spin_ = 0.0;          // m/s: what the turns add to the travel rate
+  Vec3 v_rel_ = Vec3::Zero();  // B's velocity seen from A (a static body does not move)
+};
+
+ImpactSearch::ImpactSearch(const RigidBody& a, const RigidBody& b, const BodyFacts& facts_a,
+                           const BodyFacts& facts_b, double dt, Detector detector,
+                           DetectionCache& cache)
+    : a_(a),
+      b_(b),
+      facts_a_(facts_a),
+      facts_b_(facts_b),
+      dt_(dt),
+      detector_(detector),
+      cache_(cache),
+      momentum_a_(world_momentum(a)),
+      momentum_b_(world_momentum(b)),
+      rate_(rate_of(a, facts_a) + rate_of(b, facts_b)),
+      reach_(separation_margin(std::max(facts_a.own_tol, facts_b.own_tol), facts_a.reach,
+                               facts_b.reach)) {
+  spin_ = (a.is_static ? 0.0 : rate_of(a, facts_a) - a.velocity.norm()) +
+          (b.is_static ? 0.0 : rate_of(b, facts_b) - b.velocity.norm());
+  v_rel_ = (b.is_static ? Vec3::Zero() : b.velocity) - (a.is_static ? Vec3::Zero() : a.velocity);
+}
+
+Room ImpactSearch::room(double t) const {
+  const Pose pa = pose_a(t), pb = pose_b(t);
+  const Separation sep = shape_distance(*a_.shape, pa, *b_.shape, pb);
+  if (sep.overlapping || !(sep.distance > 0)) return Room{};
+  const Vec3 n = (sep.point_b - sep.point_a) / sep.distance;
+  const double approach = -v_rel_.dot(n);
+  auto span = [](double closing, double gap) {
+    return closing > 0 ? gap / closing : std::numeric_limits<double>::infinity();
+  };
+  const double closing = std::max(0.0, approach) + spin_;
+  Room r{span(closing, sep.distance), span(std::max(0.0, -approach) + spin_, sep.distance)};
+  // The gap along n from the vertices, not the distance's own figure, proves it beyond reach
+  // (the same proof ExtendedStep::separated takes).
+  if (sep.distance > reach_) {
+    const double gap = gap_along(*a_.shape, pa, *b_.shape, pb, -n);
+    if (gap > reach_) r.quiet = span(closing, gap - reach_);
+  }
+  return r;
+}
+
+// Bisection on the detector between `before` (apart) and `after` (touching), to 1e-12 of the
+// step. Until `quiet` the pair is beyond the detector's reach: those midpoints are apart without
+// asking it, and the answer is the same bisection's.
+TimeOfImpact ImpactSearch::first_touch(double before, double after, double quiet) {
+  while (after - before > 1e-12 * dt_) {
+    const double mid = 0.5 * (before + after);
+    (!(mid < quiet) && touching(mid) ? after : before) = mid;
+  }
+  return TimeOfImpact{after, true};
+}
+
+// Two samples apart do not prove the time between them apart: bodies skimming past each other
+// can overlap briefly between them (a corner clipping another's). Certified from the distance
+// (engine/distance.h): along the direction n from A's closest point to B's, the gap d between
+// the shapes shrinks no faster than the approach along n, -(v_b - v_a) . n, plus what the turns
+// can bring (the spin part of the travel rate), so nothing touches for d over that rate after a
+// time the pair is apart, nor that long before (the rate of opening, backward). A touch between
+// samples at t0 and t1 needs both spans to fit in between; where they do not, nothing touched.
+// Else the interval is walked by those steps (conservative advancement), each at least the
+// detector's tolerance of travel (an overlap shallower than that is touching to the detector
+// anyway).
+TimeOfImpact ImpactSearch::on_grid(long n, long max_samples) {
+  const double least_step = point_in_mesh_tolerance(*a_.shape, *b_.shape) / rate_;
+  long walked = 0;
+  double before = 0.0;
+  Room at_before = room(0.0);
+  for (long k = 1; k <= n; ++k) {
+    const double t = dt_ * static_cast<double>(k) / static_cast<double>(n);
+    // The distance first: beyond the detector's reach, no detection.
+    const Room at_t = room(t);
+    if (!(at_t.quiet > 0) && touching(t)) return first_touch(before, t, before + at_before.quiet);
+    if (!(at_before.forward + at_t.backward > t - before)) {
+      // The walk asks the distance at each step, and the detector only where the distance
+      // finds the pair touching (the cheaper query first).
+      double clear = before;
+      Room at_clear = at_before;
+      for (;;) {
+        const double next = clear + std::max(at_clear.forward, least_step);
+        if (next >= t) break;
+        const Room at_next = room(next);
+        if (!(at_next.forward > 0) && touching(next))
+          return first_touch(clear, next, clear + at_clear.quiet);
+        clear = next;
+        at_clear = at_next;
+        if (++walked >= max_samples) return {std::nullopt, false};
+      }
+    }
+    before = t;
+    at_before = at_t;
+  }
+  return {};
+}
+
+TimeOfImpact ImpactSearch::beyond_grid(double least, long max_samples) {
+  // A fall from afar takes one step to the touch.
+  double t = 0.0;
+  for (long k = 0; k < max_samples; ++k) {
+    const Pose pa = pose_a(t), pb = pose_b(t);
+    const Vec3 axis = find_separating_axis(*a_.shape, pa, *b_.shape, pb, 0.0);
+    const double gap = axis == Vec3::Zero() ? 0.0 : gap_along(*a_.shape, pa, *b_.shape, pb, axis);
+    const double next = std::min(dt_, t + std::max(least, gap / rate_));
+    if (touching(next)) return first_touch(t, next, t);
+    if (next >= dt_) return {};
+    t = next;
+  }
+  return {std::nullopt, false};
+}
+
+}  // namespace
+
 TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, Detector detector,
                             long max_samples, const BodyFacts* facts_a, const BodyFacts* facts_b,
                             DetectionCache* cache) {
   std::optional<BodyFacts> own_a, own_b;
   if (!facts_a) facts_a = &own_a.emplace(BodyFacts::of(a));
   if (!facts_b) facts_b = &own_b.emplace(BodyFacts::of(b));
-  const PrincipalFrame *frame_a = &facts_a->principal, *frame_b = &facts_b->principal;
   // One detection cache for every sample (its scratch lists allocated once), the caller's when
   // given.
   std::optional<DetectionCache> own_cache;
   if (!cache) cache = &own_cache.emplace();
-  // The world angular momenta, fixed along the torque-free motion: taken once for every sample.
-  const Vec3 momentum_a = world_momentum(a), momentum_b = world_momentum(b);
-  const auto pose_a = [&](double t) { return advanced_pose(a, momentum_a, t, frame_a); };
-  const auto pose_b = [&](double t) { return advanced_pose(b, momentum_b, t, frame_b); };
-  auto touching = [&](double t) {
-    return detect(*a.shape, pose_a(t), *b.shape, pose_b(t), detector, *cache).has_value();
-  };
-  // The pair's travel rate (m/s): no point of either body moves faster under advanced().
-  const auto rate_of = [](const RigidBody& body, const BodyFacts& facts) {
-    return travel_bound(body, facts.turn_rate, facts.radius, 1.0);
-  };
-  const double rate = rate_of(a, *facts_a) + rate_of(b, *facts_b);
-  if (!(rate > 0.0)) return {};  // apart at the start and neither moves
-  // Farther apart than this, the detector finds nothing (the margin ExtendedStep::separated
-  // skips the detector by): a sample there needs no detection.
-  const double reach = separation_margin(std::max(facts_a->own_tol, facts_b->own_tol),
-                                         facts_a->reach, facts_b->reach);
-  const double spin = (a.is_static ? 0.0 : rate_of(a, *facts_a) - a.velocity.norm()) +
-                      (b.is_static ? 0.0 : rate_of(b, *facts_b) - b.velocity.norm());
-  // B's velocity seen from A (a static body does not move, whatever its velocity says).
-  const Vec3 v_rel =
-      (b.is_static ? Vec3::Zero() : b.velocity) - (a.is_static ? Vec3::Zero() : a.velocity);
-  // What the distance at time t proves (conservative advancement, below): how long after
-  // (forward) and before (backward) t the pair stays apart, and how long after t it stays beyond
-  // the detector's reach (`quiet`; 0 when it is not beyond it at t).
-  struct Room {
-    double forward = 0.0, backward = 0.0, quiet = 0.0;
-  };
-  auto room = [&](double t) {
-    const Pose pa = pose_a(t), pb = pose_b(t);
-    const Separation sep = shape_distance(*a.shape, pa, *b.shape, pb);
-    if (sep.overlapping || !(sep.distance > 0)) return Room{};
-    const Vec3 n = (sep.point_b - sep.point_a) / sep.distance;
-    const double approach = -v_rel.dot(n);
-    auto span = [&](double closing, double gap) {
-      return closing > 0 ? gap / closing : std::numeric_limits<double>::infinity();
-    };
-    const double closing = std::max(0.0, approach) + spin;
-    Room r{span(closing, sep.distance), span(std::max(0.0, -approach) + spin, sep.distance)};
-    // The gap along n from the vertices, not the distance's own figure, proves it beyond reach
-    // (the same proof ExtendedStep::separated takes).
-    if (sep.distance > reach) {
-      const double gap = gap_along(*a.shape, pa, *b.shape, pb, -n);
-      if (gap > reach) r.quiet = span(closing, gap - reach);
-    }
-    return r;
-  };
-  // Bisection on the detector between `before` (apart) and `after` (touching). Until `quiet`
-  // the pair is beyond the detector's reach: those midpoints are apart without asking it, and
-  // conservative advancement first moves `quiet` on while it gains a thousandth of the bracket
-  // a step (each a distance, cheaper than the detections it saves). The answer is the same
-  // bisection's.
-  auto first_touch = [&](double before, double after, double quiet) {
-    while (after - before > 1e-12 * dt) {
-      const double mid = 0.5 * (before + after);
-      (!(mid < quiet) && touching(mid) ? after : before) = mid;
-    }
-    return TimeOfImpact{after, true};
-  };
+  ImpactSearch search(a, b, *facts_a, *facts_b, dt, detector, *cache);
+  if (!(search.rate() > 0.0)) return {};  // apart at the start and neither moves
   const double thin = std::min(facts_a->thickness, facts_b->thickness);
-  const double grid = std::ceil(rate * dt / (0.25 * thin));
-  if (grid <= static_cast<double>(max_samples)) {
-    const long n = std::max(1L, static_cast<long>(grid));
-    // Two samples apart do not prove the time between them apart: bodies skimming past each
-    // other can overlap briefly between them (a corner clipping another's). Certified from the
-    // distance (engine/distance.h): along the direction n from A's closest point to B's, the
-    // gap d between the shapes shrinks no faster than the approach along n, -(v_b - v_a) . n,
-    // plus what the turns can bring (the spin part of the travel rate), so nothing touches for
-    // d over that rate after a time the pair is apart, nor that long before (the rate of
-    // opening, backward). A touch between samples at t0 and t1 needs both spans to fit in
-    // between; where they do not, nothing touched. Else the interval is walked by those steps
-    // (conservative advancement), each at least the detector's tolerance of travel (an overlap
-    // shallower than that is touching to the detector anyway).
-    const double least_step = point_in_mesh_tolerance(*a.shape, *b.shape) / rate;
-    long walked = 0;
-    double before = 0.0;
-    Room at_before = room(0.0);
-    for (long k = 1; k <= n; ++k) {
-      const double t = dt * static_cast<double>(k) / static_cast<double>(n);
-      // The distance first: beyond the detector's reach, no detection.
-      const Room at_t = room(t);
-      if (!(at_t.quiet > 0) && touching(t)) return first_touch(before, t, before + at_before.quiet);
-      if (!(at_before.forward + at_t.backward > t - before)) {
-        // The walk asks the distance at each step, and the detector only where the distance
-        // finds the pair touching (the cheaper query first).
-        double clear = before;
-        Room at_clear = at_before;
-        for (;;) {
-          const double next = clear + std::max(at_clear.forward, least_step);
-          if (next >= t) break;
-          const Room at_next = room(next);
-          if (!(at_next.forward > 0) && touching(next))
-            return first_touch(clear, next, clear + at_clear.quiet);
-          clear = next;
-          at_clear = at_next;
-          if (++walked >= max_samples) return {std::nullopt, false};
-        }
-      }
-      before = t;
-      at_before = at_t;
-    }
-    return {};
-  }
+  const double grid = std::ceil(search.rate() * dt / (0.25 * thin));
+  if (grid <= static_cast<double>(max_samples))
+    return search.on_grid(std::max(1L, static_cast<long>(grid)), max_samples);
   // Too many samples for a grid: each step at least the grid's, longer while a separating axis
-  // shows room (a fall from afar takes one step to the touch).
-  const double least = 0.25 * thin / rate;
-  double t = 0.0;
-  for (long k = 0; k < max_samples; ++k) {
-    const Pose pa = pose_a(t), pb = pose_b(t);
-    const Vec3 axis = find_separating_axis(*a.shape, pa, *b.shape, pb, 0.0);
-    const double gap = axis == Vec3::Zero() ? 0.0 : gap_along(*a.shape, pa, *b.shape, pb, axis);
-    const double next = std::min(dt, t + std::max(least, gap / rate));
-    if (touching(next)) return first_touch(t, next, t);
-    if (next >= dt) return {};
-    t = next;
-  }
-  return {std::nullopt, false};
+  // shows room.
+  return search.beyond_grid(0.25 * thin / search.rate(), max_samples);
 }
 
 }  // namespace rbx
