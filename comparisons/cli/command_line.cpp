@@ -53,20 +53,27 @@ const CLI::Validator kAtLeastOne(
     },
     "N >= 1");
 
-// A positive, finite number of seconds.
-const CLI::Validator kPositiveSeconds(
-    [](std::string& text) -> std::string {
-      size_t used = 0;
-      double value = 0;
-      try {
-        value = std::stod(text, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == text.size() && std::isfinite(value) && value > 0) return "";
-      return "must be a positive number of seconds, got '" + text + "'";
-    },
-    "S > 0");
+// A finite number of seconds, above zero (or at least zero where zero has a meaning).
+CLI::Validator seconds_at_least(bool zero_allowed) {
+  return CLI::Validator(
+      [zero_allowed](std::string& text) -> std::string {
+        size_t used = 0;
+        double value = 0;
+        try {
+          value = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == text.size() && std::isfinite(value) &&
+            (value > 0 || (zero_allowed && value == 0)))
+          return "";
+        return std::string(zero_allowed ? "must be a number of seconds >= 0"
+                                        : "must be a positive number of seconds") +
+               ", got '" + text + "'";
+      },
+      zero_allowed ? "S >= 0" : "S > 0");
+}
+const CLI::Validator kPositiveSeconds = seconds_at_least(false);
 
 // run, contacts, distance, toi, compare: the commands on scene files.
 void add_scene_commands(CLI::App& app, Options& o) {
@@ -106,6 +113,11 @@ void add_library_commands(CLI::App& app, Options& o) {
                    "also compare this report's runs with reports/baseline.json as rbx check "
                    "does (every backend); exit 1 when a metric is worse");
   report->add_option("--baseline", o.report.baseline, "with --check: the baseline file");
+  report
+      ->add_option("--timing-budget", o.report.timing_budget_s,
+                   "seconds each contact query and main dynamics run is timed for, at least "
+                   "(default 0.01); 0: one call each, the answers only")
+      ->check(seconds_at_least(true));
   report->add_flag("--explore", o.report.explore,
                    "also summarise explore's fixed random samples (contact and impact kinds, seed "
                    "1): the default when no scene is named");

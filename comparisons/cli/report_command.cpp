@@ -108,6 +108,27 @@ std::string verdict_counts(const std::vector<SceneEvaluation>& evs) {
          " documented (known_failure)";
 }
 
+// Explore's fixed random samples for the report, through every chosen backend but the oracle
+// (`backends_option`: the --backends list, "" or "all" for every one), into `in`; the libraries'
+// answers fill the cache at `cache_dir` that rbx check reads.
+void run_report_explore(const std::string& backends_option, const std::string& cache_dir,
+                        ParallelRun& par, SummaryInputs& in) {
+  const std::vector<std::string> chosen = backends_option.empty() || backends_option == "all"
+                                              ? std::vector<std::string>{}
+                                              : parse_backend_list(backends_option);
+  std::vector<std::string> contact, impact;
+  for (const Backend& b : backends()) {
+    if (b.name == "exact" ||
+        (!chosen.empty() && std::find(chosen.begin(), chosen.end(), b.name) == chosen.end()))
+      continue;
+    if (b.contact) contact.push_back(b.name);
+    if (b.dynamics) impact.push_back(b.name);
+  }
+  const ResultCache fill(cache_dir, ResultCache::code_fingerprint(), false);
+  in.explore =
+      explore_check_metrics(contact, impact, in.explore_set, nullptr, &par, &fill, &in.queries);
+}
+
 }  // namespace
 
 int report_command(const ReportOptions& opt) {
@@ -143,20 +164,7 @@ int report_command(const ReportOptions& opt) {
   // Explore's fixed random samples (the whole library, or --explore), on every rank.
   SummaryInputs in;
   if (opt.explore || opt.inputs.empty()) {
-    const std::vector<std::string> chosen = opt.backends.empty() || opt.backends == "all"
-                                                ? std::vector<std::string>{}
-                                                : parse_backend_list(opt.backends);
-    std::vector<std::string> contact, impact;
-    for (const Backend& b : backends()) {
-      if (b.name == "exact" ||
-          (!chosen.empty() && std::find(chosen.begin(), chosen.end(), b.name) == chosen.end()))
-        continue;
-      if (b.contact) contact.push_back(b.name);
-      if (b.dynamics) impact.push_back(b.name);
-    }
-    const ResultCache fill(hopt.cache_dir, ResultCache::code_fingerprint(), false);
-    in.explore =
-        explore_check_metrics(contact, impact, in.explore_set, nullptr, &par, &fill, &in.queries);
+    run_report_explore(opt.backends, hopt.cache_dir, par, in);
     parts.end("explore");
   }
   if (!par.root()) return 0;  // rank 0 writes everything
@@ -202,9 +210,9 @@ int report_command(const ReportOptions& opt) {
                                          tmp.string());
     parts.end("tosses");
     const std::string summary = report_summary_markdown(scenes, evs, in);
-    const std::string details =
-        report_details_markdown(scenes, evs, tmp.string(), figures_ok, views_ok) +
-        explore_details_markdown(in.explore, in.explore_set);
+    const std::string details = report_details_markdown(scenes, evs, tmp.string(), figures_ok,
+                                                        views_ok, opt.timing_budget_s) +
+                                explore_details_markdown(in.explore, in.explore_set);
     write_text((tmp / "report.md").string(), summary);
     write_text((tmp / "details.md").string(), details);
     write_report_pages(tmp.string(), scenes, evs, summary, details, views_ok);

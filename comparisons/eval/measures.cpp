@@ -119,6 +119,11 @@ PairRuns contact_runs(const std::vector<const Backend*>& backends, const RigidBo
     TimingPlan plan;
     plan.min_time_s = budget_s;
     time_contacts(subjects, runs, a, b, plan);
+  } else {
+    // No repeats: an answer's time is the one call that gave it, as a dynamics run's is.
+    for (ContactRun* r : runs)
+      if (!r->cached && r->timing.rounds == 0 && timeable(*r))
+        r->timing = Timing::once(r->timing.cold_s);
   }
   if (cache.enabled())
     for (size_t i = 0; i < subjects.size(); ++i)

@@ -382,7 +382,8 @@ Json geometry_json(const Scene& scene) {
 
 std::string report_details_markdown(const std::vector<Scene>& scenes,
                                     const std::vector<SceneEvaluation>& evs,
-                                    const std::string& report_dir, bool figures_ok, bool views_ok) {
+                                    const std::string& report_dir, bool figures_ok, bool views_ok,
+                                    double timing_budget_s) {
   std::ostringstream md;
   const std::vector<std::string> cols = report_columns(evs);
   md << "# rbx accuracy report: every table\n\n"
@@ -393,10 +394,10 @@ std::string report_details_markdown(const std::vector<Scene>& scenes,
         "[stability.csv](stability.csv), [laws.csv](laws.csv).\n\n";
   std::vector<FailureCause> causes;
   const std::vector<ScoreRow> rows = score_rows(scenes, evs, cols, &causes);
-  md << scorecard_markdown(rows) << causes_markdown(causes, false, views_ok);
+  md << scorecard_markdown(rows, timing_budget_s) << causes_markdown(causes, false, views_ok);
   md << summary_section(scenes, evs, cols, views_ok) << contact_phase_section(scenes, evs, cols)
      << disagreement_section(scenes, evs, cols);
-  if (const std::string q = query_time_markdown(evs, cols); !q.empty())
+  if (const std::string q = query_time_markdown(evs, cols, timing_budget_s); !q.empty())
     md << "## Contact query time\n\n" << q;
   md << solver_budgets_markdown(evs);
   md << stability_section(scenes, evs) << contact_laws_details_markdown(scenes, evs, cols)

@@ -33,10 +33,11 @@ std::string solver_budgets_markdown(const std::vector<SceneEvaluation>& evs);
 /// every backend, contact phase, who disagrees and why, contact query time, solver budgets,
 /// stability, contact laws, every ensemble's table (predictability) and every scene's detail.
 /// `figures_ok` and `views_ok` say whether the figures (in `report_dir`) and replay pages were
-/// written.
+/// written; `timing_budget_s`, the run's HarnessOptions::timing_budget_s (query_time_markdown).
 std::string report_details_markdown(const std::vector<Scene>& scenes,
                                     const std::vector<SceneEvaluation>& evs,
-                                    const std::string& report_dir, bool figures_ok, bool views_ok);
+                                    const std::string& report_dir, bool figures_ok, bool views_ok,
+                                    double timing_budget_s = HarnessOptions{}.timing_budget_s);
 
 /// results.json, metrics.csv, error_vs_runtime.csv and stability.csv into `dir`.
 void write_report_tables(const std::string& dir, const std::vector<Scene>& scenes,

@@ -346,7 +346,7 @@ std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
   return rows;
 }
 
-std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
+std::string scorecard_markdown(const std::vector<ScoreRow>& rows, double timing_budget_s) {
   std::ostringstream md;
   md << "## Scorecard\n\n"
         "One table per scene family, backends ranked by their median error against the truth "
@@ -356,8 +356,11 @@ std::string scorecard_markdown(const std::vector<ScoreRow>& rows) {
         "tolerance*: scenes with no ✗ and no ~ in the full tables (details.md); `unsupported` "
         "scenes are not counted. *Median error (n)*: the median over the n scenes that have a "
         "truth to compare with (the others have none). Run time: median over the scenes of "
-        "each scene's warm median (a dynamics run repeated, a query repeated; docs/bench.md), "
-        "wall clock; a library builds its shapes inside each query, custom reuses its hulls; "
+     << (timing_budget_s > 0
+             ? "each scene's warm median (a dynamics run repeated, a query repeated; "
+               "docs/bench.md), "
+             : "each scene's one call (this run timed no repeats: `--timing-budget 0`), ")
+     << "wall clock; a library builds its shapes inside each query, custom reuses its hulls; "
         "in brackets the same query with the library's shapes prebuilt, the fair comparison "
         "with custom. *Coverage error* (contacts): how far the backend's points fall short of the "
         "true contact patch, the largest distance from a corner of the `exact` patch to the hull "
@@ -499,7 +502,7 @@ std::string causes_markdown(const std::vector<FailureCause>& causes, bool compac
 }
 
 std::string query_time_markdown(const std::vector<SceneEvaluation>& evs,
-                                const std::vector<std::string>& backends) {
+                                const std::vector<std::string>& backends, double timing_budget_s) {
   // Pairs (per call, prebuilt) of one query, per backend: the harness writes a query's
   // prebuilt point right after its per-call point (none when the answers differed).
   std::map<std::string, std::vector<Timing>> per_call;
@@ -546,17 +549,21 @@ std::string query_time_markdown(const std::vector<SceneEvaluation>& evs,
     t.add(row);
   }
   std::ostringstream md;
-  md << "Contact query time, median over the queries of the run. Each query is timed as "
-        "benchmarks time (docs/bench.md): the backend's first call, which gave its answer, is "
-        "the *cold call*, reported apart; then, after a warm-up call, rounds of repeated calls "
-        "(each round long enough for the clock) until at least "
-     << fmt_num(HarnessOptions{}.timing_budget_s * 1e3) << " ms and " << TimingPlan{}.min_rounds
-     << " rounds, the backends of one pair taking turns round by round so that a passing load of "
-        "the "
-        "machine falls on all alike. *Per call* is the median over the rounds; *25-75 % over "
-        "rounds* is half the range between a query's quartiles relative to its median (the "
-        "median over the queries): how far one query's time moved while it was timed. *Calls "
-        "timed* adds up every query's. *Per call* is the backend as it runs (the library's "
+  md << "Contact query time, median over the queries of the run. ";
+  if (timing_budget_s > 0) {
+    md << "Each query is timed as benchmarks time (docs/bench.md): the backend's first call, "
+          "which gave its answer, is the *cold call*, reported apart; then, after a warm-up "
+          "call, rounds of repeated calls (each round long enough for the clock) until at least "
+       << fmt_num(timing_budget_s * 1e3) << " ms and " << TimingPlan{}.min_rounds
+       << " rounds, the backends of one pair taking turns round by round so that a passing load "
+          "of the machine falls on all alike. *Per call* is the median over the rounds; *25-75 % "
+          "over rounds* is half the range between a query's quartiles relative to its median "
+          "(the median over the queries): how far one query's time moved while it was timed. ";
+  } else {
+    md << "This run timed no repeats (`--timing-budget 0`): each query was called once, so "
+          "*per call* is that one cold call, with no spread over rounds. ";
+  }
+  md << "*Calls timed* adds up every query's. *Per call* is the backend as it runs (the library's "
         "shapes built in each query; custom, exact and libccd query our hulls directly, nothing "
         "to build). *Shapes prebuilt* is the same query with the library's shapes built once and "
         "kept, as a user holding them across steps would (the backend's \"prebuilt\" variant; "

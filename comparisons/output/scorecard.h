@@ -89,8 +89,10 @@ std::vector<ScoreRow> score_rows(const std::vector<Scene>& scenes,
 /// The heading of a row's group: the family, and the measure with its unit.
 std::string group_title(const ScoreRow& row);
 
-/// The scorecard in Markdown: one ranked table per group (details.md).
-std::string scorecard_markdown(const std::vector<ScoreRow>& rows);
+/// The scorecard in Markdown: one ranked table per group (details.md). `timing_budget_s`: the
+/// run's HarnessOptions::timing_budget_s, which says what its run times are.
+std::string scorecard_markdown(const std::vector<ScoreRow>& rows,
+                               double timing_budget_s = HarnessOptions{}.timing_budget_s);
 
 /// The scorecard at a glance (report.md): one table, a row per backend and a column per group,
 /// each cell the backend's rank in that group, its median error and its scenes within tolerance
@@ -105,8 +107,10 @@ std::string causes_markdown(const std::vector<FailureCause>& causes, bool compac
 /// The contact query times in Markdown: per backend, the median over the scenes' queries of the
 /// time per query with the library's shapes built in the query (as the backend runs), with them
 /// prebuilt (its "prebuilt" variant, where it has one), and the difference, the cost of
-/// building them. Empty when no contact query ran.
+/// building them. Empty when no contact query ran. `timing_budget_s`: the run's
+/// HarnessOptions::timing_budget_s, which the text states (0: one call per query, said so).
 std::string query_time_markdown(const std::vector<SceneEvaluation>& evs,
-                                const std::vector<std::string>& backends);
+                                const std::vector<std::string>& backends,
+                                double timing_budget_s = HarnessOptions{}.timing_budget_s);
 
 }  // namespace rbx

@@ -372,13 +372,18 @@ def check(inputs=None, baseline=None, backends=None, explore=False, no_cache=Fal
     return {"passed": code == 0, "exit_code": code, "output": out}
 
 
-def report(inputs=None, out=None, backends=None, explore=False):
-    """`rbx report`: the accuracy report; returns the folder it was written to."""
+def report(inputs=None, out=None, backends=None, explore=False, timing_budget=None):
+    """`rbx report`: the accuracy report; returns the folder it was written to.
+
+    timing_budget: seconds each query and run is timed for, at least (`--timing-budget`;
+    default 0.01); 0 calls each once, for the answers alone."""
     args = ["report", *[os.fspath(i) for i in (inputs or [])], *_names(backends)]
     if out is not None:
         args += ["--out", os.fspath(out)]
     if explore:
         args.append("--explore")
+    if timing_budget is not None:
+        args += ["--timing-budget", repr(float(timing_budget))]
     _command(args, show_progress=True)
     return os.fspath(out) if out is not None else os.path.join(_source_dir(), "reports", "latest")
 

@@ -517,8 +517,9 @@ TEST(Cli, ReportCheckGivesTheChecksVerdictFromTheReportsOwnRuns) {
   const std::string scenes = "scenes/contact/axis_x.toml scenes/analytic/headon_e05.toml";
   ASSERT_EQ(rbx("check " + scenes + " --baseline '" + base + "' --update").code, 0);
   // The report's runs measure the same numbers as rbx check: nothing moved.
-  const CmdResult same = rbx("report " + scenes + " --check --baseline '" + base + "' --out '" +
-                             (dir / "same").string() + "'");
+  // The verdict compares answers, never timings: no timing repeats (--timing-budget 0).
+  const CmdResult same = rbx("report " + scenes + " --check --timing-budget 0 --baseline '" + base +
+                             "' --out '" + (dir / "same").string() + "'");
   EXPECT_EQ(same.code, 0) << same.out << same.err;
   EXPECT_NE(same.out.find(": 0 worse, 0 better, 0 new;"), std::string::npos) << same.out;
   // Halve every non-zero error in the baseline: the report is written, and its check fails
@@ -528,8 +529,8 @@ TEST(Cli, ReportCheckGivesTheChecksVerdictFromTheReportsOwnRuns) {
   for (auto& [k, v] : b["metrics"].items())
     if (v.is_number() && v.get<double>() > 1e-9) v = v.get<double>() * 0.5;
   std::ofstream(base) << b.dump(2);
-  const CmdResult worse = rbx("report " + scenes + " --check --baseline '" + base + "' --out '" +
-                              (dir / "worse").string() + "'");
+  const CmdResult worse = rbx("report " + scenes + " --check --timing-budget 0 --baseline '" +
+                              base + "' --out '" + (dir / "worse").string() + "'");
   EXPECT_EQ(worse.code, 1) << worse.out << worse.err;
   EXPECT_NE(worse.out.find("    worse   "), std::string::npos) << worse.out;
   EXPECT_TRUE(fs::exists(dir / "worse" / "report.md"));
@@ -802,10 +803,52 @@ TEST(CompareMetrics, EnergyErrorIsAgainstTheClosedFormWhereThereIsOne) {
   }
 }
 
+TEST(Cli, ReportTimingBudgetZeroCallsEachQueryOnceAndSaysSo) {
+  const fs::path dir = temp_dir("report_budget");
+  const CmdResult r = rbx("report scenes/contact/axis_x.toml --timing-budget 0 --out '" +
+                          (dir / "out").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  // Every timed point is one call in one round: no repeats were run.
+  std::ifstream csv(dir / "out/error_vs_runtime.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  std::vector<std::string> names;
+  for (std::stringstream h(header); std::getline(h, line, ',');) names.push_back(line);
+  const auto calls = std::find(names.begin(), names.end(), "calls") - names.begin();
+  const auto rounds = std::find(names.begin(), names.end(), "rounds") - names.begin();
+  ASSERT_LT(static_cast<size_t>(rounds), names.size()) << header;
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cells;
+    for (std::stringstream c(line); std::getline(c, header, ',');) cells.push_back(header);
+    ASSERT_GT(cells.size(), static_cast<size_t>(rounds)) << line;
+    EXPECT_EQ(cells[static_cast<size_t>(calls)], "1") << line;
+    EXPECT_EQ(cells[static_cast<size_t>(rounds)], "1") << line;
+    ++rows;
+  }
+  EXPECT_GT(rows, 0);
+  // The tables say so, instead of describing repeats that did not run.
+  std::stringstream md;
+  md << std::ifstream(dir / "out/details.md").rdbuf();
+  EXPECT_NE(md.str().find("this run timed no repeats: `--timing-budget 0`"), std::string::npos);
+  EXPECT_EQ(md.str().find("warm median"), std::string::npos);
+  // Out of range or not a number: exit 2, one line naming the option, nothing written.
+  for (const char* bad : {"-1", "nan", "inf", "fast"}) {
+    const CmdResult b = rbx(std::string("report scenes/contact/axis_x.toml --timing-budget ") +
+                            bad + " --out '" + (dir / "bad").string() + "'");
+    EXPECT_EQ(b.code, 2) << bad;
+    EXPECT_NE(b.err.find("--timing-budget"), std::string::npos) << b.err;
+    EXPECT_NE(b.err.find("must be a number of seconds >= 0"), std::string::npos) << b.err;
+    EXPECT_FALSE(fs::exists(dir / "bad")) << bad;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(ReportTables, StabilityHasStepAndRestitutionAndCustomSeedSinksOnTheStack) {
   const fs::path dir = temp_dir("report_stab");
   const CmdResult r =
-      rbx("report scenes/stress/resting_stack.toml scenes/stress/tunnel_thin_wall.toml --out '" +
+      rbx("report scenes/stress/resting_stack.toml scenes/stress/tunnel_thin_wall.toml "
+          "--timing-budget 0 --out '" +
           (dir / "out").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   std::stringstream csv, md;
