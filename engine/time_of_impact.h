@@ -57,7 +57,9 @@ struct TimeOfImpact {
 /// - the gap along a separating axis found at the earlier sample, divided by the pair's travel
 ///   rate, so nothing can touch between them (conservative advancement).
 /// A fixed grid of the first kind when it takes at most `max_samples` samples (the cost known in
-/// advance; WorldSettings::toi_max_samples); past that, steps of the larger of the two. Then
+/// advance; WorldSettings::toi_max_samples); past that, steps of the larger of the two. A grid
+/// sample asks the distance first, and the detector only where the distance does not put the
+/// pair beyond the detector's reach (separation_margin: the answer is the same). Then
 /// bisection on the detector between the last separated and the first touching sample, to 1e-12 of
 /// dt. A search that reaches `max_samples` before dt (bodies skimming past each other at a speed of
 /// millions of their thicknesses per step) is not certified: its answer says so. Meant for pairs
