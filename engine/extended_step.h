@@ -54,6 +54,13 @@ class ExtendedStep {
   bool separated(const WorldState& world, const RigidBody& a, const RigidBody& b, int i, int j,
                  double travel = -1.0);
 
+  // For a pair the axes do not prove apart at the step's end (a, b moved there; the start poses
+  // in `world`): true when the distance proves it apart at the end and, with the gap at the
+  // start, through the whole step (the detector, with `margin`, finds nothing anywhere); the
+  // end's direction is kept as the pair's axis.
+  bool apart_through_step(const WorldState& world, const RigidBody& a, const RigidBody& b, int i,
+                          int j, double margin);
+
   // The growth of the bounding spheres (m) for one broad phase serving both the step's start and
   // its end (the look-ahead): twice the farthest any body's sphere centre reaches at its start
   // velocity; 0 (two broad phases) under the seed's Euler or when that is not small beside the

@@ -57,6 +57,39 @@ double travel_bound(const RigidBody& body, double turn_rate, double radius, doub
 
 namespace {
 
+// What the turns add to a body's travel rate (m/s): travel_bound's rate less |v|.
+double turn_speed(const RigidBody& body, const BodyFacts& facts) {
+  return body.is_static
+             ? 0.0
+             : travel_bound(body, facts.turn_rate, facts.radius, 1.0) - body.velocity.norm();
+}
+
+// B's velocity seen from A (a static body does not move): B moving along a direction from B
+// toward A closes the gap along it.
+Vec3 b_seen_from_a(const RigidBody& a, const RigidBody& b) {
+  return (b.is_static ? Vec3::Zero() : b.velocity) - (a.is_static ? Vec3::Zero() : a.velocity);
+}
+
+// How long a room (m) lasts at a closing speed (m/s).
+double span(double room, double closing) {
+  return closing > 0 ? room / closing : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+bool apart_through(const RigidBody& a, const RigidBody& b, const BodyFacts& facts_a,
+                   const BodyFacts& facts_b, const GapAlong& start, const GapAlong& end,
+                   double margin, double dt) {
+  if (!(start.gap > margin) || !(end.gap > margin)) return false;
+  const double turns = turn_speed(a, facts_a) + turn_speed(b, facts_b);
+  const Vec3 v_rel = b_seen_from_a(a, b);
+  const double forward = span(start.gap - margin, std::max(0.0, v_rel.dot(start.u)) + turns);
+  const double backward = span(end.gap - margin, std::max(0.0, -v_rel.dot(end.u)) + turns);
+  return forward + backward > dt;
+}
+
+namespace {
+
 // What the distance at a time t proves (conservative advancement): how long after (forward) and
 // before (backward) t the pair stays apart, and how long after t it stays beyond the detector's
 // reach (`quiet`; 0 when it is not beyond it at t).
@@ -119,9 +152,8 @@ ImpactSearch::ImpactSearch(const RigidBody& a, const RigidBody& b, const BodyFac
       rate_(rate_of(a, facts_a) + rate_of(b, facts_b)),
       reach_(separation_margin(std::max(facts_a.own_tol, facts_b.own_tol), facts_a.reach,
                                facts_b.reach)) {
-  spin_ = (a.is_static ? 0.0 : rate_of(a, facts_a) - a.velocity.norm()) +
-          (b.is_static ? 0.0 : rate_of(b, facts_b) - b.velocity.norm());
-  v_rel_ = (b.is_static ? Vec3::Zero() : b.velocity) - (a.is_static ? Vec3::Zero() : a.velocity);
+  spin_ = turn_speed(a, facts_a) + turn_speed(b, facts_b);
+  v_rel_ = b_seen_from_a(a, b);
 }
 
 Room ImpactSearch::room(double t) const {
@@ -130,16 +162,13 @@ Room ImpactSearch::room(double t) const {
   if (sep.overlapping || !(sep.distance > 0)) return Room{};
   const Vec3 n = (sep.point_b - sep.point_a) / sep.distance;
   const double approach = -v_rel_.dot(n);
-  auto span = [](double closing, double gap) {
-    return closing > 0 ? gap / closing : std::numeric_limits<double>::infinity();
-  };
   const double closing = std::max(0.0, approach) + spin_;
-  Room r{span(closing, sep.distance), span(std::max(0.0, -approach) + spin_, sep.distance)};
+  Room r{span(sep.distance, closing), span(sep.distance, std::max(0.0, -approach) + spin_)};
   // The gap along n from the vertices, not the distance's own figure, proves it beyond reach
   // (the same proof ExtendedStep::separated takes).
   if (sep.distance > reach_) {
     const double gap = gap_along(*a_.shape, pa, *b_.shape, pb, -n);
-    if (gap > reach_) r.quiet = span(closing, gap - reach_);
+    if (gap > reach_) r.quiet = span(gap - reach_, closing);
   }
   return r;
 }

@@ -43,6 +43,23 @@ double sweep_length(const RigidBody& body, double radius, double t);
 /// caller. Zero for a static body.
 double travel_bound(const RigidBody& body, double turn_rate, double radius, double t);
 
+/// A gap between A and B along a fixed unit direction `u` from B toward A (gap_along): the
+/// least over A's points of u . x less the most over B's (m).
+struct GapAlong {
+  Vec3 u = Vec3::UnitZ();
+  double gap = 0.0;
+};
+
+/// True when A and B, moved as time_of_impact moves them from their current poses, are proved
+/// farther apart than `margin` all through [0, dt] by `start` (a gap at time 0) and `end` (a
+/// gap at dt): along a fixed direction the gap shrinks no faster than the approach along it
+/// plus what the turns add (travel_bound less |v|), so `start` lasts forward and `end`
+/// backward, and together they cover the step. Then a detector whose reach is `margin` finds
+/// nothing in the step: time_of_impact's own answer, without its samples.
+bool apart_through(const RigidBody& a, const RigidBody& b, const BodyFacts& facts_a,
+                   const BodyFacts& facts_b, const GapAlong& start, const GapAlong& end,
+                   double margin, double dt);
+
 /// The answer of a time-of-impact search.
 struct TimeOfImpact {
   std::optional<double> time;  // s into the step: the first touch; none when none within dt
