@@ -119,6 +119,8 @@ class ImpactSearch {
   bool touching(double t) {
     return detect(*a_.shape, pose_a(t), *b_.shape, pose_b(t), detector_, cache_).has_value();
   }
+  // The time the pair takes to travel the detector's tolerance (s).
+  double tolerance_time() const { return point_in_mesh_tolerance(*a_.shape, *b_.shape) / rate_; }
   Room room(double t) const;
   TimeOfImpact first_touch(double before, double after, double quiet);
 
@@ -173,11 +175,14 @@ Room ImpactSearch::room(double t) const {
   return r;
 }
 
-// Bisection on the detector between `before` (apart) and `after` (touching), to 1e-12 of the
-// step. Until `quiet` the pair is beyond the detector's reach: those midpoints are apart without
-// asking it, and the answer is the same bisection's.
+// Bisection on the detector between `before` (apart) and `after` (touching), until the pair
+// travels no more than the detector's tolerance between them (1e-12 of the step at the least):
+// the detector calls a pair touching within that tolerance, so a finer time only places its own
+// rounding of the touch. Until `quiet` the pair is beyond the detector's reach: those midpoints
+// are apart without asking it, and the answer is the same bisection's.
 TimeOfImpact ImpactSearch::first_touch(double before, double after, double quiet) {
-  while (after - before > 1e-12 * dt_) {
+  const double resolution = std::max(1e-12 * dt_, tolerance_time());
+  while (after - before > resolution) {
     const double mid = 0.5 * (before + after);
     (!(mid < quiet) && touching(mid) ? after : before) = mid;
   }
@@ -195,7 +200,7 @@ TimeOfImpact ImpactSearch::first_touch(double before, double after, double quiet
 // detector's tolerance of travel (an overlap shallower than that is touching to the detector
 // anyway).
 TimeOfImpact ImpactSearch::on_grid(long n, long max_samples) {
-  const double least_step = point_in_mesh_tolerance(*a_.shape, *b_.shape) / rate_;
+  const double least_step = tolerance_time();
   long walked = 0;
   double before = 0.0;
   Room at_before = room(0.0);

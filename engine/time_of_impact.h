@@ -77,12 +77,15 @@ struct TimeOfImpact {
 /// advance; WorldSettings::toi_max_samples); past that, steps of the larger of the two. A grid
 /// sample asks the distance first, and the detector only where the distance does not put the
 /// pair beyond the detector's reach (separation_margin: the answer is the same). Then
-/// bisection on the detector between the last separated and the first touching sample, to 1e-12 of
-/// dt. A search that reaches `max_samples` before dt (bodies skimming past each other at a speed of
-/// millions of their thicknesses per step) is not certified: its answer says so. Meant for pairs
-/// separated at the step's start. `facts_a`, `facts_b`: the bodies' facts kept by the caller (the
-/// same numbers as BodyFacts::of, which is called when they are not given); `cache`: a detection
-/// cache to reuse (the search makes its own when none is given; the answer is the same).
+/// bisection on the detector between the last separated and the first touching sample, until
+/// the pair's travel between them is within the detector's tolerance (point_in_mesh_tolerance;
+/// 1e-12 of dt at the least): the answer is a time the detector finds them touching, less than
+/// the detector's tolerance of travel after one it does not. A search that reaches `max_samples`
+/// before dt (bodies skimming past each other at a speed of millions of their thicknesses per step)
+/// is not certified: its answer says so. Meant for pairs separated at the step's start. `facts_a`,
+/// `facts_b`: the bodies' facts kept by the caller (the same numbers as BodyFacts::of, which is
+/// called when they are not given); `cache`: a detection cache to reuse (the search makes its own
+/// when none is given; the answer is the same).
 TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, Detector detector,
                             long max_samples, const BodyFacts* facts_a = nullptr,
                             const BodyFacts* facts_b = nullptr, DetectionCache* cache = nullptr);

@@ -37,8 +37,9 @@ TEST(TimeOfImpact, ThinPlateMeetsThinWallAtTheClosedFormTime) {
   ASSERT_TRUE(hit.certified);
   ASSERT_TRUE(hit.time);
   const double t = *hit.time;
-  // Bisection to 1e-12 of dt plus the detector's touching tolerance (1e-9 of the size, 2e-11 s
-  // at 100 m/s).
+  // The detector's touching tolerance (1e-9 of the size, 2e-11 s at 100 m/s), once for where it
+  // first calls the pair touching and once more for the bisection, which stops within that
+  // tolerance of travel.
   EXPECT_NEAR(t, 0.0129, 1e-10);
   const TimeOfImpact miss = time_of_impact(plate(), wall(), 0.012, Detector::Faithful, kSamples);
   EXPECT_TRUE(miss.certified);
@@ -59,8 +60,9 @@ TEST(TimeOfImpact, AFallAtTheSpeedLimitIsCaughtAtItsClosedFormTime) {
     const TimeOfImpact hit = time_of_impact(cube, slab, dt, Detector::Accelerated, 100);
     ASSERT_TRUE(hit.certified) << "dt " << dt;
     ASSERT_TRUE(hit.time) << "dt " << dt;
-    // Bisection to 1e-12 of dt, the detector's touching tolerance (1e-9 of the size: 3e-18 s
-    // at this speed) and the round-off of a position 1e5 m from the origin (1.5e-11 m, 5e-20 s).
+    // Bisection to 1e-12 of dt (longer than the detector's tolerance of travel here: 1e-9 of
+    // the size, 3e-18 s at this speed, which also bounds where it first calls the pair
+    // touching) and the round-off of a position 1e5 m from the origin (1.5e-11 m, 5e-20 s).
     EXPECT_NEAR(*hit.time, drop / v, 1e-12 * dt + 1e-17) << "dt " << dt;
   }
   // The extended world bounces it (e = 1): one collision, the velocity reversed to round-off.

@@ -77,10 +77,11 @@ std::pair<int, int> compare_on_random_pairs(uint64_t seed, int trials, double sk
   // Boxes, icospheres and prisms at random turns, B set apart from A along a random direction by
   // up to half a size beyond touching and sent back toward A, to arrive at a random fraction of
   // 1.2 steps (so about one in six arrives too late), with a sideways drift; A drifts too. The step
-  // is 10 ms. custom samples the detector in time and bisects to 1e-12 of the step; its detector
-  // counts a pair as touching within its tolerance (engine/detect.h: 1e-9 of the larger size),
-  // reached up to that tolerance over the closing speed early. So a hit agrees within 1e-12 dt +
-  // 2e-9 size / (closing speed along the normal). Every draw in a statement of its own: C++ leaves
+  // is 10 ms. custom samples the detector in time; its detector counts a pair as touching within
+  // its tolerance (engine/detect.h: 1e-9 of the larger size), reached up to that tolerance over
+  // the closing speed early, and it bisects until the pair travels no more than that tolerance
+  // (or 1e-12 of the step), at most that late. So a hit agrees within 1e-12 dt + 2e-9 size /
+  // (closing speed along the normal). Every draw in a statement of its own: C++ leaves
   // the order of the draws within one expression unspecified, and the pairs must be the same under
   // every compiler.
   std::mt19937_64 rng(seed);
