@@ -194,8 +194,7 @@ const std::vector<BodyPair>& ExtendedStep::look_ahead_pairs(const WorldState& wo
   bool within = grow_ > 0.0;
   for (size_t i = 0; within && i < n; ++i)
     within =
-        travel_bound(world.bodies[i], world.facts[i].turn_rate,
-                     centre_reach(world.bodies[i], world.facts[i]), world.sim.dt) <= 0.5 * grow_;
+        rates_[i].over(centre_reach(world.bodies[i], world.facts[i]), world.sim.dt) <= 0.5 * grow_;
   if (!within) return ahead_broad_phase_.find_pairs(ahead_);
   spheres_.resize(n);
   for (size_t i = 0; i < n; ++i) spheres_[i] = bounding_sphere(ahead_[i]);
@@ -354,8 +353,11 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
   // step's velocities, touch is moved to its first touch like the fast pairs above, so an impact
   // is resolved where it begins whatever its phase in the step.
   std::vector<double> travel(n, 0.0);
-  for (size_t i = 0; i < n; ++i)
-    travel[i] = travel_bound(world.bodies[i], facts[i].turn_rate, facts[i].radius, dt);
+  rates_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    rates_[i] = travel_rate(world.bodies[i], facts[i].turn_rate);
+    travel[i] = rates_[i].over(facts[i].radius, dt);
+  }
   for (size_t i = 0; i < n; ++i) {
     const RigidBody& b = world.bodies[i];
     ahead_.push_back(b.is_static ? b : advanced(b, dt, &facts[i].principal));

@@ -12,6 +12,7 @@
 #include "engine/contact_solver.h"
 #include "engine/detect.h"
 #include "engine/pair_table.h"
+#include "engine/time_of_impact.h"
 #include "engine/world_state.h"
 
 namespace rbx {
@@ -70,7 +71,8 @@ class ExtendedStep {
   // sphere's centre lie (m): what travel_bound's radius must cover.
   static double centre_reach(const RigidBody& body, const BodyFacts& facts);
   // The pairs whose spheres touch at the step's end (ahead_): the start's grown pairs filtered,
-  // or the look-ahead broad phase when a sphere centre moved too far for them.
+  // or the look-ahead broad phase when a sphere centre moved too far for them (by rates_, this
+  // step's).
   const std::vector<BodyPair>& look_ahead_pairs(const WorldState& world);
   // Places a world box around each of `bodies` (the set separated() is asked about next): a
   // moving body's is its bounding ball's about the centre of mass, a static body's the box of its
@@ -95,7 +97,8 @@ class ExtendedStep {
   std::vector<BodyPair> grown_pairs_;  // the start's pairs of spheres grown by grow_
   std::vector<BodyPair> ahead_pairs_;  // scratch: look_ahead_pairs' output
   std::vector<BodyPair> touching_;     // scratch: the pairs with a manifold at the step's start
-  std::vector<BoundingSphere> spheres_;      // scratch: one pose's bounding spheres
+  std::vector<BoundingSphere> spheres_;  // scratch: one pose's bounding spheres
+  std::vector<TravelRate> rates_;        // scratch: the bodies' travel rates after the step's solve
   std::vector<Vec3> static_lo_, static_hi_;  // m, world: the static bodies' boxes, once
   // The manifolds' detector cache and contact-plane scratch, reused pair after pair.
   DetectionCache detection_;

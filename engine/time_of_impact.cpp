@@ -47,12 +47,17 @@ double sweep_length(const RigidBody& body, double radius, double t) {
   return (body.velocity.norm() + body.angular_velocity.norm() * radius) * t;
 }
 
-double travel_bound(const RigidBody& body, double turn_rate, double radius, double t) {
-  if (body.is_static) return 0.0;
+TravelRate travel_rate(const RigidBody& body, double turn_rate) {
+  if (body.is_static) return {};
   // |L| = |I_body R^T w|: a rotation keeps the norm.
   const double momentum =
       (body.inertia_body * (body.orientation.conjugate() * body.angular_velocity)).norm();
-  return (body.velocity.norm() + turn_rate * momentum * radius) * t;
+  return {body.velocity.norm(), turn_rate * momentum};
+}
+
+double travel_bound(const RigidBody& body, double turn_rate, double radius, double t) {
+  if (body.is_static) return 0.0;
+  return travel_rate(body, turn_rate).over(radius, t);
 }
 
 namespace {

@@ -43,6 +43,15 @@ double sweep_length(const RigidBody& body, double radius, double t);
 /// caller. Zero for a static body.
 double travel_bound(const RigidBody& body, double turn_rate, double radius, double t);
 
+/// What travel_bound multiplies out: a body's speed |v| (m/s) and its turn rate times |L|
+/// (rad/s), so that `over(radius, t)` is travel_bound(body, turn_rate, radius, t) bit for bit, for
+/// a caller asking with several radii. Both zero for a static body.
+struct TravelRate {
+  double speed = 0.0, turn = 0.0;
+  double over(double radius, double t) const { return (speed + turn * radius) * t; }
+};
+TravelRate travel_rate(const RigidBody& body, double turn_rate);
+
 /// A gap between A and B along a fixed unit direction `u` from B toward A (gap_along): the
 /// least over A's points of u . x less the most over B's (m).
 struct GapAlong {
