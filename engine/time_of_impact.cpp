@@ -219,7 +219,8 @@ TimeOfImpact ImpactSearch::on_grid(long n, long max_samples) {
       // finds the pair touching (the cheaper query first).
       double clear = before;
       Room at_clear = at_before;
-      for (;;) {
+      // It ends where the span the last distance proves meets the one t's proves backward.
+      while (!(at_clear.forward + at_t.backward > t - clear)) {
         const double next = clear + std::max(at_clear.forward, least_step);
         if (next >= t) break;
         const Room at_next = room(next);
