@@ -100,6 +100,14 @@ std::vector<PairManifold> ExtendedStep::detect_manifolds(WorldState& world) {
   // the broad phase's pairs are those of spheres grown by it, kept for the look-ahead; here the
   // seed's test on the start spheres keeps exactly the bounding check's pairs, in its order.
   std::vector<PairManifold> manifolds;
+  // Which bodies are where the last step's look-ahead put them (ahead_, still the last step's):
+  // for those, the gaps proved at its end still bound theirs.
+  const size_t n = world.bodies.size();
+  unmoved_.assign(n, 0);
+  if (ahead_.size() == n)
+    for (size_t i = 0; i < n; ++i)
+      unmoved_[i] = world.bodies[i].position == ahead_[i].position &&
+                    world.bodies[i].orientation.coeffs() == ahead_[i].orientation.coeffs();
   place_boxes(world.bodies, world.facts);
   grow_ = look_ahead_growth(world);
   const std::vector<BodyPair>& pairs = world.broad_phase.find_pairs(world.bodies, grow_);
@@ -243,7 +251,19 @@ bool ExtendedStep::separated(const WorldState& world, const RigidBody& a, const 
   Witness* kept = witnesses_.find(key);
   // Proved at the step's start with room for both bodies' travel along the step (no point moves
   // farther): still apart at its end.
-  if (travel >= 0.0 && kept && kept->step == steps_ && kept->gap - travel > margin) return true;
+  if (travel >= 0.0 && kept && kept->step == steps_ && kept->gap - travel > margin) {
+    kept->end_gap = kept->gap - travel;
+    kept->end_step = steps_;
+    return true;
+  }
+  // At the step's start, the bound the last step's end left, while neither body has moved since
+  // (no time of impact, no projection).
+  if (travel < 0.0 && kept && kept->end_step == steps_ - 1 && kept->end_gap > margin &&
+      unmoved_[i] && unmoved_[j]) {
+    kept->gap = kept->end_gap;
+    kept->step = steps_;
+    return true;
+  }
   if (kept) {
     // The bounding boxes' bound first (exact for boxes), the vertices only when it falls short.
     const Vec3 u = b.orientation * kept->axis;
@@ -252,13 +272,18 @@ bool ExtendedStep::separated(const WorldState& world, const RigidBody& a, const 
     if (gap > margin) {
       kept->gap = gap;
       kept->step = steps_;
+      if (travel >= 0.0) {
+        kept->end_gap = gap;
+        kept->end_step = steps_;
+      }
       return true;
     }
   }
   const Vec3 u = find_separating_axis(*a.shape, a.pose(), *b.shape, b.pose(), margin);
   if (u != Vec3::Zero()) {
-    witnesses_.put(key, {b.orientation.conjugate() * u,
-                         gap_along(*a.shape, a.pose(), *b.shape, b.pose(), u), steps_});
+    const double gap = gap_along(*a.shape, a.pose(), *b.shape, b.pose(), u);
+    witnesses_.put(key,
+                   {b.orientation.conjugate() * u, gap, steps_, gap, travel >= 0.0 ? steps_ : -1});
     return true;
   }
   if (travel >= 0.0 && apart_through_step(world, a, b, i, j, margin)) return true;
@@ -288,7 +313,7 @@ bool ExtendedStep::apart_through_step(const WorldState& world, const RigidBody& 
       kept && kept->step == steps_
           ? std::optional<GapAlong>(GapAlong{b0.orientation * kept->axis, kept->gap})
           : apart(a0, b0);
-  witnesses_.put(key, {b.orientation.conjugate() * end->u, end->gap, steps_});
+  witnesses_.put(key, {b.orientation.conjugate() * end->u, end->gap, steps_, end->gap, steps_});
   return start &&
          apart_through(a0, b0, world.facts[i], world.facts[j], *start, *end, margin, world.sim.dt);
 }

@@ -83,11 +83,16 @@ class ExtendedStep {
   BroadPhase ahead_broad_phase_;
   std::vector<RigidBody> ahead_;  // scratch: the bodies moved to the step's end
   // What proved a pair apart (engine/separation.h): the axis, in b's frame, tried first at the
-  // next test; the gap along it (m) and the step (steps_) at which it was measured.
+  // next test; the gap along it (m) and the step (steps_) at which it was measured (or bounded
+  // from below). `end_gap`: a lower bound on the gap at the end of step `end_step`, along the
+  // world direction the gap was last measured along; while nothing but the step's own motion
+  // moves the bodies (their travel covers it), a bound along a fixed direction stays one.
   struct Witness {
     Vec3 axis = Vec3::UnitZ();
     double gap = 0.0;
     long step = -1;
+    double end_gap = 0.0;
+    long end_step = -1;
   };
   // Per pair (key i * bodies + j) that passed the bounding check but was found apart.
   PairTable<Witness> witnesses_;
@@ -99,6 +104,7 @@ class ExtendedStep {
   std::vector<BodyPair> touching_;     // scratch: the pairs with a manifold at the step's start
   std::vector<BoundingSphere> spheres_;  // scratch: one pose's bounding spheres
   std::vector<TravelRate> rates_;        // scratch: the bodies' travel rates after the step's solve
+  std::vector<char> unmoved_;            // per body: at its pose in ahead_ from the last step
   std::vector<Vec3> static_lo_, static_hi_;  // m, world: the static bodies' boxes, once
   // The manifolds' detector cache and contact-plane scratch, reused pair after pair.
   DetectionCache detection_;
