@@ -77,15 +77,15 @@ constexpr const char* kDeepProfile =
     "search about a fifth and the region's centre about a twentieth. FCL's convex pairs run "
     "libccd's MPR, which estimates the depth without certifying the least overlap.";
 
-// The profile behind the whole-step goal (perf, 2026-11-28, many_1000 over the bench's first 60
-// steps, with the broad phase's pairs kept from step to step), a measured cause.
+// The profile behind the whole-step goal (callgrind, 2026-12-06, many_1000 over its first 300
+// steps), a measured cause.
 constexpr const char* kStepProfile =
-    "the whole step, many_1000: the separation proofs of the pairs passing the bounding check are "
-    "about a third of the step (the seed's bounding spheres of neighbouring cubes overlap, so "
-    "about 2,700 pairs pass it each step), the look-ahead's moves of every body about a sixth, "
-    "the broad phase (its pairs kept from step to step) and the state check about a tenth each. "
-    "On many_100 Bullet's own time varies by a quarter from run to run (0.26 to 0.33 µs per "
-    "body-step).";
+    "the whole step, many_1000: the time of impact that moves each new contact to its first touch "
+    "is about a third of the step (its bisection on the detector about a quarter), the "
+    "separation proofs of the pairs passing the bounding check (the seed's bounding spheres of "
+    "neighbouring cubes overlap, so about 2,700 pairs pass it each step) about a fifth, the "
+    "look-ahead's moves of every body about a tenth, and the broad phase, the contact solve and "
+    "the manifolds about a twentieth each.";
 
 std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& results) {
   std::vector<PerfGoal> goals;
