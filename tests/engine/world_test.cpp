@@ -290,7 +290,9 @@ TEST(World, EveryPairTouchingAtAStepsStartIsSolvedInThatStep) {
                    Detector::Accelerated))
           touching.emplace_back(i, j);
     ASSERT_TRUE(world.step()) << world.failure();
-    for (const auto& [i, j] : touching) {
+    for (const std::pair<int, int>& pair : touching) {
+      // Named, not bound: a lambda may not capture a structured binding before C++20.
+      const int i = pair.first, j = pair.second;
       ++touching_pairs;
       if (!now[i].is_static && !now[j].is_static) ++between_boxes;
       const bool solved = std::any_of(
