@@ -10,6 +10,7 @@
 #include "engine/distance.h"
 #include "engine/integrate.h"
 #include "engine/separation.h"
+#include "engine/touch_witness.h"
 
 namespace rbx {
 
@@ -121,11 +122,10 @@ class ImpactSearch {
   }
   Pose pose_a(double t) const { return advanced_pose(a_, momentum_a_, t, &facts_a_.principal); }
   Pose pose_b(double t) const { return advanced_pose(b_, momentum_b_, t, &facts_b_.principal); }
-  bool touching(double t) {
-    return detect(*a_.shape, pose_a(t), *b_.shape, pose_b(t), detector_, cache_).has_value();
-  }
+  // The detector's answer at t; where the last touch it found settles it, without it.
+  bool touching(double t);
   // The time the pair takes to travel the detector's tolerance (s).
-  double tolerance_time() const { return point_in_mesh_tolerance(*a_.shape, *b_.shape) / rate_; }
+  double tolerance_time() const { return tol_ / rate_; }
   Room room(double t) const;
   TimeOfImpact first_touch(double before, double after, double quiet);
 
@@ -140,8 +140,10 @@ class ImpactSearch {
   // Farther apart than this, the detector finds nothing (the margin ExtendedStep::separated
   // skips the detector by): a sample there needs no detection.
   const double reach_;
-  double spin_ = 0.0;          // m/s: what the turns add to the travel rate
-  Vec3 v_rel_ = Vec3::Zero();  // B's velocity seen from A (a static body does not move)
+  const double tol_;                     // m, the detector's tolerance (point_in_mesh_tolerance)
+  double spin_ = 0.0;                    // m/s: what the turns add to the travel rate
+  Vec3 v_rel_ = Vec3::Zero();            // B's velocity seen from A (a static body does not move)
+  std::optional<TouchWitness> witness_;  // of the last touch the detector found
 };
 
 ImpactSearch::ImpactSearch(const RigidBody& a, const RigidBody& b, const BodyFacts& facts_a,
@@ -158,9 +160,21 @@ ImpactSearch::ImpactSearch(const RigidBody& a, const RigidBody& b, const BodyFac
       momentum_b_(world_momentum(b)),
       rate_(rate_of(a, facts_a) + rate_of(b, facts_b)),
       reach_(separation_margin(std::max(facts_a.own_tol, facts_b.own_tol), facts_a.reach,
-                               facts_b.reach)) {
+                               facts_b.reach)),
+      tol_(point_in_mesh_tolerance(*a.shape, *b.shape)) {
   spin_ = turn_speed(a, facts_a) + turn_speed(b, facts_b);
   v_rel_ = b_seen_from_a(a, b);
+}
+
+bool ImpactSearch::touching(double t) {
+  const Pose pa = pose_a(t), pb = pose_b(t);
+  if (witness_) {
+    const std::optional<bool> settled = witness_->settle(pa, pb, reach_, tol_);
+    if (settled) return *settled;
+  }
+  const std::optional<ContactPoint> hit = detect(*a_.shape, pa, *b_.shape, pb, detector_, cache_);
+  if (hit) witness_ = TouchWitness::of(*a_.shape, pa, *b_.shape, pb, *hit);
+  return hit.has_value();
 }
 
 Room ImpactSearch::room(double t) const {
@@ -184,7 +198,8 @@ Room ImpactSearch::room(double t) const {
 // travels no more than the detector's tolerance between them (1e-12 of the step at the least):
 // the detector calls a pair touching within that tolerance, so a finer time only places its own
 // rounding of the touch. Until `quiet` the pair is beyond the detector's reach: those midpoints
-// are apart without asking it, and the answer is the same bisection's.
+// are apart without asking it, and the answer is the same bisection's. So are most of the others
+// (touching(): the touch's witness), all but the last few near the touch.
 TimeOfImpact ImpactSearch::first_touch(double before, double after, double quiet) {
   const double resolution = std::max(1e-12 * dt_, tolerance_time());
   while (after - before > resolution) {

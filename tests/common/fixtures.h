@@ -40,6 +40,15 @@ inline Quat random_rotation(std::mt19937& rng) {
   return Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
 }
 
+/// A sharp wedge: a triangular prism whose edge angle is about 11 degrees (the detector's
+/// tolerance reaches far beyond its sharp edge: tolerance_reach above 5).
+inline ConvexPolyhedron sharp_wedge() {
+  return ConvexPolyhedron::from_triangles(
+      {Vec3(0, 0, 0), Vec3(1, 0.1, 0), Vec3(1, -0.1, 0), Vec3(0, 0, 0.5), Vec3(1, 0.1, 0.5),
+       Vec3(1, -0.1, 0.5)},
+      {{0, 1, 2}, {3, 5, 4}, {0, 4, 1}, {0, 3, 4}, {1, 5, 2}, {1, 4, 5}, {2, 3, 0}, {2, 5, 3}});
+}
+
 /// The same double to the bit (-0 and 0 differ, a NaN equals itself).
 inline bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 

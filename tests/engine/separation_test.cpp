@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "engine/detect.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {
@@ -20,23 +21,17 @@ Quat random_rotation(std::mt19937_64& rng) {
   return q.normalized();
 }
 
-/// A sharp wedge: a triangular prism whose edge angle is about 11 degrees.
-ConvexPolyhedron wedge() {
-  return ConvexPolyhedron::from_triangles(
-      {Vec3(0, 0, 0), Vec3(1, 0.1, 0), Vec3(1, -0.1, 0), Vec3(0, 0, 0.5), Vec3(1, 0.1, 0.5),
-       Vec3(1, -0.1, 0.5)},
-      {{0, 1, 2}, {3, 5, 4}, {0, 4, 1}, {0, 3, 4}, {1, 5, 2}, {1, 4, 5}, {2, 3, 0}, {2, 5, 3}});
-}
+using test::sharp_wedge;
 
 TEST(Separation, ReachIsSqrt3ForABoxAndLargerForAWedge) {
   EXPECT_NEAR(tolerance_reach(make_box(Vec3(1.0, 2.0, 0.5))), std::sqrt(3.0), 1e-12);
-  EXPECT_GT(tolerance_reach(wedge()), 5.0);  // 1 / sin(~5.7 deg) at the sharp edge's corners
+  EXPECT_GT(tolerance_reach(sharp_wedge()), 5.0);  // 1 / sin(~5.7 deg) at the sharp edge's corners
 }
 
 TEST(Separation, AWitnessMeansTheDetectorFindsNothing) {
   const std::vector<ConvexPolyhedron> shapes = {
       make_box(Vec3(1.0, 1.0, 1.0)), make_box(Vec3(2.0, 0.3, 0.7)), make_prism(0.6, 1.2, 7),
-      make_icosphere(0.5, 1), wedge()};
+      make_icosphere(0.5, 1), sharp_wedge()};
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int witnessed = 0, near = 0;
