@@ -296,13 +296,17 @@ bool ExtendedStep::apart_through_step(const WorldState& world, const RigidBody& 
   // At the step's end the pairs the axes leave are new contacts, or near misses the axes do not
   // prove apart: two boxes' edges passing crosswise. The direction between the closest points
   // proves those apart at the end, and is kept like any other axis.
-  const auto apart = [margin](const RigidBody& p, const RigidBody& q) -> std::optional<GapAlong> {
-    const Separation s = shape_distance(*p.shape, p.pose(), *q.shape, q.pose());
+  const auto apart = [margin](const RigidBody& p, const RigidBody& q,
+                              const Separation& s) -> std::optional<GapAlong> {
     if (s.overlapping || !(s.distance > margin)) return std::nullopt;
     const Vec3 u = (s.point_a - s.point_b) / s.distance;
     return GapAlong{u, gap_along(*p.shape, p.pose(), *q.shape, q.pose(), u)};
   };
-  const std::optional<GapAlong> end = apart(a, b);
+  const auto distance = [](const RigidBody& p, const RigidBody& q) {
+    return shape_distance(*p.shape, p.pose(), *q.shape, q.pose());
+  };
+  end_distance_ = distance(a, b);
+  const std::optional<GapAlong> end = apart(a, b, *end_distance_);
   if (!end || !(end->gap > margin)) return false;
   const long long key = static_cast<long long>(i) * static_cast<long long>(world.bodies.size()) + j;
   const Witness* kept = witnesses_.find(key);
@@ -312,7 +316,7 @@ bool ExtendedStep::apart_through_step(const WorldState& world, const RigidBody& 
   const std::optional<GapAlong> start =
       kept && kept->step == steps_
           ? std::optional<GapAlong>(GapAlong{b0.orientation * kept->axis, kept->gap})
-          : apart(a0, b0);
+          : apart(a0, b0, distance(a0, b0));
   witnesses_.put(key, {b.orientation.conjugate() * end->u, end->gap, steps_, end->gap, steps_});
   return start &&
          apart_through(a0, b0, world.facts[i], world.facts[j], *start, *end, margin, world.sim.dt);
@@ -400,10 +404,13 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
       continue;
     // Still apart at the step's end: by the gap proved at its start less both bodies' travel,
     // else by the pair's kept axis or a new one.
+    end_distance_.reset();
     if (separated(world, a, b, i, j, travel[i] + travel[j])) continue;
-    const TimeOfImpact t =
-        time_of_impact(world.bodies[i], world.bodies[j], dt, world.detector,
-                       world.tunables.toi_max_samples, &facts[i], &facts[j], &detection_);
+    // The end's distance, when separated() took it, is the search's own sample at dt: a and b
+    // are where advanced() puts the pair, and the search's poses are those bit for bit.
+    const TimeOfImpact t = time_of_impact(world.bodies[i], world.bodies[j], dt, world.detector,
+                                          world.tunables.toi_max_samples, &facts[i], &facts[j],
+                                          &detection_, end_distance_ ? &*end_distance_ : nullptr);
     if (!t.certified) report_uncertified(world, i, j);
     if (t.time) hits.emplace_back(*t.time, i, j);
   }

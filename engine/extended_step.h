@@ -58,7 +58,7 @@ class ExtendedStep {
   // For a pair the axes do not prove apart at the step's end (a, b moved there; the start poses
   // in `world`): true when the distance proves it apart at the end and, with the gap at the
   // start, through the whole step (the detector, with `margin`, finds nothing anywhere); the
-  // end's direction is kept as the pair's axis.
+  // end's direction is kept as the pair's axis, and the end's distance in end_distance_.
   bool apart_through_step(const WorldState& world, const RigidBody& a, const RigidBody& b, int i,
                           int j, double margin);
 
@@ -82,6 +82,9 @@ class ExtendedStep {
   // The second broad phase, on the poses at the step's end (new contacts).
   BroadPhase ahead_broad_phase_;
   std::vector<RigidBody> ahead_;  // scratch: the bodies moved to the step's end
+  // The distance at the step's end of the last pair apart_through_step was asked about (none
+  // when separated() did not reach it): the time of impact's own sample there, handed over.
+  std::optional<Separation> end_distance_;
   // What proved a pair apart (engine/separation.h): the axis, in b's frame, tried first at the
   // next test; the gap along it (m) and the step (steps_) at which it was measured (or bounded
   // from below). `end_gap`: a lower bound on the gap at the end of step `end_step`, along the

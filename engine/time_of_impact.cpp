@@ -108,7 +108,8 @@ struct Room {
 class ImpactSearch {
  public:
   ImpactSearch(const RigidBody& a, const RigidBody& b, const BodyFacts& facts_a,
-               const BodyFacts& facts_b, double dt, Detector detector, DetectionCache& cache);
+               const BodyFacts& facts_b, double dt, Detector detector, DetectionCache& cache,
+               const Separation* at_end);
   // The pair's travel rate (m/s): no point of either body moves faster under advanced().
   double rate() const { return rate_; }
   // Samples on a grid of n intervals, certified between them from the distance.
@@ -144,11 +145,12 @@ class ImpactSearch {
   double spin_ = 0.0;                    // m/s: what the turns add to the travel rate
   Vec3 v_rel_ = Vec3::Zero();            // B's velocity seen from A (a static body does not move)
   std::optional<TouchWitness> witness_;  // of the last touch the detector found
+  const Separation* at_end_;             // the distance at dt, when the caller took it
 };
 
 ImpactSearch::ImpactSearch(const RigidBody& a, const RigidBody& b, const BodyFacts& facts_a,
                            const BodyFacts& facts_b, double dt, Detector detector,
-                           DetectionCache& cache)
+                           DetectionCache& cache, const Separation* at_end)
     : a_(a),
       b_(b),
       facts_a_(facts_a),
@@ -161,7 +163,8 @@ ImpactSearch::ImpactSearch(const RigidBody& a, const RigidBody& b, const BodyFac
       rate_(rate_of(a, facts_a) + rate_of(b, facts_b)),
       reach_(separation_margin(std::max(facts_a.own_tol, facts_b.own_tol), facts_a.reach,
                                facts_b.reach)),
-      tol_(point_in_mesh_tolerance(*a.shape, *b.shape)) {
+      tol_(point_in_mesh_tolerance(*a.shape, *b.shape)),
+      at_end_(at_end) {
   spin_ = turn_speed(a, facts_a) + turn_speed(b, facts_b);
   v_rel_ = b_seen_from_a(a, b);
 }
@@ -179,7 +182,8 @@ bool ImpactSearch::touching(double t) {
 
 Room ImpactSearch::room(double t) const {
   const Pose pa = pose_a(t), pb = pose_b(t);
-  const Separation sep = shape_distance(*a_.shape, pa, *b_.shape, pb);
+  const Separation sep =
+      t == dt_ && at_end_ ? *at_end_ : shape_distance(*a_.shape, pa, *b_.shape, pb);
   if (sep.overlapping || !(sep.distance > 0)) return Room{};
   const Vec3 n = (sep.point_b - sep.point_a) / sep.distance;
   const double approach = -v_rel_.dot(n);
@@ -271,7 +275,7 @@ TimeOfImpact ImpactSearch::beyond_grid(double least, long max_samples) {
 
 TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, Detector detector,
                             long max_samples, const BodyFacts* facts_a, const BodyFacts* facts_b,
-                            DetectionCache* cache) {
+                            DetectionCache* cache, const Separation* at_end) {
   std::optional<BodyFacts> own_a, own_b;
   if (!facts_a) facts_a = &own_a.emplace(BodyFacts::of(a));
   if (!facts_b) facts_b = &own_b.emplace(BodyFacts::of(b));
@@ -279,7 +283,7 @@ TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, D
   // given.
   std::optional<DetectionCache> own_cache;
   if (!cache) cache = &own_cache.emplace();
-  ImpactSearch search(a, b, *facts_a, *facts_b, dt, detector, *cache);
+  ImpactSearch search(a, b, *facts_a, *facts_b, dt, detector, *cache, at_end);
   if (!(search.rate() > 0.0)) return {};  // apart at the start and neither moves
   const double thin = std::min(facts_a->thickness, facts_b->thickness);
   const double grid = std::ceil(search.rate() * dt / (0.25 * thin));

@@ -10,6 +10,7 @@
 #include "engine/body.h"
 #include "engine/body_facts.h"
 #include "engine/detect.h"
+#include "engine/distance.h"
 #include "engine/integrate.h"
 
 namespace rbx {
@@ -94,9 +95,11 @@ struct TimeOfImpact {
 /// is not certified: its answer says so. Meant for pairs separated at the step's start. `facts_a`,
 /// `facts_b`: the bodies' facts kept by the caller (the same numbers as BodyFacts::of, which is
 /// called when they are not given); `cache`: a detection cache to reuse (the search makes its own
-/// when none is given; the answer is the same).
+/// when none is given; the answer is the same); `at_end`: shape_distance of the pair moved to dt
+/// (advanced()), when the caller has taken it (the search's own sample there, not taken again).
 TimeOfImpact time_of_impact(const RigidBody& a, const RigidBody& b, double dt, Detector detector,
                             long max_samples, const BodyFacts* facts_a = nullptr,
-                            const BodyFacts* facts_b = nullptr, DetectionCache* cache = nullptr);
+                            const BodyFacts* facts_b = nullptr, DetectionCache* cache = nullptr,
+                            const Separation* at_end = nullptr);
 
 }  // namespace rbx

@@ -267,5 +267,36 @@ TEST(TimeOfImpact, AnAdvancedPoseIsTheAdvancedBodysPoseBitForBit) {
   }
 }
 
+// The distance at the step's end handed to the search (what the extended step took to try to
+// prove the pair apart) is the search's own sample there: every answer stays the same, touching
+// pairs, skims and misses alike.
+TEST(TimeOfImpact, TheEndsDistanceHandedOverLeavesTheAnswerAsItIs) {
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), size(0.3, 1.5);
+  const double dt = 0.05;
+  auto random_quat = [&] { return Quat(u(rng), u(rng), u(rng), u(rng)).normalized(); };
+  int hits = 0;
+  for (int k = 0; k < 600; ++k) {
+    const RigidBody a =
+        box_body("a", Vec3(size(rng), size(rng), size(rng)), 1.0, Vec3::Zero(), random_quat(),
+                 10.0 * Vec3(u(rng), u(rng), u(rng)), 20.0 * Vec3(u(rng), u(rng), u(rng)));
+    const RigidBody b = box_body(
+        "b", Vec3(size(rng), size(rng), size(rng)), 2.0, 1.6 * Vec3(u(rng), u(rng), u(rng)),
+        random_quat(), 10.0 * Vec3(u(rng), u(rng), u(rng)), 20.0 * Vec3(u(rng), u(rng), u(rng)));
+    const BodyFacts fa = BodyFacts::of(a), fb = BodyFacts::of(b);
+    const RigidBody a1 = advanced(a, dt, &fa.principal), b1 = advanced(b, dt, &fb.principal);
+    const Separation end = shape_distance(*a1.shape, a1.pose(), *b1.shape, b1.pose());
+    const TimeOfImpact own = time_of_impact(a, b, dt, Detector::Accelerated, kSamples, &fa, &fb);
+    const TimeOfImpact handed =
+        time_of_impact(a, b, dt, Detector::Accelerated, kSamples, &fa, &fb, nullptr, &end);
+    EXPECT_EQ(own.certified, handed.certified) << "pair " << k;
+    ASSERT_EQ(own.time.has_value(), handed.time.has_value()) << "pair " << k;
+    if (!own.time) continue;
+    ++hits;
+    EXPECT_TRUE(test::same_bits(*own.time, *handed.time)) << "pair " << k;
+  }
+  EXPECT_GT(hits, 50);
+}
+
 }  // namespace
 }  // namespace rbx
