@@ -17,6 +17,9 @@ BodyFacts BodyFacts::of(const RigidBody& body) {
   f.own_tol = point_in_mesh_tolerance(shape, shape);
   f.principal = principal_frame(body.inertia_body);
   f.turn_rate = free_turn_rate(f.principal);
+  f.sphere_centre = shape.bounds().center();
+  f.sphere_radius = shape.bounds().half_extents().norm();
+  f.centre_reach = std::max(f.radius, f.sphere_centre.norm());
   return f;
 }
 

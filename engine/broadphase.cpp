@@ -51,13 +51,18 @@ void BroadPhase::test_pair(int i, int j) {
 const std::vector<BodyPair>& BroadPhase::find_pairs(const std::vector<RigidBody>& bodies,
                                                     double grow) {
   // The seed's spheres, once per body.
+  given_.resize(bodies.size());
+  for (size_t i = 0; i < bodies.size(); ++i) given_[i] = bounding_sphere(bodies[i]);
+  return find_pairs(bodies, given_, grow);
+}
+
+const std::vector<BodyPair>& BroadPhase::find_pairs(const std::vector<RigidBody>& bodies,
+                                                    const std::vector<BoundingSphere>& spheres,
+                                                    double grow) {
   const int n = static_cast<int>(bodies.size());
-  base_.resize(n);
+  base_.assign(spheres.begin(), spheres.end());
   static_.resize(n);
-  for (int i = 0; i < n; ++i) {
-    static_[i] = bodies[i].is_static;
-    base_[i] = bounding_sphere(bodies[i]);
-  }
+  for (int i = 0; i < n; ++i) static_[i] = bodies[i].is_static;
   if (method_ == BroadPhaseMethod::AllPairs || !(tunables_.pair_cache_margin > 0.0)) {
     index(grow);
     return pairs_;

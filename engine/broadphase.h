@@ -55,6 +55,11 @@ class BroadPhase {
   /// spheres, each grown by `grow`, touch: a superset, for a caller that filters it with the
   /// seed's test at more than one pose of the bodies.
   const std::vector<BodyPair>& find_pairs(const std::vector<RigidBody>& bodies, double grow = 0.0);
+  /// The same, with the bodies' bounding spheres given (`spheres[i]` bounding_sphere(bodies[i]),
+  /// bit for bit: a caller that keeps them).
+  const std::vector<BodyPair>& find_pairs(const std::vector<RigidBody>& bodies,
+                                          const std::vector<BoundingSphere>& spheres,
+                                          double grow = 0.0);
 
   /// The method this broad phase runs.
   BroadPhaseMethod method() const { return method_; }
@@ -95,6 +100,7 @@ class BroadPhase {
   WorldSettings tunables_;
   bool used_grid_ = false;
   std::vector<BoundingSphere> base_;             // this call's bounding spheres (bounding_sphere())
+  std::vector<BoundingSphere> given_;            // scratch: the spheres computed for a caller
   std::vector<BoundingSphere> spheres_;          // the index's: base_ grown
   std::vector<Vec3> box_min_, box_max_;          // m, padded boxes around them
   std::vector<int> order_;                       // sweep and prune: sorted along sap_axis_

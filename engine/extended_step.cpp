@@ -84,9 +84,9 @@ double ExtendedStep::look_ahead_growth(const WorldState& world) {
   for (size_t i = 0; i < world.bodies.size(); ++i) {
     const RigidBody& b = world.bodies[i];
     if (b.is_static) continue;
-    most = std::max(most,
-                    travel_bound(b, world.facts[i].turn_rate, centre_reach(b, world.facts[i]), dt) +
-                        world.sim.gravity.norm() * dt * dt);
+    most =
+        std::max(most, travel_bound(b, world.facts[i].turn_rate, world.facts[i].centre_reach, dt) +
+                           world.sim.gravity.norm() * dt * dt);
     least_radius = std::min(least_radius, world.facts[i].radius);
   }
   // Worth it only while the growth keeps the spheres near their size (a fast body would grow
@@ -110,12 +110,10 @@ std::vector<PairManifold> ExtendedStep::detect_manifolds(WorldState& world) {
                     world.bodies[i].orientation.coeffs() == ahead_[i].orientation.coeffs();
   place_boxes(world.bodies, world.facts);
   grow_ = look_ahead_growth(world);
-  const std::vector<BodyPair>& pairs = world.broad_phase.find_pairs(world.bodies, grow_);
-  if (grow_ > 0.0) {
-    grown_pairs_.assign(pairs.begin(), pairs.end());
-    spheres_.resize(world.bodies.size());
-    for (size_t i = 0; i < world.bodies.size(); ++i) spheres_[i] = bounding_sphere(world.bodies[i]);
-  }
+  spheres_.resize(n);
+  for (size_t i = 0; i < n; ++i) spheres_[i] = bounding_sphere(world.bodies[i], world.facts[i]);
+  const std::vector<BodyPair>& pairs = world.broad_phase.find_pairs(world.bodies, spheres_, grow_);
+  if (grow_ > 0.0) grown_pairs_.assign(pairs.begin(), pairs.end());
   for (const BodyPair& pair : pairs) {
     const RigidBody &a = world.bodies[pair.first], &b = world.bodies[pair.second];
     if (a.is_static && b.is_static) continue;
@@ -189,10 +187,6 @@ void ExtendedStep::integrate_bodies(WorldState& world, const std::vector<bool>& 
   }
 }
 
-double ExtendedStep::centre_reach(const RigidBody& body, const BodyFacts& facts) {
-  return std::max(facts.radius, body.shape->bounds().center().norm());
-}
-
 const std::vector<BodyPair>& ExtendedStep::look_ahead_pairs(const WorldState& world) {
   // The start's grown pairs hold every pair whose spheres touch at the step's end while no
   // sphere centre moved more than half the growth (two centres then close in by at most the
@@ -201,11 +195,10 @@ const std::vector<BodyPair>& ExtendedStep::look_ahead_pairs(const WorldState& wo
   const size_t n = ahead_.size();
   bool within = grow_ > 0.0;
   for (size_t i = 0; within && i < n; ++i)
-    within =
-        rates_[i].over(centre_reach(world.bodies[i], world.facts[i]), world.sim.dt) <= 0.5 * grow_;
-  if (!within) return ahead_broad_phase_.find_pairs(ahead_);
+    within = rates_[i].over(world.facts[i].centre_reach, world.sim.dt) <= 0.5 * grow_;
   spheres_.resize(n);
-  for (size_t i = 0; i < n; ++i) spheres_[i] = bounding_sphere(ahead_[i]);
+  for (size_t i = 0; i < n; ++i) spheres_[i] = bounding_sphere(ahead_[i], world.facts[i]);
+  if (!within) return ahead_broad_phase_.find_pairs(ahead_, spheres_);
   ahead_pairs_.clear();
   for (const BodyPair& p : grown_pairs_)
     if (spheres_touch(spheres_[p.first], spheres_[p.second])) ahead_pairs_.push_back(p);

@@ -67,9 +67,6 @@ class ExtendedStep {
   // velocity; 0 (two broad phases) under the seed's Euler or when that is not small beside the
   // smallest body.
   static double look_ahead_growth(const WorldState& world);
-  // The distance from the centre of mass within which the body's points and its bounding
-  // sphere's centre lie (m): what travel_bound's radius must cover.
-  static double centre_reach(const RigidBody& body, const BodyFacts& facts);
   // The pairs whose spheres touch at the step's end (ahead_): the start's grown pairs filtered,
   // or the look-ahead broad phase when a sphere centre moved too far for them (by rates_, this
   // step's).

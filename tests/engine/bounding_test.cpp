@@ -8,7 +8,9 @@
 #include <memory>
 #include <random>
 
+#include "engine/body_facts.h"
 #include "engine/detect.h"
+#include "tests/common/fixtures.h"
 
 namespace rbx {
 namespace {
@@ -45,6 +47,25 @@ TEST(BoundingSphere, OffCentreShapeUsesItsBoxCentreInTheWorld) {
   const BoundingSphere s = bounding_sphere(body_with(tetra, p, q));
   EXPECT_NEAR(s.radius, std::sqrt(3.0) / 2, kRadiusRoundOff);
   EXPECT_LE((s.center - (q * Vec3(0.5, 0.5, 0.5) + p)).norm(), kRadiusRoundOff);
+}
+
+TEST(BoundingSphere, FromTheBodysFactsItIsTheSameBitForBit) {
+  // The extended step places a crowd's spheres from the bodies' facts, without reading their
+  // shapes: the same numbers, for a centred box and an off-centre tetrahedron, at any pose.
+  const ConvexPolyhedron tetra = ConvexPolyhedron::from_triangles(
+      {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}});
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-100.0, 100.0);
+  for (const ConvexPolyhedron& shape : {make_box(Vec3(0.3, 1.7, 0.9)), tetra}) {
+    for (int k = 0; k < 200; ++k) {
+      const RigidBody b =
+          body_with(shape, Vec3(u(rng), u(rng), u(rng)), test::random_rotation(rng));
+      const BodyFacts facts = BodyFacts::of(b);
+      const BoundingSphere s = bounding_sphere(b), f = bounding_sphere(b, facts);
+      EXPECT_EQ(s.center, f.center);
+      EXPECT_TRUE(test::same_bits(s.radius, f.radius));
+    }
+  }
 }
 
 TEST(BoundingCheck, SumOfRadiiIsTheThreshold) {
