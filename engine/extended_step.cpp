@@ -36,6 +36,28 @@ void report_uncertified(WorldState& world, int i, int j) {
   world.uncertain = s.str();
 }
 
+// `to` made `from`, for a look-ahead body kept from step to step: the name and shape are copied
+// only when they differ (once: no string copy and no reference count each step), the rest
+// always: what advanced() reads and the pose.
+void refresh(RigidBody& to, const RigidBody& from) {
+  if (to.shape != from.shape || to.name != from.name) {
+    to = from;
+    return;
+  }
+  to.shape_kind = from.shape_kind;
+  to.box_size = from.box_size;
+  to.shape_origin_offset = from.shape_origin_offset;
+  to.is_static = from.is_static;
+  to.mass = from.mass;
+  to.inertia_body = from.inertia_body;
+  to.inverse_mass = from.inverse_mass;
+  to.inverse_inertia_body = from.inverse_inertia_body;
+  to.position = from.position;
+  to.orientation = from.orientation;
+  to.velocity = from.velocity;
+  to.angular_velocity = from.angular_velocity;
+}
+
 }  // namespace
 
 // The step as a list of stages: detect, approach velocities, forces, solve, events, time of
@@ -64,7 +86,7 @@ void ExtendedStep::advance(WorldState& world) {
   // contact (engine/time_of_impact.h) are moved to their first contact, resolved there, and
   // moved on for the rest of the step: an adaptive step for those two bodies only.
   const std::vector<bool> moved = time_of_impact_step(world, manifolds, settings);
-  integrate_bodies(world, moved, ahead_);
+  integrate_bodies(world, moved, ahead_filled_ ? &ahead_ : nullptr);
   // Only pairs that pressed together (a normal impulse) are projected apart: a penetration
   // that no approach caused, such as two overlapping bodies moving together
   // (stress/zero_relative_velocity), is left as it is, as the seed leaves it.
@@ -104,7 +126,7 @@ std::vector<PairManifold> ExtendedStep::detect_manifolds(WorldState& world) {
   // for those, the gaps proved at its end still bound theirs.
   const size_t n = world.bodies.size();
   unmoved_.assign(n, 0);
-  if (ahead_.size() == n)
+  if (ahead_filled_ && ahead_.size() == n)
     for (size_t i = 0; i < n; ++i)
       unmoved_[i] = world.bodies[i].position == ahead_[i].position &&
                     world.bodies[i].orientation.coeffs() == ahead_[i].orientation.coeffs();
@@ -167,19 +189,21 @@ std::vector<double> ExtendedStep::record_events(WorldState& world,
 }
 
 void ExtendedStep::integrate_bodies(WorldState& world, const std::vector<bool>& moved,
-                                    const std::vector<RigidBody>& ahead) {
+                                    const std::vector<RigidBody>* ahead) {
   // Gravity is already in the velocities for the symplectic scheme.
   const std::vector<BodyFacts>& facts = world.facts;
   for (size_t i = 0; i < world.bodies.size(); ++i) {
     RigidBody& b = world.bodies[i];
     if (moved[i]) continue;  // already carried through the step by its time of impact
-    if (world.sim.integrator == Integrator::Symplectic && ahead.size() == world.bodies.size()) {
+    if (world.sim.integrator == Integrator::Symplectic && ahead &&
+        ahead->size() == world.bodies.size()) {
       // The time of impact's look ahead already made this very move (advanced() is the same
       // integration with no gravity), and nothing touched the body since.
-      b.position = ahead[i].position;
-      b.orientation = ahead[i].orientation;
-      b.velocity = ahead[i].velocity;
-      b.angular_velocity = ahead[i].angular_velocity;
+      const RigidBody& moved_ahead = (*ahead)[i];
+      b.position = moved_ahead.position;
+      b.orientation = moved_ahead.orientation;
+      b.velocity = moved_ahead.velocity;
+      b.angular_velocity = moved_ahead.angular_velocity;
     } else if (world.sim.integrator == Integrator::Symplectic)
       integrate_symplectic(b, Vec3::Zero(), world.sim.dt, &facts[i].principal);
     else
@@ -321,7 +345,7 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
   const double dt = world.sim.dt;
   const size_t n = world.bodies.size();
   std::vector<bool> moved(n, false);
-  ahead_.clear();
+  ahead_filled_ = false;
   if (world.sim.integrator != Integrator::Symplectic) return moved;  // the seed's Euler: no TOI
   // Per body: thickness and bounding radius (fixed by the shape), sweep over the step.
   const std::vector<BodyFacts>& facts = world.facts;
@@ -380,10 +404,14 @@ std::vector<bool> ExtendedStep::time_of_impact_step(WorldState& world,
     rates_[i] = travel_rate(world.bodies[i], facts[i].turn_rate);
     travel[i] = rates_[i].over(facts[i].radius, dt);
   }
+  // advanced(), in place: the same integration on the kept copy.
+  ahead_.resize(n);
   for (size_t i = 0; i < n; ++i) {
-    const RigidBody& b = world.bodies[i];
-    ahead_.push_back(b.is_static ? b : advanced(b, dt, &facts[i].principal));
+    refresh(ahead_[i], world.bodies[i]);
+    if (!ahead_[i].is_static)
+      integrate_symplectic(ahead_[i], Vec3::Zero(), dt, &facts[i].principal);
   }
+  ahead_filled_ = true;
   // The pairs the fast search above asked (few: fast bodies only).
   std::vector<BodyPair> asked;
   for (const auto& [t, i, j] : hits) asked.emplace_back(i, j);

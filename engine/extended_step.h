@@ -45,9 +45,9 @@ class ExtendedStep {
                                         const std::vector<PairManifold>& manifolds,
                                         const ContactSolverSettings& settings);
   // Integrates every body the time of impact did not carry (`moved`) through the step; with the
-  // symplectic scheme, takes the move from `ahead` (the bodies at the step's end) when filled.
+  // symplectic scheme, takes the move from `ahead` (the bodies at the step's end) when given.
   static void integrate_bodies(WorldState& world, const std::vector<bool>& moved,
-                               const std::vector<RigidBody>& ahead);
+                               const std::vector<RigidBody>* ahead);
   // True when bodies i and j, as `a` and `b` (at the step's start, or moved to its end), are
   // proved apart (the detector would find nothing): by their world boxes; with `travel` (m, the
   // two bodies' travel over the step, for poses at its end), by the gap kept this step at its
@@ -78,7 +78,11 @@ class ExtendedStep {
 
   // The second broad phase, on the poses at the step's end (new contacts).
   BroadPhase ahead_broad_phase_;
-  std::vector<RigidBody> ahead_;  // scratch: the bodies moved to the step's end
+  // The bodies moved to the step's end; kept from step to step (each step refreshes what it
+  // moves), and filled (`ahead_filled_`) by the symplectic scheme's time of impact: at a step's
+  // start, the last step's.
+  std::vector<RigidBody> ahead_;
+  bool ahead_filled_ = false;
   // The distance at the step's end of the last pair apart_through_step was asked about (none
   // when separated() did not reach it): the time of impact's own sample there, handed over.
   std::optional<Separation> end_distance_;
