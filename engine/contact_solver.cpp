@@ -22,20 +22,30 @@ struct BodyInverse {
   Mat3 inv_inertia = Mat3::Zero();  // world frame
 };
 
-// Filled for the bodies the manifolds name (the others are never read): one world-frame
-// inertia per body in contact, not per body in the world.
-std::vector<BodyInverse> inverses(const std::vector<RigidBody>& bodies,
-                                  const std::vector<PairManifold>& manifolds) {
-  std::vector<BodyInverse> out(bodies.size());
-  std::vector<bool> done(bodies.size(), false);
-  for (const PairManifold& pm : manifolds)
-    for (int i : {pm.a, pm.b}) {
-      if (done[i] || bodies[i].is_static) continue;
-      done[i] = true;
-      out[i] = {bodies[i].inverse_mass, bodies[i].inverse_inertia_world()};
-    }
-  return out;
-}
+// Each body's inverse mass and world-frame inverse inertia, for the bodies the manifolds name
+// (the others are never read): one world-frame inertia per body in contact, and storage for
+// those alone (a crowd's bodies are mostly out of contact). A static body's are zero.
+class Inverses {
+ public:
+  Inverses(const std::vector<RigidBody>& bodies, const std::vector<PairManifold>& manifolds)
+      : slot_(bodies.size(), -1) {
+    for (const PairManifold& pm : manifolds)
+      for (int i : {pm.a, pm.b}) {
+        if (slot_[static_cast<size_t>(i)] >= 0) continue;
+        slot_[static_cast<size_t>(i)] = static_cast<int>(of_.size());
+        const RigidBody& b = bodies[static_cast<size_t>(i)];
+        of_.push_back(b.is_static ? BodyInverse{}
+                                  : BodyInverse{b.inverse_mass, b.inverse_inertia_world()});
+      }
+  }
+  const BodyInverse& operator[](int i) const {
+    return of_[static_cast<size_t>(slot_[static_cast<size_t>(i)])];
+  }
+
+ private:
+  std::vector<int> slot_;  // per body: its place in of_, -1 when not named
+  std::vector<BodyInverse> of_;
+};
 
 // One constraint row set: a point with its normal and tangent directions.
 struct Row {
@@ -112,8 +122,8 @@ enum class Mode { Separate, Stick, Slide };
 
 // One island's problem for the active-set solve: K, b, the guess and its answer.
 struct ActiveSet {
-  ActiveSet(std::vector<RigidBody>& bodies_in, const std::vector<BodyInverse>& inv_in,
-            std::vector<Row>& rows_in, double mu_in, double tolerance_in);
+  ActiveSet(std::vector<RigidBody>& bodies_in, const Inverses& inv_in, std::vector<Row>& rows_in,
+            double mu_in, double tolerance_in);
 
   // The row's direction e: 0 the normal, 1 and 2 the tangents.
   static const Vec3& direction(const Row& r, int k) {
@@ -128,7 +138,7 @@ struct ActiveSet {
   void apply_answer();
 
   std::vector<RigidBody>& bodies;
-  const std::vector<BodyInverse>& inv;
+  const Inverses& inv;
   std::vector<Row>& rows;
   const double mu, base_tolerance;
   double tolerance;         // m/s: base_tolerance, or the last guess's round-off if larger
@@ -142,7 +152,7 @@ struct ActiveSet {
   Eigen::VectorXd x, w;    // the last guess's impulses and K x - b
 };
 
-ActiveSet::ActiveSet(std::vector<RigidBody>& bodies_in, const std::vector<BodyInverse>& inv_in,
+ActiveSet::ActiveSet(std::vector<RigidBody>& bodies_in, const Inverses& inv_in,
                      std::vector<Row>& rows_in, double mu_in, double tolerance_in)
     : bodies(bodies_in),
       inv(inv_in),
@@ -374,8 +384,8 @@ void ActiveSet::apply_answer() {
 /// with some points bouncing and some resting) drops the assumption its least-squares answer
 /// breaks most. Returns false, touching nothing, when the guesses do not settle in 20 rounds
 /// or no assumption can be dropped; the projections then solve it.
-bool solve_active_set(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>& inv,
-                      std::vector<Row>& rows, double mu, double tolerance) {
+bool solve_active_set(std::vector<RigidBody>& bodies, const Inverses& inv, std::vector<Row>& rows,
+                      double mu, double tolerance) {
   constexpr int kMaxRounds = 20;
   if (rows.empty()) return false;
   ActiveSet problem(bodies, inv, rows, mu, tolerance);
@@ -405,9 +415,8 @@ bool solve_active_set(std::vector<RigidBody>& bodies, const std::vector<BodyInve
 
 // One island's staggered projections, its convergence test and its energy guard.
 struct IslandSolver {
-  IslandSolver(std::vector<RigidBody>& bodies_in, const std::vector<BodyInverse>& inv_in,
-               std::vector<Row>& rows_in, const ContactSolverSettings& settings_in,
-               SolverWork& work_in);
+  IslandSolver(std::vector<RigidBody>& bodies_in, const Inverses& inv_in, std::vector<Row>& rows_in,
+               const ContactSolverSettings& settings_in, SolverWork& work_in);
 
   double normal_iteration();
   double friction_iteration();
@@ -422,7 +431,7 @@ struct IslandSolver {
   void guard_energy();
 
   std::vector<RigidBody>& bodies;
-  const std::vector<BodyInverse>& inv;
+  const Inverses& inv;
   std::vector<Row>& rows;
   const ContactSolverSettings& settings;
   SolverWork& work;
@@ -436,9 +445,9 @@ struct IslandSolver {
   long budget_left = 0;  // iterations this solve may still take (WorldSettings::iteration_budget)
 };
 
-IslandSolver::IslandSolver(std::vector<RigidBody>& bodies_in,
-                           const std::vector<BodyInverse>& inv_in, std::vector<Row>& rows_in,
-                           const ContactSolverSettings& settings_in, SolverWork& work_in)
+IslandSolver::IslandSolver(std::vector<RigidBody>& bodies_in, const Inverses& inv_in,
+                           std::vector<Row>& rows_in, const ContactSolverSettings& settings_in,
+                           SolverWork& work_in)
     : bodies(bodies_in),
       inv(inv_in),
       rows(rows_in),
@@ -672,8 +681,8 @@ void IslandSolver::guard_energy() {
 /// impulses in place): active sets first (solve_active_set, islands of up to active_set_rows
 /// points), then staggered projections from their answer or from zero, and the energy guard on
 /// restitution. Adds what it did to `work`.
-void solve_island(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>& inv,
-                  std::vector<Row>& rows, const ContactSolverSettings& settings, SolverWork& work) {
+void solve_island(std::vector<RigidBody>& bodies, const Inverses& inv, std::vector<Row>& rows,
+                  const ContactSolverSettings& settings, SolverWork& work) {
   IslandSolver island(bodies, inv, rows, settings, work);
   island.solve();
   island.guard_energy();
@@ -681,8 +690,7 @@ void solve_island(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>
 
 // The rows of every manifold point whose pair is not both static: directions, effective
 // masses, Newton's target and the convergence test's speed scale.
-std::vector<Row> make_rows(const std::vector<RigidBody>& bodies,
-                           const std::vector<BodyInverse>& inv,
+std::vector<Row> make_rows(const std::vector<RigidBody>& bodies, const Inverses& inv,
                            const std::vector<PairManifold>& manifolds,
                            const std::vector<std::vector<double>>& approach,
                            const ContactSolverSettings& settings) {
@@ -734,9 +742,8 @@ std::vector<Row> make_rows(const std::vector<RigidBody>& bodies,
 // separate islands cannot affect each other, so each is solved to its own convergence
 // instead of iterating every row until the slowest island converges (many_1000: ~1,700
 // iterations of every row per step for one face contact). Islands in the order of their first row.
-void solve_islands(std::vector<RigidBody>& bodies, const std::vector<BodyInverse>& inv,
-                   std::vector<Row>& rows, const ContactSolverSettings& settings,
-                   SolverWork& work) {
+void solve_islands(std::vector<RigidBody>& bodies, const Inverses& inv, std::vector<Row>& rows,
+                   const ContactSolverSettings& settings, SolverWork& work) {
   std::vector<int> parent(bodies.size());
   for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
   auto root = [&](int i) {
@@ -769,7 +776,7 @@ std::vector<SolvedPoint> solve_contact_velocities(std::vector<RigidBody>& bodies
                                                   const std::vector<std::vector<double>>& approach,
                                                   const ContactSolverSettings& settings,
                                                   SolverWork* work) {
-  const std::vector<BodyInverse> inv = inverses(bodies, manifolds);
+  const Inverses inv(bodies, manifolds);
   std::vector<Row> rows = make_rows(bodies, inv, manifolds, approach, settings);
   SolverWork done;
   solve_islands(bodies, inv, rows, settings, done);
@@ -796,7 +803,7 @@ void project_contact_positions(std::vector<RigidBody>& bodies,
   // Moving positions with the velocities held does not keep the angular momentum about the
   // origin (r x m v changes with r): measured on many_1000, the drift of 1.2e-7 (relative) is
   // this projection's (without it, 1e-15); Bullet's positional correction drifts 1.1e-6 there.
-  const std::vector<BodyInverse> inv = inverses(bodies, manifolds);
+  const Inverses inv(bodies, manifolds);
   for (int it = 0; it < tunables.position_iterations; ++it)
     for (const PairManifold& pm : manifolds) {
       RigidBody &a = bodies[pm.a], &b = bodies[pm.b];
