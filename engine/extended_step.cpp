@@ -36,11 +36,12 @@ void report_uncertified(WorldState& world, int i, int j) {
   world.uncertain = s.str();
 }
 
-// `to` made `from`, for a look-ahead body kept from step to step: the name and shape are copied
-// only when they differ (once: no string copy and no reference count each step), the rest
-// always: what advanced() reads and the pose.
+// `to` made `from`, for a look-ahead body kept from step to step: the shape, and with it the
+// name, copied only when the shape differs (once: no string copy and no reference count each
+// step; a look-ahead body's name is never read), the rest always: what advanced() reads and the
+// pose.
 void refresh(RigidBody& to, const RigidBody& from) {
-  if (to.shape != from.shape || to.name != from.name) {
+  if (to.shape != from.shape) {
     to = from;
     return;
   }
