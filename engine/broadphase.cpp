@@ -51,16 +51,21 @@ void BroadPhase::test_pair(int i, int j) {
 const std::vector<BodyPair>& BroadPhase::find_pairs(const std::vector<RigidBody>& bodies,
                                                     double grow) {
   // The seed's spheres, once per body.
-  given_.resize(bodies.size());
-  for (size_t i = 0; i < bodies.size(); ++i) given_[i] = bounding_sphere(bodies[i]);
-  return find_pairs(bodies, given_, grow);
+  base_.resize(bodies.size());
+  for (size_t i = 0; i < bodies.size(); ++i) base_[i] = bounding_sphere(bodies[i]);
+  return pairs_of_base(bodies, grow);
 }
 
 const std::vector<BodyPair>& BroadPhase::find_pairs(const std::vector<RigidBody>& bodies,
                                                     const std::vector<BoundingSphere>& spheres,
                                                     double grow) {
-  const int n = static_cast<int>(bodies.size());
   base_.assign(spheres.begin(), spheres.end());
+  return pairs_of_base(bodies, grow);
+}
+
+const std::vector<BodyPair>& BroadPhase::pairs_of_base(const std::vector<RigidBody>& bodies,
+                                                       double grow) {
+  const int n = static_cast<int>(bodies.size());
   static_.resize(n);
   for (int i = 0; i < n; ++i) static_[i] = bodies[i].is_static;
   if (method_ == BroadPhaseMethod::AllPairs || !(tunables_.pair_cache_margin > 0.0)) {

@@ -72,6 +72,8 @@ class BroadPhase {
   bool used_grid() const { return used_grid_; }
 
  private:
+  // find_pairs on this call's spheres, placed in base_.
+  const std::vector<BodyPair>& pairs_of_base(const std::vector<RigidBody>& bodies, double grow);
   // Indexes this call's spheres (base_), each grown by `grow`, into pairs_ in (i, j) order.
   void index(double grow);
   // Whether the kept pairs hold every pair of this call's spheres grown by `grow`.
@@ -100,7 +102,6 @@ class BroadPhase {
   WorldSettings tunables_;
   bool used_grid_ = false;
   std::vector<BoundingSphere> base_;             // this call's bounding spheres (bounding_sphere())
-  std::vector<BoundingSphere> given_;            // scratch: the spheres computed for a caller
   std::vector<BoundingSphere> spheres_;          // the index's: base_ grown
   std::vector<Vec3> box_min_, box_max_;          // m, padded boxes around them
   std::vector<int> order_;                       // sweep and prune: sorted along sap_axis_
