@@ -81,11 +81,11 @@ constexpr const char* kDeepProfile =
 // steps), a measured cause.
 constexpr const char* kStepProfile =
     "the whole step, many_1000: the time of impact that moves each new contact to its first touch "
-    "is about a third of the step (its bisection on the detector about a quarter), the "
-    "separation proofs of the pairs passing the bounding check (the seed's bounding spheres of "
-    "neighbouring cubes overlap, so about 2,700 pairs pass it each step) about a fifth, the "
-    "look-ahead's moves of every body about a tenth, and the broad phase, the contact solve and "
-    "the manifolds about a twentieth each.";
+    "is about a quarter of the step (its samples' detections and the touch witness's answers "
+    "about a sixth, its distances about a tenth), the separation proofs of the pairs passing the "
+    "bounding check (the seed's bounding spheres of neighbouring cubes overlap, so about 2,700 "
+    "pairs pass it each step) about a sixth, the look-ahead's moves of every body about a tenth, "
+    "and the broad phase, the contact solve and the manifolds about a twentieth each.";
 
 std::vector<PerfGoal> perf_goals(const BenchPlan& plan, const BenchResults& results) {
   std::vector<PerfGoal> goals;
