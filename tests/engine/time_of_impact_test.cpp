@@ -7,6 +7,7 @@
 #include <cmath>
 #include <optional>
 #include <random>
+#include <utility>
 
 #include "engine/distance.h"
 #include "engine/separation.h"
@@ -147,15 +148,28 @@ TEST(TimeOfImpact, NoPointTravelsFartherThanTheTravelBound) {
   EXPECT_GT(tightest, 0.2);
 }
 
+// Two random boxes passing close by (B's centre within 1.6 m of A's along each axis), at speeds up
+// to 17 m/s and turn rates up to 35 rad/s: fast enough to skim each other within a step of
+// 0.05 s.
+std::pair<RigidBody, RigidBody> skimming_pair(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0), size(0.3, 1.5);
+  auto random_quat = [&] { return Quat(u(rng), u(rng), u(rng), u(rng)).normalized(); };
+  RigidBody a =
+      box_body("a", Vec3(size(rng), size(rng), size(rng)), 1.0, Vec3::Zero(), random_quat(),
+               10.0 * Vec3(u(rng), u(rng), u(rng)), 20.0 * Vec3(u(rng), u(rng), u(rng)));
+  RigidBody b = box_body("b", Vec3(size(rng), size(rng), size(rng)), 2.0,
+                         1.6 * Vec3(u(rng), u(rng), u(rng)), random_quat(),
+                         10.0 * Vec3(u(rng), u(rng), u(rng)), 20.0 * Vec3(u(rng), u(rng), u(rng)));
+  return {std::move(a), std::move(b)};
+}
+
 // The certificate the extended step skips a search by (apart_through): wherever a gap at each
 // end of the step proves a pair apart all through it, the search itself finds no touch. Random
 // boxes passing close by, fast enough to skim each other within a step (apart at both ends, a
 // corner clipping between), so both answers occur.
 TEST(TimeOfImpact, GapsAtBothEndsProveAStepApartOnlyWhereTheSearchFindsNoTouch) {
   std::mt19937_64 rng(29);
-  std::uniform_real_distribution<double> u(-1.0, 1.0), size(0.3, 1.5);
   const double dt = 0.05;
-  auto random_quat = [&] { return Quat(u(rng), u(rng), u(rng), u(rng)).normalized(); };
   auto gap_between = [](const RigidBody& a, const RigidBody& b) -> std::optional<GapAlong> {
     const Separation s = shape_distance(*a.shape, a.pose(), *b.shape, b.pose());
     if (s.overlapping) return std::nullopt;
@@ -164,12 +178,7 @@ TEST(TimeOfImpact, GapsAtBothEndsProveAStepApartOnlyWhereTheSearchFindsNoTouch) 
   };
   int proved = 0, skims = 0;
   for (int k = 0; k < 4000; ++k) {
-    const RigidBody a =
-        box_body("a", Vec3(size(rng), size(rng), size(rng)), 1.0, Vec3::Zero(), random_quat(),
-                 10.0 * Vec3(u(rng), u(rng), u(rng)), 20.0 * Vec3(u(rng), u(rng), u(rng)));
-    const RigidBody b = box_body(
-        "b", Vec3(size(rng), size(rng), size(rng)), 2.0, 1.6 * Vec3(u(rng), u(rng), u(rng)),
-        random_quat(), 10.0 * Vec3(u(rng), u(rng), u(rng)), 20.0 * Vec3(u(rng), u(rng), u(rng)));
+    const auto [a, b] = skimming_pair(rng);
     const BodyFacts fa = BodyFacts::of(a), fb = BodyFacts::of(b);
     const double margin = separation_margin(std::max(fa.own_tol, fb.own_tol), fa.reach, fb.reach);
     const std::optional<GapAlong> start = gap_between(a, b);
@@ -272,17 +281,10 @@ TEST(TimeOfImpact, AnAdvancedPoseIsTheAdvancedBodysPoseBitForBit) {
 // pairs, skims and misses alike.
 TEST(TimeOfImpact, TheEndsDistanceHandedOverLeavesTheAnswerAsItIs) {
   std::mt19937_64 rng(31);
-  std::uniform_real_distribution<double> u(-1.0, 1.0), size(0.3, 1.5);
   const double dt = 0.05;
-  auto random_quat = [&] { return Quat(u(rng), u(rng), u(rng), u(rng)).normalized(); };
   int hits = 0;
   for (int k = 0; k < 600; ++k) {
-    const RigidBody a =
-        box_body("a", Vec3(size(rng), size(rng), size(rng)), 1.0, Vec3::Zero(), random_quat(),
-                 10.0 * Vec3(u(rng), u(rng), u(rng)), 20.0 * Vec3(u(rng), u(rng), u(rng)));
-    const RigidBody b = box_body(
-        "b", Vec3(size(rng), size(rng), size(rng)), 2.0, 1.6 * Vec3(u(rng), u(rng), u(rng)),
-        random_quat(), 10.0 * Vec3(u(rng), u(rng), u(rng)), 20.0 * Vec3(u(rng), u(rng), u(rng)));
+    const auto [a, b] = skimming_pair(rng);
     const BodyFacts fa = BodyFacts::of(a), fb = BodyFacts::of(b);
     const RigidBody a1 = advanced(a, dt, &fa.principal), b1 = advanced(b, dt, &fb.principal);
     const Separation end = shape_distance(*a1.shape, a1.pose(), *b1.shape, b1.pose());
